@@ -1,0 +1,43 @@
+//! File loaders. [`load`] picks one by extension; each returns a validated [`Scene`].
+
+pub mod cloud;
+pub mod gltf;
+pub mod obj;
+pub mod ply;
+pub mod scene_file;
+
+use crate::{Result, Scene, SceneError};
+use std::path::Path;
+
+/// File extensions `load` understands, for help texts and error messages.
+pub const EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "ply", "cloud", "toml"];
+
+/// Loads a scene file, choosing the loader by extension.
+pub fn load(path: &Path) -> Result<Scene> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    if !path.exists() {
+        return Err(SceneError::load(path, "no such file"));
+    }
+    let scene = match ext.as_str() {
+        "gltf" | "glb" => gltf::load(path)?,
+        "obj" => obj::load(path)?,
+        "ply" => ply::load(path)?,
+        "cloud" => cloud::load(path)?,
+        "toml" => scene_file::load(path)?,
+        _ => {
+            return Err(SceneError::load(
+                path,
+                format!(
+                    "unknown file type '.{ext}' (voxgi reads {})",
+                    EXTENSIONS.join(", ")
+                ),
+            ));
+        }
+    };
+    scene.validate().map_err(|e| e.in_file(path))?;
+    Ok(scene)
+}

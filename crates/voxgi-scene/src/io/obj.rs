@@ -1,0 +1,6 @@
+use crate::{Result, Scene, SceneError};
+use std::path::Path;
+
+pub fn load(path: &Path) -> Result<Scene> {
+    Err(SceneError::load(path, "obj loader not written yet"))
+}

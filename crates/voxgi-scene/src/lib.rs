@@ -1,0 +1,341 @@
+//! voxgi's scene model and loaders.
+//!
+//! This crate has no GPU dependency so that loaders build and test in seconds and other tools can
+//! read scenes without a device. Every loader returns a [`Scene`] that passed [`Scene::validate`],
+//! so the renderer can trust indices and counts.
+
+pub mod builtin;
+mod error;
+pub mod io;
+mod model;
+mod util;
+
+pub use error::SceneError;
+pub use glam;
+pub use model::*;
+pub use util::{compute_normals, srgb_to_linear};
+
+use glam::{Mat4, Vec3};
+
+pub type Result<T, E = SceneError> = std::result::Result<T, E>;
+
+/// Hard limits that keep a hostile file from exhausting memory before we notice.
+pub mod limits {
+    /// Vertices or points in one mesh or cloud.
+    pub const MAX_ELEMENTS: usize = 1 << 28;
+    /// Texture width or height.
+    pub const MAX_TEXTURE_DIM: u32 = 16384;
+}
+
+impl Scene {
+    /// World-space bounds of all mesh instances, point clouds and the surfaces of area lights.
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for inst in &self.instances {
+            if let Some(mesh) = self.meshes.get(inst.mesh) {
+                for &p in &mesh.positions {
+                    b.grow(inst.transform.transform_point3(p));
+                }
+            }
+        }
+        for pc in &self.point_clouds {
+            for &p in &pc.positions {
+                b.grow(pc.transform.transform_point3(p));
+            }
+        }
+        b
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .filter_map(|i| self.meshes.get(i.mesh))
+            .map(|m| m.indices.len() / 3)
+            .sum()
+    }
+
+    pub fn point_count(&self) -> usize {
+        self.point_clouds.iter().map(|p| p.positions.len()).sum()
+    }
+
+    /// True when nothing in the scene emits light: no lights and no emissive material in use.
+    pub fn is_unlit(&self) -> bool {
+        self.lights.is_empty()
+            && !self.instances.iter().any(|i| {
+                self.meshes
+                    .get(i.mesh)
+                    .and_then(|m| self.materials.get(m.material))
+                    .is_some_and(|m| m.is_emissive())
+            })
+            && self.point_clouds.iter().all(|p| p.emission.is_empty())
+    }
+
+    /// Appends a mesh with its own material and one static instance of it; returns the instance.
+    pub fn add_mesh(&mut self, mesh: Mesh, material: Material, transform: Mat4) -> usize {
+        let mut mesh = mesh;
+        mesh.material = self.materials.len();
+        self.materials.push(material);
+        let name = mesh.name.clone();
+        self.meshes.push(mesh);
+        self.instances.push(Instance {
+            name,
+            mesh: self.meshes.len() - 1,
+            transform,
+            dynamic: false,
+            light: None,
+        });
+        self.instances.len() - 1
+    }
+
+    /// Adds an area light together with the emissive surface that shows it, so the light is
+    /// visible to the camera and to voxelization.
+    pub fn add_area_light(&mut self, light: Light) -> usize {
+        let LightKind::Area { shape } = light.kind else {
+            self.lights.push(light);
+            return self.lights.len() - 1;
+        };
+        let n = light.direction.normalize();
+        let (positions, indices) = match shape {
+            AreaShape::Rect { u, v } => {
+                let c = light.position;
+                let mut idx = vec![0, 1, 2, 0, 2, 3];
+                // Wind the quad so its geometric normal points along the light's direction.
+                if u.cross(v).dot(n) < 0.0 {
+                    idx = vec![0, 2, 1, 0, 3, 2];
+                }
+                (vec![c - u - v, c + u - v, c + u + v, c - u + v], idx)
+            }
+            AreaShape::Disc { radius } => {
+                let (t, b) = n.any_orthonormal_pair();
+                let segments = 32;
+                let mut p = vec![light.position];
+                let mut idx = Vec::new();
+                for i in 0..segments {
+                    let a = i as f32 / segments as f32 * std::f32::consts::TAU;
+                    p.push(light.position + radius * (a.cos() * t + a.sin() * b));
+                    let (j, k) = (1 + i, 1 + (i + 1) % segments);
+                    idx.extend_from_slice(&[0, j, k]);
+                }
+                // t x b = n, so counter-clockwise in (t, b) faces along n.
+                (p, idx)
+            }
+        };
+        let emissive = light.radiometric().to_array();
+        let mesh = Mesh {
+            name: light.name.clone(),
+            normals: vec![n; positions.len()],
+            uvs: Vec::new(),
+            positions,
+            indices,
+            material: 0,
+        };
+        let material = Material {
+            name: format!("{} (emitter)", light.name),
+            base_color: [0.78, 0.78, 0.78, 1.0],
+            emissive,
+            ..Default::default()
+        };
+        self.lights.push(light);
+        let li = self.lights.len() - 1;
+        let inst = self.add_mesh(mesh, material, Mat4::IDENTITY);
+        self.instances[inst].light = Some(li);
+        li
+    }
+
+    /// Checks every index and count the renderer relies on. Loaders call this last.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |msg: String| Err(SceneError::Invalid(msg));
+        for (i, m) in self.meshes.iter().enumerate() {
+            let n = m.positions.len();
+            if m.indices.len() % 3 != 0 {
+                return bad(format!(
+                    "mesh {i} '{}': index count {} is not a multiple of 3",
+                    m.name,
+                    m.indices.len()
+                ));
+            }
+            if m.normals.len() != n {
+                return bad(format!(
+                    "mesh {i} '{}': {} normals for {n} positions",
+                    m.name,
+                    m.normals.len()
+                ));
+            }
+            if !m.uvs.is_empty() && m.uvs.len() != n {
+                return bad(format!(
+                    "mesh {i} '{}': {} UVs for {n} positions",
+                    m.name,
+                    m.uvs.len()
+                ));
+            }
+            if let Some(&ix) = m.indices.iter().find(|&&ix| ix as usize >= n) {
+                return bad(format!(
+                    "mesh {i} '{}': index {ix} out of range ({n} vertices)",
+                    m.name
+                ));
+            }
+            if m.positions.iter().any(|p| !p.is_finite()) {
+                return bad(format!("mesh {i} '{}': non-finite vertex position", m.name));
+            }
+            if m.material >= self.materials.len() {
+                return bad(format!(
+                    "mesh {i} '{}': material {} out of range",
+                    m.name, m.material
+                ));
+            }
+        }
+        for (i, m) in self.materials.iter().enumerate() {
+            for t in [m.base_color_texture, m.emissive_texture]
+                .into_iter()
+                .flatten()
+            {
+                if t >= self.textures.len() {
+                    return bad(format!(
+                        "material {i} '{}': texture {t} out of range",
+                        m.name
+                    ));
+                }
+            }
+            if m.base_color
+                .iter()
+                .chain(&m.emissive)
+                .any(|c| !c.is_finite() || *c < 0.0)
+            {
+                return bad(format!(
+                    "material {i} '{}': negative or non-finite colour",
+                    m.name
+                ));
+            }
+        }
+        for (i, t) in self.textures.iter().enumerate() {
+            if t.width == 0 || t.height == 0 || t.rgba8.len() != (t.width * t.height * 4) as usize {
+                return bad(format!(
+                    "texture {i} '{}': {}x{} with {} bytes",
+                    t.name,
+                    t.width,
+                    t.height,
+                    t.rgba8.len()
+                ));
+            }
+        }
+        for (i, inst) in self.instances.iter().enumerate() {
+            if inst.mesh >= self.meshes.len() {
+                return bad(format!(
+                    "instance {i} '{}': mesh {} out of range",
+                    inst.name, inst.mesh
+                ));
+            }
+            if !inst.transform.is_finite() {
+                return bad(format!(
+                    "instance {i} '{}': non-finite transform",
+                    inst.name
+                ));
+            }
+            if inst.light.is_some_and(|l| l >= self.lights.len()) {
+                return bad(format!("instance {i} '{}': light out of range", inst.name));
+            }
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let ok = l.position.is_finite()
+                && l.direction.is_finite()
+                && (l.direction.length() - 1.0).abs() < 1e-3
+                && l.intensity.is_finite()
+                && l.intensity >= 0.0
+                && l.color.iter().all(|c| c.is_finite() && *c >= 0.0);
+            if !ok {
+                return bad(format!(
+                    "light {i} '{}': non-finite or negative values, or direction not unit length",
+                    l.name
+                ));
+            }
+            match l.kind {
+                LightKind::Spot {
+                    inner_angle,
+                    outer_angle,
+                } => {
+                    if !(0.0 <= inner_angle
+                        && inner_angle <= outer_angle
+                        && outer_angle <= std::f32::consts::FRAC_PI_2)
+                    {
+                        return bad(format!(
+                            "light {i} '{}': spot angles must satisfy 0 <= inner <= outer <= 90 degrees",
+                            l.name
+                        ));
+                    }
+                }
+                LightKind::Area { .. } => {
+                    if !(l.area() > 0.0 && l.area().is_finite()) {
+                        return bad(format!("light {i} '{}': area light has zero area", l.name));
+                    }
+                }
+                _ => {}
+            }
+        }
+        for (i, pc) in self.point_clouds.iter().enumerate() {
+            let n = pc.positions.len();
+            let ok_len = |len: usize| len == 0 || len == n;
+            if pc.colors.len() != n
+                || !ok_len(pc.normals.len())
+                || !ok_len(pc.radii.len())
+                || !ok_len(pc.emission.len())
+            {
+                return bad(format!(
+                    "point cloud {i} '{}': attribute counts differ from the {n} positions",
+                    pc.name
+                ));
+            }
+            if pc.positions.iter().any(|p| !p.is_finite()) {
+                return bad(format!(
+                    "point cloud {i} '{}': non-finite point position",
+                    pc.name
+                ));
+            }
+        }
+        for (i, c) in self.cameras.iter().enumerate() {
+            if !(c.position.is_finite()
+                && c.forward.is_finite()
+                && c.up.is_finite()
+                && c.znear > 0.0)
+            {
+                return bad(format!(
+                    "camera {i} '{}': non-finite values or znear <= 0",
+                    c.name
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Camera used when neither the file nor the user gives one: in front of the bounds (+Z side,
+    /// slightly above), looking at their centre, far enough back to see the bounding sphere.
+    pub fn default_camera(&self) -> Camera {
+        let b = self.bounds();
+        let (center, radius) = if b.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (b.center(), (b.size().length() * 0.5).max(1e-3))
+        };
+        let yfov = 45f32;
+        let dist = radius / (yfov.to_radians() * 0.5).sin();
+        let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
+        let mut cam = Camera::look_at(center + dir * dist, center, yfov);
+        cam.name = "default".into();
+        cam.znear = (dist - radius).max(radius * 1e-3);
+        cam
+    }
+
+    /// A sun for scenes that have no light at all, so they render as something other than black:
+    /// from above and behind the default camera's right shoulder.
+    pub fn default_sun() -> Light {
+        Light {
+            name: "default sun".into(),
+            kind: LightKind::Directional,
+            color: [1.0, 0.98, 0.95],
+            intensity: 3.0,
+            position: Vec3::ZERO,
+            direction: Vec3::new(-0.4, -1.0, -0.3).normalize(),
+            range: None,
+            cast_shadows: true,
+        }
+    }
+}
