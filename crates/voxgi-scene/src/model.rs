@@ -58,6 +58,9 @@ pub struct Material {
     pub emissive_texture: Option<usize>,
     pub roughness: f32,
     pub metallic: f32,
+    /// Scales the specular reflectance of dielectrics (F0 = 0.04 x specular), as glTF's
+    /// KHR_materials_specular does: 1 is glTF's default, 0 a pure Lambertian surface.
+    pub specular: f32,
     pub alpha_mode: AlphaMode,
     pub double_sided: bool,
 }
@@ -74,6 +77,7 @@ impl Default for Material {
             emissive_texture: None,
             roughness: 1.0,
             metallic: 0.0,
+            specular: 1.0,
             alpha_mode: AlphaMode::Opaque,
             double_sided: false,
         }
@@ -81,10 +85,12 @@ impl Default for Material {
 }
 
 impl Material {
+    /// A pure Lambertian surface (no specular lobe), like the measured Cornell box walls.
     pub fn diffuse(name: &str, rgb: [f32; 3]) -> Self {
         Material {
             name: name.into(),
             base_color: [rgb[0], rgb[1], rgb[2], 1.0],
+            specular: 0.0,
             ..Default::default()
         }
     }

@@ -1,1 +1,26 @@
-pub use voxgi_scene;
+//! voxgi: real-time global illumination by voxel cone tracing, on wgpu.
+//!
+//! ```no_run
+//! let ctx = voxgi::GpuContext::from_env()?;
+//! let scene = voxgi::scene::builtin::cornell_box();
+//! let mut renderer = voxgi::Renderer::new(&ctx, &scene, voxgi::Settings::default())?;
+//! let camera = renderer.default_camera().clone();
+//! renderer.render(&camera, 512, 512)?.save("cornell.png".as_ref())?;
+//! # Ok::<(), voxgi::Error>(())
+//! ```
+
+mod error;
+mod frame;
+pub mod gpu;
+pub mod gpu_scene;
+pub mod output;
+pub mod passes;
+mod settings;
+
+pub use error::{Error, Result};
+pub use frame::{FrameTargets, Renderer};
+pub use gpu::GpuContext;
+pub use output::RenderOutput;
+pub use settings::{MAX_IMAGE_SIZE, Settings, Tonemap, ViewMode, validate_size};
+/// The scene model and loaders (re-exported from `voxgi-scene`).
+pub use voxgi_scene as scene;

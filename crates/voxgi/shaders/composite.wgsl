@@ -1,0 +1,66 @@
+// composite: deferred shading. Direct light from every light (with shadows) plus emission, in
+// linear radiance, written to the HDR target.
+
+//!include shared/scene.wgsl
+//!include shared/lights.wgsl
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(2) var<storage, read> shadow_views: array<ShadowView>;
+@group(0) @binding(3) var shadow_maps: texture_2d_array<f32>;
+@group(0) @binding(4) var gb_albedo: texture_2d<f32>;
+@group(0) @binding(5) var gb_normal: texture_2d<f32>;
+@group(0) @binding(6) var gb_emission: texture_2d<f32>;
+@group(0) @binding(7) var gb_depth: texture_depth_2d;
+@group(0) @binding(8) var hdr: texture_storage_2d<rgba32float, write>;
+
+const VIEW_FINAL: u32 = 0u;
+const VIEW_ALBEDO: u32 = 1u;
+const VIEW_NORMAL: u32 = 2u;
+const VIEW_DIRECT: u32 = 3u;
+
+fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
+    let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let w = frame.inv_view_proj * ndc;
+    return w.xyz / w.w;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if f32(id.x) >= frame.size.x || f32(id.y) >= frame.size.y {
+        return;
+    }
+    let px = id.xy;
+    let depth = textureLoad(gb_depth, px, 0);
+    if depth >= 1.0 {
+        textureStore(hdr, px, frame.background);
+        return;
+    }
+    let am = textureLoad(gb_albedo, px, 0);
+    let nr = textureLoad(gb_normal, px, 0);
+    let em = textureLoad(gb_emission, px, 0);
+    let p = world_position(px, depth);
+    let n = normalize(nr.xyz);
+    let v = normalize(frame.camera_pos - p);
+    let s = Surface(am.rgb, am.a, nr.w, em.a);
+
+    var direct = vec3<f32>(0.0);
+    for (var i = 0u; i < frame.light_count; i++) {
+        direct += shade_light(lights[i], s, p, n, v, frame.shadow_softness);
+    }
+    var out = direct + em.rgb;
+    switch frame.view_mode {
+        case VIEW_ALBEDO: {
+            out = am.rgb;
+        }
+        case VIEW_NORMAL: {
+            out = n * 0.5 + 0.5;
+        }
+        case VIEW_DIRECT: {
+            out = direct;
+        }
+        default: {}
+    }
+    textureStore(hdr, px, vec4<f32>(out, 1.0));
+}

@@ -1,0 +1,53 @@
+// The material model shared by the rasterizer, the cone tracer and the reference path tracer:
+// Lambert diffuse plus GGX specular (Smith height-correlated visibility, Schlick Fresnel).
+
+struct Surface {
+    albedo: vec3<f32>,
+    metallic: f32,
+    roughness: f32,
+    specular: f32,
+}
+
+fn f0_of(s: Surface) -> vec3<f32> {
+    return mix(vec3<f32>(0.04 * s.specular), s.albedo, s.metallic);
+}
+
+// Perceptual roughness -> GGX alpha, floored so point lights keep a finite highlight.
+fn ggx_alpha(roughness: f32) -> f32 {
+    let r = clamp(roughness, 0.045, 1.0);
+    return r * r;
+}
+
+fn d_ggx(n_dot_h: f32, a: f32) -> f32 {
+    let a2 = a * a;
+    let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+// Smith height-correlated visibility term, G / (4 n.l n.v).
+fn v_smith(n_dot_v: f32, n_dot_l: f32, a: f32) -> f32 {
+    let a2 = a * a;
+    let gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
+    let gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
+    return 0.5 / max(gv + gl, 1e-7);
+}
+
+fn f_schlick(f0: vec3<f32>, v_dot_h: f32) -> vec3<f32> {
+    let f = pow(1.0 - v_dot_h, 5.0);
+    return f0 + (vec3<f32>(1.0) - f0) * f;
+}
+
+fn brdf_diffuse(s: Surface) -> vec3<f32> {
+    return s.albedo * (1.0 - s.metallic) / PI;
+}
+
+// GGX specular BRDF value for light direction l and view direction v (both unit, pointing away
+// from the surface). `alpha_scale` widens the lobe's normalisation for area lights.
+fn brdf_specular(s: Surface, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    let h = normalize(v + l);
+    let n_dot_l = max(dot(n, l), 0.0);
+    let n_dot_v = max(dot(n, v), 1e-4);
+    let a = ggx_alpha(s.roughness);
+    return d_ggx(max(dot(n, h), 0.0), a) * v_smith(n_dot_v, n_dot_l, a)
+        * f_schlick(f0_of(s), max(dot(v, h), 0.0));
+}

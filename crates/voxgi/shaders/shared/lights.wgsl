@@ -1,0 +1,270 @@
+// Direct light from every light type, with filtered shadows. Expects the including shader to
+// declare `lights`, `shadow_views` and `shadow_maps` (a texture_2d_array<f32> of distances).
+
+//!include shared/scene.wgsl
+//!include shared/brdf.wgsl
+
+// Golden-angle (Vogel) disc: even coverage for any tap count, the same pattern every pixel so
+// images are deterministic.
+fn vogel(i: u32, n: u32) -> vec2<f32> {
+    let r = sqrt((f32(i) + 0.5) / f32(n));
+    let a = f32(i) * 2.39996323;
+    return r * vec2<f32>(cos(a), sin(a));
+}
+
+// Which of a light's views sees p: the cube face of the dominant axis for 6-view lights.
+fn shadow_view_index(light: Light, p: vec3<f32>) -> u32 {
+    if light.shadow_count < 6u {
+        return light.shadow_first;
+    }
+    let d = p - shadow_views[light.shadow_first].origin;
+    let a = abs(d);
+    var face = 0u;
+    if a.x >= a.y && a.x >= a.z {
+        face = select(1u, 0u, d.x > 0.0);
+    } else if a.y >= a.z {
+        face = select(3u, 2u, d.y > 0.0);
+    } else {
+        face = select(5u, 4u, d.z > 0.0);
+    }
+    return light.shadow_first + face;
+}
+
+fn shadow_uv(view: ShadowView, p: vec3<f32>) -> vec3<f32> {
+    let clip = view.view_proj * vec4<f32>(p, 1.0);
+    let ndc = clip.xyz / clip.w;
+    return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, clip.w);
+}
+
+fn shadow_distance(view: ShadowView, p: vec3<f32>) -> f32 {
+    if view.kind == SHADOW_ORTHO {
+        return dot(p - view.origin, view.dir);
+    }
+    return length(p - view.origin);
+}
+
+// World size of one shadow texel at distance `dist` from the view's origin.
+fn shadow_texel_world(view: ShadowView, dist: f32) -> f32 {
+    if view.kind == SHADOW_ORTHO {
+        return view.texel;
+    }
+    return view.texel * dist;
+}
+
+fn shadow_texel(view: ShadowView, t: vec2<i32>) -> f32 {
+    let r = i32(view.resolution);
+    let c = clamp(t, vec2<i32>(0), vec2<i32>(r - 1));
+    return textureLoad(shadow_maps, c, i32(view.layer), 0).r;
+}
+
+// Bilinearly weighted depth comparison at one uv: 1 lit, 0 shadowed.
+fn shadow_tap(view: ShadowView, uv: vec2<f32>, dist: f32) -> f32 {
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+        return 1.0;
+    }
+    let st = uv * view.resolution - 0.5;
+    let i = vec2<i32>(floor(st));
+    let f = fract(st);
+    let s00 = select(0.0, 1.0, dist <= shadow_texel(view, i));
+    let s10 = select(0.0, 1.0, dist <= shadow_texel(view, i + vec2<i32>(1, 0)));
+    let s01 = select(0.0, 1.0, dist <= shadow_texel(view, i + vec2<i32>(0, 1)));
+    let s11 = select(0.0, 1.0, dist <= shadow_texel(view, i + vec2<i32>(1, 1)));
+    return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
+}
+
+const PCF_TAPS: u32 = 16u;
+const PCSS_SEARCH_TAPS: u32 = 16u;
+const PCSS_TAPS: u32 = 32u;
+
+// Visibility of a light from p (normal n), in [0, 1].
+fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> f32 {
+    if light.shadow_count == 0u {
+        return 1.0;
+    }
+    let view = shadow_views[shadow_view_index(light, p)];
+    let d0 = shadow_distance(view, p);
+    let texel = shadow_texel_world(view, max(d0, view.near));
+    // Normal offset plus a constant slope allowance: the receiver is pushed off its surface by
+    // a couple of texels so a flat surface never shadows itself.
+    let pb = p + n * texel * 1.5;
+    let dist = shadow_distance(view, pb) - texel * 1.0;
+    let uvw = shadow_uv(view, pb);
+    let uv = uvw.xy;
+    // Size of one texel in uv, and of the requested radius.
+    let texel_uv = 1.0 / view.resolution;
+
+    if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+        // Percentage-closer soft shadows: the penumbra width follows the light's size and the
+        // blocker/receiver distances, as similar triangles give it.
+        let tan_to_uv = 1.0 / (view.texel * view.resolution);
+        let half = light.size;
+        let search = clamp(half * tan_to_uv / max(0.25 * dist, view.near), 2.0 * texel_uv, 0.25);
+        var blockers = 0.0;
+        var blocker_sum = 0.0;
+        for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
+            let o = uv + vogel(i, PCSS_SEARCH_TAPS) * search;
+            let t = vec2<i32>(floor(o * view.resolution));
+            let z = shadow_texel(view, t);
+            if z < dist {
+                blockers += 1.0;
+                blocker_sum += z;
+            }
+        }
+        if blockers == 0.0 {
+            return 1.0;
+        }
+        let zb = max(blocker_sum / blockers, view.near);
+        let radius = clamp(half * (dist - zb) / (zb * dist) * tan_to_uv, texel_uv, 0.25);
+        var lit = 0.0;
+        for (var i = 0u; i < PCSS_TAPS; i++) {
+            lit += shadow_tap(view, uv + vogel(i, PCSS_TAPS) * radius, dist);
+        }
+        return lit / f32(PCSS_TAPS);
+    }
+
+    let radius = softness * texel_uv;
+    var lit = 0.0;
+    for (var i = 0u; i < PCF_TAPS; i++) {
+        lit += shadow_tap(view, uv + vogel(i, PCF_TAPS) * radius, dist);
+    }
+    return lit / f32(PCF_TAPS);
+}
+
+// glTF KHR_lights_punctual range window: smooth fall to zero at `range`.
+fn range_window(dist: f32, range: f32) -> f32 {
+    if range <= 0.0 {
+        return 1.0;
+    }
+    let r = dist / range;
+    let w = clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    return w * w;
+}
+
+// Spot cone: 1 inside the inner angle, 0 outside the outer, and in between the square of the
+// linear ramp in cosine (the KHR_lights_punctual reference implementation).
+fn spot_falloff(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    let t = clamp((cos_angle - cos_outer) / max(cos_inner - cos_outer, 1e-4), 0.0, 1.0);
+    return t * t;
+}
+
+const MAX_POLY: u32 = 18u;
+
+// Irradiance at p (normal n) from a uniform one-sided polygonal emitter of unit radiance: the
+// Lambert formula E = 1/2 sum_i angle_i (n . unit(v_i x v_i+1)) over the polygon clipped to the
+// upper hemisphere. Exact for unoccluded Lambertian receivers.
+fn polygon_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    var src: array<vec3<f32>, MAX_POLY>;
+    var count = 0u;
+    if light.kind == LIGHT_RECT {
+        let c = light.position - p;
+        src[0] = c - light.axis_u - light.axis_v;
+        src[1] = c + light.axis_u - light.axis_v;
+        src[2] = c + light.axis_u + light.axis_v;
+        src[3] = c - light.axis_u + light.axis_v;
+        count = 4u;
+    } else {
+        // A 16-gon with the disc's area.
+        let k = 16u;
+        let scale = sqrt(PI / (f32(k) * 0.5 * sin(2.0 * PI / f32(k))));
+        for (var i = 0u; i < k; i++) {
+            let a = f32(i) / f32(k) * 2.0 * PI;
+            src[i] = light.position - p + scale * (cos(a) * light.axis_u + sin(a) * light.axis_v);
+        }
+        count = k;
+    }
+    // Clip against the receiver's tangent plane (Sutherland-Hodgman).
+    var poly: array<vec3<f32>, MAX_POLY>;
+    var m = 0u;
+    for (var i = 0u; i < count; i++) {
+        let a = src[i];
+        let b = src[(i + 1u) % count];
+        let da = dot(a, n);
+        let db = dot(b, n);
+        if da >= 0.0 {
+            poly[m] = a;
+            m++;
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            poly[m] = a + (b - a) * (da / (da - db));
+            m++;
+        }
+    }
+    if m < 3u {
+        return 0.0;
+    }
+    var sum = 0.0;
+    for (var i = 0u; i < m; i++) {
+        let a = normalize(poly[i]);
+        let b = normalize(poly[(i + 1u) % m]);
+        let c = cross(a, b);
+        let len = length(c);
+        if len > 1e-9 {
+            sum += atan2(len, dot(a, b)) * dot(c / len, n);
+        }
+    }
+    return 0.5 * abs(sum);
+}
+
+// Outgoing radiance towards v from one light.
+fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, softness: f32) -> vec3<f32> {
+    if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+        // One-sided emitter: nothing behind its plane is lit.
+        if dot(p - light.position, light.direction) <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        let e = polygon_irradiance(light, p, n);
+        if e <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        let vis = light_visibility(light, p, n, softness);
+        // Specular: GGX evaluated towards the point of the light nearest the mirror ray
+        // (representative point), normalised for the lobe widening a light of this size causes.
+        let r = reflect(-v, n);
+        let denom = dot(r, light.direction);
+        var q = light.position;
+        if denom < -1e-4 {
+            let hit = p + r * (dot(light.position - p, light.direction) / denom);
+            let rel = hit - light.position;
+            if light.kind == LIGHT_RECT {
+                let uu = dot(light.axis_u, light.axis_u);
+                let vv = dot(light.axis_v, light.axis_v);
+                let cu = clamp(dot(rel, light.axis_u) / uu, -1.0, 1.0);
+                let cv = clamp(dot(rel, light.axis_v) / vv, -1.0, 1.0);
+                q = light.position + cu * light.axis_u + cv * light.axis_v;
+            } else {
+                let rad = length(light.axis_u);
+                let l = length(rel);
+                q = light.position + rel * min(1.0, rad / max(l, 1e-6));
+            }
+        }
+        let l = normalize(q - p);
+        let dist = length(q - p);
+        let a = ggx_alpha(s.roughness);
+        let a2 = clamp(a + light.size / (2.0 * max(dist, 1e-4)), 0.0, 1.0);
+        let norm = (a / a2) * (a / a2);
+        let spec = brdf_specular(s, n, v, l) * norm;
+        return (brdf_diffuse(s) + spec) * light.radiance * e * vis;
+    }
+
+    var l: vec3<f32>;
+    var e: vec3<f32>;
+    if light.kind == LIGHT_DIRECTIONAL {
+        l = -light.direction;
+        e = light.radiance;
+    } else {
+        let to = light.position - p;
+        let d2 = max(dot(to, to), 1e-8);
+        let d = sqrt(d2);
+        l = to / d;
+        e = light.radiance / d2 * range_window(d, light.range);
+        if light.kind == LIGHT_SPOT {
+            e *= spot_falloff(dot(-l, light.direction), light.cos_inner, light.cos_outer);
+        }
+    }
+    let n_dot_l = dot(n, l);
+    if n_dot_l <= 0.0 || all(e <= vec3<f32>(0.0)) {
+        return vec3<f32>(0.0);
+    }
+    let vis = light_visibility(light, p, n, softness);
+    return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l * vis;
+}

@@ -1,0 +1,111 @@
+// Structs shared by every pass. Each has a #[repr(C)] twin in src/gpu_scene.rs; the test
+// `wgsl_struct_sizes` checks the two agree.
+
+const PI: f32 = 3.14159265358979;
+const NO_INDEX: u32 = 0xffffffffu;
+
+// Per-frame camera and output parameters.
+struct Frame {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    camera_pos: vec3<f32>,
+    light_count: u32,
+    size: vec2<f32>,
+    inv_size: vec2<f32>,
+    // 2^EV, applied before tone mapping.
+    exposure: f32,
+    // 0 ACES filmic, 1 Khronos PBR Neutral, 2 clamp.
+    tonemap: u32,
+    // Filter radius of punctual-light shadows, in shadow-map texels.
+    shadow_softness: f32,
+    // Output selection for debugging (0 = final).
+    view_mode: u32,
+    background: vec4<f32>,
+}
+
+// One vertex, pulled from a storage buffer (no vertex buffers: every pass reads the same data).
+struct Vertex {
+    position: vec3<f32>,
+    u: f32,
+    normal: vec3<f32>,
+    v: f32,
+}
+
+// One mesh instance: a draw call's per-instance data, indexed by instance_index.
+struct Draw {
+    model: mat4x4<f32>,
+    // Inverse transpose of the model matrix, for normals.
+    normal_matrix: mat4x4<f32>,
+    material: u32,
+    // Index of the area light this geometry shows, or NO_INDEX.
+    light: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+struct Material {
+    base_color: vec4<f32>,
+    // Emitted radiance, W/(m^2 sr).
+    emissive: vec3<f32>,
+    roughness: f32,
+    metallic: f32,
+    // Scales the dielectric F0 of 0.04 (KHR_materials_specular); 0 makes a pure Lambertian.
+    specular: f32,
+    // Layers in the texture array, -1 for none.
+    base_texture: i32,
+    emissive_texture: i32,
+    // Texels with alpha below this are cut out; 0 for opaque materials.
+    alpha_cutoff: f32,
+    double_sided: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+const LIGHT_DIRECTIONAL: u32 = 0u;
+const LIGHT_POINT: u32 = 1u;
+const LIGHT_SPOT: u32 = 2u;
+const LIGHT_RECT: u32 = 3u;
+const LIGHT_DISC: u32 = 4u;
+
+struct Light {
+    position: vec3<f32>,
+    kind: u32,
+    // Where photons travel; for area lights the emitting side's normal.
+    direction: vec3<f32>,
+    // Point/spot range of influence in metres, 0 for unlimited.
+    range: f32,
+    // W/m^2 (directional), W/sr (point, spot), W/(m^2 sr) (area).
+    radiance: vec3<f32>,
+    area: f32,
+    // Rect: half-edge vectors. Disc: an orthonormal tangent frame scaled by the radius.
+    axis_u: vec3<f32>,
+    cos_inner: f32,
+    axis_v: vec3<f32>,
+    cos_outer: f32,
+    // Index of the first shadow view and how many (0 = no shadows, 1, or 6 for a cube).
+    shadow_first: u32,
+    shadow_count: u32,
+    // Radius of a disc with the light's area: sets the penumbra size.
+    size: f32,
+    _pad: f32,
+}
+
+const SHADOW_ORTHO: u32 = 0u;
+const SHADOW_PERSPECTIVE: u32 = 1u;
+
+// One rendered shadow map (a layer of the shadow atlas). It stores, per texel, the distance of
+// the nearest occluder: along `dir` from `origin` for orthographic views, from `origin` for
+// perspective ones.
+struct ShadowView {
+    view_proj: mat4x4<f32>,
+    origin: vec3<f32>,
+    kind: u32,
+    dir: vec3<f32>,
+    // World size of a texel (orthographic) or its size in tangent units at distance 1
+    // (perspective).
+    texel: f32,
+    near: f32,
+    far: f32,
+    resolution: f32,
+    layer: u32,
+}

@@ -1,0 +1,91 @@
+//! Short constructors for bind group layout entries, so each pass's layout reads as a list.
+
+use wgpu::{BindGroupLayoutEntry as Entry, BindingType, ShaderStages};
+
+pub fn uniform(binding: u32, visibility: ShaderStages, dynamic: bool) -> Entry {
+    Entry {
+        binding,
+        visibility,
+        ty: BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub fn storage(binding: u32, visibility: ShaderStages, read_only: bool) -> Entry {
+    Entry {
+        binding,
+        visibility,
+        ty: BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub fn texture(
+    binding: u32,
+    visibility: ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> Entry {
+    Entry {
+        binding,
+        visibility,
+        ty: BindingType::Texture {
+            sample_type,
+            view_dimension,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A 2D float texture read with textureLoad only (no filtering needed).
+pub fn texture_2d_load(binding: u32, visibility: ShaderStages) -> Entry {
+    texture(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D2,
+    )
+}
+
+pub fn storage_texture(binding: u32, format: wgpu::TextureFormat) -> Entry {
+    Entry {
+        binding,
+        visibility: ShaderStages::COMPUTE,
+        ty: BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
+pub fn sampler(binding: u32, visibility: ShaderStages) -> Entry {
+    Entry {
+        binding,
+        visibility,
+        ty: BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
+/// Bind group entries from (binding, resource) pairs.
+pub fn entries<'a>(resources: Vec<wgpu::BindingResource<'a>>) -> Vec<wgpu::BindGroupEntry<'a>> {
+    resources
+        .into_iter()
+        .enumerate()
+        .map(|(i, resource)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource,
+        })
+        .collect()
+}

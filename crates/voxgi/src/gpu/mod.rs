@@ -1,0 +1,8 @@
+//! Device setup, shader composition, readback.
+
+mod context;
+pub mod layout;
+pub mod readback;
+pub mod shader;
+
+pub use context::GpuContext;

@@ -1,0 +1,73 @@
+//! WGSL composition: a shader names the shared files it needs with `//!include shared/NAME.wgsl`
+//! lines, which are replaced by those files (each at most once). Tiny on purpose: WGSL has no
+//! modules yet, and this is all voxgi needs.
+
+/// Every WGSL file, by path relative to `crates/voxgi/shaders`.
+const SOURCES: &[(&str, &str)] = &[
+    (
+        "shared/scene.wgsl",
+        include_str!("../../shaders/shared/scene.wgsl"),
+    ),
+    (
+        "shared/brdf.wgsl",
+        include_str!("../../shaders/shared/brdf.wgsl"),
+    ),
+    (
+        "shared/lights.wgsl",
+        include_str!("../../shaders/shared/lights.wgsl"),
+    ),
+    ("shadow.wgsl", include_str!("../../shaders/shadow.wgsl")),
+    ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
+    (
+        "composite.wgsl",
+        include_str!("../../shaders/composite.wgsl"),
+    ),
+    ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+];
+
+fn raw(name: &str) -> &'static str {
+    SOURCES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .unwrap_or_else(|| panic!("unknown shader file {name}"))
+}
+
+/// The full WGSL of shader `name` with its includes expanded.
+pub fn compose(name: &str) -> String {
+    let mut out = String::new();
+    let mut seen = Vec::new();
+    expand(name, &mut out, &mut seen);
+    out
+}
+
+fn expand(name: &str, out: &mut String, seen: &mut Vec<String>) {
+    if seen.iter().any(|s| s == name) {
+        return;
+    }
+    seen.push(name.to_string());
+    for line in raw(name).lines() {
+        if let Some(inc) = line.trim().strip_prefix("//!include ") {
+            expand(inc.trim(), out, seen);
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+}
+
+/// Compiles shader `name`; the label is the shader's name so pipelines and timings agree.
+pub fn module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(compose(name).into()),
+    })
+}
+
+/// The names of all pass shaders (for tests that validate every one).
+pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
+    SOURCES
+        .iter()
+        .map(|(n, _)| *n)
+        .filter(|n| !n.starts_with("shared/"))
+}

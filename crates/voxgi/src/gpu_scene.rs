@@ -1,0 +1,445 @@
+//! The scene on the GPU: vertices, indices, per-instance draws, materials, textures, lights.
+//! Every pass reads geometry from these buffers (vertex pulling), so the rasterizer, the
+//! voxelizer and the path tracer see exactly the same data.
+
+use crate::{Error, Result, Settings};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene};
+use wgpu::util::DeviceExt;
+
+/// Mirrors `Frame` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuFrame {
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 3],
+    pub light_count: u32,
+    pub size: [f32; 2],
+    pub inv_size: [f32; 2],
+    pub exposure: f32,
+    pub tonemap: u32,
+    pub shadow_softness: f32,
+    pub view_mode: u32,
+    pub background: [f32; 4],
+}
+
+/// Mirrors `Vertex` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    pub u: f32,
+    pub normal: [f32; 3],
+    pub v: f32,
+}
+
+/// Mirrors `Draw` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuDraw {
+    pub model: [[f32; 4]; 4],
+    pub normal_matrix: [[f32; 4]; 4],
+    pub material: u32,
+    pub light: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Mirrors `Material` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub base_color: [f32; 4],
+    pub emissive: [f32; 3],
+    pub roughness: f32,
+    pub metallic: f32,
+    pub specular: f32,
+    pub base_texture: i32,
+    pub emissive_texture: i32,
+    pub alpha_cutoff: f32,
+    pub double_sided: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Mirrors `Light` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub kind: u32,
+    pub direction: [f32; 3],
+    pub range: f32,
+    pub radiance: [f32; 3],
+    pub area: f32,
+    pub axis_u: [f32; 3],
+    pub cos_inner: f32,
+    pub axis_v: [f32; 3],
+    pub cos_outer: f32,
+    pub shadow_first: u32,
+    pub shadow_count: u32,
+    pub size: f32,
+    pub _pad: f32,
+}
+
+pub const LIGHT_DIRECTIONAL: u32 = 0;
+pub const LIGHT_POINT: u32 = 1;
+pub const LIGHT_SPOT: u32 = 2;
+pub const LIGHT_RECT: u32 = 3;
+pub const LIGHT_DISC: u32 = 4;
+pub const NO_INDEX: u32 = u32::MAX;
+
+/// One indexed draw: a mesh instance.
+#[derive(Clone, Debug)]
+pub struct DrawCall {
+    pub indices: std::ops::Range<u32>,
+    pub base_vertex: i32,
+    /// Index into the draws buffer (passed as the instance index).
+    pub draw: u32,
+    /// The area light this geometry shows; it does not shadow its own light.
+    pub light: Option<usize>,
+}
+
+pub struct GpuScene {
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub draws: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    pub textures: wgpu::Texture,
+    pub texture_view: wgpu::TextureView,
+    pub sampler: wgpu::Sampler,
+    pub calls: Vec<DrawCall>,
+    /// CPU copy of the lights, without shadow assignments (the shadow pass fills those).
+    pub gpu_lights: Vec<GpuLight>,
+    pub light_count: u32,
+}
+
+fn mat(m: Mat4) -> [[f32; 4]; 4] {
+    m.to_cols_array_2d()
+}
+
+/// Converts scene lights to their GPU form (shadow fields left zero).
+pub fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
+    scene
+        .lights
+        .iter()
+        .map(|l| {
+            let mut g = GpuLight {
+                position: l.position.to_array(),
+                direction: l.direction.normalize().to_array(),
+                range: l.range.unwrap_or(0.0),
+                radiance: l.radiometric().to_array(),
+                area: l.area(),
+                size: (l.area() / std::f32::consts::PI).sqrt(),
+                ..Default::default()
+            };
+            match l.kind {
+                LightKind::Directional => g.kind = LIGHT_DIRECTIONAL,
+                LightKind::Point => g.kind = LIGHT_POINT,
+                LightKind::Spot {
+                    inner_angle,
+                    outer_angle,
+                } => {
+                    g.kind = LIGHT_SPOT;
+                    g.cos_inner = inner_angle.cos();
+                    g.cos_outer = outer_angle.cos();
+                }
+                LightKind::Area {
+                    shape: AreaShape::Rect { u, v },
+                } => {
+                    g.kind = LIGHT_RECT;
+                    g.axis_u = u.to_array();
+                    g.axis_v = v.to_array();
+                }
+                LightKind::Area {
+                    shape: AreaShape::Disc { radius },
+                } => {
+                    g.kind = LIGHT_DISC;
+                    let (t, b) = l.direction.normalize().any_orthonormal_pair();
+                    g.axis_u = (t * radius).to_array();
+                    g.axis_v = (b * radius).to_array();
+                }
+            }
+            g
+        })
+        .collect()
+}
+
+impl GpuScene {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        settings: &Settings,
+    ) -> Result<Self> {
+        let mut vertices: Vec<GpuVertex> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut ranges = Vec::with_capacity(scene.meshes.len());
+        for m in &scene.meshes {
+            let base = vertices.len();
+            let first = indices.len() as u32;
+            for (i, p) in m.positions.iter().enumerate() {
+                let uv = m.uvs.get(i).copied().unwrap_or_default();
+                vertices.push(GpuVertex {
+                    position: p.to_array(),
+                    u: uv.x,
+                    normal: m.normals[i].to_array(),
+                    v: uv.y,
+                });
+            }
+            indices.extend_from_slice(&m.indices);
+            ranges.push((first..indices.len() as u32, base as i32));
+        }
+        let mut draws = Vec::with_capacity(scene.instances.len());
+        let mut calls = Vec::with_capacity(scene.instances.len());
+        for inst in &scene.instances {
+            let mesh = &scene.meshes[inst.mesh];
+            if mesh.indices.is_empty() {
+                continue;
+            }
+            let normal_matrix = inst.transform.inverse().transpose();
+            let normal_matrix = if normal_matrix.is_finite() {
+                normal_matrix
+            } else {
+                Mat4::IDENTITY
+            };
+            calls.push(DrawCall {
+                indices: ranges[inst.mesh].0.clone(),
+                base_vertex: ranges[inst.mesh].1,
+                draw: draws.len() as u32,
+                light: inst.light,
+            });
+            draws.push(GpuDraw {
+                model: mat(inst.transform),
+                normal_matrix: mat(normal_matrix),
+                material: mesh.material as u32,
+                light: inst.light.map_or(NO_INDEX, |l| l as u32),
+                _pad: [0; 2],
+            });
+        }
+        let (textures, layer_of) = upload_textures(device, queue, scene, settings)?;
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial {
+                base_color: m.base_color,
+                emissive: m.emissive,
+                roughness: m.roughness.clamp(0.0, 1.0),
+                metallic: m.metallic.clamp(0.0, 1.0),
+                specular: m.specular.max(0.0),
+                base_texture: m.base_color_texture.map_or(-1, |t| layer_of[t]),
+                emissive_texture: m.emissive_texture.map_or(-1, |t| layer_of[t]),
+                alpha_cutoff: match m.alpha_mode {
+                    AlphaMode::Mask(c) => c,
+                    _ => 0.0,
+                },
+                double_sided: m.double_sided as u32,
+                _pad: [0; 2],
+            })
+            .collect();
+        let lights = gpu_lights(scene);
+
+        let storage = |label: &str, bytes: &[u8], min: usize| {
+            let mut data = bytes.to_vec();
+            // Storage bindings must not be empty.
+            data.resize(data.len().max(min), 0);
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &data,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        let max_binding = device.limits().max_storage_buffer_binding_size as usize;
+        let vbytes = std::mem::size_of_val(vertices.as_slice());
+        if vbytes > max_binding {
+            return Err(Error::Setting(format!(
+                "the scene's {} vertices need {} MiB, more than this GPU's storage-buffer limit of {} MiB",
+                vertices.len(),
+                vbytes >> 20,
+                max_binding >> 20
+            )));
+        }
+        Ok(GpuScene {
+            vertices: storage("vertices", bytemuck::cast_slice(&vertices), 32),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("indices"),
+                contents: bytemuck::cast_slice(if indices.is_empty() {
+                    &[0u32; 3]
+                } else {
+                    &indices
+                }),
+                usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
+            }),
+            draws: storage("draws", bytemuck::cast_slice(&draws), 144),
+            materials: storage("materials", bytemuck::cast_slice(&materials), 64),
+            lights: storage("lights", bytemuck::cast_slice(&lights), 96),
+            texture_view: textures.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            }),
+            textures,
+            sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("material textures"),
+                address_mode_u: wgpu::AddressMode::Repeat,
+                address_mode_v: wgpu::AddressMode::Repeat,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                anisotropy_clamp: 1,
+                ..Default::default()
+            }),
+            calls,
+            light_count: lights.len() as u32,
+            gpu_lights: lights,
+        })
+    }
+
+    /// Bytes of GPU memory per resource, for `voxgi bench` and `info`.
+    pub fn memory(&self) -> Vec<(&'static str, u64)> {
+        let t = &self.textures;
+        let mut tex = 0u64;
+        for mip in 0..t.mip_level_count() {
+            let w = (t.width() >> mip).max(1) as u64;
+            let h = (t.height() >> mip).max(1) as u64;
+            tex += w * h * 4 * t.depth_or_array_layers() as u64;
+        }
+        vec![
+            ("vertices", self.vertices.size()),
+            ("indices", self.indices.size()),
+            ("draws", self.draws.size()),
+            ("materials", self.materials.size()),
+            ("lights", self.lights.size()),
+            ("textures", tex),
+        ]
+    }
+}
+
+/// All material textures go into one RGBA8 sRGB 2D array at a common power-of-two size, so that
+/// every pass, raster or compute, samples them the same way without bindless support.
+fn upload_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &Scene,
+    settings: &Settings,
+) -> Result<(wgpu::Texture, Vec<i32>)> {
+    let used: Vec<usize> = {
+        let mut u: Vec<usize> = scene
+            .materials
+            .iter()
+            .flat_map(|m| [m.base_color_texture, m.emissive_texture])
+            .flatten()
+            .collect();
+        u.sort_unstable();
+        u.dedup();
+        u
+    };
+    let mut layer_of = vec![-1i32; scene.textures.len()];
+    let largest = used
+        .iter()
+        .map(|&t| scene.textures[t].width.max(scene.textures[t].height))
+        .max()
+        .unwrap_or(1);
+    let size = largest
+        .next_power_of_two()
+        .clamp(1, settings.max_texture_size.max(1));
+    let mips = size.ilog2() + 1;
+    let layers = used.len().max(1) as u32;
+    if layers > device.limits().max_texture_array_layers {
+        return Err(Error::Setting(format!(
+            "the scene uses {layers} textures, more than this GPU's {} array layers",
+            device.limits().max_texture_array_layers
+        )));
+    }
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("material textures"),
+        size: wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let write = |layer: u32, mip: u32, s: u32, data: &[u8]| {
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: mip,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            data,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * s),
+                rows_per_image: Some(s),
+            },
+            wgpu::Extent3d {
+                width: s,
+                height: s,
+                depth_or_array_layers: 1,
+            },
+        );
+    };
+    if used.is_empty() {
+        for mip in 0..mips {
+            let s = (size >> mip).max(1);
+            write(0, mip, s, &vec![255u8; (s * s * 4) as usize]);
+        }
+    }
+    for (layer, &t) in used.iter().enumerate() {
+        layer_of[t] = layer as i32;
+        let tex = &scene.textures[t];
+        let img = image::RgbaImage::from_raw(tex.width, tex.height, tex.rgba8.clone()).ok_or_else(
+            || Error::Setting(format!("texture '{}' has the wrong byte count", tex.name)),
+        )?;
+        // Filter in linear light so mips of sRGB textures keep their brightness.
+        let mut level = to_linear(&img);
+        for mip in 0..mips {
+            let s = (size >> mip).max(1);
+            level = image::imageops::resize(&level, s, s, image::imageops::FilterType::Triangle);
+            write(layer as u32, mip, s, &to_srgb8(&level));
+        }
+    }
+    Ok((texture, layer_of))
+}
+
+fn to_linear(img: &image::RgbaImage) -> image::Rgba32FImage {
+    image::Rgba32FImage::from_fn(img.width(), img.height(), |x, y| {
+        let p = img.get_pixel(x, y).0;
+        let c = |v: u8| voxgi_scene::srgb_to_linear(v as f32 / 255.0);
+        image::Rgba([c(p[0]), c(p[1]), c(p[2]), p[3] as f32 / 255.0])
+    })
+}
+
+fn to_srgb8(img: &image::Rgba32FImage) -> Vec<u8> {
+    img.pixels()
+        .flat_map(|p| {
+            let c = |v: f32| (crate::output::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+            [
+                c(p[0]),
+                c(p[1]),
+                c(p[2]),
+                (p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
+            ]
+        })
+        .collect()
+}
+
+/// World-space bounds of everything drawn, never empty (a unit box for empty scenes).
+pub fn scene_bounds(scene: &Scene) -> (Vec3, f32) {
+    let b = scene.bounds();
+    if b.is_empty() {
+        return (Vec3::ZERO, 1.0);
+    }
+    (b.center(), (b.size().length() * 0.5).max(1e-3))
+}

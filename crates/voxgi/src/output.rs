@@ -1,0 +1,116 @@
+//! Rendered images and writing them: PNG (sRGB, tone mapped) and EXR (linear HDR).
+
+use crate::{Error, Result};
+use std::path::Path;
+
+/// What one render produced.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    pub width: u32,
+    pub height: u32,
+    /// Linear radiance, RGBA f32, row-major from the top-left, before exposure.
+    pub hdr: Vec<f32>,
+    /// Tone-mapped sRGB-encoded RGBA8.
+    pub ldr: Vec<u8>,
+}
+
+impl RenderOutput {
+    /// Linear radiance of pixel (x, y).
+    pub fn radiance(&self, x: u32, y: u32) -> [f32; 3] {
+        let i = ((y * self.width + x) * 4) as usize;
+        [self.hdr[i], self.hdr[i + 1], self.hdr[i + 2]]
+    }
+
+    /// Mean linear radiance over the image.
+    pub fn mean_radiance(&self) -> [f32; 3] {
+        let mut s = [0f64; 3];
+        for p in self.hdr.chunks_exact(4) {
+            for c in 0..3 {
+                s[c] += p[c] as f64;
+            }
+        }
+        let n = (self.width * self.height).max(1) as f64;
+        [(s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32]
+    }
+
+    /// Writes by extension: `.png` gets the tone-mapped image, `.exr` the linear radiance.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        let fail = |reason: String| Error::Output {
+            path: path.to_path_buf(),
+            reason,
+        };
+        match ext.as_str() {
+            "png" => image::save_buffer(
+                path,
+                &self.ldr,
+                self.width,
+                self.height,
+                image::ExtendedColorType::Rgba8,
+            )
+            .map_err(|e| fail(e.to_string())),
+            "exr" => {
+                let (w, h) = (self.width as usize, self.height as usize);
+                exr::prelude::write_rgb_file(path, w, h, |x, y| {
+                    let i = (y * w + x) * 4;
+                    (self.hdr[i], self.hdr[i + 1], self.hdr[i + 2])
+                })
+                .map_err(|e| fail(e.to_string()))
+            }
+            _ => Err(fail(format!(
+                "unknown image type '.{ext}' (use .png or .exr)"
+            ))),
+        }
+    }
+}
+
+/// The sRGB opto-electronic transfer function (IEC 61966-2-1), clamping to [0, 1].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.0031308 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Reads an image as linear RGB f32: EXR as stored, PNG/JPEG sRGB-decoded.
+pub fn load_linear(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
+    let fail = |reason: String| Error::Output {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext == "exr" {
+        let img = exr::prelude::read_first_rgba_layer_from_file(
+            path,
+            |res, _| (res.width(), vec![[0f32; 3]; res.width() * res.height()]),
+            |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = [r, g, b]
+            },
+        )
+        .map_err(|e| fail(e.to_string()))?;
+        let size = img.layer_data.size;
+        return Ok((
+            size.width() as u32,
+            size.height() as u32,
+            img.layer_data.channel_data.pixels.1,
+        ));
+    }
+    let img = image::open(path)
+        .map_err(|e| fail(e.to_string()))?
+        .to_rgb8();
+    let px = img
+        .pixels()
+        .map(|p| p.0.map(|v| voxgi_scene::srgb_to_linear(v as f32 / 255.0)))
+        .collect();
+    Ok((img.width(), img.height(), px))
+}

@@ -1,0 +1,100 @@
+//! composite: deferred shading of direct light and emission into the HDR target.
+
+use crate::frame::FrameTargets;
+use crate::gpu::{layout, shader};
+use crate::gpu_scene::GpuScene;
+use crate::passes::shadow::ShadowAtlas;
+
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+pub struct CompositePass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl CompositePass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::storage(1, c, true),
+                layout::storage(2, c, true),
+                layout::texture(
+                    3,
+                    c,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                layout::texture_2d_load(4, c),
+                layout::texture_2d_load(5, c),
+                layout::texture_2d_load(6, c),
+                layout::texture(
+                    7,
+                    c,
+                    wgpu::TextureSampleType::Depth,
+                    wgpu::TextureViewDimension::D2,
+                ),
+                layout::storage_texture(8, HDR_FORMAT),
+            ],
+        });
+        let pipeline = compute_pipeline(device, "composite", "composite.wgsl", &layout);
+        CompositePass { pipeline, layout }
+    }
+
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        scene: &GpuScene,
+        atlas: &ShadowAtlas,
+    ) {
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("composite"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                t.frame.as_entire_binding(),
+                scene.lights.as_entire_binding(),
+                atlas.views_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&atlas.array_view),
+                wgpu::BindingResource::TextureView(&t.albedo),
+                wgpu::BindingResource::TextureView(&t.normal),
+                wgpu::BindingResource::TextureView(&t.emission),
+                wgpu::BindingResource::TextureView(&t.depth),
+                wgpu::BindingResource::TextureView(&t.hdr),
+            ]),
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("composite"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+    }
+}
+
+/// A compute pipeline whose label is the pass name, from the WGSL file's `main`.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    layout: &wgpu::BindGroupLayout,
+) -> wgpu::ComputePipeline {
+    let module = shader::module(device, file);
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}

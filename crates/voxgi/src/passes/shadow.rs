@@ -1,0 +1,377 @@
+//! shadow: one distance map per shadow view, all in one texture array (the shadow atlas).
+//! Directional lights get an orthographic view fitted to the scene, spot lights a perspective
+//! one, point and area lights six (a cube around the light).
+
+use crate::gpu::{layout, shader};
+use crate::gpu_scene::{
+    GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT, LIGHT_SPOT,
+};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+/// Mirrors `ShadowView` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuShadowView {
+    pub view_proj: [[f32; 4]; 4],
+    pub origin: [f32; 3],
+    pub kind: u32,
+    pub dir: [f32; 3],
+    pub texel: f32,
+    pub near: f32,
+    pub far: f32,
+    pub resolution: f32,
+    pub layer: u32,
+}
+
+const SHADOW_ORTHO: u32 = 0;
+const SHADOW_PERSPECTIVE: u32 = 1;
+/// Uniform dynamic offsets must be multiples of 256 bytes.
+const UNIFORM_STRIDE: u64 = 256;
+pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// The shadow views of a scene's lights and the textures they render into.
+pub struct ShadowAtlas {
+    pub views: Vec<GpuShadowView>,
+    /// Which light each view belongs to.
+    pub view_light: Vec<usize>,
+    pub texture: wgpu::Texture,
+    pub array_view: wgpu::TextureView,
+    layer_views: Vec<wgpu::TextureView>,
+    depth_view: wgpu::TextureView,
+    pub views_buffer: wgpu::Buffer,
+    uniforms: wgpu::Buffer,
+}
+
+fn up_for(dir: Vec3) -> Vec3 {
+    if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y }
+}
+
+/// Lays out shadow views for every shadow-casting light and records in `lights` where each
+/// light's views are.
+pub fn plan_views(
+    lights: &mut [GpuLight],
+    casts: &[bool],
+    center: Vec3,
+    radius: f32,
+    res: u32,
+) -> (Vec<GpuShadowView>, Vec<usize>) {
+    let mut views = Vec::new();
+    let mut owner = Vec::new();
+    let near = (radius * 1e-4).max(1e-5);
+    let res_f = res as f32;
+    for (li, light) in lights.iter_mut().enumerate() {
+        if !casts[li] {
+            continue;
+        }
+        let first = views.len() as u32;
+        let pos = Vec3::from(light.position);
+        let dir = Vec3::from(light.direction).normalize();
+        let far_from = |o: Vec3| (o - center).length() + radius * 1.01;
+        let mut push = |view: Mat4,
+                        proj: Mat4,
+                        origin: Vec3,
+                        kind: u32,
+                        vdir: Vec3,
+                        texel: f32,
+                        near: f32,
+                        far: f32| {
+            views.push(GpuShadowView {
+                view_proj: (proj * view).to_cols_array_2d(),
+                origin: origin.to_array(),
+                kind,
+                dir: vdir.to_array(),
+                texel,
+                near,
+                far,
+                resolution: res_f,
+                layer: 0,
+            });
+            owner.push(li);
+        };
+        match light.kind {
+            LIGHT_DIRECTIONAL => {
+                // Fit the scene's bounding sphere; the map starts just outside it.
+                let origin = center - dir * radius * 1.05;
+                let view = Mat4::look_at_rh(origin, origin + dir, up_for(dir));
+                let proj =
+                    Mat4::orthographic_rh(-radius, radius, -radius, radius, 0.0, radius * 2.1);
+                push(
+                    view,
+                    proj,
+                    origin,
+                    SHADOW_ORTHO,
+                    dir,
+                    2.0 * radius / res_f,
+                    0.0,
+                    radius * 2.1,
+                );
+            }
+            LIGHT_SPOT => {
+                let half = (light.cos_outer.clamp(-1.0, 1.0).acos() + 2f32.to_radians())
+                    .min(85f32.to_radians());
+                let view = Mat4::look_at_rh(pos, pos + dir, up_for(dir));
+                let far = far_from(pos);
+                let proj = Mat4::perspective_rh(2.0 * half, 1.0, near, far);
+                push(
+                    view,
+                    proj,
+                    pos,
+                    SHADOW_PERSPECTIVE,
+                    dir,
+                    2.0 * half.tan() / res_f,
+                    near,
+                    far,
+                );
+            }
+            LIGHT_POINT | LIGHT_RECT | LIGHT_DISC => {
+                // Area lights look out from just in front of their surface.
+                let origin = if light.kind == LIGHT_POINT {
+                    pos
+                } else {
+                    pos + dir * near * 2.0
+                };
+                // A guard band of a few texels lets filter taps near a face's edge stay inside it.
+                let tan_half = 1.0 + 4.0 / res_f;
+                let far = far_from(origin);
+                let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, far);
+                for axis in [
+                    Vec3::X,
+                    Vec3::NEG_X,
+                    Vec3::Y,
+                    Vec3::NEG_Y,
+                    Vec3::Z,
+                    Vec3::NEG_Z,
+                ] {
+                    let view = Mat4::look_at_rh(origin, origin + axis, up_for(axis));
+                    push(
+                        view,
+                        proj,
+                        origin,
+                        SHADOW_PERSPECTIVE,
+                        axis,
+                        2.0 * tan_half / res_f,
+                        near,
+                        far,
+                    );
+                }
+            }
+            _ => {}
+        }
+        light.shadow_first = first;
+        light.shadow_count = views.len() as u32 - first;
+    }
+    for (i, v) in views.iter_mut().enumerate() {
+        v.layer = i as u32;
+    }
+    (views, owner)
+}
+
+impl ShadowAtlas {
+    pub fn new(
+        device: &wgpu::Device,
+        views: Vec<GpuShadowView>,
+        view_light: Vec<usize>,
+        res: u32,
+    ) -> Self {
+        let layers = views.len().max(1) as u32;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow atlas"),
+            size: wgpu::Extent3d {
+                width: res,
+                height: res,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: ATLAS_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let layer_views = (0..layers)
+            .map(|l| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("shadow layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: l,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow depth"),
+            size: wgpu::Extent3d {
+                width: res,
+                height: res,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let mut uniform_bytes = vec![0u8; UNIFORM_STRIDE as usize * views.len().max(1)];
+        for (i, v) in views.iter().enumerate() {
+            let o = i * UNIFORM_STRIDE as usize;
+            uniform_bytes[o..o + size_of::<GpuShadowView>()].copy_from_slice(bytemuck::bytes_of(v));
+        }
+        let mut view_bytes = bytemuck::cast_slice::<_, u8>(&views).to_vec();
+        view_bytes.resize(view_bytes.len().max(size_of::<GpuShadowView>()), 0);
+        ShadowAtlas {
+            uniforms: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow view uniforms"),
+                contents: &uniform_bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            views_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow views"),
+                contents: &view_bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
+            views,
+            view_light,
+            texture,
+            array_view,
+            layer_views,
+            depth_view: depth.create_view(&Default::default()),
+        }
+    }
+
+    pub fn bytes(&self) -> u64 {
+        let t = &self.texture;
+        (t.width() * t.height() * t.depth_or_array_layers()) as u64 * 8
+    }
+}
+
+pub struct ShadowPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl ShadowPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let vs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow"),
+            entries: &[
+                layout::uniform(0, vs, true),
+                layout::storage(1, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(2, wgpu::ShaderStages::VERTEX, true),
+            ],
+        });
+        let module = shader::module(device, "shadow.wgsl");
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(ATLAS_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        ShadowPass { pipeline, layout }
+    }
+
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        scene: &GpuScene,
+    ) {
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &atlas.uniforms,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<GpuShadowView>() as u64),
+                }),
+                scene.vertices.as_entire_binding(),
+                scene.draws.as_entire_binding(),
+            ]),
+        });
+        for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: layer,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        // Nothing seen: the occluder is infinitely far.
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: 3.0e38,
+                            g: 0.0,
+                            b: 0.0,
+                            a: 0.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &atlas.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
+            pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+            let owner = atlas.view_light[i];
+            for call in &scene.calls {
+                // An emitter does not shadow its own light.
+                if call.light == Some(owner) {
+                    continue;
+                }
+                pass.draw_indexed(
+                    call.indices.clone(),
+                    call.base_vertex,
+                    call.draw..call.draw + 1,
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! Every knob of the renderer in one place, with documented defaults and range checks.
+
+use crate::{Error, Result};
+
+/// The curve that maps exposed linear radiance to display values.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Tonemap {
+    /// Narkowicz's fit of ACES: filmic toe and shoulder, desaturates very bright colours.
+    #[default]
+    Aces,
+    /// Khronos PBR Neutral: base colours stay exact up to 0.76, highlights roll off.
+    Neutral,
+    /// No curve: clamp to [0, 1]. For measurements.
+    Clamp,
+}
+
+/// What the output shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ViewMode {
+    /// The lit image.
+    #[default]
+    Final,
+    /// Surface albedo (the G-buffer).
+    Albedo,
+    /// World-space normals mapped to colour.
+    Normal,
+    /// Direct light only, without emission.
+    Direct,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Width and height of each shadow map in texels (64..=8192). Default 1024.
+    pub shadow_map_size: u32,
+    /// Filter radius of point, spot and directional shadows in texels (0..=16). Area lights get
+    /// penumbrae from their size instead. Default 1.5.
+    pub shadow_softness: f32,
+    /// Exposure in stops: the image is scaled by 2^exposure before tone mapping (-20..=20).
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+    /// Radiance of pixels that see no geometry.
+    pub background: [f32; 3],
+    pub view: ViewMode,
+    /// Largest material texture size; bigger textures are downsampled (1..=8192). Default 1024.
+    pub max_texture_size: u32,
+    /// Add a sun when the scene has no light and nothing emissive, instead of rendering black.
+    pub default_light: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            shadow_map_size: 1024,
+            shadow_softness: 1.5,
+            exposure: 0.0,
+            tonemap: Tonemap::Aces,
+            background: [0.0; 3],
+            view: ViewMode::Final,
+            max_texture_size: 1024,
+            default_light: true,
+        }
+    }
+}
+
+impl Settings {
+    /// Checks every value against its documented range.
+    pub fn validate(&self) -> Result<()> {
+        let fail = |m: String| Err(Error::Setting(m));
+        if !(64..=8192).contains(&self.shadow_map_size) {
+            return fail(format!(
+                "shadow map size {} is outside 64..=8192",
+                self.shadow_map_size
+            ));
+        }
+        if !(0.0..=16.0).contains(&self.shadow_softness) {
+            return fail(format!(
+                "shadow softness {} is outside 0..=16 texels",
+                self.shadow_softness
+            ));
+        }
+        if !(-20.0..=20.0).contains(&self.exposure) {
+            return fail(format!("exposure {} EV is outside -20..=20", self.exposure));
+        }
+        if !self.background.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return fail("background must be finite and non-negative".into());
+        }
+        if !(1..=8192).contains(&self.max_texture_size) {
+            return fail(format!(
+                "max texture size {} is outside 1..=8192",
+                self.max_texture_size
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Largest image side voxgi renders (memory for the targets grows with its square).
+pub const MAX_IMAGE_SIZE: u32 = 8192;
+
+/// Checks an output size.
+pub fn validate_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 || width > MAX_IMAGE_SIZE || height > MAX_IMAGE_SIZE {
+        return Err(Error::Setting(format!(
+            "image size {width}x{height} is outside 1x1..={MAX_IMAGE_SIZE}x{MAX_IMAGE_SIZE}"
+        )));
+    }
+    Ok(())
+}
