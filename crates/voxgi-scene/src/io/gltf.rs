@@ -22,9 +22,8 @@ pub fn load(path: &Path) -> Result<Scene> {
     let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, io_reason(&e)))?;
     // The loader checks everything it hands to the `gltf` crate, but a panic in a dependency on
     // a hostile file must still come back as an error, not abort the caller.
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        load_bytes(path, &bytes)
-    }));
+    let outcome =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes)));
     let scene = match outcome {
         Ok(Ok(scene)) => scene,
         Ok(Err(reason)) => return Err(SceneError::load(path, reason)),
@@ -56,7 +55,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
         return Err("empty file".into());
     }
     let is_glb = bytes.starts_with(b"glTF");
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
         if is_glb {
             format!("invalid binary glTF: {e}")
         } else if path
@@ -68,8 +67,9 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
             format!("invalid glTF: {e}")
         }
     })?;
-    let base = path.parent().unwrap_or(Path::new("."));
     let doc = &gltf.document;
+    validate_json(doc.as_json())?;
+    let base = path.parent().unwrap_or(Path::new("."));
     let buffers = load_buffers(doc, base, gltf.blob.as_deref())?;
 
     let mut scene = Scene {
@@ -143,7 +143,10 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
     }
 
     let Some(gscene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
-        log::warn!("{}: the file has no scenes; nothing is placed", path.display());
+        log::warn!(
+            "{}: the file has no scenes; nothing is placed",
+            path.display()
+        );
         return Ok(scene);
     };
 
@@ -261,6 +264,45 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
     cameras.sort_by_key(|(ni, _)| *ni);
     scene.cameras = cameras.into_iter().map(|(_, c)| c).collect();
     Ok(scene)
+}
+
+/// Runs the `gltf` crate's schema validation, after checking what its own validation indexes
+/// without a bounds check (a primitive's POSITION accessor). Missing POSITION `min`/`max`, which
+/// the spec requires but many exporters omit, is tolerated since the loader never uses them.
+fn validate_json(root: &gltf::json::Root) -> R<()> {
+    use gltf::json::validation::{Error as VError, Validate};
+    for (mi, m) in root.meshes.iter().enumerate() {
+        for (pi, p) in m.primitives.iter().enumerate() {
+            for (sem, acc) in &p.attributes {
+                if acc.value() >= root.accessors.len() {
+                    let sem = match sem {
+                        gltf::json::validation::Checked::Valid(s) => format!("{s:?}"),
+                        gltf::json::validation::Checked::Invalid => "?".into(),
+                    };
+                    return Err(format!(
+                        "meshes[{mi}].primitives[{pi}].attributes[{sem}]: accessor {} does not \
+                         exist ({} accessors)",
+                        acc.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, err| {
+        let path = path();
+        let p = path.as_str();
+        let min_max = p.ends_with(".min") || p.ends_with(".max");
+        if !(min_max && matches!(err, VError::Missing)) {
+            errors.push(format!("{p}: {err}"));
+        }
+    });
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("invalid glTF: {}", errors.join("; ")))
+    }
 }
 
 fn local_transform(node: &gltf::Node) -> Mat4 {
@@ -386,12 +428,8 @@ fn base64_decode(s: &str) -> R<Vec<u8>> {
         if padding {
             return Err("invalid base64 in data URI (data after '=' padding)".into());
         }
-        let v = val(c).ok_or_else(|| {
-            format!(
-                "invalid base64 in data URI (character {:?})",
-                char::from(c)
-            )
-        })?;
+        let v = val(c)
+            .ok_or_else(|| format!("invalid base64 in data URI (character {:?})", char::from(c)))?;
         acc = (acc << 6) | v;
         bits += 6;
         if bits >= 8 {
@@ -427,9 +465,7 @@ fn load_image(image: &gltf::Image, base: &Path, buffers: &[Vec<u8>]) -> R<Textur
             "image {i}: unknown image format (voxgi reads PNG and JPEG)"
         ));
     }
-    let (w, h) = r
-        .into_dimensions()
-        .map_err(|e| format!("image {i}: {e}"))?;
+    let (w, h) = r.into_dimensions().map_err(|e| format!("image {i}: {e}"))?;
     let max = limits::MAX_TEXTURE_DIM;
     if w > max || h > max {
         return Err(format!(
@@ -577,11 +613,7 @@ fn collect<T: Default + Clone, I: Iterator<Item = T>>(
     Ok(v)
 }
 
-fn load_primitive(
-    prim: &gltf::Primitive,
-    buffers: &[Vec<u8>],
-    what: &str,
-) -> R<Option<Mesh>> {
+fn load_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>], what: &str) -> R<Option<Mesh>> {
     let mode = prim.mode();
     if !matches!(
         mode,
@@ -621,11 +653,7 @@ fn load_primitive(
                 ],
                 "indices",
             )?;
-            let v = collect(
-                &acc,
-                reader.read_indices().map(|r| r.into_u32()),
-                "indices",
-            )?;
+            let v = collect(&acc, reader.read_indices().map(|r| r.into_u32()), "indices")?;
             if let Some(&bad) = v.iter().find(|&&i| i as usize >= n) {
                 return Err(format!(
                     "accessor {}: index {bad} out of range for {n} vertices",
@@ -638,7 +666,7 @@ fn load_primitive(
     };
     let indices = match mode {
         Mode::Triangles => {
-            if raw_indices.len() % 3 != 0 {
+            if !raw_indices.len().is_multiple_of(3) {
                 return Err(format!(
                     "{what}: {} indices is not a multiple of 3",
                     raw_indices.len()
