@@ -577,6 +577,61 @@ fn sparse_accessor_is_applied() {
     assert_eq!(scene.bounds().max.y, 4.0);
 }
 
+#[test]
+fn sixteen_bit_and_grey_alpha_images_become_rgba8() {
+    let rgba16 = png(image::DynamicImage::ImageRgba16(
+        image::ImageBuffer::from_raw(1, 1, vec![65535u16, 257 * 100, 0, 257 * 7]).unwrap(),
+    ));
+    let la8 = png(image::DynamicImage::ImageLumaA8(
+        image::GrayAlphaImage::from_raw(1, 1, vec![50, 60]).unwrap(),
+    ));
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "images": [
+            {"uri": format!("data:image/png;base64,{}", base64(&rgba16))},
+            {"uri": format!("data:image/png;base64,{}", base64(&la8))}
+        ]
+    });
+    let p = write("images16.gltf", &serde_json::to_vec(&doc).unwrap());
+    let scene = io::load(&p).unwrap();
+    // 16-bit channels scale by 255/65535, i.e. v/257 exactly for multiples of 257.
+    assert_eq!(scene.textures[0].rgba8, vec![255, 100, 0, 7]);
+    // Grey is replicated into RGB, alpha kept.
+    assert_eq!(scene.textures[1].rgba8, vec![50, 50, 50, 60]);
+}
+
+#[test]
+fn sparse_accessor_without_buffer_view() {
+    // POSITION has no bufferView (all zeros) and a sparse block setting vertices 1 and 2.
+    let mut b = Bin::default();
+    let ids = b.view(&[1u8, 2]);
+    let vals: Vec<u8> = [1.0f32, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    let vals = b.view(&vals);
+    b.align();
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3",
+            "sparse": {"count": 2, "indices": {"bufferView": ids, "componentType": 5121},
+                       "values": {"bufferView": vals}}}],
+        "buffers": [{"byteLength": b.data.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&b.data))}],
+        "bufferViews": b.views,
+    });
+    let p = write("sparse_zero_base.gltf", &serde_json::to_vec(&doc).unwrap());
+    let scene = io::load(&p).unwrap();
+    // Exact: zeros and stored f32 values.
+    assert_eq!(
+        scene.meshes[0].positions,
+        vec![Vec3::ZERO, Vec3::X, Vec3::Y]
+    );
+    assert_eq!(scene.meshes[0].normals, vec![Vec3::Z; 3]);
+}
+
 // ------------------------------------------------------------------------------------------
 // Bad input
 
@@ -641,6 +696,11 @@ fn bad_input_fails_with_the_file_name() {
             "binary glTF",
         ),
         ("wrong_magic.glb", wrong_magic, "no 'glTF' magic"),
+        (
+            "no_bin_chunk.gltf",
+            serde_json::to_vec(&gdoc).unwrap(),
+            "buffer 0: refers to the GLB binary chunk, but the file has none",
+        ),
         (
             "missing_buffer.gltf",
             edited(|d| d["buffers"][0]["uri"] = json!("nowhere.bin")),
