@@ -22,6 +22,9 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
 
 @fragment
 fn fs_main(in: VsOut) -> @location(0) f32 {
+    if dot(view.plane.xyz, in.world) + view.plane.w < 0.0 {
+        discard;
+    }
     if view.kind == SHADOW_ORTHO {
         return dot(in.world - view.origin, view.dir);
     }

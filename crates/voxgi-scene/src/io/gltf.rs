@@ -99,6 +99,8 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
             emissive_texture: m.emissive_texture().map(|i| image_of(i.texture())),
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
+            // KHR_materials_specular is not read: glTF's default specular factor is 1.
+            specular: 1.0,
             alpha_mode: match m.alpha_mode() {
                 gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
                 gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),

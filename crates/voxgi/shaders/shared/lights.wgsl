@@ -57,11 +57,36 @@ fn shadow_texel(view: ShadowView, t: vec2<i32>) -> f32 {
     return textureLoad(shadow_maps, c, i32(view.layer), 0).r;
 }
 
-// Bilinearly weighted depth comparison at one uv: 1 lit, 0 shadowed.
-fn shadow_tap(view: ShadowView, uv: vec2<f32>, dist: f32) -> f32 {
+// The distance a planar receiver (through p, normal n) would have at shadow-map position uv:
+// comparing occluders against this instead of p's own distance stops wide filters from letting
+// a tilted surface shadow itself (receiver-plane depth bias, exact for planes).
+fn receiver_distance(view: ShadowView, uv: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let ndc = vec2<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
+    let a4 = view.inv_view_proj * vec4<f32>(ndc, 0.0, 1.0);
+    let b4 = view.inv_view_proj * vec4<f32>(ndc, 1.0, 1.0);
+    let a = a4.xyz / a4.w;
+    let b = b4.xyz / b4.w;
+    let dir = normalize(b - a);
+    let denom = dot(dir, n);
+    if abs(denom) < 1e-4 {
+        return 3.0e38;
+    }
+    let x = a + dir * (dot(p - a, n) / denom);
+    if view.kind == SHADOW_ORTHO {
+        return dot(x - view.origin, view.dir);
+    }
+    if dot(x - view.origin, dir) < 0.0 {
+        return 3.0e38;
+    }
+    return length(x - view.origin);
+}
+
+// Bilinearly weighted comparison at one uv against the receiver plane: 1 lit, 0 shadowed.
+fn shadow_tap(view: ShadowView, uv: vec2<f32>, p: vec3<f32>, n: vec3<f32>, bias: f32) -> f32 {
     if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
         return 1.0;
     }
+    let dist = receiver_distance(view, uv, p, n) - bias;
     let st = uv * view.resolution - 0.5;
     let i = vec2<i32>(floor(st));
     let f = fract(st);
@@ -84,13 +109,18 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     let view = shadow_views[shadow_view_index(light, p)];
     let d0 = shadow_distance(view, p);
     let texel = shadow_texel_world(view, max(d0, view.near));
-    // Normal offset plus a constant slope allowance: the receiver is pushed off its surface by
-    // a couple of texels so a flat surface never shadows itself.
-    let pb = p + n * texel * 1.5;
-    let dist = shadow_distance(view, pb) - texel * 1.0;
-    let uvw = shadow_uv(view, pb);
-    let uv = uvw.xy;
-    // Size of one texel in uv, and of the requested radius.
+    // Light direction at p, for the slope of the receiver as the light sees it.
+    var to_light = -view.dir;
+    if view.kind != SHADOW_ORTHO {
+        to_light = normalize(view.origin - p);
+    }
+    let cos_t = clamp(abs(dot(n, to_light)), 0.05, 1.0);
+    let tan_t = sqrt(1.0 - cos_t * cos_t) / cos_t;
+    // Within one texel a tilted receiver's distance varies by texel * tan: allow that, plus a
+    // texel for the rasterizer's rounding.
+    let bias = texel * (1.0 + min(tan_t, 8.0));
+    let uv = shadow_uv(view, p).xy;
+    let dist = d0 - bias;
     let texel_uv = 1.0 / view.resolution;
 
     if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
@@ -98,14 +128,14 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
         // blocker/receiver distances, as similar triangles give it.
         let tan_to_uv = 1.0 / (view.texel * view.resolution);
         let half = light.size;
-        let search = clamp(half * tan_to_uv / max(0.25 * dist, view.near), 2.0 * texel_uv, 0.25);
+        let search = clamp(half * tan_to_uv / max(0.25 * d0, view.near), 2.0 * texel_uv, 0.25);
         var blockers = 0.0;
         var blocker_sum = 0.0;
         for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
             let o = uv + vogel(i, PCSS_SEARCH_TAPS) * search;
             let t = vec2<i32>(floor(o * view.resolution));
             let z = shadow_texel(view, t);
-            if z < dist {
+            if z < receiver_distance(view, o, p, n) - bias {
                 blockers += 1.0;
                 blocker_sum += z;
             }
@@ -117,7 +147,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
         let radius = clamp(half * (dist - zb) / (zb * dist) * tan_to_uv, texel_uv, 0.25);
         var lit = 0.0;
         for (var i = 0u; i < PCSS_TAPS; i++) {
-            lit += shadow_tap(view, uv + vogel(i, PCSS_TAPS) * radius, dist);
+            lit += shadow_tap(view, uv + vogel(i, PCSS_TAPS) * radius, p, n, bias);
         }
         return lit / f32(PCSS_TAPS);
     }
@@ -125,7 +155,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     let radius = softness * texel_uv;
     var lit = 0.0;
     for (var i = 0u; i < PCF_TAPS; i++) {
-        lit += shadow_tap(view, uv + vogel(i, PCF_TAPS) * radius, dist);
+        lit += shadow_tap(view, uv + vogel(i, PCF_TAPS) * radius, p, n, bias);
     }
     return lit / f32(PCF_TAPS);
 }

@@ -98,6 +98,7 @@ const SHADOW_PERSPECTIVE: u32 = 1u;
 // perspective ones.
 struct ShadowView {
     view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
     origin: vec3<f32>,
     kind: u32,
     dir: vec3<f32>,
@@ -108,4 +109,7 @@ struct ShadowView {
     far: f32,
     resolution: f32,
     layer: u32,
+    // Geometry behind this plane (dot(plane.xyz, x) + plane.w < 0) casts no shadow: nothing
+    // behind a one-sided emitter can block it. Zero for other lights.
+    plane: vec4<f32>,
 }

@@ -15,6 +15,7 @@ use wgpu::util::DeviceExt;
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuShadowView {
     pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
     pub origin: [f32; 3],
     pub kind: u32,
     pub dir: [f32; 3],
@@ -23,6 +24,7 @@ pub struct GpuShadowView {
     pub far: f32,
     pub resolution: f32,
     pub layer: u32,
+    pub plane: [f32; 4],
 }
 
 const SHADOW_ORTHO: u32 = 0;
@@ -69,6 +71,11 @@ pub fn plan_views(
         let pos = Vec3::from(light.position);
         let dir = Vec3::from(light.direction).normalize();
         let far_from = |o: Vec3| (o - center).length() + radius * 1.01;
+        let plane = if matches!(light.kind, LIGHT_RECT | LIGHT_DISC) {
+            [dir.x, dir.y, dir.z, -dir.dot(pos)]
+        } else {
+            [0.0; 4]
+        };
         let mut push = |view: Mat4,
                         proj: Mat4,
                         origin: Vec3,
@@ -79,6 +86,7 @@ pub fn plan_views(
                         far: f32| {
             views.push(GpuShadowView {
                 view_proj: (proj * view).to_cols_array_2d(),
+                inv_view_proj: (proj * view).inverse().to_cols_array_2d(),
                 origin: origin.to_array(),
                 kind,
                 dir: vdir.to_array(),
@@ -87,6 +95,7 @@ pub fn plan_views(
                 far,
                 resolution: res_f,
                 layer: 0,
+                plane,
             });
             owner.push(li);
         };
