@@ -58,7 +58,7 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<PointCloud, String> {
     let expected = 4 + RECORD_SIZE as u64 * count as u64;
     if bytes.len() as u64 != expected {
         return Err(format!(
-            "size mismatch: {count} samples need {expected} bytes (4 + 27 × {count}), file has {} bytes",
+            "size mismatch: expected {expected} bytes for {count} samples (4 + 27 × {count}), file has {} bytes",
             bytes.len()
         ));
     }

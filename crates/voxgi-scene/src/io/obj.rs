@@ -23,6 +23,9 @@ pub fn load(path: &Path) -> Result<Scene> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
+        // Otherwise tobj turns `l` and `p` elements into degenerate triangles.
+        ignore_lines: true,
+        ignore_points: true,
         ..Default::default()
     };
     let (models, materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &opts, |mtl| {
@@ -242,9 +245,13 @@ fn describe_obj_error(bytes: &[u8], e: tobj::LoadError) -> String {
                             let count = [nv, nt, nn][k.min(2)];
                             let ok = if ix > 0 { ix <= count } else { -ix <= count };
                             if !ok || ix == 0 {
-                                let kind = ["vertex", "texture coordinate", "normal"][k.min(2)];
+                                let (kind, plural) = [
+                                    ("vertex", "vertices"),
+                                    ("texture coordinate", "texture coordinates"),
+                                    ("normal", "normals"),
+                                ][k.min(2)];
                                 return format!(
-                                    "line {}: face {kind} index {ix} out of range ({count} {kind}s defined so far)",
+                                    "line {}: face {kind} index {ix} out of range ({count} {plural} defined before it)",
                                     i + 1
                                 );
                             }
