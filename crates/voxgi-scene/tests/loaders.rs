@@ -412,7 +412,7 @@ fn bad_inputs_fail_with_the_file_name() {
         ("ply not a ply", "text.ply", b"hello\n".to_vec(), "not a PLY"),
         ("ply missing z", "noz.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n".to_vec(), "x, y, z"),
         ("ply list past end", "list.ply", bin_list, "runs past"),
-        ("ply ascii too few values", "short.ply", (ply_head("ascii", "2") + "end_header\n0 0 0\n1 1          \n").into_bytes(), "line 8: too few values"),
+        ("ply ascii too few values", "short.ply", (ply_head("ascii", "2") + "end_header\n0 0 0\n1 1          \n").into_bytes(), "line 9: too few values for vertex 1"),
         ("obj face index out of range", "range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 40\n".to_vec(), "line 4: face vertex index 40 out of range (3 vertices"),
         ("obj no triangles", "points.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\n".to_vec(), "contains no triangles"),
         ("obj empty", "empty.obj", vec![], "contains no triangles"),
