@@ -160,11 +160,12 @@ impl Scene {
         let linear = glam::Mat3::from_mat4(transform);
         let normal_m = linear.inverse().transpose();
         self.textures.extend(other.textures);
-        self.materials.extend(other.materials.into_iter().map(|mut m| {
-            m.base_color_texture = m.base_color_texture.map(|t| t + tex0);
-            m.emissive_texture = m.emissive_texture.map(|t| t + tex0);
-            m
-        }));
+        self.materials
+            .extend(other.materials.into_iter().map(|mut m| {
+                m.base_color_texture = m.base_color_texture.map(|t| t + tex0);
+                m.emissive_texture = m.emissive_texture.map(|t| t + tex0);
+                m
+            }));
         self.meshes.extend(other.meshes.into_iter().map(|mut m| {
             m.material += mat0;
             m
@@ -216,6 +217,7 @@ impl Scene {
     }
 
     /// Checks every index and count the renderer relies on. Loaders call this last.
+    #[allow(clippy::collapsible_match)] // one arm per light kind reads better than match guards
     pub fn validate(&self) -> Result<()> {
         let bad = |msg: String| Err(SceneError::Invalid(msg));
         for (i, m) in self.meshes.iter().enumerate() {

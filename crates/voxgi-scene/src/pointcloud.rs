@@ -86,7 +86,7 @@ pub fn estimate_normals(pc: &mut PointCloud, k: usize, viewpoint: Vec3) {
         }
         let (vals, vecs) = symmetric_eigen3(c);
         // Degenerate: all neighbours on a line or a point; the smallest axis is meaningless.
-        if !(vals[1] > 1e-12 * vals[2].max(f64::MIN_POSITIVE)) {
+        if vals[1].is_nan() || vals[1] <= 1e-12 * vals[2].max(f64::MIN_POSITIVE) {
             return towards;
         }
         let n = DVec3::new(vecs[0][0], vecs[1][0], vecs[2][0])
@@ -152,10 +152,10 @@ pub fn symmetric_eigen3(m: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
                 row[p] = c * akp - s * akq;
                 row[q] = s * akp + c * akq;
             }
+            let (row_p, row_q) = (a[p], a[q]);
             for col in 0..3 {
-                let (apk, aqk) = (a[p][col], a[q][col]);
-                a[p][col] = c * apk - s * aqk;
-                a[q][col] = s * apk + c * aqk;
+                a[p][col] = c * row_p[col] - s * row_q[col];
+                a[q][col] = s * row_p[col] + c * row_q[col];
             }
             for row in v.iter_mut() {
                 let (vkp, vkq) = (row[p], row[q]);
@@ -203,6 +203,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop)] // filling a symmetric matrix by (i, j) is clearest
     fn eigen_solver_on_random_and_special_matrices() {
         let mut r = rng(7);
         for _ in 0..1000 {
@@ -223,7 +224,10 @@ mod tests {
         check_eigen([[1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 1.0, 1.0]]);
         let (vals, vecs) = symmetric_eigen3([[4.0, 0.0, 0.0], [0.0, 9.0, 0.0], [0.0, 0.0, 1.0]]);
         assert_eq!(vals, [1.0, 4.0, 9.0]);
-        assert_eq!([vecs[0][0], vecs[1][0], vecs[2][0]].map(f64::abs), [0.0, 0.0, 1.0]);
+        assert_eq!(
+            [vecs[0][0], vecs[1][0], vecs[2][0]].map(f64::abs),
+            [0.0, 0.0, 1.0]
+        );
     }
 
     fn jittered_plane(n: usize, jitter: f32) -> PointCloud {
@@ -245,7 +249,10 @@ mod tests {
 
     #[test]
     fn normals_of_a_jittered_plane_face_the_viewpoint() {
-        for (view, want) in [(Vec3::new(0.3, 0.2, 5.0), Vec3::Z), (Vec3::new(0.1, 0.1, -2.0), Vec3::NEG_Z)] {
+        for (view, want) in [
+            (Vec3::new(0.3, 0.2, 5.0), Vec3::Z),
+            (Vec3::new(0.1, 0.1, -2.0), Vec3::NEG_Z),
+        ] {
             let mut pc = jittered_plane(60, 0.006);
             estimate_normals(&mut pc, 12, view);
             assert_eq!(pc.normals.len(), pc.positions.len());
@@ -271,7 +278,11 @@ mod tests {
         }
         let want = rot * Vec3::Z;
         estimate_normals(&mut pc, 16, want * 10.0);
-        let mut err: Vec<f32> = pc.normals.iter().map(|n| n.dot(want).clamp(-1.0, 1.0).acos().to_degrees()).collect();
+        let mut err: Vec<f32> = pc
+            .normals
+            .iter()
+            .map(|n| n.dot(want).clamp(-1.0, 1.0).acos().to_degrees())
+            .collect();
         err.sort_by(f32::total_cmp);
         assert!(err[err.len() / 2] < 1.0, "median {}", err[err.len() / 2]);
         assert!(pc.normals.iter().all(|n| n.dot(want) > 0.0));

@@ -38,7 +38,6 @@ fn shared_scenes() -> Option<PathBuf> {
     }
 }
 
-
 #[test]
 fn obj_with_mtl_and_texture() {
     let dir = tmp("obj");
@@ -69,7 +68,11 @@ fn obj_with_mtl_and_texture() {
     let quad = s.meshes.iter().find(|m| m.name == "quad").unwrap();
     assert!(quad.normals.iter().all(|n| *n == Vec3::Z));
     // OBJ v runs up from the bottom; the model's runs down from the top: v' = 1 - v, exact.
-    let i0 = quad.positions.iter().position(|p| *p == Vec3::ZERO).unwrap();
+    let i0 = quad
+        .positions
+        .iter()
+        .position(|p| *p == Vec3::ZERO)
+        .unwrap();
     assert_eq!(quad.uvs[i0], Vec2::new(0.0, 1.0));
     let red = &s.materials[quad.material];
     assert_eq!(red.base_color, [0.5, 0.25, 0.125, 0.5]);
@@ -96,7 +99,11 @@ fn obj_with_mtl_and_texture() {
     let s = io::load(&obj).unwrap();
     assert_eq!(s.triangle_count(), 4);
     assert!(s.lights.is_empty());
-    assert!(s.materials.iter().all(|m| m.base_color == [0.8, 0.8, 0.8, 1.0]));
+    assert!(
+        s.materials
+            .iter()
+            .all(|m| m.base_color == [0.8, 0.8, 0.8, 1.0])
+    );
 }
 
 #[test]
@@ -123,8 +130,15 @@ fn ascii_ply_mesh() {
 }
 
 /// Builds a binary PLY point cloud: double or float xyz, float normals, uchar colours, radius.
-fn binary_cloud(big: bool, double: bool, pts: &[([f64; 3], [f32; 3], [u8; 3], f32)]) -> Vec<u8> {
-    let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+/// One test point: position, normal, sRGB colour, radius.
+type TestPoint = ([f64; 3], [f32; 3], [u8; 3], f32);
+
+fn binary_cloud(big: bool, double: bool, pts: &[TestPoint]) -> Vec<u8> {
+    let fmt = if big {
+        "binary_big_endian"
+    } else {
+        "binary_little_endian"
+    };
     let pt = if double { "double" } else { "float" };
     let mut out = format!(
         "ply\nformat {fmt} 1.0\nelement vertex {}\nproperty {pt} x\nproperty {pt} y\nproperty {pt} z\n\
@@ -133,11 +147,21 @@ fn binary_cloud(big: bool, double: bool, pts: &[([f64; 3], [f32; 3], [u8; 3], f3
         pts.len()
     )
     .into_bytes();
-    let f32b = |v: f32| if big { v.to_be_bytes() } else { v.to_le_bytes() };
+    let f32b = |v: f32| {
+        if big {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        }
+    };
     for (p, n, c, r) in pts {
         for v in p {
             if double {
-                out.extend(if big { v.to_be_bytes() } else { v.to_le_bytes() });
+                out.extend(if big {
+                    v.to_be_bytes()
+                } else {
+                    v.to_le_bytes()
+                });
             } else {
                 out.extend(f32b(*v as f32));
             }
@@ -168,8 +192,14 @@ fn binary_ply_point_clouds_le_and_be() {
         assert_eq!(pc.positions.len(), 3);
         for (i, (pos, n, c, r)) in pts.iter().enumerate() {
             // All values are exactly representable in f32: exact equality.
-            assert_eq!(pc.positions[i], Vec3::new(pos[0] as f32, pos[1] as f32, pos[2] as f32));
-            assert!(close(pc.normals[i], Vec3::from(*n).normalize()), "{name} {i}");
+            assert_eq!(
+                pc.positions[i],
+                Vec3::new(pos[0] as f32, pos[1] as f32, pos[2] as f32)
+            );
+            assert!(
+                close(pc.normals[i], Vec3::from(*n).normalize()),
+                "{name} {i}"
+            );
             assert_eq!(pc.colors[i], c.map(|c| srgb_to_linear(c as f32 / 255.0)));
             assert_eq!(pc.radii[i], *r);
         }
@@ -189,7 +219,10 @@ fn binary_ply_point_clouds_le_and_be() {
         "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
          property float diffuse_red\nproperty float diffuse_green\nproperty float diffuse_blue\nend_header\n0 0 0 0.25 0.5 1\n",
     );
-    assert_eq!(io::load(&p).unwrap().point_clouds[0].colors, vec![[0.25, 0.5, 1.0]]);
+    assert_eq!(
+        io::load(&p).unwrap().point_clouds[0].colors,
+        vec![[0.25, 0.5, 1.0]]
+    );
 }
 
 #[test]
@@ -329,7 +362,11 @@ debug = { cones = 6 }
     let n0 = cb.lights.len();
     assert_eq!(s.lights.len(), n0 + 5);
     assert_eq!(s.instances.len(), 1 + cb.instances.len() + 2);
-    assert!(s.instances[1..=cb.instances.len()].iter().all(|i| !i.dynamic));
+    assert!(
+        s.instances[1..=cb.instances.len()]
+            .iter()
+            .all(|i| !i.dynamic)
+    );
     let l = &s.lights[n0..];
     assert_eq!(l[0].kind, LightKind::Directional);
     assert!(close(l[0].direction, Vec3::NEG_Y));
@@ -337,38 +374,80 @@ debug = { cones = 6 }
     assert_eq!(l[1].name, "bulb");
     assert_eq!(l[1].radiometric(), Vec3::new(10.0, 5.0, 2.5));
     assert_eq!(l[1].range, Some(8.0));
-    let LightKind::Spot { inner_angle, outer_angle } = l[2].kind else { panic!("{:?}", l[2].kind) };
+    let LightKind::Spot {
+        inner_angle,
+        outer_angle,
+    } = l[2].kind
+    else {
+        panic!("{:?}", l[2].kind)
+    };
     assert!((inner_angle - 20f32.to_radians()).abs() < 1e-6);
     assert!((outer_angle - 30f32.to_radians()).abs() < 1e-6);
     assert!(!l[2].cast_shadows);
     assert!(close(l[2].direction, Vec3::NEG_Y));
-    let LightKind::Area { shape: AreaShape::Rect { u, v } } = l[3].kind else { panic!() };
+    let LightKind::Area {
+        shape: AreaShape::Rect { u, v },
+    } = l[3].kind
+    else {
+        panic!()
+    };
     assert!((l[3].area() - 0.2).abs() < 1e-6);
-    assert!(u.cross(v).dot(Vec3::NEG_Y) > 0.0, "rect must face its direction");
-    assert!(matches!(l[4].kind, LightKind::Area { shape: AreaShape::Disc { radius } } if radius == 0.25));
+    assert!(
+        u.cross(v).dot(Vec3::NEG_Y) > 0.0,
+        "rect must face its direction"
+    );
+    assert!(
+        matches!(l[4].kind, LightKind::Area { shape: AreaShape::Disc { radius } } if radius == 0.25)
+    );
     assert!(close(l[4].direction, Vec3::NEG_Z));
     // Each area light got its emitter instance.
-    let emitters: Vec<_> = s.instances.iter().filter_map(|i| i.light).filter(|&li| li >= n0).collect();
+    let emitters: Vec<_> = s
+        .instances
+        .iter()
+        .filter_map(|i| i.light)
+        .filter(|&li| li >= n0)
+        .collect();
     assert_eq!(emitters, vec![n0 + 3, n0 + 4]);
 
     // The file's camera wins; the included one follows, moved by its include's transform.
     assert_eq!(s.cameras[0].position, Vec3::new(0.0, 1.0, 4.0));
-    assert_eq!(s.cameras[0].projection, Projection::Perspective { yfov: 50f32.to_radians() });
-    let sub_cam = s.cameras.iter().find(|c| c.projection == Projection::Perspective { yfov: 30f32.to_radians() }).unwrap();
+    assert_eq!(
+        s.cameras[0].projection,
+        Projection::Perspective {
+            yfov: 50f32.to_radians()
+        }
+    );
+    let sub_cam = s
+        .cameras
+        .iter()
+        .find(|c| {
+            c.projection
+                == Projection::Perspective {
+                    yfov: 30f32.to_radians(),
+                }
+        })
+        .unwrap();
     assert!(close(sub_cam.position, Vec3::new(0.0, 0.0, 8.0)));
     assert!(close(sub_cam.forward, Vec3::NEG_Z));
 
     // Without its own camera the first included camera is the default view.
     let nocam = write(&dir, "nocam.toml", "[[include]]\nfile = \"sub/box.toml\"\n");
     let s = io::load(&nocam).unwrap();
-    assert_eq!(s.cameras[0].projection, Projection::Perspective { yfov: 30f32.to_radians() });
+    assert_eq!(
+        s.cameras[0].projection,
+        Projection::Perspective {
+            yfov: 30f32.to_radians()
+        }
+    );
 }
 
 #[test]
 fn bad_inputs_fail_with_the_file_name() {
     let dir = tmp("bad");
     let ply_head = |fmt: &str, n: &str| {
-        format!("ply\nformat {fmt} 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\n")
+        format!(
+            "ply\nformat {fmt} 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\n"
+        )
     };
     let tri_ply = |face: &str| {
         format!(
@@ -444,7 +523,11 @@ fn bad_inputs_fail_with_the_file_name() {
         .iter()
         .map(|(case, name, bytes, frag)| (*case, write(&dir, name, bytes), *frag))
         .collect();
-    rows.push(("nonexistent path", dir.join("does_not_exist.ply"), "no such file"));
+    rows.push((
+        "nonexistent path",
+        dir.join("does_not_exist.ply"),
+        "no such file",
+    ));
     rows.push(("directory path", dir.join("folder.obj"), ""));
     assert!(rows.len() >= 24);
     let mut failures = Vec::new();
@@ -477,7 +560,10 @@ fn emissive_non_quad_stays_geometry() {
     );
     let s = io::load(&p).unwrap();
     assert!(s.lights.is_empty());
-    assert!(!s.is_unlit(), "the emissive geometry still lights the scene");
+    assert!(
+        !s.is_unlit(),
+        "the emissive geometry still lights the scene"
+    );
 }
 
 #[test]
@@ -501,7 +587,12 @@ fn conformance_with_real_files() {
     let dm = &dragon.meshes[0];
     let computed = voxgi_scene::compute_normals(&dm.positions, &dm.indices);
     assert!(dm.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
-    assert!(dm.normals.iter().zip(&computed).any(|(a, b)| a.dot(*b) < 0.999));
+    assert!(
+        dm.normals
+            .iter()
+            .zip(&computed)
+            .any(|(a, b)| a.dot(*b) < 0.999)
+    );
     let mut office = load("pointcloud_pcl_office1/office1_xyzrgb.ply");
     assert_eq!(office.point_count(), 254_456);
     let pc = &mut office.point_clouds[0];
@@ -516,7 +607,12 @@ fn conformance_with_real_files() {
     println!("office cloud: normals (k=16) {t_normals:.2?}, radii (k=8) {t_radii:.2?}");
     assert_eq!(pc.normals.len(), 254_456);
     assert!(pc.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
-    assert!(pc.normals.iter().zip(&pc.positions).all(|(n, p)| n.dot(-*p) >= 0.0));
+    assert!(
+        pc.normals
+            .iter()
+            .zip(&pc.positions)
+            .all(|(n, p)| n.dot(-*p) >= 0.0)
+    );
     assert!(pc.radii.iter().all(|r| r.is_finite() && *r >= 0.0));
     // The brief's budget is 2 s for 254k points in release; debug builds are ~10x slower.
     if !cfg!(debug_assertions) {
@@ -529,14 +625,29 @@ fn conformance_with_real_files() {
     // Exact: Ke 17 12 4 is copied, intensity 1.
     assert_eq!(l.radiometric(), Vec3::new(17.0, 12.0, 4.0));
     // Float noise only: the light's four vertices lie exactly at y = 1.98.
-    assert!((l.direction - Vec3::NEG_Y).length() < 1e-5, "{}", l.direction);
+    assert!(
+        (l.direction - Vec3::NEG_Y).length() < 1e-5,
+        "{}",
+        l.direction
+    );
     // 0.47 m x 0.38 m from the file's corner coordinates; 1e-4 for f32 rounding.
     assert!((l.area() - 0.47 * 0.38).abs() < 1e-4, "{}", l.area());
-    let n_light_instances = mcguire.instances.iter().filter(|i| i.light.is_some()).count();
+    let n_light_instances = mcguire
+        .instances
+        .iter()
+        .filter(|i| i.light.is_some())
+        .count();
     assert_eq!(n_light_instances, 1);
 
     for m in [
-        "back", "ceiling", "floor", "greenwall", "largebox", "luminaire", "redwall", "smallbox",
+        "back",
+        "ceiling",
+        "floor",
+        "greenwall",
+        "largebox",
+        "luminaire",
+        "redwall",
+        "smallbox",
     ] {
         let s = load(&format!("cornell_box_mitsuba/meshes/cbox_{m}.obj"));
         assert!(s.triangle_count() >= 2, "{m}");

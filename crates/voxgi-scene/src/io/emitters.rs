@@ -82,7 +82,7 @@ pub struct Parallelogram {
 /// `corners` holds three points per triangle (world space). Returns the parallelogram the
 /// triangles cover exactly, or `None`.
 pub fn parallelogram(tri_points: &[Vec3]) -> Option<Parallelogram> {
-    if tri_points.len() < 6 || tri_points.len() % 3 != 0 {
+    if tri_points.len() < 6 || !tri_points.len().is_multiple_of(3) {
         return None;
     }
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
@@ -191,7 +191,11 @@ mod tests {
         let l = &s.lights[0];
         assert!((l.direction - Vec3::NEG_Y).length() < 1e-6);
         assert!((l.position - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-6);
-        assert!((l.area() - 0.5).abs() < 1e-6, "1 m x 0.5 m, area {}", l.area());
+        assert!(
+            (l.area() - 0.5).abs() < 1e-6,
+            "1 m x 0.5 m, area {}",
+            l.area()
+        );
         assert_eq!(l.color, [17.0, 12.0, 4.0]);
         assert!(s.validate().is_ok());
     }

@@ -26,7 +26,6 @@ pub fn load(path: &Path) -> Result<Scene> {
         // Otherwise tobj turns `l` and `p` elements into degenerate triangles.
         ignore_lines: true,
         ignore_points: true,
-        ..Default::default()
     };
     let (models, materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &opts, |mtl| {
         let p = dir.join(mtl);
@@ -73,7 +72,10 @@ pub fn load(path: &Path) -> Result<Scene> {
         if n > limits::MAX_ELEMENTS {
             return Err(SceneError::load(
                 path,
-                format!("object '{}' has {n} vertices, more than the limit", model.name),
+                format!(
+                    "object '{}' has {n} vertices, more than the limit",
+                    model.name
+                ),
             ));
         }
         let positions: Vec<Vec3> = m
@@ -179,16 +181,18 @@ fn convert_material(
         if !p.is_file() && obj_dir.join(&file).is_file() {
             p = obj_dir.join(&file);
         }
-        *cache.entry(p.clone()).or_insert_with(|| match load_texture(&p) {
-            Ok(t) => {
-                textures.push(t);
-                Some(textures.len() - 1)
-            }
-            Err(e) => {
-                log::warn!("texture {} not loaded: {e}", p.display());
-                None
-            }
-        })
+        *cache
+            .entry(p.clone())
+            .or_insert_with(|| match load_texture(&p) {
+                Ok(t) => {
+                    textures.push(t);
+                    Some(textures.len() - 1)
+                }
+                Err(e) => {
+                    log::warn!("texture {} not loaded: {e}", p.display());
+                    None
+                }
+            })
     };
     if let Some(t) = &m.diffuse_texture {
         mat.base_color_texture = texture(t);

@@ -155,9 +155,9 @@ fn parse_header(bytes: &[u8]) -> std::result::Result<Header, String> {
                 });
             }
             Some("property") => {
-                let el = elements.last_mut().ok_or_else(|| {
-                    format!("header line {line_no}: property before any element")
-                })?;
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| format!("header line {line_no}: property before any element"))?;
                 let prop = match words[..] {
                     [_, "list", ct, it, name] => Property {
                         name: name.into(),
@@ -275,9 +275,7 @@ impl<'a> Body<'a> {
                     .parse()
                     .map_err(|_| format!("line {line}: '{tok}' is not a number ({what})"))?;
                 if !ty.is_float() && v.fract() != 0.0 {
-                    return Err(format!(
-                        "line {line}: '{tok}' is not an integer ({what})"
-                    ));
+                    return Err(format!("line {line}: '{tok}' is not an integer ({what})"));
                 }
                 Ok(v)
             }
@@ -437,7 +435,11 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
                         if !fits {
                             return Err(format!(
                                 "{what}: list of {n} entries runs past the end of the {}",
-                                if h.format == Format::Ascii { "line" } else { "file" }
+                                if h.format == Format::Ascii {
+                                    "line"
+                                } else {
+                                    "file"
+                                }
                             ));
                         }
                         let keep = Some(pi) == face_prop;
@@ -501,7 +503,11 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
                     }
                 }
                 for k in 1..list.len() - 1 {
-                    indices.extend_from_slice(&[list[0] as u32, list[k] as u32, list[k + 1] as u32]);
+                    indices.extend_from_slice(&[
+                        list[0] as u32,
+                        list[k] as u32,
+                        list[k + 1] as u32,
+                    ]);
                 }
                 face_count += 1;
             }
@@ -554,7 +560,11 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
         scene.point_clouds.push(PointCloud {
             name: name.into(),
             positions,
-            colors: if has_colors { colors } else { vec![[0.8; 3]; n] },
+            colors: if has_colors {
+                colors
+            } else {
+                vec![[0.8; 3]; n]
+            },
             normals,
             radii,
             emission: Vec::new(),

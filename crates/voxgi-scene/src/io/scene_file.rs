@@ -227,8 +227,9 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     for (i, inc) in file.include.iter().enumerate() {
         let what = format!("include {}", i + 1);
         let mut sub = match (&inc.file, &inc.builtin) {
-            (Some(f), None) => crate::io::load(&dir.join(f))
-                .map_err(|e| err(format!("{what} ('{f}'): {e}")))?,
+            (Some(f), None) => {
+                crate::io::load(&dir.join(f)).map_err(|e| err(format!("{what} ('{f}'): {e}")))?
+            }
             (None, Some(b)) => {
                 crate::builtin::by_name(b).map_err(|e| err(format!("{what}: {e}")))?
             }
@@ -248,8 +249,7 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         };
         let t = Vec3::from(inc.translate);
         let r = Vec3::from(inc.rotate);
-        if !(scale.is_finite() && scale.cmpne(Vec3::ZERO).all() && t.is_finite() && r.is_finite())
-        {
+        if !(scale.is_finite() && scale.cmpne(Vec3::ZERO).all() && t.is_finite() && r.is_finite()) {
             return Err(err(format!(
                 "{what}: translate, rotate and scale must be finite and scale non-zero"
             )));
@@ -280,21 +280,26 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     if let Some(c) = &file.camera {
         let (p, t) = (Vec3::from(c.position), Vec3::from(c.target));
         if !(p.is_finite() && t.is_finite()) || p.distance(t) <= 0.0 {
-            return Err(err("camera: position and target must be finite and differ".into()));
+            return Err(err(
+                "camera: position and target must be finite and differ".into()
+            ));
         }
         if !(c.fov > 0.0 && c.fov < 180.0) {
-            return Err(err(format!("camera: fov {} is not in (0, 180) degrees", c.fov)));
+            return Err(err(format!(
+                "camera: fov {} is not in (0, 180) degrees",
+                c.fov
+            )));
         }
         let mut cam = Camera::look_at(p, t, c.fov);
         cam.name = "scene file camera".into();
         if let Some(zn) = c.znear {
-            if !(zn > 0.0) {
+            if zn.is_nan() || zn <= 0.0 {
                 return Err(err(format!("camera: znear {zn} must be > 0")));
             }
             cam.znear = zn;
         }
         if let Some(zf) = c.zfar {
-            if !(zf > cam.znear) {
+            if zf.is_nan() || zf <= cam.znear {
                 return Err(err(format!("camera: zfar {zf} must exceed znear")));
             }
             cam.zfar = Some(zf);
