@@ -127,6 +127,16 @@ fn ascii_ply_mesh() {
     // Vertex 2 only touches the quad, whose CCW normal is +Z.
     assert!(close(m.normals[2], Vec3::Z));
     assert!(s.point_clouds.is_empty());
+    assert_eq!(s.instances.len(), 1);
+
+    // The `vertex_index` spelling, and a float index list, are read the same way.
+    let text = std::fs::read_to_string(&p).unwrap();
+    let alt = text.replace(
+        "list uchar int vertex_indices",
+        "list uchar float vertex_index",
+    );
+    let p2 = write(&dir, "quad_alt.ply", alt);
+    assert_eq!(io::load(&p2).unwrap().meshes[0].indices, m.indices);
 }
 
 /// Builds a binary PLY point cloud: double or float xyz, float normals, uchar colours, radius.
@@ -564,6 +574,103 @@ fn emissive_non_quad_stays_geometry() {
         !s.is_unlit(),
         "the emissive geometry still lights the scene"
     );
+}
+
+/// Every prefix of a valid file, and the file with single bytes changed, must load or fail
+/// cleanly: never panic, never allocate from a corrupt count. Cheap stand-in for fuzzing.
+#[test]
+fn truncated_and_corrupted_files_never_panic() {
+    let dir = tmp("fuzz");
+    let pts: Vec<TestPoint> = (0..4)
+        .map(|i| ([i as f64, 1.0, 2.0], [0.0, 1.0, 0.0], [1, 2, 3], 0.1))
+        .collect();
+    let mut mesh_bin = b"ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n".to_vec();
+    for v in [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        mesh_bin.extend(v.to_be_bytes());
+    }
+    mesh_bin.push(3);
+    for i in [0u32, 1, 2] {
+        mesh_bin.extend(i.to_be_bytes());
+    }
+    let mut cloud = 2i32.to_le_bytes().to_vec();
+    for _ in 0..2 {
+        for v in [1f32, 2.0, 3.0, 0.0, 1.0, 0.0] {
+            cloud.extend(v.to_le_bytes());
+        }
+        cloud.extend([9u8, 8, 7]);
+    }
+    let files: Vec<(&str, Vec<u8>)> = vec![
+        ("f.ply", binary_cloud(false, false, &pts)),
+        ("f.ply", binary_cloud(true, true, &pts)),
+        ("f.ply", mesh_bin),
+        ("f.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec()),
+        ("f.cloud", cloud),
+        ("f.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n".to_vec()),
+    ];
+    let mut tried = 0;
+    for (fi, (ext, bytes)) in files.iter().enumerate() {
+        assert!(
+            io::load(&write(&dir, ext, bytes)).is_ok(),
+            "file {fi} must be valid"
+        );
+        let mut variants: Vec<Vec<u8>> = (0..bytes.len()).map(|n| bytes[..n].to_vec()).collect();
+        for i in 0..bytes.len() {
+            for x in [0x00u8, 0xff, b'9', b' ', b'\n'] {
+                let mut b = bytes.clone();
+                b[i] = x;
+                variants.push(b);
+            }
+        }
+        for (vi, v) in variants.iter().enumerate() {
+            let p = write(&dir, ext, v);
+            let r = std::panic::catch_unwind(|| io::load(&p).map(|s| s.validate()));
+            assert!(r.is_ok(), "file {fi} variant {vi} panicked: {v:?}");
+            tried += 1;
+        }
+    }
+    assert!(tried > 1000);
+}
+
+#[test]
+fn append_remaps_indices_and_transforms_lights() {
+    let mut s = builtin::cornell_box();
+    let one = s.clone();
+    let t = Mat4::from_translation(Vec3::new(10.0, 0.0, 0.0))
+        * Mat4::from_scale(Vec3::new(2.0, 1.0, 3.0));
+    s.append(one.clone(), t, true);
+    s.validate().unwrap();
+    assert_eq!(s.meshes.len(), 2 * one.meshes.len());
+    assert_eq!(s.lights.len(), 2 * one.lights.len());
+    for (a, b) in one
+        .instances
+        .iter()
+        .zip(&s.instances[one.instances.len()..])
+    {
+        assert_eq!(b.mesh, a.mesh + one.meshes.len());
+        assert_eq!(b.light, a.light.map(|l| l + one.lights.len()));
+        assert_eq!(
+            s.meshes[b.mesh].material,
+            s.meshes[a.mesh].material + one.materials.len()
+        );
+        assert!(b.dynamic);
+        assert_eq!(b.transform, t * a.transform);
+    }
+    for (a, b) in one.lights.iter().zip(&s.lights[one.lights.len()..]) {
+        assert!(close(b.position, t.transform_point3(a.position)));
+        if let LightKind::Area {
+            shape: AreaShape::Rect { u, v },
+        } = b.kind
+        {
+            // Under non-uniform scale the emitting normal must stay perpendicular to the edges
+            // (inverse transpose), and keep its side.
+            assert!(u.dot(b.direction).abs() < 1e-5 && v.dot(b.direction).abs() < 1e-5);
+            assert!(b.direction.dot(a.direction) > 0.0);
+            // Area scales with the x and z factors for a light in the y = const plane: 2 x 3.
+            if a.direction.y.abs() > 0.999 {
+                assert!((b.area() - 6.0 * a.area()).abs() < 1e-5 * b.area());
+            }
+        }
+    }
 }
 
 #[test]

@@ -496,7 +496,8 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
                     continue;
                 }
                 for &v in &list {
-                    if v < 0.0 || v >= nv as f64 {
+                    // Written so that NaN (possible with float index lists) is rejected too.
+                    if !(v >= 0.0 && v < nv as f64) {
                         return Err(format!(
                             "face {r}: vertex index {v} out of range ({nv} vertices)"
                         ));
