@@ -655,6 +655,7 @@ fn append_remaps_indices_and_transforms_lights() {
         assert!(b.dynamic);
         assert_eq!(b.transform, t * a.transform);
     }
+    let mut checked_rects = 0;
     for (a, b) in one.lights.iter().zip(&s.lights[one.lights.len()..]) {
         assert!(close(b.position, t.transform_point3(a.position)));
         if let LightKind::Area {
@@ -668,9 +669,14 @@ fn append_remaps_indices_and_transforms_lights() {
             // Area scales with the x and z factors for a light in the y = const plane: 2 x 3.
             if a.direction.y.abs() > 0.999 {
                 assert!((b.area() - 6.0 * a.area()).abs() < 1e-5 * b.area());
+                checked_rects += 1;
             }
         }
     }
+    assert!(
+        checked_rects > 0,
+        "the built-in box has a ceiling rect light"
+    );
 }
 
 #[test]
@@ -679,7 +685,8 @@ fn conformance_with_real_files() {
     let load = |rel: &str| {
         let t = std::time::Instant::now();
         let s = io::load(&root.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
-        println!("{rel}: {:.2?}", t.elapsed());
+        let b = s.bounds();
+        println!("{rel}: {:.2?}, bounds {} .. {}", t.elapsed(), b.min, b.max);
         s
     };
     // Triangle and point counts are exact: these are published numbers for the files.

@@ -415,6 +415,10 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
         if el.name == "face" && face_prop.is_none() && el.count > 0 {
             return Err("face element has no 'vertex_indices' list".into());
         }
+        if el.props.is_empty() {
+            // Nothing to read; do not spin through a (possibly huge) declared count.
+            continue;
+        }
         for r in 0..el.count {
             let what = format!("{} {r}", el.name);
             body.begin_record(&what)?;
