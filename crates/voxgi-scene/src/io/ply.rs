@@ -1,10 +1,12 @@
 //! PLY (Stanford polygon format), ASCII and binary little/big endian.
 //!
-//! This is a small parser of our own rather than `ply-rs-bw`: we must reject element counts that
-//! cannot fit the file *before* allocating anything (a header may claim 2^40 vertices), and we
-//! want error messages with line numbers and element indices. Both are easier to guarantee in
-//! ~300 lines we control than through the crate's generic property maps, which also allocate a
-//! hash map per vertex.
+//! This is a small parser of our own rather than `ply-rs-bw`. That crate caps its
+//! preallocation, but it builds a key-value map per vertex by default (slow and memory-hungry
+//! for 254k-point clouds unless one implements its `PropertyAccess` traits per element type),
+//! its errors carry no line or element numbers, and it has no notion of checking declared counts
+//! against the file size. Here every count is checked against the bytes that remain before
+//! anything is allocated (a header may claim 2^40 vertices), list lengths are bounded by the
+//! bytes or tokens left, and messages name the line (ASCII) or element index.
 //!
 //! Read: `vertex` element with `x y z` (float or double), optional `nx ny nz`, optional colour
 //! `red green blue` or `diffuse_red ...` (integer types are sRGB-encoded and scaled by the type's
