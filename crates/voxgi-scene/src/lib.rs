@@ -8,6 +8,7 @@ pub mod builtin;
 mod error;
 pub mod io;
 mod model;
+pub mod pointcloud;
 mod util;
 
 pub use error::SceneError;
@@ -142,7 +143,81 @@ impl Scene {
         li
     }
 
+    /// Moves `other` into this scene, placed by `transform` (object to world), remapping its
+    /// mesh, material, texture and light indices. Positions transform as points; spot and
+    /// directional light directions and area-light edge vectors transform as vectors (the
+    /// linear part); an area light's emitting normal uses the inverse transpose so it stays
+    /// perpendicular to its edges under non-uniform scale. Disc radii scale by the square root
+    /// of the area change (a non-uniformly scaled disc is an ellipse; we keep its area).
+    /// `dynamic` marks all of `other`'s instances and point clouds dynamic.
+    pub fn append(&mut self, other: Scene, transform: Mat4, dynamic: bool) {
+        let (mesh0, mat0, tex0, light0) = (
+            self.meshes.len(),
+            self.materials.len(),
+            self.textures.len(),
+            self.lights.len(),
+        );
+        let linear = glam::Mat3::from_mat4(transform);
+        let normal_m = linear.inverse().transpose();
+        self.textures.extend(other.textures);
+        self.materials
+            .extend(other.materials.into_iter().map(|mut m| {
+                m.base_color_texture = m.base_color_texture.map(|t| t + tex0);
+                m.emissive_texture = m.emissive_texture.map(|t| t + tex0);
+                m
+            }));
+        self.meshes.extend(other.meshes.into_iter().map(|mut m| {
+            m.material += mat0;
+            m
+        }));
+        self.instances
+            .extend(other.instances.into_iter().map(|mut i| {
+                i.mesh += mesh0;
+                i.light = i.light.map(|l| l + light0);
+                i.transform = transform * i.transform;
+                i.dynamic |= dynamic;
+                i
+            }));
+        self.point_clouds
+            .extend(other.point_clouds.into_iter().map(|mut p| {
+                p.transform = transform * p.transform;
+                p.dynamic |= dynamic;
+                p
+            }));
+        self.lights.extend(other.lights.into_iter().map(|mut l| {
+            l.position = transform.transform_point3(l.position);
+            let old_dir = l.direction;
+            l.direction = match l.kind {
+                LightKind::Area { .. } => (normal_m * l.direction).normalize_or(l.direction),
+                _ => (linear * l.direction).normalize_or(l.direction),
+            };
+            if let LightKind::Area { shape } = &mut l.kind {
+                match shape {
+                    AreaShape::Rect { u, v } => {
+                        *u = linear * *u;
+                        *v = linear * *v;
+                    }
+                    AreaShape::Disc { radius } => {
+                        let (t, b) = old_dir.any_orthonormal_pair();
+                        let scale = (linear * t).cross(linear * b).length().sqrt();
+                        *radius *= scale;
+                    }
+                }
+            }
+            l
+        }));
+        self.cameras.extend(other.cameras.into_iter().map(|mut c| {
+            c.position = transform.transform_point3(c.position);
+            c.forward = (linear * c.forward).normalize_or(c.forward);
+            let up = (linear * c.up).normalize_or(c.up);
+            let right = c.forward.cross(up).normalize_or(Vec3::X);
+            c.up = right.cross(c.forward).normalize_or(Vec3::Y);
+            c
+        }));
+    }
+
     /// Checks every index and count the renderer relies on. Loaders call this last.
+    #[allow(clippy::collapsible_match)] // one arm per light kind reads better than match guards
     pub fn validate(&self) -> Result<()> {
         let bad = |msg: String| Err(SceneError::Invalid(msg));
         for (i, m) in self.meshes.iter().enumerate() {

@@ -1,6 +1,7 @@
 //! File loaders. [`load`] picks one by extension; each returns a validated [`Scene`].
 
 pub mod cloud;
+pub mod emitters;
 pub mod gltf;
 pub mod obj;
 pub mod ply;
@@ -24,8 +25,16 @@ pub fn load(path: &Path) -> Result<Scene> {
     }
     let scene = match ext.as_str() {
         "gltf" | "glb" => gltf::load(path)?,
-        "obj" => obj::load(path)?,
-        "ply" => ply::load(path)?,
+        "obj" => {
+            let mut s = obj::load(path)?;
+            emitters::promote_emissive_quads(&mut s);
+            s
+        }
+        "ply" => {
+            let mut s = ply::load(path)?;
+            emitters::promote_emissive_quads(&mut s);
+            s
+        }
         "cloud" => cloud::load(path)?,
         "toml" => scene_file::load(path)?,
         _ => {

@@ -1,6 +1,469 @@
-use crate::{Result, Scene, SceneError};
-use std::path::Path;
+//! Scene files: TOML that assembles other files, adds lights and a camera, and carries renderer
+//! settings.
+//!
+//! Every table rejects unknown keys, so a typo is an error naming the key. Full example:
+//!
+//! ```toml
+//! name = "sponza at noon"          # optional; default: the file stem
+//!
+//! [[include]]                      # any number, applied in order
+//! file = "../scenes/sponza.obj"    # relative to this file; any format voxgi reads, also .toml
+//! # builtin = "cornell-box"        # instead of `file`: a built-in scene (exactly one of the two)
+//! translate = [0.0, 0.0, 0.0]      # metres (default 0)
+//! rotate = [0.0, 90.0, 0.0]        # degrees about X, then Y, then Z (default 0)
+//! scale = 0.01                     # number or [x, y, z], non-zero (default 1)
+//! dynamic = false                  # the included instances may move (default false)
+//! [include.material]               # optional; overrides every material of this include
+//! base_color = [0.8, 0.8, 0.8]     # linear RGB; also drops the base-colour texture
+//! emissive = [0.0, 0.0, 0.0]       # linear radiance; also drops the emissive texture
+//! roughness = 0.5
+//! metallic = 0.0
+//!
+//! [[light]]
+//! type = "spot"                    # "directional" | "point" | "spot" | "area"
+//! name = "key"                     # optional
+//! color = [1.0, 1.0, 1.0]          # linear RGB (default white)
+//! intensity = 10.0                 # required, >= 0; units as in `LightKind`
+//! position = [0.0, 3.0, 0.0]       # required except for directional lights
+//! target = [0.0, 0.0, 0.0]         # or direction = [0.0, -1.0, 0.0] (not both)
+//! inner_angle = 20.0               # spot: half-angles from the axis in degrees,
+//! outer_angle = 30.0               #   0 <= inner <= outer <= 90 (defaults 0 and 45)
+//! range = 20.0                     # point/spot: optional cut-off distance in metres
+//! cast_shadows = true              # default true
+//!
+//! [[light]]
+//! type = "area"                    # one-sided, emits towards `direction` / `target`
+//! intensity = 5.0                  # radiance
+//! position = [0.0, 1.98, 0.0]
+//! direction = [0.0, -1.0, 0.0]
+//! shape = "rect"                   # "rect" with size = [w, h] in metres, or "disc" with radius
+//! size = [0.5, 0.4]                # w runs along the horizontal tangent (X when facing ±Y)
+//!
+//! [[light]]
+//! type = "directional"
+//! intensity = 3.0                  # irradiance
+//! direction = [-0.4, -1.0, -0.3]   # or position + target
+//!
+//! [camera]                         # optional; wins over cameras of included files
+//! position = [0.0, 1.0, 3.5]
+//! target = [0.0, 1.0, 0.0]
+//! fov = 45.0                       # vertical, degrees (default 45)
+//! znear = 0.01                     # optional
+//! zfar = 100.0                     # optional
+//!
+//! [settings]                       # anything; handed to the renderer untouched
+//! voxel_resolution = 256
+//! ```
+//!
+//! Included scenes keep their own lights and cameras; without a `[camera]` the first included
+//! camera is the default view. Include cycles are reported as errors.
+
+use crate::{AreaShape, Camera, Light, LightKind, Result, Scene, SceneError};
+use glam::{Mat4, Vec3};
+use serde::Deserialize;
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    name: Option<String>,
+    #[serde(default)]
+    include: Vec<Include>,
+    #[serde(default)]
+    light: Vec<LightDef>,
+    camera: Option<CameraDef>,
+    settings: Option<toml::Table>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct Include {
+    file: Option<String>,
+    builtin: Option<String>,
+    #[serde(default)]
+    translate: [f32; 3],
+    #[serde(default)]
+    rotate: [f32; 3],
+    scale: Option<Scale>,
+    #[serde(default)]
+    dynamic: bool,
+    material: Option<MaterialOverride>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy)]
+#[serde(untagged)]
+enum Scale {
+    Uniform(f32),
+    Axes([f32; 3]),
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct MaterialOverride {
+    base_color: Option<[f32; 3]>,
+    emissive: Option<[f32; 3]>,
+    roughness: Option<f32>,
+    metallic: Option<f32>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "lowercase")]
+enum LightType {
+    Directional,
+    Point,
+    Spot,
+    Area,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "lowercase")]
+enum ShapeType {
+    Rect,
+    Disc,
+}
+
+fn default_white() -> [f32; 3] {
+    [1.0; 3]
+}
+fn default_true() -> bool {
+    true
+}
+fn default_fov() -> f32 {
+    45.0
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct LightDef {
+    #[serde(rename = "type")]
+    kind: LightType,
+    name: Option<String>,
+    #[serde(default = "default_white")]
+    color: [f32; 3],
+    intensity: f32,
+    position: Option<[f32; 3]>,
+    target: Option<[f32; 3]>,
+    direction: Option<[f32; 3]>,
+    inner_angle: Option<f32>,
+    outer_angle: Option<f32>,
+    range: Option<f32>,
+    shape: Option<ShapeType>,
+    size: Option<[f32; 2]>,
+    radius: Option<f32>,
+    #[serde(default = "default_true")]
+    cast_shadows: bool,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct CameraDef {
+    position: [f32; 3],
+    target: [f32; 3],
+    #[serde(default = "default_fov")]
+    fov: f32,
+    znear: Option<f32>,
+    zfar: Option<f32>,
+}
+
+/// Most nested includes we follow (a cycle is caught earlier; this bounds legit nesting).
+const MAX_DEPTH: usize = 32;
+
+thread_local! {
+    /// Scene files being loaded on this thread, outermost first, to detect include cycles.
+    static STACK: RefCell<Vec<PathBuf>> = const { RefCell::new(Vec::new()) };
+}
+
+struct StackGuard;
+impl Drop for StackGuard {
+    fn drop(&mut self) {
+        STACK.with(|s| s.borrow_mut().pop());
+    }
+}
 
 pub fn load(path: &Path) -> Result<Scene> {
-    Err(SceneError::load(path, "scene_file loader not written yet"))
+    load_with_settings(path).map(|(s, _)| s)
+}
+
+/// Loads a scene file and returns its `[settings]` table, if any, untouched.
+pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
+    let err = |reason: String| SceneError::load(path, reason);
+    let canon = path
+        .canonicalize()
+        .map_err(|e| err(format!("cannot open: {e}")))?;
+    let cycle = STACK.with(|s| {
+        let s = s.borrow();
+        if s.contains(&canon) {
+            let chain: Vec<String> = s
+                .iter()
+                .chain(std::iter::once(&canon))
+                .map(|p| p.display().to_string())
+                .collect();
+            Some(format!("include cycle: {}", chain.join(" -> ")))
+        } else if s.len() >= MAX_DEPTH {
+            Some(format!("includes nested deeper than {MAX_DEPTH} levels"))
+        } else {
+            None
+        }
+    });
+    if let Some(reason) = cycle {
+        return Err(err(reason));
+    }
+    STACK.with(|s| s.borrow_mut().push(canon));
+    let _guard = StackGuard;
+
+    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    let file: SceneFile = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut scene = Scene {
+        name: file.name.clone().unwrap_or_else(|| {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into())
+        }),
+        ..Default::default()
+    };
+
+    for (i, inc) in file.include.iter().enumerate() {
+        let what = format!("include {}", i + 1);
+        let mut sub = match (&inc.file, &inc.builtin) {
+            (Some(f), None) => {
+                crate::io::load(&dir.join(f)).map_err(|e| err(format!("{what} ('{f}'): {e}")))?
+            }
+            (None, Some(b)) => {
+                crate::builtin::by_name(b).map_err(|e| err(format!("{what}: {e}")))?
+            }
+            _ => {
+                return Err(err(format!(
+                    "{what}: needs exactly one of `file` and `builtin`"
+                )));
+            }
+        };
+        if let Some(o) = &inc.material {
+            apply_override(&mut sub, o).map_err(|r| err(format!("{what}: {r}")))?;
+        }
+        let scale = match inc.scale {
+            None => Vec3::ONE,
+            Some(Scale::Uniform(s)) => Vec3::splat(s),
+            Some(Scale::Axes(a)) => Vec3::from(a),
+        };
+        let t = Vec3::from(inc.translate);
+        let r = Vec3::from(inc.rotate);
+        if !(scale.is_finite() && scale.cmpne(Vec3::ZERO).all() && t.is_finite() && r.is_finite()) {
+            return Err(err(format!(
+                "{what}: translate, rotate and scale must be finite and scale non-zero"
+            )));
+        }
+        let transform = Mat4::from_translation(t)
+            * Mat4::from_rotation_z(r.z.to_radians())
+            * Mat4::from_rotation_y(r.y.to_radians())
+            * Mat4::from_rotation_x(r.x.to_radians())
+            * Mat4::from_scale(scale);
+        scene.append(sub, transform, inc.dynamic);
+    }
+
+    for (i, l) in file.light.iter().enumerate() {
+        let light = make_light(l, i).map_err(|r| {
+            err(format!(
+                "light {} ({}): {r}",
+                i + 1,
+                format!("{:?}", l.kind).to_lowercase()
+            ))
+        })?;
+        if matches!(light.kind, LightKind::Area { .. }) {
+            scene.add_area_light(light);
+        } else {
+            scene.lights.push(light);
+        }
+    }
+
+    if let Some(c) = &file.camera {
+        let (p, t) = (Vec3::from(c.position), Vec3::from(c.target));
+        if !(p.is_finite() && t.is_finite()) || p.distance(t) <= 0.0 {
+            return Err(err(
+                "camera: position and target must be finite and differ".into()
+            ));
+        }
+        if !(c.fov > 0.0 && c.fov < 180.0) {
+            return Err(err(format!(
+                "camera: fov {} is not in (0, 180) degrees",
+                c.fov
+            )));
+        }
+        let mut cam = Camera::look_at(p, t, c.fov);
+        cam.name = "scene file camera".into();
+        if let Some(zn) = c.znear {
+            if zn.is_nan() || zn <= 0.0 {
+                return Err(err(format!("camera: znear {zn} must be > 0")));
+            }
+            cam.znear = zn;
+        }
+        if let Some(zf) = c.zfar {
+            if zf.is_nan() || zf <= cam.znear {
+                return Err(err(format!("camera: zfar {zf} must exceed znear")));
+            }
+            cam.zfar = Some(zf);
+        }
+        scene.cameras.insert(0, cam);
+    }
+    Ok((scene, file.settings))
+}
+
+fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Result<(), String> {
+    let ok_color = |c: &[f32; 3]| c.iter().all(|v| v.is_finite() && *v >= 0.0);
+    if o.base_color.as_ref().is_some_and(|c| !ok_color(c))
+        || o.emissive.as_ref().is_some_and(|c| !ok_color(c))
+    {
+        return Err("material colours must be finite and >= 0".into());
+    }
+    for (k, v) in [("roughness", o.roughness), ("metallic", o.metallic)] {
+        if v.is_some_and(|v| !(0.0..=1.0).contains(&v)) {
+            return Err(format!("material {k} must be in [0, 1]"));
+        }
+    }
+    for m in &mut scene.materials {
+        if let Some(c) = o.base_color {
+            m.base_color = [c[0], c[1], c[2], m.base_color[3]];
+            m.base_color_texture = None;
+        }
+        if let Some(e) = o.emissive {
+            m.emissive = e;
+            m.emissive_texture = None;
+        }
+        if let Some(r) = o.roughness {
+            m.roughness = r;
+        }
+        if let Some(x) = o.metallic {
+            m.metallic = x;
+        }
+    }
+    Ok(())
+}
+
+fn vec(name: &str, v: Option<[f32; 3]>) -> std::result::Result<Option<Vec3>, String> {
+    match v.map(Vec3::from) {
+        Some(v) if !v.is_finite() => Err(format!("`{name}` is not finite")),
+        v => Ok(v),
+    }
+}
+
+fn make_light(l: &LightDef, index: usize) -> std::result::Result<Light, String> {
+    if !(l.intensity.is_finite() && l.intensity >= 0.0) {
+        return Err(format!("intensity {} must be finite and >= 0", l.intensity));
+    }
+    if !l.color.iter().all(|c| c.is_finite() && *c >= 0.0) {
+        return Err(format!("color {:?} must be finite and >= 0", l.color));
+    }
+    let position = vec("position", l.position)?;
+    let target = vec("target", l.target)?;
+    let direction = vec("direction", l.direction)?;
+    let needs_position = l.kind != LightType::Directional;
+    if needs_position && position.is_none() {
+        return Err("needs `position`".into());
+    }
+    let pos = position.unwrap_or(Vec3::ZERO);
+    let dir = match (direction, target) {
+        (Some(_), Some(_)) => return Err("give `direction` or `target`, not both".into()),
+        (Some(d), None) => Some(d),
+        (None, Some(t)) => {
+            if position.is_none() {
+                return Err("`target` needs `position`".into());
+            }
+            Some(t - pos)
+        }
+        (None, None) => None,
+    };
+    let dir = match (l.kind, dir) {
+        (LightType::Point, _) => dir.unwrap_or(Vec3::NEG_Y),
+        (_, None) => return Err("needs `direction` or `target`".into()),
+        (_, Some(d)) => d
+            .try_normalize()
+            .ok_or("direction is zero (target equals position?)")?,
+    };
+    let kind_only = |key: &str, present: bool, kind: &str| {
+        if present {
+            Err(format!("`{key}` only applies to {kind} lights"))
+        } else {
+            Ok(())
+        }
+    };
+    if l.kind != LightType::Spot {
+        kind_only("inner_angle", l.inner_angle.is_some(), "spot")?;
+        kind_only("outer_angle", l.outer_angle.is_some(), "spot")?;
+    }
+    if l.kind != LightType::Area {
+        kind_only("shape", l.shape.is_some(), "area")?;
+        kind_only("size", l.size.is_some(), "area")?;
+        kind_only("radius", l.radius.is_some(), "area")?;
+    }
+    if let Some(r) = l.range
+        && !(r > 0.0 && r.is_finite())
+    {
+        return Err(format!("range {r} must be > 0"));
+    }
+    let kind = match l.kind {
+        LightType::Directional => LightKind::Directional,
+        LightType::Point => LightKind::Point,
+        LightType::Spot => {
+            let inner = l.inner_angle.unwrap_or(0.0);
+            let outer = l.outer_angle.unwrap_or(45.0);
+            if !(0.0 <= inner && inner <= outer && outer <= 90.0) {
+                return Err(format!(
+                    "spot angles must satisfy 0 <= inner_angle <= outer_angle <= 90 degrees (got inner {inner}, outer {outer})"
+                ));
+            }
+            LightKind::Spot {
+                inner_angle: inner.to_radians(),
+                outer_angle: outer.to_radians(),
+            }
+        }
+        LightType::Area => {
+            let shape = match l.shape {
+                None => return Err("needs `shape` (\"rect\" or \"disc\")".into()),
+                Some(ShapeType::Rect) => {
+                    kind_only("radius", l.radius.is_some(), "disc area")?;
+                    let Some([w, h]) = l.size else {
+                        return Err("rect needs `size = [w, h]`".into());
+                    };
+                    if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
+                        return Err(format!("size [{w}, {h}] must be positive"));
+                    }
+                    let t = if dir.y.abs() > 0.99 {
+                        Vec3::X
+                    } else {
+                        Vec3::Y.cross(dir).normalize()
+                    };
+                    // t x (dir x t) = dir, so the rect's u x v faces along the light.
+                    AreaShape::Rect {
+                        u: t * (0.5 * w),
+                        v: dir.cross(t) * (0.5 * h),
+                    }
+                }
+                Some(ShapeType::Disc) => {
+                    kind_only("size", l.size.is_some(), "rect area")?;
+                    let Some(r) = l.radius else {
+                        return Err("disc needs `radius`".into());
+                    };
+                    if !(r > 0.0 && r.is_finite()) {
+                        return Err(format!("radius {r} must be positive"));
+                    }
+                    AreaShape::Disc { radius: r }
+                }
+            };
+            LightKind::Area { shape }
+        }
+    };
+    Ok(Light {
+        name: l
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("light {}", index + 1)),
+        kind,
+        color: l.color,
+        intensity: l.intensity,
+        position: pos,
+        direction: dir,
+        range: l.range,
+        cast_shadows: l.cast_shadows,
+    })
 }

@@ -1,0 +1,769 @@
+//! Loader tests: round trips with exact values, bad input, and (when present) the real files in
+//! /work/shared/scenes. Every file a test needs is written to the temp directory by the test.
+
+use std::path::{Path, PathBuf};
+use voxgi_scene::glam::{Mat4, Vec2, Vec3};
+use voxgi_scene::{
+    AlphaMode, AreaShape, LightKind, PointCloud, Projection, builtin, io, pointcloud,
+    srgb_to_linear,
+};
+
+/// A fresh directory for one test (tests run in parallel).
+fn tmp(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxgi-loaders-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// Exact comparisons are used where the loader only copies or converts with one f32 operation;
+/// `close` (1e-6) where a normalisation or trigonometric function is involved.
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-6
+}
+
+fn shared_scenes() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        println!("skipped: {} not found", p.display());
+        None
+    }
+}
+
+#[test]
+fn obj_with_mtl_and_texture() {
+    let dir = tmp("obj");
+    std::fs::create_dir_all(dir.join("tex")).unwrap();
+    let mut png = image::RgbaImage::new(2, 1);
+    png.put_pixel(0, 0, image::Rgba([255, 0, 0, 255]));
+    png.put_pixel(1, 0, image::Rgba([0, 10, 200, 128]));
+    png.save(dir.join("tex/checker.png")).unwrap();
+    write(
+        &dir,
+        "mats.mtl",
+        "newmtl red\nKd 0.5 0.25 0.125\nNs 98\nd 0.5\nmap_Kd tex/checker.png\n\nnewmtl glow\nKd 0 0 0\nKe 2 3 4\n",
+    );
+    let obj = write(
+        &dir,
+        "room.obj",
+        "mtllib mats.mtl\n\
+         v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+         vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+         o quad\nusemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\n\
+         o lamp\nv 0 2 0\nv 1 2 0\nv 1 2 1\nv 0 2 1\nusemtl glow\nf 5 6 7 8\n",
+    );
+    let s = io::load(&obj).unwrap();
+    assert_eq!(s.name, "room");
+    assert_eq!(s.meshes.len(), 2);
+    assert_eq!(s.instances.len(), 2);
+    assert_eq!(s.triangle_count(), 4);
+    let quad = s.meshes.iter().find(|m| m.name == "quad").unwrap();
+    assert!(quad.normals.iter().all(|n| *n == Vec3::Z));
+    // OBJ v runs up from the bottom; the model's runs down from the top: v' = 1 - v, exact.
+    let i0 = quad
+        .positions
+        .iter()
+        .position(|p| *p == Vec3::ZERO)
+        .unwrap();
+    assert_eq!(quad.uvs[i0], Vec2::new(0.0, 1.0));
+    let red = &s.materials[quad.material];
+    assert_eq!(red.base_color, [0.5, 0.25, 0.125, 0.5]);
+    assert_eq!(red.alpha_mode, AlphaMode::Blend);
+    // sqrt(2 / (98 + 2)) = sqrt(0.02); one f32 sqrt.
+    assert!((red.roughness - 0.02f32.sqrt()).abs() < 1e-6);
+    let t = &s.textures[red.base_color_texture.unwrap()];
+    assert_eq!((t.width, t.height), (2, 1));
+    assert_eq!(t.rgba8, vec![255, 0, 0, 255, 0, 10, 200, 128]);
+
+    // The lamp is an emissive parallelogram: promoted to an area light facing -Y (CCW seen from
+    // below), radiance copied from Ke.
+    assert_eq!(s.lights.len(), 1);
+    let l = &s.lights[0];
+    assert_eq!(l.radiometric(), Vec3::new(2.0, 3.0, 4.0));
+    assert!(close(l.direction, Vec3::NEG_Y));
+    assert!(close(l.position, Vec3::new(0.5, 2.0, 0.5)));
+    assert!((l.area() - 1.0).abs() < 1e-6);
+    let lamp_inst = s.instances.iter().find(|i| i.name == "lamp").unwrap();
+    assert_eq!(lamp_inst.light, Some(0));
+
+    // Without its MTL the OBJ still loads, with default materials.
+    std::fs::remove_file(dir.join("mats.mtl")).unwrap();
+    let s = io::load(&obj).unwrap();
+    assert_eq!(s.triangle_count(), 4);
+    assert!(s.lights.is_empty());
+    assert!(
+        s.materials
+            .iter()
+            .all(|m| m.base_color == [0.8, 0.8, 0.8, 1.0])
+    );
+}
+
+#[test]
+fn ascii_ply_mesh() {
+    let dir = tmp("ply_ascii");
+    let p = write(
+        &dir,
+        "quad.ply",
+        "ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 5\nproperty float x\nproperty float y\n\
+         property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n\
+         element face 2\nproperty list uchar int vertex_indices\nelement edge 1\nproperty int a\nproperty int b\nend_header\n\
+         0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n0 1 0 10 10 10\n0.5 0.5 -1.25 0 0 0\n\
+         4 0 1 2 3\n3 0 4 1\n0 1\n",
+    );
+    let s = io::load(&p).unwrap();
+    assert_eq!(s.meshes.len(), 1);
+    let m = &s.meshes[0];
+    assert_eq!(m.positions[4], Vec3::new(0.5, 0.5, -1.25));
+    // The quad becomes the fan (0 1 2) (0 2 3), then the triangle.
+    assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3, 0, 4, 1]);
+    // Vertex 2 only touches the quad, whose CCW normal is +Z.
+    assert!(close(m.normals[2], Vec3::Z));
+    assert!(s.point_clouds.is_empty());
+    assert_eq!(s.instances.len(), 1);
+
+    // The `vertex_index` spelling, and a float index list, are read the same way.
+    let text = std::fs::read_to_string(&p).unwrap();
+    let alt = text.replace(
+        "list uchar int vertex_indices",
+        "list uchar float vertex_index",
+    );
+    let p2 = write(&dir, "quad_alt.ply", alt);
+    assert_eq!(io::load(&p2).unwrap().meshes[0].indices, m.indices);
+}
+
+/// Builds a binary PLY point cloud: double or float xyz, float normals, uchar colours, radius.
+/// One test point: position, normal, sRGB colour, radius.
+type TestPoint = ([f64; 3], [f32; 3], [u8; 3], f32);
+
+fn binary_cloud(big: bool, double: bool, pts: &[TestPoint]) -> Vec<u8> {
+    let fmt = if big {
+        "binary_big_endian"
+    } else {
+        "binary_little_endian"
+    };
+    let pt = if double { "double" } else { "float" };
+    let mut out = format!(
+        "ply\nformat {fmt} 1.0\nelement vertex {}\nproperty {pt} x\nproperty {pt} y\nproperty {pt} z\n\
+         property float nx\nproperty float ny\nproperty float nz\nproperty uchar red\nproperty uchar green\n\
+         property uchar blue\nproperty float radius\nend_header\n",
+        pts.len()
+    )
+    .into_bytes();
+    let f32b = |v: f32| {
+        if big {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        }
+    };
+    for (p, n, c, r) in pts {
+        for v in p {
+            if double {
+                out.extend(if big {
+                    v.to_be_bytes()
+                } else {
+                    v.to_le_bytes()
+                });
+            } else {
+                out.extend(f32b(*v as f32));
+            }
+        }
+        for v in n {
+            out.extend(f32b(*v));
+        }
+        out.extend(c);
+        out.extend(f32b(*r));
+    }
+    out
+}
+
+#[test]
+fn binary_ply_point_clouds_le_and_be() {
+    let dir = tmp("ply_bin");
+    let pts = [
+        ([1.5, -2.0, 3.25], [0.0, 0.0, 2.0], [255, 128, 0], 0.01),
+        ([-7.0, 0.125, 1e3], [0.0, -1.0, 0.0], [10, 20, 30], 0.5),
+        ([0.0, 0.0, 0.0], [3.0, 4.0, 0.0], [0, 0, 0], 2.0),
+    ];
+    for (big, double) in [(false, false), (true, false), (false, true), (true, true)] {
+        let name = format!("cloud_{big}_{double}.ply");
+        let p = write(&dir, &name, binary_cloud(big, double, &pts));
+        let s = io::load(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(s.meshes.is_empty());
+        let pc = &s.point_clouds[0];
+        assert_eq!(pc.positions.len(), 3);
+        for (i, (pos, n, c, r)) in pts.iter().enumerate() {
+            // All values are exactly representable in f32: exact equality.
+            assert_eq!(
+                pc.positions[i],
+                Vec3::new(pos[0] as f32, pos[1] as f32, pos[2] as f32)
+            );
+            assert!(
+                close(pc.normals[i], Vec3::from(*n).normalize()),
+                "{name} {i}"
+            );
+            assert_eq!(pc.colors[i], c.map(|c| srgb_to_linear(c as f32 / 255.0)));
+            assert_eq!(pc.radii[i], *r);
+        }
+    }
+    // Without colour properties points are 0.8 grey; float colours are taken as linear.
+    let p = write(
+        &dir,
+        "plain.ply",
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 1 1\n",
+    );
+    let s = io::load(&p).unwrap();
+    assert_eq!(s.point_clouds[0].colors, vec![[0.8; 3]; 2]);
+    assert!(s.point_clouds[0].normals.is_empty());
+    let p = write(
+        &dir,
+        "fcol.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+         property float diffuse_red\nproperty float diffuse_green\nproperty float diffuse_blue\nend_header\n0 0 0 0.25 0.5 1\n",
+    );
+    assert_eq!(
+        io::load(&p).unwrap().point_clouds[0].colors,
+        vec![[0.25, 0.5, 1.0]]
+    );
+}
+
+#[test]
+fn cloud_write_then_load() {
+    let dir = tmp("cloud");
+    let bytes = [0u8, 1, 2, 100, 187, 255];
+    let pc = PointCloud {
+        name: "c".into(),
+        positions: vec![Vec3::new(1.0, 2.0, 3.0), Vec3::new(-0.5, 0.0, 1e-3)],
+        colors: vec![
+            [bytes[0], bytes[1], bytes[2]].map(|b| srgb_to_linear(b as f32 / 255.0)),
+            [bytes[3], bytes[4], bytes[5]].map(|b| srgb_to_linear(b as f32 / 255.0)),
+        ],
+        normals: vec![Vec3::Y, Vec3::new(0.6, 0.0, -0.8)],
+        transform: Mat4::IDENTITY,
+        ..Default::default()
+    };
+    let p = dir.join("pts.cloud");
+    voxgi_scene::io::cloud::write(&p, &pc).unwrap();
+    let raw = std::fs::read(&p).unwrap();
+    // 4-byte count + 27 bytes per record, little endian, packed.
+    assert_eq!(raw.len(), 4 + 27 * 2);
+    assert_eq!(&raw[0..4], &2i32.to_le_bytes());
+    assert_eq!(&raw[4..8], &1.0f32.to_le_bytes());
+    assert_eq!(&raw[16..20], &0.0f32.to_le_bytes());
+    assert_eq!(&raw[20..24], &1.0f32.to_le_bytes());
+    assert_eq!(&raw[28..31], &bytes[0..3]);
+    assert_eq!(&raw[55..58], &bytes[3..6]);
+    let s = io::load(&p).unwrap();
+    let back = &s.point_clouds[0];
+    assert_eq!(back.positions, pc.positions);
+    // Colours came from 8-bit sRGB, so encoding and decoding reproduces them exactly.
+    assert_eq!(back.colors, pc.colors);
+    for (a, b) in back.normals.iter().zip(&pc.normals) {
+        assert!(close(*a, *b));
+    }
+}
+
+#[test]
+fn scene_file_with_includes_lights_camera_settings() {
+    let dir = tmp("scene");
+    write(&dir, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    write(
+        &dir,
+        "sub/box.toml",
+        "[[include]]\nbuiltin = \"cornell-box\"\n\n[camera]\nposition = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 30.0\n",
+    );
+    let main = write(
+        &dir,
+        "main.toml",
+        r#"name = "test scene"
+[[include]]
+file = "tri.obj"
+translate = [1.0, 0.0, 0.0]
+rotate = [0.0, 90.0, 0.0]
+scale = 2.0
+dynamic = true
+[include.material]
+base_color = [0.1, 0.2, 0.3]
+roughness = 0.25
+
+[[include]]
+file = "sub/box.toml"
+translate = [0.0, 0.0, 5.0]
+scale = [1.0, 2.0, 1.0]
+
+[[light]]
+type = "directional"
+intensity = 3.0
+direction = [0.0, -2.0, 0.0]
+
+[[light]]
+type = "point"
+name = "bulb"
+color = [1.0, 0.5, 0.25]
+intensity = 10.0
+position = [0.0, 3.0, 0.0]
+range = 8.0
+
+[[light]]
+type = "spot"
+intensity = 5.0
+position = [0.0, 3.0, 0.0]
+target = [0.0, 0.0, 0.0]
+inner_angle = 20.0
+outer_angle = 30.0
+cast_shadows = false
+
+[[light]]
+type = "area"
+intensity = 4.0
+position = [0.0, 2.0, 0.0]
+direction = [0.0, -1.0, 0.0]
+shape = "rect"
+size = [0.5, 0.4]
+
+[[light]]
+type = "area"
+intensity = 1.0
+position = [1.0, 1.0, 1.0]
+target = [1.0, 1.0, 0.0]
+shape = "disc"
+radius = 0.25
+
+[camera]
+position = [0.0, 1.0, 4.0]
+target = [0.0, 1.0, 0.0]
+fov = 50.0
+
+[settings]
+voxel_resolution = 128
+debug = { cones = 6 }
+"#,
+    );
+    let (s, settings) = io::scene_file::load_with_settings(&main).unwrap();
+    s.validate().unwrap();
+    assert_eq!(s.name, "test scene");
+    let settings = settings.unwrap();
+    assert_eq!(settings["voxel_resolution"].as_integer(), Some(128));
+    assert_eq!(settings["debug"]["cones"].as_integer(), Some(6));
+
+    // The triangle: scale 2, rotate 90° about Y, translate +X. (1,0,0) -> (2,0,0) -> (0,0,-2)
+    // -> (1,0,-2); (0,1,0) -> (0,2,0) -> (1,2,0). 1e-6: the rotation's cos(90°) is ~-4e-8.
+    let tri = &s.instances[0];
+    assert!(tri.dynamic);
+    let m = &s.meshes[tri.mesh];
+    let w = |i: usize| tri.transform.transform_point3(m.positions[i]);
+    assert!(close(w(1), Vec3::new(1.0, 0.0, -2.0)), "{}", w(1));
+    assert!(close(w(2), Vec3::new(1.0, 2.0, 0.0)), "{}", w(2));
+    let mat = &s.materials[m.material];
+    assert_eq!(mat.base_color, [0.1, 0.2, 0.3, 1.0]);
+    assert_eq!(mat.roughness, 0.25);
+
+    // The nested built-in box keeps its lights; then come the file's five lights in order.
+    let cb = builtin::cornell_box();
+    let n0 = cb.lights.len();
+    assert_eq!(s.lights.len(), n0 + 5);
+    assert_eq!(s.instances.len(), 1 + cb.instances.len() + 2);
+    assert!(
+        s.instances[1..=cb.instances.len()]
+            .iter()
+            .all(|i| !i.dynamic)
+    );
+    let l = &s.lights[n0..];
+    assert_eq!(l[0].kind, LightKind::Directional);
+    assert!(close(l[0].direction, Vec3::NEG_Y));
+    assert_eq!(l[1].kind, LightKind::Point);
+    assert_eq!(l[1].name, "bulb");
+    assert_eq!(l[1].radiometric(), Vec3::new(10.0, 5.0, 2.5));
+    assert_eq!(l[1].range, Some(8.0));
+    let LightKind::Spot {
+        inner_angle,
+        outer_angle,
+    } = l[2].kind
+    else {
+        panic!("{:?}", l[2].kind)
+    };
+    assert!((inner_angle - 20f32.to_radians()).abs() < 1e-6);
+    assert!((outer_angle - 30f32.to_radians()).abs() < 1e-6);
+    assert!(!l[2].cast_shadows);
+    assert!(close(l[2].direction, Vec3::NEG_Y));
+    let LightKind::Area {
+        shape: AreaShape::Rect { u, v },
+    } = l[3].kind
+    else {
+        panic!()
+    };
+    assert!((l[3].area() - 0.2).abs() < 1e-6);
+    assert!(
+        u.cross(v).dot(Vec3::NEG_Y) > 0.0,
+        "rect must face its direction"
+    );
+    assert!(
+        matches!(l[4].kind, LightKind::Area { shape: AreaShape::Disc { radius } } if radius == 0.25)
+    );
+    assert!(close(l[4].direction, Vec3::NEG_Z));
+    // Each area light got its emitter instance.
+    let emitters: Vec<_> = s
+        .instances
+        .iter()
+        .filter_map(|i| i.light)
+        .filter(|&li| li >= n0)
+        .collect();
+    assert_eq!(emitters, vec![n0 + 3, n0 + 4]);
+
+    // The file's camera wins; the included one follows, moved by its include's transform.
+    assert_eq!(s.cameras[0].position, Vec3::new(0.0, 1.0, 4.0));
+    assert_eq!(
+        s.cameras[0].projection,
+        Projection::Perspective {
+            yfov: 50f32.to_radians()
+        }
+    );
+    let sub_cam = s
+        .cameras
+        .iter()
+        .find(|c| {
+            c.projection
+                == Projection::Perspective {
+                    yfov: 30f32.to_radians(),
+                }
+        })
+        .unwrap();
+    assert!(close(sub_cam.position, Vec3::new(0.0, 0.0, 8.0)));
+    assert!(close(sub_cam.forward, Vec3::NEG_Z));
+
+    // Without its own camera the first included camera is the default view.
+    let nocam = write(&dir, "nocam.toml", "[[include]]\nfile = \"sub/box.toml\"\n");
+    let s = io::load(&nocam).unwrap();
+    assert_eq!(
+        s.cameras[0].projection,
+        Projection::Perspective {
+            yfov: 30f32.to_radians()
+        }
+    );
+}
+
+#[test]
+fn bad_inputs_fail_with_the_file_name() {
+    let dir = tmp("bad");
+    let ply_head = |fmt: &str, n: &str| {
+        format!(
+            "ply\nformat {fmt} 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\n"
+        )
+    };
+    let tri_ply = |face: &str| {
+        format!(
+            "{}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n{face}\n",
+            ply_head("ascii", "3")
+        )
+    };
+    let mut bin_list = ply_head("binary_little_endian", "1");
+    bin_list += "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    let mut bin_list = bin_list.into_bytes();
+    bin_list.extend([0u8; 12]);
+    bin_list.extend([255u8, 0, 0, 0, 0]);
+    let cloud = |count: i32, records: usize, extra: usize| {
+        let mut b = count.to_le_bytes().to_vec();
+        for _ in 0..records {
+            for v in [0f32, 0.0, 0.0, 0.0, 1.0, 0.0] {
+                b.extend(v.to_le_bytes());
+            }
+            b.extend([1u8, 2, 3]);
+        }
+        b.extend(vec![0u8; extra]);
+        b
+    };
+    let mut zero_ndf = 1i32.to_le_bytes().to_vec();
+    zero_ndf.extend([0u8; 27]);
+    let mut trunc_bin = (ply_head("binary_little_endian", "3") + "end_header\n").into_bytes();
+    trunc_bin.extend([0u8; 20]);
+    let light = |body: &str| format!("[[light]]\n{body}\n");
+
+    // (case, file name, contents, fragment the reason must contain ("" = only the file name)).
+    #[rustfmt::skip]
+    let cases: Vec<(&str, &str, Vec<u8>, &str)> = vec![
+        ("ply truncated binary", "trunc_bin.ply", trunc_bin, "truncated"),
+        ("ply 2^40 vertices", "huge.ply", (ply_head("binary_little_endian", "1099511627776") + "end_header\n").into_bytes(), "limit"),
+        ("ply count larger than file", "big.ply", (ply_head("binary_little_endian", "1000") + "end_header\n").into_bytes(), "body has only"),
+        ("ply ascii non-number", "word.ply", (ply_head("ascii", "1") + "end_header\n0 zero 0\n").into_bytes(), "'zero' is not a number"),
+        ("ply face index out of range", "face.ply", tri_ply("3 0 1 7").into_bytes(), "vertex index 7 out of range (3 vertices)"),
+        ("ply negative face index", "negface.ply", tri_ply("3 0 -1 2").into_bytes(), "out of range"),
+        ("ply empty", "empty.ply", vec![], "empty"),
+        ("ply no end_header", "noend.ply", ply_head("ascii", "1").into_bytes(), "end_header"),
+        ("ply not a ply", "text.ply", b"hello\n".to_vec(), "not a PLY"),
+        ("ply missing z", "noz.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n".to_vec(), "x, y, z"),
+        ("ply list past end", "list.ply", bin_list, "runs past"),
+        ("ply ascii too few values", "short.ply", (ply_head("ascii", "2") + "end_header\n0 0 0\n1 1          \n").into_bytes(), "line 9: too few values for vertex 1"),
+        ("obj face index out of range", "range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 40\n".to_vec(), "line 4: face vertex index 40 out of range (3 vertices"),
+        ("obj no triangles", "points.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\n".to_vec(), "contains no triangles"),
+        ("obj empty", "empty.obj", vec![], "contains no triangles"),
+        ("obj nan vertex", "nan.obj", b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(), "not finite"),
+        ("cloud truncated", "trunc.cloud", cloud(2, 1, 10), "expected"),
+        ("cloud negative count", "neg.cloud", cloud(-5, 0, 0), "negative sample count -5"),
+        ("cloud count beyond file", "count.cloud", cloud(1000, 1, 0), "27004 bytes"),
+        ("cloud trailing bytes", "trail.cloud", cloud(1, 1, 3), "file has 34 bytes"),
+        ("cloud shorter than count", "tiny.cloud", vec![1, 0], "too short"),
+        ("cloud zero NDF", "ndf.cloud", zero_ndf, "record 0"),
+        ("toml syntax error", "syntax.toml", b"[[include]\nfile = \n".to_vec(), ""),
+        ("toml unknown key", "typo.toml", b"[camera]\npositon = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n".to_vec(), "positon"),
+        ("toml missing include", "missing.toml", b"[[include]]\nfile = \"nope.obj\"\n".to_vec(), "nope.obj"),
+        ("toml self include", "self.toml", b"[[include]]\nfile = \"self.toml\"\n".to_vec(), "include cycle"),
+        ("toml mutual include", "ping.toml", b"[[include]]\nfile = \"pong.toml\"\n".to_vec(), "include cycle"),
+        ("toml bad light type", "laser.toml", light("type = \"laser\"\nintensity = 1.0").into_bytes(), "laser"),
+        ("toml spot inner > outer", "spot.toml", light("type = \"spot\"\nintensity = 1.0\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ninner_angle = 40.0\nouter_angle = 30.0").into_bytes(), "inner"),
+        ("toml negative intensity", "negint.toml", light("type = \"point\"\nintensity = -1.0\nposition = [0.0, 1.0, 0.0]").into_bytes(), "intensity -1"),
+        ("toml area without size", "nosize.toml", light("type = \"area\"\nintensity = 1.0\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nshape = \"rect\"").into_bytes(), "size"),
+        ("toml unknown builtin", "nobuiltin.toml", b"[[include]]\nbuiltin = \"moon-base\"\n".to_vec(), "moon-base"),
+        ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type"),
+        ("gltf invalid json", "bad.gltf", b"{ not json".to_vec(), ""),
+        ("glb empty", "empty.glb", vec![], ""),
+        ("glb truncated", "trunc.glb", b"glTF\x02\x00\x00\x00\xff\xff\x00\x00".to_vec(), ""),
+    ];
+    write(&dir, "pong.toml", "[[include]]\nfile = \"ping.toml\"\n");
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    let mut rows: Vec<(&str, PathBuf, &str)> = cases
+        .iter()
+        .map(|(case, name, bytes, frag)| (*case, write(&dir, name, bytes), *frag))
+        .collect();
+    rows.push((
+        "nonexistent path",
+        dir.join("does_not_exist.ply"),
+        "no such file",
+    ));
+    rows.push(("directory path", dir.join("folder.obj"), ""));
+    assert!(rows.len() >= 24);
+    let mut failures = Vec::new();
+    for (case, path, frag) in &rows {
+        let name = path.file_name().unwrap().to_str().unwrap();
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| io::load(path)));
+        match result {
+            Err(_) => failures.push(format!("{case}: panicked")),
+            Ok(Ok(_)) => failures.push(format!("{case}: loaded without error")),
+            Ok(Err(e)) => {
+                let msg = e.to_string();
+                if !msg.contains(name) || !msg.contains(frag) {
+                    failures.push(format!("{case}: message lacks '{name}' or '{frag}': {msg}"));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn emissive_non_quad_stays_geometry() {
+    // An emissive triangle pair that forms an L shape (not a parallelogram) is not a light.
+    let dir = tmp("nonquad");
+    write(&dir, "m.mtl", "newmtl e\nKe 1 1 1\n");
+    let p = write(
+        &dir,
+        "l.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 2 0 0\nv 2 1 0\nusemtl e\nf 1 2 3\nf 2 4 5\n",
+    );
+    let s = io::load(&p).unwrap();
+    assert!(s.lights.is_empty());
+    assert!(
+        !s.is_unlit(),
+        "the emissive geometry still lights the scene"
+    );
+}
+
+/// Every prefix of a valid file, and the file with single bytes changed, must load or fail
+/// cleanly: never panic, never allocate from a corrupt count. Cheap stand-in for fuzzing.
+#[test]
+fn truncated_and_corrupted_files_never_panic() {
+    let dir = tmp("fuzz");
+    let pts: Vec<TestPoint> = (0..4)
+        .map(|i| ([i as f64, 1.0, 2.0], [0.0, 1.0, 0.0], [1, 2, 3], 0.1))
+        .collect();
+    let mut mesh_bin = b"ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n".to_vec();
+    for v in [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        mesh_bin.extend(v.to_be_bytes());
+    }
+    mesh_bin.push(3);
+    for i in [0u32, 1, 2] {
+        mesh_bin.extend(i.to_be_bytes());
+    }
+    let mut cloud = 2i32.to_le_bytes().to_vec();
+    for _ in 0..2 {
+        for v in [1f32, 2.0, 3.0, 0.0, 1.0, 0.0] {
+            cloud.extend(v.to_le_bytes());
+        }
+        cloud.extend([9u8, 8, 7]);
+    }
+    let files: Vec<(&str, Vec<u8>)> = vec![
+        ("f.ply", binary_cloud(false, false, &pts)),
+        ("f.ply", binary_cloud(true, true, &pts)),
+        ("f.ply", mesh_bin),
+        ("f.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec()),
+        ("f.cloud", cloud),
+        ("f.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n".to_vec()),
+    ];
+    let mut tried = 0;
+    for (fi, (ext, bytes)) in files.iter().enumerate() {
+        assert!(
+            io::load(&write(&dir, ext, bytes)).is_ok(),
+            "file {fi} must be valid"
+        );
+        let mut variants: Vec<Vec<u8>> = (0..bytes.len()).map(|n| bytes[..n].to_vec()).collect();
+        for i in 0..bytes.len() {
+            for x in [0x00u8, 0xff, b'9', b' ', b'\n'] {
+                let mut b = bytes.clone();
+                b[i] = x;
+                variants.push(b);
+            }
+        }
+        for (vi, v) in variants.iter().enumerate() {
+            let p = write(&dir, ext, v);
+            let r = std::panic::catch_unwind(|| io::load(&p).map(|s| s.validate()));
+            assert!(r.is_ok(), "file {fi} variant {vi} panicked: {v:?}");
+            tried += 1;
+        }
+    }
+    assert!(tried > 1000);
+}
+
+#[test]
+fn append_remaps_indices_and_transforms_lights() {
+    let mut s = builtin::cornell_box();
+    let one = s.clone();
+    let t = Mat4::from_translation(Vec3::new(10.0, 0.0, 0.0))
+        * Mat4::from_scale(Vec3::new(2.0, 1.0, 3.0));
+    s.append(one.clone(), t, true);
+    s.validate().unwrap();
+    assert_eq!(s.meshes.len(), 2 * one.meshes.len());
+    assert_eq!(s.lights.len(), 2 * one.lights.len());
+    for (a, b) in one
+        .instances
+        .iter()
+        .zip(&s.instances[one.instances.len()..])
+    {
+        assert_eq!(b.mesh, a.mesh + one.meshes.len());
+        assert_eq!(b.light, a.light.map(|l| l + one.lights.len()));
+        assert_eq!(
+            s.meshes[b.mesh].material,
+            s.meshes[a.mesh].material + one.materials.len()
+        );
+        assert!(b.dynamic);
+        assert_eq!(b.transform, t * a.transform);
+    }
+    let mut checked_rects = 0;
+    for (a, b) in one.lights.iter().zip(&s.lights[one.lights.len()..]) {
+        assert!(close(b.position, t.transform_point3(a.position)));
+        if let LightKind::Area {
+            shape: AreaShape::Rect { u, v },
+        } = b.kind
+        {
+            // Under non-uniform scale the emitting normal must stay perpendicular to the edges
+            // (inverse transpose), and keep its side.
+            assert!(u.dot(b.direction).abs() < 1e-5 && v.dot(b.direction).abs() < 1e-5);
+            assert!(b.direction.dot(a.direction) > 0.0);
+            // Area scales with the x and z factors for a light in the y = const plane: 2 x 3.
+            if a.direction.y.abs() > 0.999 {
+                assert!((b.area() - 6.0 * a.area()).abs() < 1e-5 * b.area());
+                checked_rects += 1;
+            }
+        }
+    }
+    assert!(
+        checked_rects > 0,
+        "the built-in box has a ceiling rect light"
+    );
+}
+
+#[test]
+fn conformance_with_real_files() {
+    let Some(root) = shared_scenes() else { return };
+    let load = |rel: &str| {
+        let t = std::time::Instant::now();
+        let s = io::load(&root.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        let b = s.bounds();
+        println!("{rel}: {:.2?}, bounds {} .. {}", t.elapsed(), b.min, b.max);
+        s
+    };
+    // Triangle and point counts are exact: these are published numbers for the files.
+    let sponza = load("sponza_dabrovic_geometry_only/sponza.obj");
+    assert_eq!(sponza.triangle_count(), 66_454);
+    let bunny = load("stanford_bunny/bun_zipper.ply");
+    assert_eq!(bunny.triangle_count(), 69_451);
+    let dragon = load("stanford_dragon_100k/dragon.ply");
+    assert_eq!(dragon.triangle_count(), 100_000);
+    // The file's normals are unit length and are kept (not recomputed): compare with the
+    // computed ones, which differ somewhere on a 100k-triangle scan.
+    let dm = &dragon.meshes[0];
+    let computed = voxgi_scene::compute_normals(&dm.positions, &dm.indices);
+    assert!(dm.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
+    assert!(
+        dm.normals
+            .iter()
+            .zip(&computed)
+            .any(|(a, b)| a.dot(*b) < 0.999)
+    );
+    let mut office = load("pointcloud_pcl_office1/office1_xyzrgb.ply");
+    assert_eq!(office.point_count(), 254_456);
+    let pc = &mut office.point_clouds[0];
+    assert!(pc.normals.is_empty());
+    // The PCL capture's sensor sits at the origin.
+    let t = std::time::Instant::now();
+    pointcloud::estimate_normals(pc, 16, Vec3::ZERO);
+    let t_normals = t.elapsed();
+    let t = std::time::Instant::now();
+    pointcloud::estimate_radii(pc, 8);
+    let t_radii = t.elapsed();
+    println!("office cloud: normals (k=16) {t_normals:.2?}, radii (k=8) {t_radii:.2?}");
+    assert_eq!(pc.normals.len(), 254_456);
+    assert!(pc.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
+    assert!(
+        pc.normals
+            .iter()
+            .zip(&pc.positions)
+            .all(|(n, p)| n.dot(-*p) >= 0.0)
+    );
+    assert!(pc.radii.iter().all(|r| r.is_finite() && *r >= 0.0));
+    // The brief's budget is 2 s for 254k points in release; debug builds are ~10x slower.
+    if !cfg!(debug_assertions) {
+        assert!(t_normals.as_secs_f32() < 2.0, "{t_normals:?}");
+    }
+
+    let mcguire = load("cornell_box_mcguire/CornellBox-Original.obj");
+    assert_eq!(mcguire.lights.len(), 1, "{:?}", mcguire.lights);
+    let l = &mcguire.lights[0];
+    // Exact: Ke 17 12 4 is copied, intensity 1.
+    assert_eq!(l.radiometric(), Vec3::new(17.0, 12.0, 4.0));
+    // Float noise only: the light's four vertices lie exactly at y = 1.98.
+    assert!(
+        (l.direction - Vec3::NEG_Y).length() < 1e-5,
+        "{}",
+        l.direction
+    );
+    // 0.47 m x 0.38 m from the file's corner coordinates; 1e-4 for f32 rounding.
+    assert!((l.area() - 0.47 * 0.38).abs() < 1e-4, "{}", l.area());
+    let n_light_instances = mcguire
+        .instances
+        .iter()
+        .filter(|i| i.light.is_some())
+        .count();
+    assert_eq!(n_light_instances, 1);
+
+    for m in [
+        "back",
+        "ceiling",
+        "floor",
+        "greenwall",
+        "largebox",
+        "luminaire",
+        "redwall",
+        "smallbox",
+    ] {
+        let s = load(&format!("cornell_box_mitsuba/meshes/cbox_{m}.obj"));
+        assert!(s.triangle_count() >= 2, "{m}");
+    }
+}
