@@ -1,0 +1,79 @@
+//! Shared device and small helpers for building test scenes and probing images.
+
+use std::sync::OnceLock;
+use voxgi::scene::glam::{Mat4, Vec3};
+use voxgi::scene::{Camera, Material, Mesh, Scene};
+use voxgi::{GpuContext, RenderOutput, Renderer, Settings};
+
+/// The one device all GPU tests share.
+pub fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| {
+        GpuContext::from_env().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"))
+    })
+}
+
+/// A flat square of side `size` at height `y`, normal +Y, as a two-triangle mesh.
+pub fn quad_mesh(name: &str, center: Vec3, size: f32) -> Mesh {
+    let h = size * 0.5;
+    let p = |x: f32, z: f32| center + Vec3::new(x, 0.0, z);
+    Mesh {
+        name: name.into(),
+        positions: vec![p(-h, -h), p(-h, h), p(h, h), p(h, -h)],
+        normals: vec![Vec3::Y; 4],
+        uvs: Vec::new(),
+        // Counter-clockwise seen from +Y.
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material: 0,
+    }
+}
+
+/// A 20 m Lambertian plane at y = 0 with the given albedo and no lights.
+pub fn plane_scene(albedo: f32) -> Scene {
+    let mut s = Scene::default();
+    s.add_mesh(
+        quad_mesh("plane", Vec3::ZERO, 20.0),
+        Material::diffuse("plane", [albedo; 3]),
+        Mat4::IDENTITY,
+    );
+    s
+}
+
+/// Settings for measurements: no tone curve, no default light.
+pub fn measuring() -> Settings {
+    Settings {
+        tonemap: voxgi::Tonemap::Clamp,
+        default_light: false,
+        ..Settings::default()
+    }
+}
+
+pub fn render(scene: &Scene, settings: Settings, camera: &Camera, w: u32, h: u32) -> RenderOutput {
+    let mut r = Renderer::new(ctx(), scene, settings).expect("renderer");
+    r.render(camera, w, h).expect("render")
+}
+
+/// The camera ray through the centre of pixel (x, y), as the renderer's projection makes it.
+pub fn pixel_ray(cam: &Camera, w: u32, h: u32, x: u32, y: u32) -> Vec3 {
+    let voxgi::scene::Projection::Perspective { yfov } = cam.projection else {
+        panic!("perspective cameras only");
+    };
+    let t = (yfov * 0.5).tan();
+    let ndc_x = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
+    let ndc_y = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
+    let right = cam.forward.cross(cam.up).normalize();
+    (cam.forward + right * ndc_x * t * (w as f32 / h as f32) + cam.up * ndc_y * t).normalize()
+}
+
+/// Where the ray through pixel (x, y) meets the plane y = 0.
+pub fn pixel_on_ground(cam: &Camera, w: u32, h: u32, x: u32, y: u32) -> Vec3 {
+    let d = pixel_ray(cam, w, h, x, y);
+    let t = -cam.position.y / d.y;
+    assert!(t > 0.0, "pixel ({x}, {y}) does not see the ground");
+    cam.position + d * t
+}
+
+/// Relative difference, safe at zero.
+pub fn rel(a: f32, b: f32) -> f32 {
+    (a - b).abs() / b.abs().max(1e-6)
+}

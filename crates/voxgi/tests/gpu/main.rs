@@ -1,0 +1,9 @@
+//! GPU tests: one binary (linking wgpu once), one module per topic, one shared device.
+//! They run on whatever adapter the environment picks (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`);
+//! in CI that is Mesa's lavapipe.
+
+mod analytic;
+mod common;
+mod errors;
+mod golden;
+mod shaders;
