@@ -353,6 +353,12 @@ fn describe(s: &Scene, label: &str) -> String {
 }
 
 fn main() {
+    // Headless: Vulkan's window-system layer complains on stderr when there is no session
+    // directory, although nothing here opens a window. Give it an empty one.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // SAFETY: nothing else runs yet; no other thread can read the environment.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match &cli.command {

@@ -1,0 +1,189 @@
+//! The `voxgi` command as a user runs it: exit codes, one-line errors naming the file, outputs.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn voxgi(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_voxgi"))
+        .args(args)
+        .output()
+        .expect("run voxgi")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxgi_cli_tests_{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The last line of stderr: the one-line cause.
+fn error_line(o: &Output) -> String {
+    stderr(o).lines().last().unwrap_or_default().to_string()
+}
+
+#[test]
+fn renders_the_builtin_cornell_box_to_png_and_exr() {
+    let png = tmp("cornell.png");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "64x48",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&png).expect("a PNG was written").to_rgb8();
+    assert_eq!((img.width(), img.height()), (64, 48));
+    // Not black: the mean 8-bit value of the direct-lit box is about 60.
+    let mean = img.as_raw().iter().map(|&c| c as f64).sum::<f64>() / img.as_raw().len() as f64;
+    assert!(mean > 20.0, "mean pixel value {mean}");
+    assert!(
+        stderr(&o).contains("rendering 64x48"),
+        "progress is reported: {}",
+        stderr(&o)
+    );
+
+    let exr = tmp("cornell.exr");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        exr.to_str().unwrap(),
+        "--size",
+        "32x32",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&exr).unwrap();
+    // OpenEXR magic number 20000630, little-endian.
+    assert_eq!(&bytes[..4], &[0x76, 0x2f, 0x31, 0x01]);
+}
+
+#[test]
+fn errors_name_the_file_and_exit_nonzero() {
+    let missing = tmp("missing_model.obj");
+    let out = tmp("x.png");
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            vec![
+                "render".into(),
+                missing.display().to_string(),
+                "-o".into(),
+                out.display().to_string(),
+            ],
+            vec!["missing_model.obj", "no such file"],
+        ),
+        (
+            vec![
+                "render".into(),
+                "--builtin".into(),
+                "nope".into(),
+                "-o".into(),
+                out.display().to_string(),
+            ],
+            vec!["nope", "cornell-box"],
+        ),
+        (
+            vec![
+                "render".into(),
+                "--builtin".into(),
+                "cornell-box".into(),
+                "-o".into(),
+                "picture.jpg".into(),
+            ],
+            vec!["picture.jpg", "png"],
+        ),
+        (
+            vec!["info".into(), missing.display().to_string()],
+            vec!["missing_model.obj"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = voxgi(&a);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+        let line = error_line(&o);
+        assert!(line.starts_with("voxgi: error: "), "{args:?}: {line}");
+        for n in needles {
+            assert!(line.contains(n), "{args:?}: '{line}' lacks '{n}'");
+        }
+    }
+}
+
+#[test]
+fn absurd_arguments_are_refused_by_the_parser() {
+    for args in [
+        vec![
+            "render",
+            "--builtin",
+            "cornell-box",
+            "-o",
+            "a.png",
+            "--size",
+            "0x5",
+        ],
+        vec![
+            "render",
+            "--builtin",
+            "cornell-box",
+            "-o",
+            "a.png",
+            "--size",
+            "big",
+        ],
+        vec![
+            "render",
+            "--builtin",
+            "cornell-box",
+            "-o",
+            "a.png",
+            "--eye",
+            "1,2",
+        ],
+        vec![
+            "render",
+            "--builtin",
+            "cornell-box",
+            "-o",
+            "a.png",
+            "--exposure",
+            "nan-ish",
+        ],
+    ] {
+        let o = voxgi(&args);
+        assert!(!o.status.success(), "{args:?} was accepted");
+    }
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        tmp("b.png").to_str().unwrap(),
+        "--shadow-map-size",
+        "3",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        error_line(&o).contains("shadow map size 3"),
+        "{}",
+        error_line(&o)
+    );
+}
+
+#[test]
+fn info_reports_counts() {
+    let o = voxgi(&["info", "--builtin", "cornell-box"]);
+    assert!(o.status.success());
+    let s = String::from_utf8_lossy(&o.stdout);
+    // 5 walls x 2 + 2 blocks x 10 (top and four sides) + the light's 2 triangles.
+    assert!(s.contains("32 triangles drawn"), "{s}");
+    assert!(s.contains("ceiling light"), "{s}");
+    // 130 mm x 105 mm = 0.01365 m².
+    assert!(s.contains("area 0.013"), "{s}");
+}
