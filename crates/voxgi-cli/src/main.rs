@@ -103,6 +103,8 @@ enum ViewArg {
     Albedo,
     Normal,
     Direct,
+    Ao,
+    Indirect,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -192,6 +194,8 @@ fn render(args: &RenderArgs) -> Result<()> {
             ViewArg::Albedo => ViewMode::Albedo,
             ViewArg::Normal => ViewMode::Normal,
             ViewArg::Direct => ViewMode::Direct,
+            ViewArg::Ao => ViewMode::Ao,
+            ViewArg::Indirect => ViewMode::Indirect,
         },
         ..Settings::default()
     };

@@ -1,5 +1,5 @@
-// composite: deferred shading. Direct light from every light (with shadows) plus emission, in
-// linear radiance, written to the HDR target.
+// composite: deferred shading. Direct light from every light (with shadows), emission and the
+// gathered indirect light, in linear radiance, written to the HDR target.
 
 //!include shared/scene.wgsl
 //!include shared/lights.wgsl
@@ -13,11 +13,15 @@
 @group(0) @binding(6) var gb_emission: texture_2d<f32>;
 @group(0) @binding(7) var gb_depth: texture_depth_2d;
 @group(0) @binding(8) var hdr: texture_storage_2d<rgba32float, write>;
+// rgb: indirect radiance, a: ambient occlusion (from the gather pass).
+@group(0) @binding(9) var indirect: texture_2d<f32>;
 
 const VIEW_FINAL: u32 = 0u;
 const VIEW_ALBEDO: u32 = 1u;
 const VIEW_NORMAL: u32 = 2u;
 const VIEW_DIRECT: u32 = 3u;
+const VIEW_AO: u32 = 4u;
+const VIEW_INDIRECT: u32 = 5u;
 
 fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
     let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
@@ -49,7 +53,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < frame.light_count; i++) {
         direct += shade_light(lights[i], s, p, n, v, frame.shadow_softness);
     }
-    var out = direct + em.rgb;
+    let ind = textureLoad(indirect, px, 0);
+    var out = direct + em.rgb + ind.rgb;
     switch frame.view_mode {
         case VIEW_ALBEDO: {
             out = am.rgb;
@@ -59,6 +64,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         case VIEW_DIRECT: {
             out = direct;
+        }
+        case VIEW_AO: {
+            out = vec3<f32>(ind.a);
+        }
+        case VIEW_INDIRECT: {
+            out = ind.rgb;
         }
         default: {}
     }

@@ -1,18 +1,35 @@
-//! The renderer: uploads a scene once, then renders frames by calling the passes in a fixed
-//! order — shadow, gbuffer, composite, tonemap — from `Renderer::render`.
+//! The renderer: uploads a scene once, then renders frames by calling the passes in one fixed
+//! order from `Renderer::render`:
+//!
+//! shadow → voxelize → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
+//!        → gbuffer → gather → upsample → composite → tonemap
+//!
+//! The voxel passes (and the shadow maps they read) run when the scene changed — on the first
+//! frame, or every frame with `Settings::revoxelize_every_frame`.
 
 use crate::gpu::readback;
+use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
 use crate::output::RenderOutput;
+use crate::passes::bounce::BouncePass;
 use crate::passes::composite::{CompositePass, HDR_FORMAT};
+use crate::passes::filter::FilterPass;
+use crate::passes::gather::{GatherPass, INDIRECT_FORMAT};
 use crate::passes::gbuffer::{self, GbufferPass};
+use crate::passes::inject::InjectPass;
 use crate::passes::shadow::{self, ShadowAtlas, ShadowPass};
 use crate::passes::tonemap::{LDR_FORMAT, TonemapPass};
+use crate::passes::upsample::UpsamplePass;
+use crate::passes::voxelize::VoxelizePass;
+use crate::settings::UNLIMITED_BOUNCES;
 use crate::settings::{Settings, Tonemap, ViewMode, validate_size};
+use crate::voxel::dense::{DenseVolume, estimate_fragments, triangle_table};
+use crate::voxel::{GpuCones, Grid};
 use crate::{Error, GpuContext, Result};
 use glam::{Mat4, Vec3};
 use std::borrow::Cow;
 use voxgi_scene::{Camera, Projection, Scene};
+use wgpu::util::DeviceExt;
 
 /// Render targets of one output size.
 pub struct FrameTargets {
@@ -25,12 +42,16 @@ pub struct FrameTargets {
     pub depth: wgpu::TextureView,
     pub hdr: wgpu::TextureView,
     pub ldr: wgpu::TextureView,
+    /// Indirect light at full resolution (rgb) and ambient occlusion (a).
+    pub indirect: wgpu::TextureView,
+    /// The gather's half-resolution target, when gathering at half resolution.
+    pub indirect_low: Option<wgpu::TextureView>,
     hdr_texture: wgpu::Texture,
     ldr_texture: wgpu::Texture,
 }
 
 impl FrameTargets {
-    fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+    fn new(device: &wgpu::Device, width: u32, height: u32, half: bool) -> Self {
         let make = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -67,6 +88,24 @@ impl FrameTargets {
             normal: view(make("gbuffer normal", gbuffer::NORMAL_FORMAT, rt)),
             emission: view(make("gbuffer emission", gbuffer::EMISSION_FORMAT, rt)),
             depth: view(make("gbuffer depth", gbuffer::DEPTH_FORMAT, rt)),
+            indirect: view(make("indirect", INDIRECT_FORMAT, st)),
+            indirect_low: half.then(|| {
+                let low = device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("indirect half"),
+                    size: wgpu::Extent3d {
+                        width: width.div_ceil(2),
+                        height: height.div_ceil(2),
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: INDIRECT_FORMAT,
+                    usage: st,
+                    view_formats: &[],
+                });
+                low.create_view(&Default::default())
+            }),
             hdr: hdr_texture.create_view(&Default::default()),
             ldr: ldr_texture.create_view(&Default::default()),
             hdr_texture,
@@ -74,8 +113,21 @@ impl FrameTargets {
         }
     }
 
-    /// Bytes per pixel of all targets together.
-    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4;
+    /// Bytes per pixel of all full-resolution targets together.
+    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8;
+
+    /// Where the gather writes: the half-resolution target or the full one.
+    pub fn gather_target(&self) -> &wgpu::TextureView {
+        self.indirect_low.as_ref().unwrap_or(&self.indirect)
+    }
+
+    pub fn gather_size(&self) -> (u32, u32) {
+        if self.indirect_low.is_some() {
+            (self.width.div_ceil(2), self.height.div_ceil(2))
+        } else {
+            (self.width, self.height)
+        }
+    }
 }
 
 /// A scene uploaded to the GPU, ready to render from any camera.
@@ -89,6 +141,20 @@ pub struct Renderer {
     gbuffer: GbufferPass,
     composite: CompositePass,
     tonemap: TonemapPass,
+    voxelize: VoxelizePass,
+    inject: InjectPass,
+    filter: FilterPass,
+    bounce: BouncePass,
+    gather: GatherPass,
+    upsample: UpsamplePass,
+    volume: DenseVolume,
+    triangles: (wgpu::Buffer, u32),
+    cones: wgpu::Buffer,
+    /// Voxel bounces per update (the per-pixel gather adds the last bounce).
+    voxel_bounces: u32,
+    /// The voxels (and shadow maps) must be rebuilt before the next frame.
+    dirty: bool,
+    timer: GpuTimer,
     targets: Option<FrameTargets>,
     center: Vec3,
     radius: f32,
@@ -142,6 +208,28 @@ impl Renderer {
                 TonemapPass::new(&device),
             )
         })?;
+        let b = scene.bounds();
+        let grid = Grid::around(b.min, b.max, settings.voxel_resolution);
+        let capacity = fragment_capacity(&device, estimate_fragments(scene, &grid))?;
+        let voxel_passes = ctx.checked("voxel pipelines", || {
+            (
+                VoxelizePass::new(&device),
+                InjectPass::new(&device, gpu_scene.light_count),
+                FilterPass::new(&device),
+                BouncePass::new(&device),
+                GatherPass::new(&device),
+                UpsamplePass::new(&device),
+                DenseVolume::new(&device, grid, settings.anisotropic, capacity),
+                triangle_table(&device, &gpu_scene),
+            )
+        })?;
+        let voxel_bounces = voxel_bounce_count(scene, settings.bounces);
+        let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("cones"),
+            contents: bytemuck::bytes_of(&cone_uniforms(&settings, &grid)),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let timer = GpuTimer::disabled(&queue);
         let default_camera = scene
             .cameras
             .first()
@@ -157,6 +245,18 @@ impl Renderer {
             gbuffer: passes.1,
             composite: passes.2,
             tonemap: passes.3,
+            voxelize: voxel_passes.0,
+            inject: voxel_passes.1,
+            filter: voxel_passes.2,
+            bounce: voxel_passes.3,
+            gather: voxel_passes.4,
+            upsample: voxel_passes.5,
+            volume: voxel_passes.6,
+            triangles: voxel_passes.7,
+            cones,
+            voxel_bounces,
+            dirty: true,
+            timer,
             targets: None,
             center,
             radius,
@@ -188,6 +288,7 @@ impl Renderer {
     pub fn memory(&self) -> Vec<(&'static str, u64)> {
         let mut m = self.scene.memory();
         m.push(("shadow atlas", self.atlas.bytes()));
+        m.extend(self.volume.memory());
         if let Some(t) = &self.targets {
             m.push((
                 "render targets",
@@ -239,9 +340,123 @@ impl Renderer {
                 ViewMode::Albedo => 1,
                 ViewMode::Normal => 2,
                 ViewMode::Direct => 3,
+                ViewMode::Ao => 4,
+                ViewMode::Indirect => 5,
             },
             background: [s.background[0], s.background[1], s.background[2], 1.0],
         }
+    }
+
+    /// Shadow maps, voxelization, injection, filtering and voxel bounces: everything that
+    /// depends on the scene and its lights but not on the camera.
+    fn update_voxels(&mut self) -> Result<()> {
+        for attempt in 0..2 {
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("voxels"),
+                });
+            let timer = &mut self.timer;
+            self.shadow
+                .record(&self.device, &mut encoder, &self.atlas, &self.scene, timer);
+            self.volume.record_begin(&self.device, &mut encoder, timer);
+            let triangles = (&self.triangles.0, self.triangles.1);
+            self.voxelize.record(
+                &self.device,
+                &mut encoder,
+                &self.scene,
+                triangles,
+                &self.volume,
+                timer,
+            );
+            self.volume.record_build(&self.device, &mut encoder, timer);
+            self.queue.submit([encoder.finish()]);
+            // More fragments than room: grow to fit and voxelize again (never overrun).
+            let (emitted, _) = self.voxel_counts()?;
+            if emitted <= self.volume.fragment_capacity as u64 {
+                break;
+            }
+            if attempt == 1 {
+                return Err(Error::Gpu {
+                    context: "voxelize".into(),
+                    reason: format!("{emitted} fragments still overflow after growing"),
+                });
+            }
+            let capacity = fragment_capacity(&self.device, emitted + emitted / 8)?;
+            log::info!("voxel fragments: {emitted} > capacity, growing to {capacity}");
+            let grid = self.volume.grid;
+            self.volume = DenseVolume::new(&self.device, grid, self.volume.anisotropic, capacity);
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("light"),
+            });
+        let timer = &mut self.timer;
+        self.inject.record(
+            &self.device,
+            &mut encoder,
+            &self.scene,
+            &self.atlas,
+            &self.volume,
+            timer,
+        );
+        self.filter
+            .record(&self.device, &mut encoder, &self.volume, timer);
+        for _ in 0..self.voxel_bounces {
+            self.bounce
+                .record(&self.device, &mut encoder, &self.volume, &self.cones, timer);
+            self.filter
+                .record(&self.device, &mut encoder, &self.volume, timer);
+        }
+        self.queue.submit([encoder.finish()]);
+        self.dirty = false;
+        Ok(())
+    }
+
+    /// Voxel statistics of the last build: (fragments emitted, occupied voxels).
+    pub fn voxel_counts(&self) -> Result<(u64, u64)> {
+        let buf = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("counter readback"),
+            size: 16,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&self.volume.counters, 0, &buf, 0, 16);
+        self.queue.submit([enc.finish()]);
+        let bytes = readback::read_buffer(&self.device, &buf)?;
+        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        Ok((c[0] as u64, c[1] as u64))
+    }
+
+    /// The dense volume, for tests and debugging.
+    pub fn volume(&self) -> &DenseVolume {
+        &self.volume
+    }
+
+    /// The device and queue this renderer uses.
+    pub fn device(&self) -> (&wgpu::Device, &wgpu::Queue) {
+        (&self.device, &self.queue)
+    }
+
+    /// Turns per-pass GPU timing on or off (when the device supports timestamps).
+    pub fn enable_timing(&mut self, on: bool) {
+        self.timer = if on {
+            GpuTimer::new(&self.device, &self.queue, true)
+        } else {
+            GpuTimer::disabled(&self.queue)
+        };
+    }
+
+    /// Milliseconds per pass of everything recorded since the last call.
+    pub fn pass_times(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        self.timer.read(&self.device)
+    }
+
+    /// Marks lights or geometry as changed: the next frame rebuilds shadows and voxels.
+    pub fn invalidate(&mut self) {
+        self.dirty = true;
     }
 
     /// Renders one frame from `camera` at `width` x `height` and reads it back.
@@ -252,12 +467,14 @@ impl Renderer {
                 "camera position and direction must be finite".into(),
             ));
         }
-        if self
-            .targets
-            .as_ref()
-            .is_none_or(|t| t.width != width || t.height != height)
-        {
-            self.targets = Some(FrameTargets::new(&self.device, width, height));
+        let half = self.settings.half_resolution;
+        if self.targets.as_ref().is_none_or(|t| {
+            t.width != width || t.height != height || t.indirect_low.is_some() != half
+        }) {
+            self.targets = Some(FrameTargets::new(&self.device, width, height, half));
+        }
+        if self.dirty || self.settings.revoxelize_every_frame {
+            self.update_voxels()?;
         }
         let frame = self.frame_uniforms(camera, width, height);
         let t = self.targets.as_ref().expect("targets were just created");
@@ -268,14 +485,28 @@ impl Renderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("frame"),
             });
-        // The fixed pass order.
-        self.shadow
-            .record(&self.device, &mut encoder, &self.atlas, &self.scene);
+        let timer = &mut self.timer;
         self.gbuffer
-            .record(&self.device, &mut encoder, t, &self.scene);
-        self.composite
-            .record(&self.device, &mut encoder, t, &self.scene, &self.atlas);
-        self.tonemap.record(&self.device, &mut encoder, t);
+            .record(&self.device, &mut encoder, t, &self.scene, timer);
+        self.gather.record(
+            &self.device,
+            &mut encoder,
+            t,
+            &self.volume,
+            &self.cones,
+            timer,
+        );
+        self.upsample.record(&self.device, &mut encoder, t, timer);
+        self.composite.record(
+            &self.device,
+            &mut encoder,
+            t,
+            &self.scene,
+            &self.atlas,
+            timer,
+        );
+        self.tonemap.record(&self.device, &mut encoder, t, timer);
+        timer.resolve(&mut encoder);
         self.queue.submit([encoder.finish()]);
 
         let hdr_bytes = readback::read_texture(&self.device, &self.queue, &t.hdr_texture)?;
@@ -286,5 +517,58 @@ impl Renderer {
             hdr: bytemuck::cast_slice(&hdr_bytes).to_vec(),
             ldr,
         })
+    }
+}
+
+/// Checks a fragment capacity against the device's storage-buffer limit.
+fn fragment_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
+    let limit = device.limits().max_storage_buffer_binding_size as u64
+        / crate::voxel::dense::FRAGMENT_BYTES;
+    let cap = wanted.max(1024);
+    if cap > limit.min(u32::MAX as u64) {
+        return Err(Error::Setting(format!(
+            "the scene needs about {cap} voxel fragments at this resolution, more than this \
+             GPU's storage-buffer limit allows ({limit}); lower the voxel resolution"
+        )));
+    }
+    Ok(cap as u32)
+}
+
+/// Voxel-space bounces for a total of `bounces` indirect bounces (the gather adds one).
+fn voxel_bounce_count(scene: &Scene, bounces: u32) -> u32 {
+    if bounces != UNLIMITED_BOUNCES {
+        return bounces.saturating_sub(1);
+    }
+    // Until the energy left, max albedo^k, is below 0.1 %.
+    let rho = scene
+        .materials
+        .iter()
+        .map(|m| m.base_color[0].max(m.base_color[1]).max(m.base_color[2]))
+        .fold(0.0f32, f32::max)
+        .clamp(0.0, 0.99);
+    if rho <= 0.0 {
+        return 0;
+    }
+    ((1e-3f32.ln() / rho.ln()).ceil() as u32).clamp(1, 64)
+}
+
+/// The cone uniforms from the settings and the volume.
+pub fn cone_uniforms(settings: &Settings, grid: &Grid) -> GpuCones {
+    let axes = settings.cones.axes();
+    let weights = settings.cones.weights();
+    let mut dirs = [[0f32; 4]; 16];
+    for (i, (a, w)) in axes.iter().zip(&weights).enumerate().take(16) {
+        dirs[i] = [a.x, a.y, a.z, *w];
+    }
+    GpuCones {
+        dirs,
+        count: axes.len().min(16) as u32,
+        diffuse_tan: (settings.cones.aperture() * 0.5).tan(),
+        step_factor: settings.step_factor,
+        max_distance: settings.max_distance.unwrap_or(grid.extent() * 3f32.sqrt()),
+        ao_lambda: settings.ao_lambda,
+        ao_radius: settings.ao_radius.unwrap_or(grid.extent() * 0.25),
+        origin_offset: settings.origin_offset,
+        indirect: (settings.bounces > 0) as u32,
     }
 }

@@ -16,11 +16,15 @@ pub mod gpu_scene;
 pub mod output;
 pub mod passes;
 mod settings;
+pub mod voxel;
 
 pub use error::{Error, Result};
 pub use frame::{FrameTargets, Renderer};
 pub use gpu::GpuContext;
 pub use output::RenderOutput;
-pub use settings::{MAX_IMAGE_SIZE, Settings, Tonemap, ViewMode, validate_size};
+pub use settings::{
+    MAX_BOUNCES, MAX_IMAGE_SIZE, Settings, Tonemap, UNLIMITED_BOUNCES, ViewMode, validate_size,
+};
+pub use voxel::ConeSet;
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;

@@ -1,5 +1,6 @@
 //! Every knob of the renderer in one place, with documented defaults and range checks.
 
+use crate::voxel::ConeSet;
 use crate::{Error, Result};
 
 /// The curve that maps exposed linear radiance to display values.
@@ -26,7 +27,17 @@ pub enum ViewMode {
     Normal,
     /// Direct light only, without emission.
     Direct,
+    /// Ambient occlusion from the diffuse cones (white: open, black: occluded).
+    Ao,
+    /// Indirect light only.
+    Indirect,
 }
+
+/// `Settings::bounces` value for "until converged": voxel bounces are repeated until the
+/// energy left (the largest albedo to the power of the bounce count) is below 0.1 %.
+pub const UNLIMITED_BOUNCES: u32 = u32::MAX;
+/// Most bounces a finite setting may ask for.
+pub const MAX_BOUNCES: u32 = 8;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -45,6 +56,34 @@ pub struct Settings {
     pub max_texture_size: u32,
     /// Add a sun when the scene has no light and nothing emissive, instead of rendering black.
     pub default_light: bool,
+
+    /// Voxels per side of the volume at the finest level: a power of two in 16..=512.
+    /// Default 128.
+    pub voxel_resolution: u32,
+    /// Six directional values per voxel above the finest level (true, default) or one.
+    pub anisotropic: bool,
+    /// Diffuse cone set. Default: six cones of 60°.
+    pub cones: ConeSet,
+    /// Indirect bounces: 0 (direct light only) to 8, or `UNLIMITED_BOUNCES`. The last bounce is
+    /// the per-pixel gather; the others run in voxel space. Default 2.
+    pub bounces: u32,
+    /// Ambient occlusion radius in metres; `None`: a quarter of the volume's extent.
+    pub ao_radius: Option<f32>,
+    /// Ambient occlusion falloff lambda in 1/(1 + lambda r), per metre (>= 0). Default 0:
+    /// plain cosine-weighted visibility within the radius, what the AO reference computes.
+    pub ao_lambda: f32,
+    /// Cone sample step as a fraction of the cone's diameter (0.05..=2). Default 0.5.
+    pub step_factor: f32,
+    /// Cone origin offset along the normal, in finest voxels (0..=8): keeps a cone from seeing
+    /// its own surface's voxels. Default 1.5.
+    pub origin_offset: f32,
+    /// Longest cone in metres; `None`: the volume's diagonal.
+    pub max_distance: Option<f32>,
+    /// Gather indirect light at half resolution and upsample it edge-aware. Default false.
+    pub half_resolution: bool,
+    /// Voxelize, inject, filter and bounce every frame, not only when the scene changed
+    /// (for benchmarks of fully dynamic scenes).
+    pub revoxelize_every_frame: bool,
 }
 
 impl Default for Settings {
@@ -58,6 +97,17 @@ impl Default for Settings {
             view: ViewMode::Final,
             max_texture_size: 1024,
             default_light: true,
+            voxel_resolution: 128,
+            anisotropic: true,
+            cones: ConeSet::Six60,
+            bounces: 2,
+            ao_radius: None,
+            ao_lambda: 0.0,
+            step_factor: 0.5,
+            origin_offset: 1.5,
+            max_distance: None,
+            half_resolution: false,
+            revoxelize_every_frame: false,
         }
     }
 }

@@ -298,3 +298,38 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
     let vis = light_visibility(light, p, n, softness);
     return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l * vis;
 }
+
+// Irradiance (W/m^2) arriving at p with normal n from one light, shadows included. Used where
+// only Lambertian reflection matters (light injection into voxels).
+fn light_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> vec3<f32> {
+    if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+        if dot(p - light.position, light.direction) <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        let e = polygon_irradiance(light, p, n);
+        if e <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        return light.radiance * e * light_visibility(light, p, n, softness);
+    }
+    var l: vec3<f32>;
+    var e: vec3<f32>;
+    if light.kind == LIGHT_DIRECTIONAL {
+        l = -light.direction;
+        e = light.radiance;
+    } else {
+        let to = light.position - p;
+        let d2 = max(dot(to, to), 1e-8);
+        let d = sqrt(d2);
+        l = to / d;
+        e = light.radiance / d2 * range_window(d, light.range);
+        if light.kind == LIGHT_SPOT {
+            e *= spot_falloff(dot(-l, light.direction), light.cos_inner, light.cos_outer);
+        }
+    }
+    let n_dot_l = dot(n, l);
+    if n_dot_l <= 0.0 || all(e <= vec3<f32>(0.0)) {
+        return vec3<f32>(0.0);
+    }
+    return e * n_dot_l * light_visibility(light, p, n, softness);
+}

@@ -89,3 +89,33 @@ pub fn entries<'a>(resources: Vec<wgpu::BindingResource<'a>>) -> Vec<wgpu::BindG
         })
         .collect()
 }
+
+pub fn storage_texture_3d(binding: u32, format: wgpu::TextureFormat) -> Entry {
+    Entry {
+        binding,
+        visibility: ShaderStages::COMPUTE,
+        ty: BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D3,
+        },
+        count: None,
+    }
+}
+
+/// A 3D float texture read with textureLoad only.
+pub fn texture_3d_load(binding: u32, visibility: ShaderStages) -> Entry {
+    texture(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D3,
+    )
+}
+
+/// Workgroup counts for `n` threads of `group` lanes in a 2D grid (65535 per dimension).
+pub fn groups_2d(n: u32, group: u32) -> (u32, u32) {
+    let g = n.div_ceil(group).max(1);
+    let x = g.min(65535);
+    (x, g.div_ceil(x))
+}

@@ -2,27 +2,33 @@
 //! lines, which are replaced by those files (each at most once). Tiny on purpose: WGSL has no
 //! modules yet, and this is all voxgi needs.
 
+macro_rules! wgsl {
+    ($($path:literal),* $(,)?) => {
+        &[$(($path, include_str!(concat!("../../shaders/", $path)))),*]
+    };
+}
+
 /// Every WGSL file, by path relative to `crates/voxgi/shaders`.
-const SOURCES: &[(&str, &str)] = &[
-    (
-        "shared/scene.wgsl",
-        include_str!("../../shaders/shared/scene.wgsl"),
-    ),
-    (
-        "shared/brdf.wgsl",
-        include_str!("../../shaders/shared/brdf.wgsl"),
-    ),
-    (
-        "shared/lights.wgsl",
-        include_str!("../../shaders/shared/lights.wgsl"),
-    ),
-    ("shadow.wgsl", include_str!("../../shaders/shadow.wgsl")),
-    ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
-    (
-        "composite.wgsl",
-        include_str!("../../shaders/composite.wgsl"),
-    ),
-    ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+const SOURCES: &[(&str, &str)] = wgsl![
+    "shared/scene.wgsl",
+    "shared/brdf.wgsl",
+    "shared/lights.wgsl",
+    "shared/volume.wgsl",
+    "shared/fragment.wgsl",
+    "shared/dense_sample.wgsl",
+    "shared/cone.wgsl",
+    "shadow.wgsl",
+    "gbuffer.wgsl",
+    "voxelize.wgsl",
+    "dense_build.wgsl",
+    "inject.wgsl",
+    "filter.wgsl",
+    "bounce.wgsl",
+    "bounce_store.wgsl",
+    "gather.wgsl",
+    "upsample.wgsl",
+    "composite.wgsl",
+    "tonemap.wgsl",
 ];
 
 fn raw(name: &str) -> &'static str {

@@ -1,6 +1,7 @@
 //! composite: deferred shading of direct light and emission into the HDR target.
 
 use crate::frame::FrameTargets;
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::passes::shadow::ShadowAtlas;
@@ -37,6 +38,7 @@ impl CompositePass {
                     wgpu::TextureViewDimension::D2,
                 ),
                 layout::storage_texture(8, HDR_FORMAT),
+                layout::texture_2d_load(9, c),
             ],
         });
         let pipeline = compute_pipeline(device, "composite", "composite.wgsl", &layout);
@@ -50,6 +52,7 @@ impl CompositePass {
         t: &FrameTargets,
         scene: &GpuScene,
         atlas: &ShadowAtlas,
+        timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),
@@ -64,11 +67,12 @@ impl CompositePass {
                 wgpu::BindingResource::TextureView(&t.emission),
                 wgpu::BindingResource::TextureView(&t.depth),
                 wgpu::BindingResource::TextureView(&t.hdr),
+                wgpu::BindingResource::TextureView(&t.indirect),
             ]),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("composite"),
-            timestamp_writes: None,
+            timestamp_writes: timer.compute("composite"),
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);

@@ -1,6 +1,7 @@
 //! gbuffer: rasterizes all mesh instances into the G-buffer.
 
 use crate::frame::FrameTargets;
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 
@@ -83,6 +84,7 @@ impl GbufferPass {
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
         scene: &GpuScene,
+        timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
@@ -118,7 +120,7 @@ impl GbufferPass {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: None,
+            timestamp_writes: timer.render("gbuffer"),
             occlusion_query_set: None,
             multiview_mask: None,
         });

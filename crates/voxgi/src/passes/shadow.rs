@@ -2,6 +2,7 @@
 //! Directional lights get an orthographic view fitted to the scene, spot lights a perspective
 //! one, point and area lights six (a cube around the light).
 
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::{
     GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT, LIGHT_SPOT,
@@ -322,6 +323,7 @@ impl ShadowPass {
         encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         scene: &GpuScene,
+        timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow"),
@@ -362,7 +364,7 @@ impl ShadowPass {
                     }),
                     stencil_ops: None,
                 }),
-                timestamp_writes: None,
+                timestamp_writes: timer.render("shadow"),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });

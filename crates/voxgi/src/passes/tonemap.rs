@@ -2,6 +2,7 @@
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
 use crate::passes::composite::compute_pipeline;
 
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -31,6 +32,7 @@ impl TonemapPass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
+        timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tonemap"),
@@ -43,7 +45,7 @@ impl TonemapPass {
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tonemap"),
-            timestamp_writes: None,
+            timestamp_writes: timer.compute("tonemap"),
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);

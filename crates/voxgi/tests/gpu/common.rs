@@ -39,11 +39,14 @@ pub fn plane_scene(albedo: f32) -> Scene {
     s
 }
 
-/// Settings for measurements: no tone curve, no default light.
+/// Settings for measuring direct light: no tone curve, no default light, no indirect light,
+/// a small volume (the voxel passes still run).
 pub fn measuring() -> Settings {
     Settings {
         tonemap: voxgi::Tonemap::Clamp,
         default_light: false,
+        bounces: 0,
+        voxel_resolution: 32,
         ..Settings::default()
     }
 }

@@ -4,6 +4,7 @@
 use voxgi::gpu::shader;
 use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuVertex};
 use voxgi::passes::shadow::GpuShadowView;
+use voxgi::voxel::{GpuCones, GpuVolume};
 
 fn parse(name: &str) -> naga::Module {
     let src = shader::compose(name);
@@ -29,7 +30,8 @@ fn every_shader_validates() {
 
 #[test]
 fn wgsl_struct_sizes() {
-    let module = parse("composite.wgsl");
+    // gather.wgsl includes every shared struct file.
+    let module = parse("gather.wgsl");
     let size_of_wgsl = |name: &str| -> u32 {
         module
             .types
@@ -46,7 +48,8 @@ fn wgsl_struct_sizes() {
         ("Draw", size_of::<GpuDraw>()),
         ("Material", size_of::<GpuMaterial>()),
         ("Light", size_of::<GpuLight>()),
-        ("ShadowView", size_of::<GpuShadowView>()),
+        ("Volume", size_of::<GpuVolume>()),
+        ("Cones", size_of::<GpuCones>()),
     ];
     for (name, rust) in cases {
         assert_eq!(

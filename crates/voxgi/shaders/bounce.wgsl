@@ -1,0 +1,50 @@
+// bounce: one more bounce of light in voxel space. Each occupied voxel gathers irradiance with
+// the diffuse cones from the filtered volume and re-emits albedo/pi of it on top of its direct
+// light; `store` then writes the results into the finest level for re-filtering.
+
+//!include shared/scene.wgsl
+//!include shared/volume.wgsl
+//!include shared/dense_sample.wgsl
+//!include shared/cone.wgsl
+
+@group(0) @binding(0) var<uniform> vol: Volume;
+@group(0) @binding(1) var<uniform> cones: Cones;
+@group(0) @binding(2) var radiance0: texture_3d<f32>;
+@group(0) @binding(3) var aniso_px: texture_3d<f32>;
+@group(0) @binding(4) var aniso_nx: texture_3d<f32>;
+@group(0) @binding(5) var aniso_py: texture_3d<f32>;
+@group(0) @binding(6) var aniso_ny: texture_3d<f32>;
+@group(0) @binding(7) var aniso_pz: texture_3d<f32>;
+@group(0) @binding(8) var aniso_nz: texture_3d<f32>;
+@group(0) @binding(9) var voxel_sampler: sampler;
+@group(0) @binding(10) var albedo_tex: texture_3d<f32>;
+@group(0) @binding(11) var normal_tex: texture_3d<f32>;
+@group(0) @binding(12) var<storage, read> slot_voxel: array<u32>;
+@group(0) @binding(13) var<storage, read> counters: array<u32>;
+@group(0) @binding(14) var<storage, read> slot_direct: array<vec4<f32>>;
+@group(0) @binding(15) var<storage, read_write> slot_next: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = gid.x + gid.y * nwg.x * 64u;
+    if s >= counters[1] {
+        return;
+    }
+    let c = voxel_coord(slot_voxel[s], vol.resolution);
+    let albedo = textureLoad(albedo_tex, c, 0);
+    let nw = textureLoad(normal_tex, c, 0);
+    let center = voxel_center(c, vol);
+    var e = vec3<f32>(0.0);
+    if nw.w > 0.3 {
+        let n = normalize(nw.xyz);
+        // A fixed bundle orientation per voxel, varied between voxels to break up patterns.
+        let angle = fract(f32(s) * 0.6180339887) * 2.0 * PI;
+        e = gather_diffuse(center, n, angle, false).irradiance;
+    } else {
+        // Two-sided voxel: half the light from each side.
+        let n = vec3<f32>(0.0, 1.0, 0.0);
+        e = 0.5 * (gather_diffuse(center, n, 0.0, false).irradiance + gather_diffuse(center, -n, 0.0, false).irradiance);
+    }
+    let direct = slot_direct[s];
+    slot_next[s] = vec4<f32>(direct.rgb + albedo.rgb / PI * e * direct.a, direct.a);
+}

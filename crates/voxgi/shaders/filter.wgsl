@@ -1,0 +1,56 @@
+// filter: builds the volume's mip levels from the finest one. Isotropic: the mean of the 2x2x2
+// children. Anisotropic (Crassin et al. 2011, section 9): per direction, the children are first
+// composited front to back along it, two at a time, then the four results are averaged, so a
+// one-voxel wall stays opaque across itself at coarser levels instead of turning half
+// transparent.
+
+struct FilterParams {
+    // 0: isotropic mean, 1: directional.
+    mode: u32,
+    // 0 +X, 1 -X, 2 +Y, 3 -Y, 4 +Z, 5 -Z: the direction the cone travels.
+    dir: u32,
+    // Voxels per side of the level written.
+    dst_res: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: FilterParams;
+@group(0) @binding(1) var src: texture_3d<f32>;
+@group(0) @binding(2) var dst: texture_storage_3d<rgba16float, write>;
+
+fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
+    return textureLoad(src, base + o, 0);
+}
+
+@compute @workgroup_size(4, 4, 4)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if any(gid >= vec3<u32>(params.dst_res)) {
+        return;
+    }
+    let base = vec3<i32>(gid) * 2;
+    if params.mode == 0u {
+        var sum = vec4<f32>(0.0);
+        for (var i = 0; i < 8; i++) {
+            sum += child(base, vec3<i32>(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+        }
+        textureStore(dst, gid, sum * 0.125);
+        return;
+    }
+    let axis = i32(params.dir / 2u);
+    let positive = (params.dir & 1u) == 0u;
+    var sum = vec4<f32>(0.0);
+    for (var i = 0; i < 4; i++) {
+        var front = vec3<i32>(0);
+        var back = vec3<i32>(0);
+        // The two other axes take the column's offsets.
+        front[(axis + 1) % 3] = i & 1;
+        front[(axis + 2) % 3] = i >> 1;
+        back = front;
+        front[axis] = select(1, 0, positive);
+        back[axis] = select(0, 1, positive);
+        let f = child(base, front);
+        let b = child(base, back);
+        sum += f + (1.0 - f.a) * b;
+    }
+    textureStore(dst, gid, sum * 0.25);
+}

@@ -1,0 +1,87 @@
+// gather: per pixel (or per 2x2 block at half resolution), indirect light from the voxels:
+// diffuse cones (irradiance and ambient occlusion) and one glossy cone along the mirror
+// direction whose aperture follows the roughness.
+
+//!include shared/scene.wgsl
+//!include shared/volume.wgsl
+//!include shared/brdf.wgsl
+//!include shared/dense_sample.wgsl
+//!include shared/cone.wgsl
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<uniform> vol: Volume;
+@group(0) @binding(2) var<uniform> cones: Cones;
+@group(0) @binding(3) var radiance0: texture_3d<f32>;
+@group(0) @binding(4) var aniso_px: texture_3d<f32>;
+@group(0) @binding(5) var aniso_nx: texture_3d<f32>;
+@group(0) @binding(6) var aniso_py: texture_3d<f32>;
+@group(0) @binding(7) var aniso_ny: texture_3d<f32>;
+@group(0) @binding(8) var aniso_pz: texture_3d<f32>;
+@group(0) @binding(9) var aniso_nz: texture_3d<f32>;
+@group(0) @binding(10) var voxel_sampler: sampler;
+@group(0) @binding(11) var gb_albedo: texture_2d<f32>;
+@group(0) @binding(12) var gb_normal: texture_2d<f32>;
+@group(0) @binding(13) var gb_emission: texture_2d<f32>;
+@group(0) @binding(14) var gb_depth: texture_depth_2d;
+// rgb: indirect radiance towards the camera, a: ambient occlusion.
+@group(0) @binding(15) var indirect_out: texture_storage_2d<rgba16float, write>;
+
+fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
+    let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let w = frame.inv_view_proj * ndc;
+    return w.xyz / w.w;
+}
+
+// Jimenez's interleaved gradient noise: a per-pixel bundle rotation that is deterministic and
+// spreads the cones' directions evenly over neighbouring pixels.
+fn ign(p: vec2<f32>) -> f32 {
+    return fract(52.9829189 * fract(dot(p, vec2<f32>(0.06711056, 0.00583715))));
+}
+
+// Karis's analytic fit of the split-sum environment BRDF.
+fn env_brdf(f0: vec3<f32>, roughness: f32, n_dot_v: f32) -> vec3<f32> {
+    let c0 = vec4<f32>(-1.0, -0.0275, -0.572, 0.022);
+    let c1 = vec4<f32>(1.0, 0.0425, 1.04, -0.04);
+    let r = roughness * c0 + c1;
+    let a004 = min(r.x * r.x, exp2(-9.28 * n_dot_v)) * r.x + r.y;
+    let ab = vec2<f32>(-1.04, 1.04) * a004 + r.zw;
+    return f0 * ab.x + ab.y;
+}
+
+const VIEW_AO: u32 = 4u;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let out_size = textureDimensions(indirect_out);
+    if any(gid.xy >= out_size) {
+        return;
+    }
+    let scale = u32(frame.size.x) / out_size.x;
+    let px = min(gid.xy * scale, vec2<u32>(frame.size) - 1u);
+    let depth = textureLoad(gb_depth, px, 0);
+    if depth >= 1.0 {
+        textureStore(indirect_out, gid.xy, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    let am = textureLoad(gb_albedo, px, 0);
+    let nr = textureLoad(gb_normal, px, 0);
+    let em = textureLoad(gb_emission, px, 0);
+    let s = Surface(am.rgb, am.a, nr.w, em.a);
+    let p = world_position(px, depth);
+    let n = normalize(nr.xyz);
+    let v = normalize(frame.camera_pos - p);
+    let angle = ign(vec2<f32>(gid.xy)) * 2.0 * PI;
+    let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO);
+    var indirect = brdf_diffuse(s) * g.irradiance;
+    let f0 = f0_of(s);
+    if cones.indirect != 0u && max(f0.r, max(f0.g, f0.b)) > 0.0 {
+        let r = reflect(-v, n);
+        // Cone half-angle from the GGX lobe width, no narrower than a voxel allows anyway.
+        let tan_half = clamp(ggx_alpha(s.roughness), 0.01, 1.0);
+        let origin = p + n * vol.voxel_size * cones.origin_offset;
+        let spec = trace_cone(origin, r, tan_half, cones.max_distance).rgb;
+        indirect += spec * env_brdf(f0, s.roughness, max(dot(n, v), 1e-4));
+    }
+    textureStore(indirect_out, gid.xy, vec4<f32>(indirect, g.ao));
+}

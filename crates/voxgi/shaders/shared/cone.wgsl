@@ -1,0 +1,90 @@
+// Cone tracing, written once against sample_voxels(position, diameter, direction).
+
+// Front-to-back accumulation of one cone. Returns premultiplied radiance (rgb) and opacity (a).
+// Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
+// length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d).
+fn trace_cone(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -> vec4<f32> {
+    var acc = vec4<f32>(0.0);
+    var t = vol.voxel_size;
+    let min_d = vol.voxel_size;
+    for (var i = 0u; i < 512u; i++) {
+        if t >= max_dist || acc.a >= 0.995 {
+            break;
+        }
+        let d = max(min_d, 2.0 * tan_half * t);
+        let s = sample_voxels(origin + dir * t, d, dir);
+        let step = max(d * cones.step_factor, vol.voxel_size * 0.25);
+        let a = clamp(s.a, 0.0, 1.0);
+        var corrected = vec4<f32>(0.0);
+        if a > 1e-5 {
+            let ca = 1.0 - pow(1.0 - min(a, 0.9999), step / d);
+            corrected = vec4<f32>(s.rgb * (ca / a), ca);
+        }
+        acc += (1.0 - acc.a) * corrected;
+        t += step;
+    }
+    return acc;
+}
+
+// Ambient occlusion along one cone: opacity weighted by 1/(1 + lambda r), up to ao_radius.
+fn trace_ao(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f32 {
+    var occ = 0.0;
+    var t = vol.voxel_size;
+    for (var i = 0u; i < 256u; i++) {
+        if t >= cones.ao_radius || occ >= 0.995 {
+            break;
+        }
+        let d = max(vol.voxel_size, 2.0 * tan_half * t);
+        let s = sample_voxels(origin + dir * t, d, dir);
+        let step = max(d * cones.step_factor, vol.voxel_size * 0.25);
+        let a = clamp(s.a, 0.0, 0.9999);
+        let ca = 1.0 - pow(1.0 - a, step / d);
+        occ += (1.0 - occ) * ca / (1.0 + cones.ao_lambda * t);
+        t += step;
+    }
+    return occ;
+}
+
+fn tangent_frame(n: vec3<f32>) -> mat3x3<f32> {
+    // Duff et al.'s branchless orthonormal basis.
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    let t = vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+    let bt = vec3<f32>(b, s + n.y * n.y * a, -n.y);
+    return mat3x3<f32>(t, bt, n);
+}
+
+fn rotate_z(v: vec3<f32>, angle: f32) -> vec3<f32> {
+    let c = cos(angle);
+    let s = sin(angle);
+    return vec3<f32>(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+}
+
+struct Gathered {
+    // Irradiance from the cones, W/m^2.
+    irradiance: vec3<f32>,
+    // Cosine-weighted visibility in [0, 1].
+    ao: f32,
+}
+
+// Irradiance at a surface point from all diffuse cones, the bundle rotated by `angle` about n.
+fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool) -> Gathered {
+    let frame = tangent_frame(n);
+    let origin = p + n * vol.voxel_size * cones.origin_offset;
+    var e = vec3<f32>(0.0);
+    var occ = 0.0;
+    for (var i = 0u; i < cones.count; i++) {
+        let c = cones.dirs[i];
+        let d = normalize(frame * rotate_z(c.xyz, angle));
+        if cones.indirect != 0u {
+            let r = trace_cone(origin, d, cones.diffuse_tan, cones.max_distance);
+            // Weights are fractions of the cosine-weighted hemisphere, whose integral is pi.
+            e += PI * c.w * r.rgb;
+        }
+        if with_ao {
+            occ += c.w * trace_ao(origin, d, cones.diffuse_tan);
+        }
+    }
+    return Gathered(e, 1.0 - occ);
+}

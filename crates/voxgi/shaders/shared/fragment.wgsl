@@ -1,0 +1,61 @@
+// Voxel fragments: the one interface between geometry (meshes, points) and voxel structures.
+// 16 bytes: voxel coordinates, albedo + opacity, normal, emission.
+
+struct Fragment {
+    // x | y << 10 | z << 20, finest-level voxel coordinates.
+    coord: u32,
+    // pack4x8unorm(albedo.rgb, opacity), albedo linear.
+    albedo: u32,
+    // pack2x16snorm of the octahedral encoding of the unit normal.
+    normal: u32,
+    // Emitted radiance as RGB9E5.
+    emission: u32,
+}
+
+fn pack_coord(c: vec3<u32>) -> u32 {
+    return c.x | (c.y << 10u) | (c.z << 20u);
+}
+
+fn unpack_coord(v: u32) -> vec3<u32> {
+    return vec3<u32>(v & 1023u, (v >> 10u) & 1023u, (v >> 20u) & 1023u);
+}
+
+fn oct_encode(n: vec3<f32>) -> vec2<f32> {
+    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z >= 0.0 {
+        return p;
+    }
+    return (vec2<f32>(1.0) - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+}
+
+fn oct_decode(e: vec2<f32>) -> vec3<f32> {
+    var n = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    if n.z < 0.0 {
+        let xy = (vec2<f32>(1.0) - abs(n.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), n.xy >= vec2<f32>(0.0));
+        n = vec3<f32>(xy, n.z);
+    }
+    return normalize(n);
+}
+
+// Shared-exponent RGB: 9-bit mantissas, 5-bit exponent (bias 15), as in the GL format.
+fn pack_rgb9e5(c_in: vec3<f32>) -> u32 {
+    let c = clamp(c_in, vec3<f32>(0.0), vec3<f32>(65408.0));
+    let m = max(c.r, max(c.g, c.b));
+    if m < 1e-9 {
+        return 0u;
+    }
+    var e = max(-16, i32(floor(log2(m)))) + 1;
+    var scale = exp2(f32(e - 9));
+    if u32(floor(m / scale + 0.5)) >= 512u {
+        e += 1;
+        scale = exp2(f32(e - 9));
+    }
+    let q = vec3<u32>(floor(c / scale + 0.5));
+    return min(q.r, 511u) | (min(q.g, 511u) << 9u) | (min(q.b, 511u) << 18u) | (u32(e + 15) << 27u);
+}
+
+fn unpack_rgb9e5(v: u32) -> vec3<f32> {
+    let e = i32(v >> 27u) - 15;
+    let scale = exp2(f32(e - 9));
+    return vec3<f32>(f32(v & 511u), f32((v >> 9u) & 511u), f32((v >> 18u) & 511u)) * scale;
+}

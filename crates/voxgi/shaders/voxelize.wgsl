@@ -1,0 +1,186 @@
+// voxelize: every mesh triangle -> voxel fragments at the finest resolution.
+//
+// Conservative and exact: a fragment is emitted for every voxel whose closed box the triangle
+// touches (Akenine-Moller's separating-axis test), so thin and axis-aligned triangles leave no
+// holes and the result does not depend on rasterization rules. One workgroup per triangle; its
+// threads share the triangle's columns along the dominant axis, where the triangle's plane
+// spans at most three voxels.
+
+//!include shared/scene.wgsl
+//!include shared/volume.wgsl
+//!include shared/fragment.wgsl
+
+@group(0) @binding(0) var<uniform> vol: Volume;
+@group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
+@group(0) @binding(2) var<storage, read> indices: array<u32>;
+@group(0) @binding(3) var<storage, read> draws: array<Draw>;
+@group(0) @binding(4) var<storage, read> materials: array<Material>;
+@group(0) @binding(5) var textures: texture_2d_array<f32>;
+@group(0) @binding(6) var texture_sampler: sampler;
+// Per triangle: draw index, first index, base vertex, unused.
+@group(0) @binding(7) var<storage, read> triangles: array<vec4<u32>>;
+@group(0) @binding(8) var<storage, read_write> fragments: array<Fragment>;
+// [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
+@group(0) @binding(9) var<storage, read_write> counters: array<atomic<u32>>;
+// Per voxel: 0 empty, 1 has fragments (the dense build assigns slots later).
+@group(0) @binding(10) var<storage, read_write> occupancy: array<atomic<u32>>;
+
+// Does the triangle (relative to the box centre) overlap the box of half-size h along axis a?
+fn separated(a: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, h: f32) -> bool {
+    let p0 = dot(v0, a);
+    let p1 = dot(v1, a);
+    let p2 = dot(v2, a);
+    let r = h * (abs(a.x) + abs(a.y) + abs(a.z));
+    return min(p0, min(p1, p2)) > r || max(p0, max(p1, p2)) < -r;
+}
+
+// Triangle / axis-aligned box overlap by the 13 separating axes (Akenine-Moller 2001).
+fn tri_box_overlap(center: vec3<f32>, h: f32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> bool {
+    let v0 = a - center;
+    let v1 = b - center;
+    let v2 = c - center;
+    let e0 = v1 - v0;
+    let e1 = v2 - v1;
+    let e2 = v0 - v2;
+    var axes = array<vec3<f32>, 3>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+    var edges = array<vec3<f32>, 3>(e0, e1, e2);
+    for (var i = 0u; i < 3u; i++) {
+        if separated(axes[i], v0, v1, v2, h) {
+            return false;
+        }
+        for (var j = 0u; j < 3u; j++) {
+            let ax = cross(axes[i], edges[j]);
+            if dot(ax, ax) > 1e-20 && separated(ax, v0, v1, v2, h) {
+                return false;
+            }
+        }
+    }
+    let n = cross(e0, e1);
+    return !separated(n, v0, v1, v2, h);
+}
+
+@compute @workgroup_size(64)
+fn main(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let t = wg.x + wg.y * nwg.x;
+    if t >= arrayLength(&triangles) {
+        return;
+    }
+    let info = triangles[t];
+    let draw = draws[info.x];
+    let m = materials[draw.material];
+    let ia = indices[info.y] + info.z;
+    let ib = indices[info.y + 1u] + info.z;
+    let ic = indices[info.y + 2u] + info.z;
+    let va = vertices[ia];
+    let vb = vertices[ib];
+    let vc = vertices[ic];
+    let wa = (draw.model * vec4<f32>(va.position, 1.0)).xyz;
+    let wb = (draw.model * vec4<f32>(vb.position, 1.0)).xyz;
+    let wc = (draw.model * vec4<f32>(vc.position, 1.0)).xyz;
+    // Voxel space: the finest voxel is the unit cube.
+    let inv = 1.0 / vol.voxel_size;
+    let a = (wa - vol.origin) * inv;
+    let b = (wb - vol.origin) * inv;
+    let c = (wc - vol.origin) * inv;
+    let cr = cross(b - a, c - a);
+    let area2 = length(cr);
+    if area2 < 1e-12 {
+        return;
+    }
+    var n = cr / area2;
+    // Orient the geometric normal like the shading normals, which files get right more often
+    // than winding.
+    let sn = (draw.normal_matrix * vec4<f32>(va.normal + vb.normal + vc.normal, 0.0)).xyz;
+    if dot(n, sn) < 0.0 {
+        n = -n;
+    }
+
+    // Texture level of detail: about one texel per voxel.
+    let uv_area2 = abs((vb.u - va.u) * (vc.v - va.v) - (vc.u - va.u) * (vb.v - va.v));
+    let tex_size = f32(textureDimensions(textures).x);
+    let texels_per_voxel = sqrt(uv_area2 / area2) * tex_size;
+    let lod = max(log2(max(texels_per_voxel, 1e-6)), 0.0);
+
+    // Dominant axis w and the two others (u, v).
+    let an = abs(n);
+    var w = 2u;
+    if an.x >= an.y && an.x >= an.z {
+        w = 0u;
+    } else if an.y >= an.z {
+        w = 1u;
+    }
+    let u = (w + 1u) % 3u;
+    let v = (w + 2u) % 3u;
+    let res = i32(vol.resolution);
+    let lo = max(vec3<i32>(floor(min(a, min(b, c)))), vec3<i32>(0));
+    let hi = min(vec3<i32>(floor(max(a, max(b, c)))), vec3<i32>(res - 1));
+    if any(hi < lo) {
+        return;
+    }
+    let nu = u32(hi[u] - lo[u] + 1);
+    let nv = u32(hi[v] - lo[v] + 1);
+    let total = nu * nv;
+    let d = dot(n, a);
+    for (var k = lane; k < total; k += 64u) {
+        let cu = lo[u] + i32(k % nu);
+        let cv = lo[v] + i32(k / nu);
+        // The plane's depth over the column's square (|n_w| is the largest component, so the
+        // span is at most two voxels).
+        var zmin = 1e30;
+        var zmax = -1e30;
+        for (var q = 0u; q < 4u; q++) {
+            let pu = f32(cu) + f32(q & 1u);
+            let pv = f32(cv) + f32(q >> 1u);
+            let z = (d - n[u] * pu - n[v] * pv) / n[w];
+            zmin = min(zmin, z);
+            zmax = max(zmax, z);
+        }
+        let z0 = max(i32(floor(zmin)), lo[w]);
+        let z1 = min(i32(floor(zmax)), hi[w]);
+        for (var cz = z0; cz <= min(z1, z0 + 3); cz++) {
+            var cell = vec3<i32>(0);
+            cell[u] = cu;
+            cell[v] = cv;
+            cell[w] = cz;
+            let center = vec3<f32>(cell) + 0.5;
+            if !tri_box_overlap(center, 0.5, a, b, c) {
+                continue;
+            }
+            // Attributes at the voxel centre's projection onto the triangle (barycentrics
+            // clamped to the triangle).
+            let q = center - n * dot(center - a, n);
+            let l1 = dot(cross(q - a, c - a), n) / area2;
+            let l2 = dot(cross(b - a, q - a), n) / area2;
+            var bary = max(vec3<f32>(1.0 - l1 - l2, l1, l2), vec3<f32>(0.0));
+            bary /= max(bary.x + bary.y + bary.z, 1e-6);
+            let uv = bary.x * vec2<f32>(va.u, va.v) + bary.y * vec2<f32>(vb.u, vb.v) + bary.z * vec2<f32>(vc.u, vc.v);
+            var albedo = m.base_color;
+            if m.base_texture >= 0 {
+                albedo *= textureSampleLevel(textures, texture_sampler, uv, m.base_texture, lod);
+            }
+            if albedo.a < m.alpha_cutoff {
+                continue;
+            }
+            var emission = m.emissive;
+            if m.emissive_texture >= 0 {
+                emission *= textureSampleLevel(textures, texture_sampler, uv, m.emissive_texture, lod).rgb;
+            }
+            let coord = vec3<u32>(cell);
+            let slot = atomicAdd(&counters[0], 1u);
+            if slot < vol.fragment_capacity {
+                fragments[slot] = Fragment(
+                    pack_coord(coord),
+                    // Voxels bounce light diffusely: metals' diffuse albedo is zero.
+                    pack4x8unorm(vec4<f32>(albedo.rgb * (1.0 - m.metallic), 1.0)),
+                    pack2x16snorm(oct_encode(n)),
+                    pack_rgb9e5(emission),
+                );
+                atomicStore(&occupancy[voxel_index(coord, vol.resolution)], 1u);
+            }
+        }
+    }
+}

@@ -1,0 +1,102 @@
+//! bounce: one bounce of light in voxel space over the occupied voxels, then `bounce_store`
+//! writes the result into the finest level (a separate dispatch: the volume cannot be sampled
+//! and written in one).
+
+use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
+use crate::passes::composite::compute_pipeline;
+use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
+
+pub struct BouncePass {
+    gather: wgpu::ComputePipeline,
+    gather_layout: wgpu::BindGroupLayout,
+    store: wgpu::ComputePipeline,
+    store_layout: wgpu::BindGroupLayout,
+}
+
+impl BouncePass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![layout::uniform(0, c, false), layout::uniform(1, c, false)];
+        entries.extend(DenseVolume::sampling_layout(2, c));
+        entries.extend([
+            layout::texture_3d_load(10, c),
+            layout::texture_3d_load(11, c),
+            layout::storage(12, c, true),
+            layout::storage(13, c, true),
+            layout::storage(14, c, true),
+            layout::storage(15, c, false),
+        ]);
+        let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bounce"),
+            entries: &entries,
+        });
+        let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bounce_store"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::storage(1, c, true),
+                layout::storage(2, c, true),
+                layout::storage(3, c, true),
+                layout::storage_texture_3d(4, RADIANCE_FORMAT),
+            ],
+        });
+        BouncePass {
+            gather: compute_pipeline(device, "bounce", "bounce.wgsl", &gather_layout),
+            store: compute_pipeline(device, "bounce", "bounce_store.wgsl", &store_layout),
+            gather_layout,
+            store_layout,
+        }
+    }
+
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        vol: &DenseVolume,
+        cones: &wgpu::Buffer,
+        timer: &mut GpuTimer,
+    ) {
+        let views = vol.sampling_views();
+        let v = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (albedo, normal) = (v(&vol.albedo), v(&vol.normal));
+        let mut res = vec![vol.volume.as_entire_binding(), cones.as_entire_binding()];
+        res.extend(views.iter().map(wgpu::BindingResource::TextureView));
+        res.extend([
+            wgpu::BindingResource::Sampler(&vol.sampler),
+            wgpu::BindingResource::TextureView(&albedo),
+            wgpu::BindingResource::TextureView(&normal),
+            vol.slot_voxel.as_entire_binding(),
+            vol.counters.as_entire_binding(),
+            vol.slot_direct.as_entire_binding(),
+            vol.slot_next.as_entire_binding(),
+        ]);
+        let gather_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("bounce"),
+            layout: &self.gather_layout,
+            entries: &layout::entries(res),
+        });
+        let radiance = v(&vol.radiance);
+        let store_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("bounce_store"),
+            layout: &self.store_layout,
+            entries: &layout::entries(vec![
+                vol.volume.as_entire_binding(),
+                vol.slot_voxel.as_entire_binding(),
+                vol.counters.as_entire_binding(),
+                vol.slot_next.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&radiance),
+            ]),
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("bounce"),
+            timestamp_writes: timer.compute("bounce"),
+        });
+        pass.set_pipeline(&self.gather);
+        pass.set_bind_group(0, &gather_bind, &[]);
+        pass.dispatch_workgroups_indirect(&vol.args, 0);
+        pass.set_pipeline(&self.store);
+        pass.set_bind_group(0, &store_bind, &[]);
+        pass.dispatch_workgroups_indirect(&vol.args, 0);
+    }
+}

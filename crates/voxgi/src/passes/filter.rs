@@ -1,0 +1,116 @@
+//! filter: the volume's mip levels above the finest, isotropic or six-directional.
+
+use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
+use crate::passes::composite::compute_pipeline;
+use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT, mip_view};
+use wgpu::util::DeviceExt;
+
+const STRIDE: u64 = 256;
+
+pub struct FilterPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+/// One dispatch: read `src` (texture, mip), write `dst` (texture index in `aniso`, mip).
+struct Step {
+    src: Option<(usize, u32)>,
+    dst: (usize, u32),
+    params: [u32; 4],
+}
+
+impl FilterPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("filter"),
+            entries: &[
+                layout::uniform(0, c, true),
+                layout::texture_3d_load(1, c),
+                layout::storage_texture_3d(2, RADIANCE_FORMAT),
+            ],
+        });
+        FilterPass {
+            pipeline: compute_pipeline(device, "filter", "filter.wgsl", &layout),
+            layout,
+        }
+    }
+
+    fn steps(vol: &DenseVolume) -> Vec<Step> {
+        let res = vol.grid.resolution;
+        let levels = vol.grid.levels();
+        let mut steps = Vec::new();
+        let dirs = if vol.anisotropic { 6 } else { 1 };
+        for d in 0..dirs {
+            for level in 1..levels {
+                // Level 1 reads the finest (isotropic) level; later ones their own chain.
+                let src = if level == 1 {
+                    None
+                } else {
+                    Some((d, level - 2))
+                };
+                let mode = if vol.anisotropic { 1 } else { 0 };
+                steps.push(Step {
+                    src,
+                    dst: (d, level - 1),
+                    params: [mode, d as u32, res >> level, 0],
+                });
+            }
+        }
+        steps
+    }
+
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        vol: &DenseVolume,
+        timer: &mut GpuTimer,
+    ) {
+        let steps = Self::steps(vol);
+        let mut bytes = vec![0u8; steps.len() * STRIDE as usize];
+        for (i, s) in steps.iter().enumerate() {
+            bytes[i * STRIDE as usize..i * STRIDE as usize + 16]
+                .copy_from_slice(bytemuck::cast_slice(&s.params));
+        }
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("filter params"),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let binds: Vec<wgpu::BindGroup> = steps
+            .iter()
+            .map(|s| {
+                let src = match s.src {
+                    None => mip_view(&vol.radiance, 0),
+                    Some((t, m)) => mip_view(&vol.aniso[t], m),
+                };
+                let dst = mip_view(&vol.aniso[s.dst.0], s.dst.1);
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("filter"),
+                    layout: &self.layout,
+                    entries: &layout::entries(vec![
+                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &params,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                        wgpu::BindingResource::TextureView(&src),
+                        wgpu::BindingResource::TextureView(&dst),
+                    ]),
+                })
+            })
+            .collect();
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("filter"),
+            timestamp_writes: timer.compute("filter"),
+        });
+        pass.set_pipeline(&self.pipeline);
+        for (i, (s, b)) in steps.iter().zip(&binds).enumerate() {
+            pass.set_bind_group(0, b, &[(i as u64 * STRIDE) as u32]);
+            let n = s.params[2].div_ceil(4);
+            pass.dispatch_workgroups(n, n, n);
+        }
+    }
+}

@@ -1,0 +1,86 @@
+//! gather: per-pixel indirect light from the voxels (diffuse cones with AO, glossy cone), at
+//! full or half resolution.
+
+use crate::frame::FrameTargets;
+use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
+use crate::passes::composite::compute_pipeline;
+use crate::voxel::dense::DenseVolume;
+
+pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+pub struct GatherPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl GatherPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![
+            layout::uniform(0, c, false),
+            layout::uniform(1, c, false),
+            layout::uniform(2, c, false),
+        ];
+        entries.extend(DenseVolume::sampling_layout(3, c));
+        entries.extend([
+            layout::texture_2d_load(11, c),
+            layout::texture_2d_load(12, c),
+            layout::texture_2d_load(13, c),
+            layout::texture(
+                14,
+                c,
+                wgpu::TextureSampleType::Depth,
+                wgpu::TextureViewDimension::D2,
+            ),
+            layout::storage_texture(15, INDIRECT_FORMAT),
+        ]);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gather"),
+            entries: &entries,
+        });
+        GatherPass {
+            pipeline: compute_pipeline(device, "gather", "gather.wgsl", &layout),
+            layout,
+        }
+    }
+
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        vol: &DenseVolume,
+        cones: &wgpu::Buffer,
+        timer: &mut GpuTimer,
+    ) {
+        let views = vol.sampling_views();
+        let mut res = vec![
+            t.frame.as_entire_binding(),
+            vol.volume.as_entire_binding(),
+            cones.as_entire_binding(),
+        ];
+        res.extend(views.iter().map(wgpu::BindingResource::TextureView));
+        res.extend([
+            wgpu::BindingResource::Sampler(&vol.sampler),
+            wgpu::BindingResource::TextureView(&t.albedo),
+            wgpu::BindingResource::TextureView(&t.normal),
+            wgpu::BindingResource::TextureView(&t.emission),
+            wgpu::BindingResource::TextureView(&t.depth),
+            wgpu::BindingResource::TextureView(t.gather_target()),
+        ]);
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gather"),
+            layout: &self.layout,
+            entries: &layout::entries(res),
+        });
+        let (w, h) = t.gather_size();
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("gather"),
+            timestamp_writes: timer.compute("gather"),
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    }
+}

@@ -1,0 +1,84 @@
+//! voxelize: every mesh triangle into voxel fragments (conservative, exact overlap).
+
+use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
+use crate::gpu_scene::GpuScene;
+use crate::voxel::dense::DenseVolume;
+
+pub struct VoxelizePass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl VoxelizePass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxelize"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::storage(1, c, true),
+                layout::storage(2, c, true),
+                layout::storage(3, c, true),
+                layout::storage(4, c, true),
+                layout::texture(
+                    5,
+                    c,
+                    wgpu::TextureSampleType::Float { filterable: true },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                layout::sampler(6, c),
+                layout::storage(7, c, true),
+                layout::storage(8, c, false),
+                layout::storage(9, c, false),
+                layout::storage(10, c, false),
+            ],
+        });
+        let pipeline = crate::passes::composite::compute_pipeline(
+            device,
+            "voxelize",
+            "voxelize.wgsl",
+            &layout,
+        );
+        VoxelizePass { pipeline, layout }
+    }
+
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        triangles: (&wgpu::Buffer, u32),
+        vol: &DenseVolume,
+        timer: &mut GpuTimer,
+    ) {
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxelize"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                vol.volume.as_entire_binding(),
+                scene.vertices.as_entire_binding(),
+                scene.indices.as_entire_binding(),
+                scene.draws.as_entire_binding(),
+                scene.materials.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&scene.texture_view),
+                wgpu::BindingResource::Sampler(&scene.sampler),
+                triangles.0.as_entire_binding(),
+                vol.fragments.as_entire_binding(),
+                vol.counters.as_entire_binding(),
+                vol.occupancy.as_entire_binding(),
+            ]),
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("voxelize"),
+            timestamp_writes: timer.compute("voxelize"),
+        });
+        if triangles.1 == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        let (x, y) = layout::groups_2d(triangles.1, 1);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}

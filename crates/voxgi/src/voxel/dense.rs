@@ -1,0 +1,447 @@
+//! The dense mip-mapped volume (the 3D-texture approach of Aherne et al. 2020): the finest level
+//! as 3D textures (albedo/opacity, normal, emission, radiance), and above it six directional mip
+//! chains of radiance (anisotropic voxels, Crassin et al. 2011 §9) or one isotropic chain.
+//!
+//! Built from voxel fragments by `dense_build.wgsl`: occupied voxels get compact slots, so
+//! injection and bounces run over occupied voxels only, and clearing touches only the voxels
+//! the previous build filled.
+
+use super::{GpuVolume, Grid, texture_bytes};
+use crate::gpu::timer::GpuTimer;
+use crate::gpu::{layout, shader};
+use crate::gpu_scene::GpuScene;
+use wgpu::util::DeviceExt;
+
+pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Snorm;
+pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Bytes per fragment (`Fragment` in shaders/shared/fragment.wgsl).
+pub const FRAGMENT_BYTES: u64 = 16;
+/// u32 sums per slot (`ACCUM_STRIDE` in dense_build.wgsl).
+const ACCUM_STRIDE: u64 = 10;
+/// Directions of the anisotropic chains, in the order of `filter.wgsl`.
+pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+
+pub struct DenseVolume {
+    pub grid: Grid,
+    pub anisotropic: bool,
+    pub volume: wgpu::Buffer,
+    pub fragment_capacity: u32,
+    pub fragments: wgpu::Buffer,
+    /// [0] fragments emitted, [1] occupied voxels (slots), [2] slots of the previous build.
+    pub counters: wgpu::Buffer,
+    pub occupancy: wgpu::Buffer,
+    pub slot_voxel: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    pub slot_direct: wgpu::Buffer,
+    pub slot_next: wgpu::Buffer,
+    /// Indirect dispatch sizes: [0..3] over slots, [3..6] over fragments.
+    pub args: wgpu::Buffer,
+    pub albedo: wgpu::Texture,
+    pub normal: wgpu::Texture,
+    pub emission: wgpu::Texture,
+    pub radiance: wgpu::Texture,
+    /// Directional chains (+X, -X, +Y, -Y, +Z, -Z), each one level coarser than the finest. In
+    /// isotropic mode only the first exists and holds the isotropic chain.
+    pub aniso: Vec<wgpu::Texture>,
+    pub sampler: wgpu::Sampler,
+    build_layout: wgpu::BindGroupLayout,
+    args_layout: wgpu::BindGroupLayout,
+    build: BuildPipelines,
+}
+
+struct BuildPipelines {
+    begin: wgpu::ComputePipeline,
+    clear_previous: wgpu::ComputePipeline,
+    prepare_fragments: wgpu::ComputePipeline,
+    allocate: wgpu::ComputePipeline,
+    accumulate: wgpu::ComputePipeline,
+    prepare_slots: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+fn texture_3d(
+    device: &wgpu::Device,
+    label: &str,
+    res: u32,
+    mips: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: res,
+            height: res,
+            depth_or_array_layers: res,
+        },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format,
+        usage: wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
+fn storage_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: u64,
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC
+            | extra,
+        mapped_at_creation: false,
+    })
+}
+
+/// A view of one mip level, for writing it as a storage texture or reading it with textureLoad.
+pub fn mip_view(t: &wgpu::Texture, mip: u32) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        base_mip_level: mip,
+        mip_level_count: Some(1),
+        ..Default::default()
+    })
+}
+
+impl DenseVolume {
+    pub fn new(
+        device: &wgpu::Device,
+        grid: Grid,
+        anisotropic: bool,
+        fragment_capacity: u32,
+    ) -> Self {
+        let res = grid.resolution;
+        let levels = grid.levels();
+        let slots = (fragment_capacity as u64).min((res as u64).pow(3));
+        let volume = GpuVolume {
+            origin: grid.origin.to_array(),
+            resolution: res,
+            voxel_size: grid.voxel_size,
+            levels,
+            anisotropic: anisotropic as u32,
+            fragment_capacity,
+        };
+        let aniso_count = if anisotropic { 6 } else { 1 };
+        let aniso = (0..aniso_count)
+            .map(|d| {
+                texture_3d(
+                    device,
+                    &format!("voxel radiance {}", DIRECTIONS[d]),
+                    res / 2,
+                    levels - 1,
+                    RADIANCE_FORMAT,
+                )
+            })
+            .collect();
+        let build_layout = build_layout(device);
+        let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dense_build args"),
+            entries: &[layout::storage(0, wgpu::ShaderStages::COMPUTE, false)],
+        });
+        let module = shader::module(device, "dense_build.wgsl");
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dense_build"),
+            bind_group_layouts: &[Some(&build_layout)],
+            immediate_size: 0,
+        });
+        let prepare_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dense_build prepare"),
+            bind_group_layouts: &[Some(&build_layout), Some(&args_layout)],
+            immediate_size: 0,
+        });
+        let pipe = |entry: &str| {
+            let prepare = entry.starts_with("prepare");
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("dense_build"),
+                layout: Some(if prepare {
+                    &prepare_layout
+                } else {
+                    &pipeline_layout
+                }),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let build = BuildPipelines {
+            begin: pipe("begin"),
+            clear_previous: pipe("clear_previous"),
+            prepare_fragments: pipe("prepare_fragments"),
+            allocate: pipe("allocate"),
+            accumulate: pipe("accumulate"),
+            prepare_slots: pipe("prepare_slots"),
+            resolve: pipe("resolve"),
+        };
+        let no = wgpu::BufferUsages::empty();
+        DenseVolume {
+            grid,
+            anisotropic,
+            volume: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("volume"),
+                contents: bytemuck::bytes_of(&volume),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
+            fragment_capacity,
+            fragments: storage_buffer(
+                device,
+                "voxel fragments",
+                fragment_capacity as u64 * FRAGMENT_BYTES,
+                no,
+            ),
+            counters: storage_buffer(device, "voxel counters", 16, no),
+            occupancy: storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no),
+            slot_voxel: storage_buffer(device, "voxel slots", slots * 4, no),
+            accum: storage_buffer(device, "voxel sums", slots * ACCUM_STRIDE * 4, no),
+            slot_direct: storage_buffer(device, "voxel direct light", slots * 16, no),
+            slot_next: storage_buffer(device, "voxel bounce light", slots * 16, no),
+            args: storage_buffer(
+                device,
+                "voxel dispatch sizes",
+                6 * 4,
+                wgpu::BufferUsages::INDIRECT,
+            ),
+            albedo: texture_3d(device, "voxel albedo", res, 1, ALBEDO_FORMAT),
+            normal: texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT),
+            emission: texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT),
+            radiance: texture_3d(device, "voxel radiance", res, 1, RADIANCE_FORMAT),
+            aniso,
+            sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("voxels"),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..Default::default()
+            }),
+            build_layout,
+            args_layout,
+            build,
+        }
+    }
+
+    /// Bytes per GPU resource.
+    pub fn memory(&self) -> Vec<(&'static str, u64)> {
+        let res = self.grid.resolution;
+        let aniso_mips = self.grid.levels() - 1;
+        vec![
+            ("voxel fragments", self.fragments.size()),
+            ("voxel occupancy", self.occupancy.size()),
+            (
+                "voxel slots",
+                self.slot_voxel.size()
+                    + self.accum.size()
+                    + self.slot_direct.size()
+                    + self.slot_next.size(),
+            ),
+            ("voxel albedo", texture_bytes(res, 4, 1)),
+            ("voxel normal", texture_bytes(res, 4, 1)),
+            ("voxel emission", texture_bytes(res, 8, 1)),
+            ("voxel radiance", texture_bytes(res, 8, 1)),
+            (
+                if self.anisotropic {
+                    "voxel radiance mips (6 directions)"
+                } else {
+                    "voxel radiance mips"
+                },
+                self.aniso.len() as u64 * texture_bytes(res / 2, 8, aniso_mips),
+            ),
+        ]
+    }
+
+    /// Bindings cone tracing reads, from `first`: radiance0, the six chains (+X first; in
+    /// isotropic mode all six name the one chain), and the sampler.
+    pub fn sampling_layout(
+        first: u32,
+        visibility: wgpu::ShaderStages,
+    ) -> Vec<wgpu::BindGroupLayoutEntry> {
+        let mut v: Vec<_> = (0..7)
+            .map(|i| {
+                layout::texture(
+                    first + i,
+                    visibility,
+                    wgpu::TextureSampleType::Float { filterable: true },
+                    wgpu::TextureViewDimension::D3,
+                )
+            })
+            .collect();
+        v.push(layout::sampler(first + 7, visibility));
+        v
+    }
+
+    /// Views for `sampling_layout`, in the same order.
+    pub fn sampling_views(&self) -> Vec<wgpu::TextureView> {
+        let mut v = vec![self.radiance.create_view(&Default::default())];
+        for d in 0..6 {
+            let t = self.aniso.get(d).unwrap_or(&self.aniso[0]);
+            v.push(t.create_view(&Default::default()));
+        }
+        v
+    }
+
+    /// Records the start of a build: forget the previous one and clear what it filled. Runs
+    /// before `voxelize`.
+    pub fn record_begin(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+    ) {
+        let bind = self.build_bind_group(device);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dense_build"),
+                timestamp_writes: timer.compute("dense_build"),
+            });
+            pass.set_bind_group(0, &bind, &[]);
+            pass.set_pipeline(&self.build.begin);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.build.clear_previous);
+            pass.dispatch_workgroups_indirect(&self.args, 0);
+        }
+        encoder.clear_buffer(&self.occupancy, 0, None);
+        encoder.clear_buffer(&self.accum, 0, None);
+    }
+
+    /// Records the fragments -> finest level build. Runs after `voxelize`.
+    pub fn record_build(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+    ) {
+        let bind = self.build_bind_group(device);
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dense_build args"),
+            layout: &self.args_layout,
+            entries: &layout::entries(vec![self.args.as_entire_binding()]),
+        });
+        // Separate passes: the prepare kernels write the dispatch sizes the others read.
+        let steps: [(&wgpu::ComputePipeline, Option<u64>); 5] = [
+            (&self.build.prepare_fragments, None),
+            (&self.build.allocate, Some(12)),
+            (&self.build.accumulate, Some(12)),
+            (&self.build.prepare_slots, None),
+            (&self.build.resolve, Some(0)),
+        ];
+        for (pipeline, indirect) in steps {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dense_build"),
+                timestamp_writes: timer.compute("dense_build"),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            match indirect {
+                None => {
+                    pass.set_bind_group(1, &args, &[]);
+                    pass.dispatch_workgroups(1, 1, 1);
+                }
+                Some(offset) => pass.dispatch_workgroups_indirect(&self.args, offset),
+            }
+        }
+    }
+
+    fn build_bind_group(&self, device: &wgpu::Device) -> wgpu::BindGroup {
+        let v = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (a, n, e, r) = (
+            v(&self.albedo),
+            v(&self.normal),
+            v(&self.emission),
+            v(&self.radiance),
+        );
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dense_build"),
+            layout: &self.build_layout,
+            entries: &layout::entries(vec![
+                self.volume.as_entire_binding(),
+                self.fragments.as_entire_binding(),
+                self.counters.as_entire_binding(),
+                self.occupancy.as_entire_binding(),
+                self.slot_voxel.as_entire_binding(),
+                self.accum.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&a),
+                wgpu::BindingResource::TextureView(&n),
+                wgpu::BindingResource::TextureView(&e),
+                wgpu::BindingResource::TextureView(&r),
+            ]),
+        })
+    }
+}
+
+fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let c = wgpu::ShaderStages::COMPUTE;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("dense_build"),
+        entries: &[
+            layout::uniform(0, c, false),
+            layout::storage(1, c, true),
+            layout::storage(2, c, false),
+            layout::storage(3, c, false),
+            layout::storage(4, c, false),
+            layout::storage(5, c, false),
+            layout::storage_texture_3d(6, ALBEDO_FORMAT),
+            layout::storage_texture_3d(7, NORMAL_FORMAT),
+            layout::storage_texture_3d(8, EMISSION_FORMAT),
+            layout::storage_texture_3d(9, RADIANCE_FORMAT),
+        ],
+    })
+}
+
+/// An upper bound on the fragments `scene` makes on `grid`: per triangle, the columns its
+/// dominant-axis projection can touch times the three voxels a column can hold.
+pub fn estimate_fragments(scene: &voxgi_scene::Scene, grid: &Grid) -> u64 {
+    let inv = 1.0 / grid.voxel_size;
+    let mut total = 0u64;
+    for inst in &scene.instances {
+        if inst.light.is_some() {
+            continue;
+        }
+        let m = &scene.meshes[inst.mesh];
+        for t in m.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]]
+                .map(|i| inst.transform.transform_point3(m.positions[i as usize]) * inv);
+            let n = (b - a).cross(c - a);
+            let projected = 0.5 * n.abs().max_element();
+            let perimeter = (b - a).length() + (c - b).length() + (a - c).length();
+            total += (3.0 * (projected + perimeter + 2.0)) as u64;
+        }
+    }
+    total
+}
+
+/// Keeps the triangle table voxelize reads: per triangle, its draw, first index, base vertex.
+pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> (wgpu::Buffer, u32) {
+    let mut t: Vec<[u32; 4]> = Vec::new();
+    for call in &scene.calls {
+        // The visible surface of an area light is lit analytically; voxelizing it too would
+        // count its light twice.
+        if call.light.is_some() {
+            continue;
+        }
+        for first in call.indices.clone().step_by(3) {
+            t.push([call.draw, first, call.base_vertex as u32, 0]);
+        }
+    }
+    let n = t.len() as u32;
+    if t.is_empty() {
+        t.push([0; 4]);
+    }
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("voxelize triangles"),
+        contents: bytemuck::cast_slice(&t),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    (buffer, n)
+}

@@ -1,0 +1,194 @@
+//! Voxels: where the volume sits, the fragments geometry turns into, the cone sets, and the voxel
+//! structures built from fragments.
+//!
+//! Cone tracing is written once in WGSL (`shaders/shared/cone.wgsl`) against
+//! `sample_voxels(position, diameter, direction)`; a structure provides that function and the
+//! bindings it reads. The dense mip-mapped volume (`dense.rs`) is the first structure.
+
+pub mod cpu;
+pub mod dense;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+/// Mirrors `Volume` in shaders/shared/volume.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuVolume {
+    pub origin: [f32; 3],
+    pub resolution: u32,
+    pub voxel_size: f32,
+    pub levels: u32,
+    pub anisotropic: u32,
+    pub fragment_capacity: u32,
+}
+
+/// Mirrors `Cones` in shaders/shared/volume.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuCones {
+    pub dirs: [[f32; 4]; 16],
+    pub count: u32,
+    pub diffuse_tan: f32,
+    pub step_factor: f32,
+    pub max_distance: f32,
+    pub ao_lambda: f32,
+    pub ao_radius: f32,
+    pub origin_offset: f32,
+    pub indirect: u32,
+}
+
+/// A cubic grid over the scene: `resolution` voxels per side from `origin`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    pub origin: Vec3,
+    pub voxel_size: f32,
+    pub resolution: u32,
+}
+
+impl Grid {
+    /// The cube around the scene bounds with one empty voxel of margin on every side, so walls
+    /// on the bounds (the Cornell box's) lie inside the volume, not on its edge.
+    pub fn around(min: Vec3, max: Vec3, resolution: u32) -> Self {
+        let (min, max) = if min.x > max.x {
+            (Vec3::splat(-0.5), Vec3::splat(0.5))
+        } else {
+            (min, max)
+        };
+        let extent = (max - min).max_element().max(1e-3);
+        let side = extent * resolution as f32 / (resolution as f32 - 2.0);
+        let center = (min + max) * 0.5;
+        Grid {
+            origin: center - Vec3::splat(side * 0.5),
+            voxel_size: side / resolution as f32,
+            resolution,
+        }
+    }
+
+    pub fn extent(&self) -> f32 {
+        self.voxel_size * self.resolution as f32
+    }
+
+    /// Mip levels including the finest (down to 1 voxel).
+    pub fn levels(&self) -> u32 {
+        self.resolution.ilog2() + 1
+    }
+}
+
+/// A set of diffuse cones around the normal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ConeSet {
+    /// Six cones of 60° aperture: one along the normal, five tilted 60° (Crassin et al.).
+    #[default]
+    Six60,
+    /// Seven cones of 45°: one along the normal, six tilted 45° (the 3D-texture paper).
+    Seven45,
+    /// Nine cones of 45°: one along the normal, eight tilted 50°.
+    Nine45,
+}
+
+impl ConeSet {
+    pub fn name(&self) -> &'static str {
+        match self {
+            ConeSet::Six60 => "6x60",
+            ConeSet::Seven45 => "7x45",
+            ConeSet::Nine45 => "9x45",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Self> {
+        [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45]
+            .into_iter()
+            .find(|c| c.name() == s)
+    }
+
+    /// Full aperture angle of each cone in radians.
+    pub fn aperture(&self) -> f32 {
+        match self {
+            ConeSet::Six60 => 60f32.to_radians(),
+            _ => 45f32.to_radians(),
+        }
+    }
+
+    /// Tangent-space axes (z = normal).
+    pub fn axes(&self) -> Vec<Vec3> {
+        let (ring, tilt) = match self {
+            ConeSet::Six60 => (5, 60f32),
+            ConeSet::Seven45 => (6, 45f32),
+            ConeSet::Nine45 => (8, 50f32),
+        };
+        let mut v = vec![Vec3::Z];
+        let t = tilt.to_radians();
+        for i in 0..ring {
+            let phi = i as f32 / ring as f32 * std::f32::consts::TAU;
+            v.push(Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos()));
+        }
+        v
+    }
+
+    /// Each cone's weight: the cosine-weighted solid angle of the part of the hemisphere whose
+    /// directions are nearest its axis, as a fraction of the whole (pi). The cones stand for
+    /// their cells, so the weights sum to exactly 1 and no empirical factor is needed.
+    pub fn weights(&self) -> Vec<f32> {
+        cell_weights(&self.axes())
+    }
+}
+
+/// Cosine-weighted hemisphere fractions of the nearest-axis cells, by midpoint quadrature in
+/// (cos²θ, φ), where the cosine-weighted measure is uniform.
+pub fn cell_weights(axes: &[Vec3]) -> Vec<f32> {
+    let (nu, nphi) = (256, 1024);
+    let mut w = vec![0f64; axes.len()];
+    for i in 0..nu {
+        // u = sin²θ is uniform under the cosine-weighted measure.
+        let u = (i as f32 + 0.5) / nu as f32;
+        let (s, c) = (u.sqrt(), (1.0 - u).sqrt());
+        for j in 0..nphi {
+            let phi = (j as f32 + 0.5) / nphi as f32 * std::f32::consts::TAU;
+            let d = Vec3::new(s * phi.cos(), s * phi.sin(), c);
+            let best = axes
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.dot(d).total_cmp(&b.1.dot(d)))
+                .map(|(k, _)| k)
+                .unwrap_or(0);
+            w[best] += 1.0;
+        }
+    }
+    let total: f64 = w.iter().sum();
+    w.into_iter().map(|x| (x / total) as f32).collect()
+}
+
+/// Bytes of a 3D texture with `mips` levels.
+pub fn texture_bytes(res: u32, bytes_per_texel: u64, mips: u32) -> u64 {
+    (0..mips)
+        .map(|m| ((res >> m).max(1) as u64).pow(3) * bytes_per_texel)
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cone_weights_partition_the_cosine_hemisphere() {
+        for set in [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45] {
+            let w = set.weights();
+            assert_eq!(w.len(), set.axes().len());
+            // Quadrature of a partition: the fractions sum to 1 up to float rounding.
+            assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{set:?}: {w:?}");
+            // The ring cones are symmetric, so they get equal weights (to quadrature error).
+            for &x in &w[2..] {
+                assert!((x - w[1]).abs() < 2e-3, "{set:?}: {w:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn grid_has_a_margin_voxel() {
+        let g = Grid::around(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0), 64);
+        assert!((g.extent() - 2.0 * 64.0 / 62.0).abs() < 1e-5);
+        assert!((g.origin.x + g.voxel_size).abs() < 1e-5);
+        assert_eq!(g.levels(), 7);
+    }
+}
