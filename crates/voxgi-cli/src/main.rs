@@ -37,6 +37,8 @@ enum Command {
     Render(RenderArgs),
     /// Print what a scene contains: counts, bounds, materials, lights, cameras.
     Info(SceneArg),
+    /// Time every pass with GPU timestamps over many frames; print a table, write JSON.
+    Bench(BenchArgs),
 }
 
 #[derive(Args)]
@@ -59,20 +61,8 @@ struct RenderArgs {
     /// Image size in pixels.
     #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
     size: (u32, u32),
-    /// Exposure in stops (EV): the image is scaled by 2^EV before tone mapping.
-    #[arg(
-        long,
-        value_name = "EV",
-        default_value_t = 0.0,
-        allow_hyphen_values = true
-    )]
-    exposure: f32,
-    /// Tone-mapping curve for PNG output.
-    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
-    tonemap: TonemapArg,
-    /// What to show.
-    #[arg(long, value_enum, default_value_t = ViewArg::Final)]
-    view: ViewArg,
+    #[command(flatten)]
+    settings: SettingsArgs,
     /// Camera position, overriding the scene's camera (metres).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -85,9 +75,116 @@ struct RenderArgs {
     /// Which of the scene's cameras to use (by index, see `voxgi info`).
     #[arg(long, value_name = "N")]
     camera: Option<usize>,
+}
+
+/// Renderer settings shared by `render` and `bench`.
+#[derive(Args)]
+struct SettingsArgs {
+    /// Exposure in stops (EV): the image is scaled by 2^EV before tone mapping.
+    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f32,
+    /// Tone-mapping curve for PNG output.
+    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
+    tonemap: TonemapArg,
+    /// What to show.
+    #[arg(long, value_enum, default_value_t = ViewArg::Final)]
+    view: ViewArg,
     /// Shadow map resolution per view, in texels.
     #[arg(long, value_name = "N", default_value_t = Settings::default().shadow_map_size)]
     shadow_map_size: u32,
+    /// Voxels per side of the volume (power of two, 16..=512).
+    #[arg(long, value_name = "N", default_value_t = Settings::default().voxel_resolution)]
+    voxel_resolution: u32,
+    /// Indirect bounces: 0 (direct light only) to 8, or "unlimited".
+    #[arg(long, value_name = "N", default_value = "2", value_parser = parse_bounces)]
+    bounces: u32,
+    /// Diffuse cone set: 6x60, 7x45 or 9x45.
+    #[arg(long, value_name = "SET", default_value = "6x60", value_parser = parse_cones)]
+    cones: voxgi::ConeSet,
+    /// One radiance value per voxel above the finest level instead of six directional ones.
+    #[arg(long)]
+    isotropic: bool,
+    /// Gather indirect light at half resolution with an edge-aware upsample.
+    #[arg(long)]
+    half_res: bool,
+    /// Ambient-occlusion radius in metres (default: a quarter of the volume).
+    #[arg(long, value_name = "M")]
+    ao_radius: Option<f32>,
+    /// Ambient-occlusion falloff lambda in 1/(1 + lambda r), per metre.
+    #[arg(long, value_name = "L", default_value_t = Settings::default().ao_lambda)]
+    ao_lambda: f32,
+    /// Cone step as a fraction of the cone diameter.
+    #[arg(long, value_name = "F", default_value_t = Settings::default().step_factor)]
+    step_factor: f32,
+}
+
+impl SettingsArgs {
+    fn to_settings(&self) -> Settings {
+        Settings {
+            exposure: self.exposure,
+            shadow_map_size: self.shadow_map_size,
+            tonemap: match self.tonemap {
+                TonemapArg::Aces => Tonemap::Aces,
+                TonemapArg::Neutral => Tonemap::Neutral,
+                TonemapArg::Clamp => Tonemap::Clamp,
+            },
+            view: match self.view {
+                ViewArg::Final => ViewMode::Final,
+                ViewArg::Albedo => ViewMode::Albedo,
+                ViewArg::Normal => ViewMode::Normal,
+                ViewArg::Direct => ViewMode::Direct,
+                ViewArg::Ao => ViewMode::Ao,
+                ViewArg::Indirect => ViewMode::Indirect,
+            },
+            voxel_resolution: self.voxel_resolution,
+            bounces: self.bounces,
+            cones: self.cones,
+            anisotropic: !self.isotropic,
+            half_resolution: self.half_res,
+            ao_radius: self.ao_radius,
+            ao_lambda: self.ao_lambda,
+            step_factor: self.step_factor,
+            ..Settings::default()
+        }
+    }
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    #[command(flatten)]
+    scene: SceneArg,
+    /// Image size in pixels.
+    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Frames timed (after the warm-up).
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    frames: u32,
+    /// Frames rendered before timing starts.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    warmup: u32,
+    /// Voxelize, inject, filter and bounce every frame (a fully dynamic scene).
+    #[arg(long)]
+    revoxelize: bool,
+    /// Write the results as JSON here.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    #[command(flatten)]
+    settings: SettingsArgs,
+}
+
+fn parse_bounces(s: &str) -> Result<u32, String> {
+    if s == "unlimited" || s == "inf" {
+        return Ok(voxgi::UNLIMITED_BOUNCES);
+    }
+    let n: u32 = s.parse().map_err(|_| format!("'{s}' is not 0..=8 or 'unlimited'"))?;
+    if n > voxgi::MAX_BOUNCES {
+        return Err(format!("{n} bounces: use 0..={} or 'unlimited'", voxgi::MAX_BOUNCES));
+    }
+    Ok(n)
+}
+
+fn parse_cones(s: &str) -> Result<voxgi::ConeSet, String> {
+    voxgi::ConeSet::parse(s).ok_or_else(|| format!("'{s}' is not a cone set (6x60, 7x45, 9x45)"))
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -181,24 +278,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     let label = scene_label(&args.scene);
     let scene = p.stage(&format!("loading {label}"), || load_scene(&args.scene))?;
-    let settings = Settings {
-        exposure: args.exposure,
-        shadow_map_size: args.shadow_map_size,
-        tonemap: match args.tonemap {
-            TonemapArg::Aces => Tonemap::Aces,
-            TonemapArg::Neutral => Tonemap::Neutral,
-            TonemapArg::Clamp => Tonemap::Clamp,
-        },
-        view: match args.view {
-            ViewArg::Final => ViewMode::Final,
-            ViewArg::Albedo => ViewMode::Albedo,
-            ViewArg::Normal => ViewMode::Normal,
-            ViewArg::Direct => ViewMode::Direct,
-            ViewArg::Ao => ViewMode::Ao,
-            ViewArg::Indirect => ViewMode::Indirect,
-        },
-        ..Settings::default()
-    };
+    let settings = args.settings.to_settings();
     settings.validate()?;
     let ctx = p.stage("opening GPU", GpuContext::from_env)?;
     eprintln!("GPU: {} ({:?})", ctx.info.name, ctx.info.backend);
@@ -368,9 +448,125 @@ fn main() {
     let result = match &cli.command {
         Command::Render(a) => render(a),
         Command::Info(a) => info(a),
+        Command::Bench(a) => bench(a),
     };
     if let Err(e) = result {
         eprintln!("voxgi: error: {e:#}");
         std::process::exit(1);
     }
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let i = ((sorted.len() - 1) as f64 * p).round() as usize;
+    sorted[i]
+}
+
+fn bench(args: &BenchArgs) -> Result<()> {
+    let label = scene_label(&args.scene);
+    let scene = load_scene(&args.scene)?;
+    let mut settings = args.settings.to_settings();
+    settings.revoxelize_every_frame = args.revoxelize;
+    settings.validate()?;
+    let ctx = GpuContext::from_env()?;
+    if !ctx.timestamps {
+        bail!(
+            "{} does not support GPU timestamp queries; voxgi bench needs them",
+            ctx.info.name
+        );
+    }
+    let mut renderer =
+        Renderer::new(&ctx, &scene, settings.clone()).with_context(|| label.clone())?;
+    renderer.enable_timing(true);
+    let camera = renderer.default_camera().clone();
+    let (w, h) = args.size;
+    eprintln!(
+        "bench: {label}, {w}x{h}, voxels {}³, {} frames after {} warm-up, on {} ({:?})",
+        settings.voxel_resolution, args.frames, args.warmup, ctx.info.name, ctx.info.backend
+    );
+    let mut per_pass: Vec<(&'static str, Vec<f64>)> = Vec::new();
+    let mut totals = Vec::new();
+    let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
+    for i in 0..args.warmup + args.frames {
+        renderer.render_frame(&camera, w, h)?;
+        let times = renderer.pass_times()?;
+        if i == 0 {
+            first_frame = times.clone();
+        }
+        if i < args.warmup {
+            continue;
+        }
+        totals.push(times.iter().map(|(_, ms)| ms).sum::<f64>());
+        for (name, ms) in times {
+            match per_pass.iter_mut().find(|(n, _)| *n == name) {
+                Some(e) => e.1.push(ms),
+                None => per_pass.push((name, vec![ms])),
+            }
+        }
+        eprint!("\rframe {}/{}", i + 1 - args.warmup, args.frames);
+    }
+    eprintln!();
+    let (fragments, occupied) = renderer.voxel_counts()?;
+    let mut rows = Vec::new();
+    println!("{:<14} {:>10} {:>10} {:>8}", "pass", "median ms", "p95 ms", "frames");
+    for (name, v) in &mut per_pass {
+        v.sort_by(f64::total_cmp);
+        let (med, p95) = (percentile(v, 0.5), percentile(v, 0.95));
+        println!("{name:<14} {med:>10.3} {p95:>10.3} {:>8}", v.len());
+        rows.push(serde_json::json!({"name": name, "median_ms": med, "p95_ms": p95, "frames": v.len()}));
+    }
+    totals.sort_by(f64::total_cmp);
+    let (fmed, fp95) = (percentile(&totals, 0.5), percentile(&totals, 0.95));
+    println!("{:<14} {fmed:>10.3} {fp95:>10.3} {:>8}", "frame (GPU)", totals.len());
+    let update: Vec<(&'static str, f64)> = first_frame
+        .iter()
+        .filter(|(n, _)| !per_pass.iter().any(|(p, _)| p == n))
+        .copied()
+        .collect();
+    if !update.is_empty() {
+        let sum: f64 = update.iter().map(|(_, ms)| ms).sum();
+        println!("scene update, first frame only: {sum:.3} ms");
+        for (n, ms) in &update {
+            println!("  {n:<12} {ms:>10.3}");
+        }
+    }
+    let memory = renderer.memory();
+    let total_bytes: u64 = memory.iter().map(|(_, b)| b).sum();
+    println!("memory: {:.1} MiB total", total_bytes as f64 / 1048576.0);
+    for (name, bytes) in &memory {
+        println!("  {name:<36} {:>10.2} MiB", *bytes as f64 / 1048576.0);
+    }
+    println!("voxels: {fragments} fragments, {occupied} occupied voxels");
+    if let Some(path) = &args.json {
+        let json = serde_json::json!({
+            "adapter": ctx.info.name,
+            "backend": format!("{:?}", ctx.info.backend),
+            "device_type": format!("{:?}", ctx.info.device_type),
+            "driver": ctx.info.driver,
+            "scene": label,
+            "size": [w, h],
+            "frames": args.frames,
+            "settings": {
+                "voxel_resolution": settings.voxel_resolution,
+                "anisotropic": settings.anisotropic,
+                "cones": settings.cones.name(),
+                "bounces": settings.bounces,
+                "half_resolution": settings.half_resolution,
+                "revoxelize_every_frame": settings.revoxelize_every_frame,
+                "shadow_map_size": settings.shadow_map_size,
+                "step_factor": settings.step_factor,
+            },
+            "passes": rows,
+            "first_frame_ms": first_frame.iter().map(|(n, ms)| serde_json::json!({"name": n, "ms": ms})).collect::<Vec<_>>(),
+            "frame_ms": {"median": fmed, "p95": fp95},
+            "memory_bytes": memory.iter().map(|(n, b)| serde_json::json!({"name": n, "bytes": b})).collect::<Vec<_>>(),
+            "voxels": {"fragments": fragments, "occupied": occupied},
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&json)? + "\n")
+            .with_context(|| format!("{}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
 }

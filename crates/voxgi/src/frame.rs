@@ -459,8 +459,10 @@ impl Renderer {
         self.dirty = true;
     }
 
-    /// Renders one frame from `camera` at `width` x `height` and reads it back.
-    pub fn render(&mut self, camera: &Camera, width: u32, height: u32) -> Result<RenderOutput> {
+    /// Renders one frame into the targets without reading it back (for benchmarks and
+    /// viewers).
+    pub fn render_frame(&mut self, camera: &Camera, width: u32, height: u32) -> Result<()> {
+
         validate_size(width, height)?;
         if !(camera.position.is_finite() && camera.forward.is_finite() && camera.up.is_finite()) {
             return Err(Error::Setting(
@@ -509,6 +511,13 @@ impl Renderer {
         timer.resolve(&mut encoder);
         self.queue.submit([encoder.finish()]);
 
+        Ok(())
+    }
+
+    /// Renders one frame from `camera` at `width` x `height` and reads it back.
+    pub fn render(&mut self, camera: &Camera, width: u32, height: u32) -> Result<RenderOutput> {
+        self.render_frame(camera, width, height)?;
+        let t = self.targets.as_ref().expect("render_frame made the targets");
         let hdr_bytes = readback::read_texture(&self.device, &self.queue, &t.hdr_texture)?;
         let ldr = readback::read_texture(&self.device, &self.queue, &t.ldr_texture)?;
         Ok(RenderOutput {
