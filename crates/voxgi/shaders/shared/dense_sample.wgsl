@@ -35,9 +35,8 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(0.0);
     }
     let lod = clamp(log2(max(diameter / vol.voxel_size, 1.0)), 0.0, f32(vol.levels - 1u));
-    let fine = textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
     if lod <= 0.0 {
-        return fine;
+        return textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
     }
     // Levels above the finest live in the directional (or, in isotropic mode, the +X) chain,
     // whose level 0 is the volume's level 1.
@@ -48,7 +47,8 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
         coarse = textureSampleLevel(aniso_px, voxel_sampler, uvw, max(lod - 1.0, 0.0));
     }
     if lod < 1.0 {
-        return mix(fine, coarse, lod);
+        // Only between the finest level and the first coarse one is the finest level read.
+        return mix(textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0), coarse, lod);
     }
     return coarse;
 }

@@ -81,12 +81,36 @@ fn receiver_distance(view: ShadowView, uv: vec2<f32>, p: vec3<f32>, n: vec3<f32>
     return length(x - view.origin);
 }
 
+// The receiver plane's distance as a linear function of uv around uv0: value and gradient.
+// Evaluating the exact plane once per axis instead of once per tap keeps wide filters cheap.
+struct ReceiverPlane {
+    uv0: vec2<f32>,
+    d0: f32,
+    grad: vec2<f32>,
+}
+
+fn receiver_plane(view: ShadowView, uv0: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> ReceiverPlane {
+    let h = 1.0 / view.resolution;
+    let d0 = receiver_distance(view, uv0, p, n);
+    let du = receiver_distance(view, uv0 + vec2<f32>(h, 0.0), p, n) - d0;
+    let dv = receiver_distance(view, uv0 + vec2<f32>(0.0, h), p, n) - d0;
+    // A plane seen edge-on has no useful gradient: fall back to the point's own distance.
+    if abs(du) > 1e20 || abs(dv) > 1e20 || d0 > 1e20 {
+        return ReceiverPlane(uv0, shadow_distance(view, p), vec2<f32>(0.0));
+    }
+    return ReceiverPlane(uv0, d0, vec2<f32>(du, dv) / h);
+}
+
+fn plane_at(rp: ReceiverPlane, uv: vec2<f32>) -> f32 {
+    return rp.d0 + dot(rp.grad, uv - rp.uv0);
+}
+
 // Bilinearly weighted comparison at one uv against the receiver plane: 1 lit, 0 shadowed.
-fn shadow_tap(view: ShadowView, uv: vec2<f32>, p: vec3<f32>, n: vec3<f32>, bias: f32) -> f32 {
+fn shadow_tap(view: ShadowView, uv: vec2<f32>, rp: ReceiverPlane, bias: f32) -> f32 {
     if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
         return 1.0;
     }
-    let dist = receiver_distance(view, uv, p, n) - bias;
+    let dist = plane_at(rp, uv) - bias;
     let st = uv * view.resolution - 0.5;
     let i = vec2<i32>(floor(st));
     let f = fract(st);
@@ -97,9 +121,9 @@ fn shadow_tap(view: ShadowView, uv: vec2<f32>, p: vec3<f32>, n: vec3<f32>, bias:
     return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
 }
 
-const PCF_TAPS: u32 = 16u;
-const PCSS_SEARCH_TAPS: u32 = 16u;
-const PCSS_TAPS: u32 = 32u;
+const PCF_TAPS: u32 = 12u;
+const PCSS_SEARCH_TAPS: u32 = 12u;
+const PCSS_TAPS: u32 = 24u;
 
 // Visibility of a light from p (normal n), in [0, 1].
 fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> f32 {
@@ -122,6 +146,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     let uv = shadow_uv(view, p).xy;
     let dist = d0 - bias;
     let texel_uv = 1.0 / view.resolution;
+    let rp = receiver_plane(view, uv, p, n);
 
     if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
         // Percentage-closer soft shadows: the penumbra width follows the light's size and the
@@ -135,7 +160,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
             let o = uv + vogel(i, PCSS_SEARCH_TAPS) * search;
             let t = vec2<i32>(floor(o * view.resolution));
             let z = shadow_texel(view, t);
-            if z < receiver_distance(view, o, p, n) - bias {
+            if z < plane_at(rp, o) - bias {
                 blockers += 1.0;
                 blocker_sum += z;
             }
@@ -147,7 +172,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
         let radius = clamp(half * (dist - zb) / (zb * dist) * tan_to_uv, texel_uv, 0.25);
         var lit = 0.0;
         for (var i = 0u; i < PCSS_TAPS; i++) {
-            lit += shadow_tap(view, uv + vogel(i, PCSS_TAPS) * radius, p, n, bias);
+            lit += shadow_tap(view, uv + vogel(i, PCSS_TAPS) * radius, rp, bias);
         }
         return lit / f32(PCSS_TAPS);
     }
@@ -155,7 +180,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     let radius = softness * texel_uv;
     var lit = 0.0;
     for (var i = 0u; i < PCF_TAPS; i++) {
-        lit += shadow_tap(view, uv + vogel(i, PCF_TAPS) * radius, p, n, bias);
+        lit += shadow_tap(view, uv + vogel(i, PCF_TAPS) * radius, rp, bias);
     }
     return lit / f32(PCF_TAPS);
 }
