@@ -235,7 +235,19 @@ fn pick_camera(scene: &Scene, default: &Camera, args: &RenderArgs) -> Result<Cam
             Projection::Perspective { yfov } => yfov.to_degrees(),
             _ => 45.0,
         };
-        let near = cam.znear;
+        // The default camera's near plane sits just in front of the scene's bounds; a moved eye
+        // (perhaps inside the scene) needs one scaled to the scene instead.
+        let near = if args.eye.is_some() {
+            let b = scene.bounds();
+            let radius = if b.is_empty() {
+                1.0
+            } else {
+                b.size().length() * 0.5
+            };
+            cam.znear.min((radius * 1e-3).max(1e-4))
+        } else {
+            cam.znear
+        };
         cam = Camera::look_at(eye, target, fov);
         cam.znear = near;
     }

@@ -1,10 +1,13 @@
-// shadow: renders one shadow view (a layer of the shadow atlas) as occluder distances.
+// shadow: renders one shadow view (a layer of the shadow atlas) as occluder distances, from the
+// mesh instances and from point-cloud surfels.
 
 //!include shared/scene.wgsl
+//!include shared/surfel.wgsl
 
 @group(0) @binding(0) var<uniform> view: ShadowView;
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(2) var<storage, read> draws: array<Draw>;
+@group(0) @binding(3) var<storage, read> points: array<Point>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -20,13 +23,54 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
     return out;
 }
 
+struct PointOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) disc: vec2<f32>,
+}
+
+// Surfels: point `vertex_index / 6`, corner `vertex_index % 6`, the same discs as the gbuffer's.
+@vertex
+fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
+    let p = points[vi / 6u];
+    var n = point_normal(p);
+    if dot(n, n) == 0.0 {
+        // No normal: face the light, as the gbuffer's disc faces the camera.
+        if view.kind == SHADOW_ORTHO {
+            n = -view.dir;
+        } else {
+            n = normalize(view.origin - p.position);
+        }
+    }
+    let corner = surfel_corner(vi);
+    let world = surfel_world(p, n, corner);
+    var out: PointOut;
+    out.clip = view.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.disc = corner;
+    return out;
+}
+
 @fragment
-fn fs_main(in: VsOut) -> @location(0) f32 {
-    if dot(view.plane.xyz, in.world) + view.plane.w < 0.0 {
+fn fs_points(in: PointOut) -> @location(0) f32 {
+    if dot(in.disc, in.disc) > 1.0 {
+        discard;
+    }
+    return occluder_distance(in.world);
+}
+
+// The occluder distance this view stores for a surface point.
+fn occluder_distance(world: vec3<f32>) -> f32 {
+    if dot(view.plane.xyz, world) + view.plane.w < 0.0 {
         discard;
     }
     if view.kind == SHADOW_ORTHO {
-        return dot(in.world - view.origin, view.dir);
+        return dot(world - view.origin, view.dir);
     }
-    return length(in.world - view.origin);
+    return length(world - view.origin);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) f32 {
+    return occluder_distance(in.world);
 }

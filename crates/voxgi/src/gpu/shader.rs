@@ -16,6 +16,10 @@ const SOURCES: &[(&str, &str)] = &[
         "shared/lights.wgsl",
         include_str!("../../shaders/shared/lights.wgsl"),
     ),
+    (
+        "shared/surfel.wgsl",
+        include_str!("../../shaders/shared/surfel.wgsl"),
+    ),
     ("shadow.wgsl", include_str!("../../shaders/shadow.wgsl")),
     ("gbuffer.wgsl", include_str!("../../shaders/gbuffer.wgsl")),
     (
