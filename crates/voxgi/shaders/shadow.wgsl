@@ -23,6 +23,9 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
     return out;
 }
 
+// How far surfels are pushed away from the light in shadow maps, in disc radii.
+const SURFEL_SHADOW_OFFSET: f32 = 4.0;
+
 struct PointOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
@@ -43,7 +46,13 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
         }
     }
     let corner = surfel_corner(vi);
-    let world = surfel_world(p, n, corner);
+    // Away from the light by a few radii: scanned points scatter about their surface by more
+    // than the receiver-plane bias allows for, and would shadow their neighbours.
+    var away = view.dir;
+    if view.kind != SHADOW_ORTHO {
+        away = normalize(p.position - view.origin);
+    }
+    let world = surfel_world(p, n, corner) + away * (SURFEL_SHADOW_OFFSET * p.radius);
     var out: PointOut;
     out.clip = view.view_proj * vec4<f32>(world, 1.0);
     out.world = world;
