@@ -8,6 +8,8 @@
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(2) var<storage, read> draws: array<Draw>;
 @group(0) @binding(3) var<storage, read> points: array<Point>;
+// Per point: how far its neighbours stray from its tangent plane (metres).
+@group(0) @binding(4) var<storage, read> point_spread: array<f32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -23,8 +25,13 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
     return out;
 }
 
-// How far surfels are pushed away from the light in shadow maps, in disc radii.
-const SURFEL_SHADOW_OFFSET: f32 = 4.0;
+// How far surfels are pushed away from the light in shadow maps: this many disc radii plus this
+// many times the point's surface spread (measured along the light). Tuned on the Kinect office
+// scan, whose depth comes in ~5 cm steps at 4 m: 4 radii without the spread left blotches of
+// self-shadow all over its walls; 8 radii plus the spread leaves a few. Clean surfaces have no
+// spread, and their contact shadows start 8 radii from the occluder.
+const SURFEL_SHADOW_OFFSET: f32 = 8.0;
+const SURFEL_SPREAD_OFFSET: f32 = 1.0;
 
 struct PointOut {
     @builtin(position) clip: vec4<f32>,
@@ -46,13 +53,17 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
         }
     }
     let corner = surfel_corner(vi);
-    // Away from the light by a few radii: scanned points scatter about their surface by more
-    // than the receiver-plane bias allows for, and would shadow their neighbours.
+    // Away from the light: by some radii, which covers the tilt of neighbouring discs, plus the
+    // point's surface spread projected onto the light direction, so that scanned points that
+    // scatter about their surface (by more than the composite's receiver-plane bias allows for)
+    // do not shadow their neighbours.
     var away = view.dir;
     if view.kind != SHADOW_ORTHO {
         away = normalize(p.position - view.origin);
     }
-    let world = surfel_world(p, n, corner) + away * (SURFEL_SHADOW_OFFSET * p.radius);
+    let spread = point_spread[vi / 6u] / max(abs(dot(n, away)), 0.25);
+    let offset = SURFEL_SHADOW_OFFSET * p.radius + SURFEL_SPREAD_OFFSET * spread;
+    let world = surfel_world(p, n, corner) + away * offset;
     var out: PointOut;
     out.clip = view.view_proj * vec4<f32>(world, 1.0);
     out.world = world;

@@ -6,7 +6,7 @@
 use crate::{Error, Result, Settings};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene};
+use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene, pointcloud};
 use wgpu::util::DeviceExt;
 
 /// Mirrors `Frame` in shaders/shared/scene.wgsl.
@@ -203,6 +203,10 @@ pub struct GpuScene {
     pub lights: wgpu::Buffer,
     /// All point clouds' surfels (`GpuPoint`), in world space.
     pub points: wgpu::Buffer,
+    /// One f32 per point (shadow pass only): how far the point's neighbours stray from its
+    /// tangent plane, in metres (`pointcloud::surface_spread`); shadow maps push the surfel
+    /// that far away from the light so noisy scans do not shadow themselves.
+    pub point_spread: wgpu::Buffer,
     pub point_count: u32,
     pub textures: wgpu::Texture,
     pub texture_view: wgpu::TextureView,
@@ -337,7 +341,7 @@ impl GpuScene {
             })
             .collect();
         let lights = gpu_lights(scene);
-        let points = gpu_points(scene);
+        let (points, spread) = gpu_points(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
             let mut data = bytes.to_vec();
@@ -383,6 +387,7 @@ impl GpuScene {
             materials: storage("materials", bytemuck::cast_slice(&materials), 64),
             lights: storage("lights", bytemuck::cast_slice(&lights), 96),
             points: storage("points", bytemuck::cast_slice(&points), 32),
+            point_spread: storage("point spread", bytemuck::cast_slice(&spread), 4),
             point_count: points.len() as u32,
             texture_view: textures.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -421,6 +426,7 @@ impl GpuScene {
             ("materials", self.materials.size()),
             ("lights", self.lights.size()),
             ("points", self.points.size()),
+            ("point spread", self.point_spread.size()),
             ("textures", tex),
         ]
     }
@@ -429,9 +435,11 @@ impl GpuScene {
 /// Surfels of every point cloud in world space: positions by the cloud's transform, normals by
 /// its inverse transpose, radii by its mean scale. Attributes a cloud lacks get defaults here
 /// (no normal: the disc faces the viewer; radius 0: not drawn; grey albedo; no emission); the
-/// renderer estimates normals and radii before uploading.
-pub fn gpu_points(scene: &Scene) -> Vec<GpuPoint> {
+/// renderer estimates normals and radii before uploading. The second result is each point's
+/// world-space surface spread (see `GpuScene::point_spread`).
+pub fn gpu_points(scene: &Scene) -> (Vec<GpuPoint>, Vec<f32>) {
     let mut out = Vec::with_capacity(scene.point_count());
+    let mut spread_out = Vec::with_capacity(scene.point_count());
     for pc in &scene.point_clouds {
         if pc.positions.is_empty() {
             continue;
@@ -446,7 +454,18 @@ pub fn gpu_points(scene: &Scene) -> Vec<GpuPoint> {
         // Mean scale: the cube root of the volume scale (|det| of the linear part).
         let scale = m.determinant().abs().cbrt();
         let scale = if scale.is_finite() { scale } else { 1.0 };
+        let start = std::time::Instant::now();
+        // 24 neighbours (then dilated over 24 more) span a few point spacings each way.
+        let spread = pointcloud::surface_spread(pc, 24);
+        log::info!(
+            "point cloud '{}': surface spread of {} points in {:.2} s",
+            pc.name,
+            pc.positions.len(),
+            start.elapsed().as_secs_f64()
+        );
         for (i, &p) in pc.positions.iter().enumerate() {
+            let s = spread.get(i).map_or(0.0, |&s| s * scale);
+            spread_out.push(if s.is_finite() { s } else { 0.0 });
             let n = pc.normals.get(i).map_or(Vec3::ZERO, |&n| {
                 normal_matrix.transform_vector3(n).normalize_or_zero()
             });
@@ -461,7 +480,7 @@ pub fn gpu_points(scene: &Scene) -> Vec<GpuPoint> {
             ));
         }
     }
-    out
+    (out, spread_out)
 }
 
 /// All material textures go into one RGBA8 sRGB 2D array at a common power-of-two size, so that
@@ -591,4 +610,53 @@ pub fn scene_bounds(scene: &Scene) -> (Vec3, f32) {
         return (Vec3::ZERO, 1.0);
     }
     (b.center(), (b.size().length() * 0.5).max(1e-3))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_bits_rounds_like_ieee() {
+        assert_eq!(half_bits(0.0), 0);
+        assert_eq!(half_bits(-1.0), 0);
+        assert_eq!(half_bits(f32::NAN), 0);
+        assert_eq!(half_bits(1.0), 0x3c00);
+        assert_eq!(half_bits(0.5), 0x3800);
+        assert_eq!(half_bits(65504.0), 0x7bff);
+        assert_eq!(half_bits(1e9), 0x7bff);
+        assert_eq!(half_bits(2f32.powi(-24)), 1);
+        assert_eq!(half_bits(2f32.powi(-14)), 0x0400);
+        // 1 + 2^-11 is halfway between 1 and the next half: ties to even.
+        assert_eq!(half_bits(1.0 + 2f32.powi(-11)), 0x3c00);
+        assert_eq!(half_bits(1.0 + 3.0 * 2f32.powi(-11)), 0x3c02);
+    }
+
+    fn decode_octahedral(e: u32) -> Vec3 {
+        let s = |v: u32| ((v & 0xffff) as u16 as i16 as f32 / 32767.0).max(-1.0);
+        let (x, y) = (s(e), s(e >> 16));
+        let mut n = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+        let t = (-n.z).max(0.0);
+        n.x += if n.x >= 0.0 { -t } else { t };
+        n.y += if n.y >= 0.0 { -t } else { t };
+        n.normalize()
+    }
+
+    #[test]
+    fn octahedral_normals_round_trip() {
+        assert_eq!(encode_octahedral(Vec3::ZERO), POINT_NO_NORMAL);
+        assert_eq!(encode_octahedral(Vec3::NAN), POINT_NO_NORMAL);
+        for n in [
+            Vec3::X,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+            Vec3::new(0.3, -0.5, -0.8).normalize(),
+            Vec3::new(-0.9, 0.1, 0.2).normalize(),
+        ] {
+            let e = encode_octahedral(n);
+            assert_ne!(e, POINT_NO_NORMAL);
+            assert!(decode_octahedral(e).dot(n) > 0.99999, "{n}");
+        }
+    }
 }

@@ -278,6 +278,7 @@ impl ShadowPass {
                 layout::storage(1, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(2, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(3, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(4, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let module = shader::module(device, "shadow.wgsl");
@@ -344,6 +345,7 @@ impl ShadowPass {
                 scene.vertices.as_entire_binding(),
                 scene.draws.as_entire_binding(),
                 scene.points.as_entire_binding(),
+                scene.point_spread.as_entire_binding(),
             ]),
         });
         for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
