@@ -81,7 +81,12 @@ struct RenderArgs {
 #[derive(Args)]
 struct SettingsArgs {
     /// Exposure in stops (EV): the image is scaled by 2^EV before tone mapping.
-    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "EV",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
     exposure: f32,
     /// Tone-mapping curve for PNG output.
     #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
@@ -176,9 +181,14 @@ fn parse_bounces(s: &str) -> Result<u32, String> {
     if s == "unlimited" || s == "inf" {
         return Ok(voxgi::UNLIMITED_BOUNCES);
     }
-    let n: u32 = s.parse().map_err(|_| format!("'{s}' is not 0..=8 or 'unlimited'"))?;
+    let n: u32 = s
+        .parse()
+        .map_err(|_| format!("'{s}' is not 0..=8 or 'unlimited'"))?;
     if n > voxgi::MAX_BOUNCES {
-        return Err(format!("{n} bounces: use 0..={} or 'unlimited'", voxgi::MAX_BOUNCES));
+        return Err(format!(
+            "{n} bounces: use 0..={} or 'unlimited'",
+            voxgi::MAX_BOUNCES
+        ));
     }
     Ok(n)
 }
@@ -319,7 +329,19 @@ fn pick_camera(scene: &Scene, default: &Camera, args: &RenderArgs) -> Result<Cam
             Projection::Perspective { yfov } => yfov.to_degrees(),
             _ => 45.0,
         };
-        let near = cam.znear;
+        // The default camera's near plane sits just in front of the scene's bounds; a moved eye
+        // (perhaps inside the scene) needs one scaled to the scene instead.
+        let near = if args.eye.is_some() {
+            let b = scene.bounds();
+            let radius = if b.is_empty() {
+                1.0
+            } else {
+                b.size().length() * 0.5
+            };
+            cam.znear.min((radius * 1e-3).max(1e-4))
+        } else {
+            cam.znear
+        };
         cam = Camera::look_at(eye, target, fov);
         cam.znear = near;
     }
@@ -510,16 +532,25 @@ fn bench(args: &BenchArgs) -> Result<()> {
     eprintln!();
     let (fragments, occupied) = renderer.voxel_counts()?;
     let mut rows = Vec::new();
-    println!("{:<14} {:>10} {:>10} {:>8}", "pass", "median ms", "p95 ms", "frames");
+    println!(
+        "{:<14} {:>10} {:>10} {:>8}",
+        "pass", "median ms", "p95 ms", "frames"
+    );
     for (name, v) in &mut per_pass {
         v.sort_by(f64::total_cmp);
         let (med, p95) = (percentile(v, 0.5), percentile(v, 0.95));
         println!("{name:<14} {med:>10.3} {p95:>10.3} {:>8}", v.len());
-        rows.push(serde_json::json!({"name": name, "median_ms": med, "p95_ms": p95, "frames": v.len()}));
+        rows.push(
+            serde_json::json!({"name": name, "median_ms": med, "p95_ms": p95, "frames": v.len()}),
+        );
     }
     totals.sort_by(f64::total_cmp);
     let (fmed, fp95) = (percentile(&totals, 0.5), percentile(&totals, 0.95));
-    println!("{:<14} {fmed:>10.3} {fp95:>10.3} {:>8}", "frame (GPU)", totals.len());
+    println!(
+        "{:<14} {fmed:>10.3} {fp95:>10.3} {:>8}",
+        "frame (GPU)",
+        totals.len()
+    );
     let update: Vec<(&'static str, f64)> = first_frame
         .iter()
         .filter(|(n, _)| !per_pass.iter().any(|(p, _)| p == n))

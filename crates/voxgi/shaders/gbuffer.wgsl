@@ -1,7 +1,8 @@
 // gbuffer: rasterizes every mesh instance into albedo/metallic, normal/roughness, emission and
-// depth.
+// depth, then every point-cloud sample as a surfel (an oriented disc, see shared/surfel.wgsl).
 
 //!include shared/scene.wgsl
+//!include shared/surfel.wgsl
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
@@ -9,6 +10,7 @@
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(4) var textures: texture_2d_array<f32>;
 @group(0) @binding(5) var texture_sampler: sampler;
+@group(0) @binding(6) var<storage, read> points: array<Point>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -61,5 +63,50 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> GBuffer {
     out.albedo_metallic = vec4<f32>(base.rgb, m.metallic);
     out.normal_roughness = vec4<f32>(n, m.roughness);
     out.emission = vec4<f32>(emission, m.specular);
+    return out;
+}
+
+// Surfels: point `vertex_index / 6`, corner `vertex_index % 6`.
+struct PointOut {
+    @builtin(position) clip: vec4<f32>,
+    // Position in the disc, in radii: outside the unit circle is discarded.
+    @location(0) disc: vec2<f32>,
+    @location(1) @interpolate(flat) normal: vec3<f32>,
+    @location(2) @interpolate(flat) albedo: vec3<f32>,
+    @location(3) @interpolate(flat) emission: vec3<f32>,
+}
+
+@vertex
+fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
+    let p = points[vi / 6u];
+    let to_camera = frame.camera_pos - p.position;
+    var n = point_normal(p);
+    if dot(n, n) == 0.0 {
+        // No normal: face the camera.
+        n = normalize(to_camera);
+    } else if dot(n, to_camera) < 0.0 {
+        // The side the camera sees.
+        n = -n;
+    }
+    let corner = surfel_corner(vi);
+    var out: PointOut;
+    out.clip = frame.view_proj * vec4<f32>(surfel_world(p, n, corner), 1.0);
+    out.disc = corner;
+    out.normal = n;
+    out.albedo = point_albedo(p);
+    out.emission = point_emission(p);
+    return out;
+}
+
+@fragment
+fn fs_points(in: PointOut) -> GBuffer {
+    if dot(in.disc, in.disc) > 1.0 {
+        discard;
+    }
+    var out: GBuffer;
+    out.albedo_metallic = vec4<f32>(in.albedo, 0.0);
+    out.normal_roughness = vec4<f32>(in.normal, 1.0);
+    // Specular 0.5: scans are mostly matte; half the dielectric default keeps a faint sheen.
+    out.emission = vec4<f32>(in.emission, 0.5);
     return out;
 }

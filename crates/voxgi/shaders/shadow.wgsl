@@ -1,10 +1,15 @@
-// shadow: renders one shadow view (a layer of the shadow atlas) as occluder distances.
+// shadow: renders one shadow view (a layer of the shadow atlas) as occluder distances, from the
+// mesh instances and from point-cloud surfels.
 
 //!include shared/scene.wgsl
+//!include shared/surfel.wgsl
 
 @group(0) @binding(0) var<uniform> view: ShadowView;
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(2) var<storage, read> draws: array<Draw>;
+@group(0) @binding(3) var<storage, read> points: array<Point>;
+// Per point: how far its neighbours stray from its tangent plane (metres).
+@group(0) @binding(4) var<storage, read> point_spread: array<f32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -20,13 +25,72 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
     return out;
 }
 
+// How far surfels are pushed away from the light in shadow maps: this many disc radii plus this
+// many times the point's surface spread (measured along the light). Tuned on the Kinect office
+// scan, whose depth comes in ~5 cm steps at 4 m: 4 radii without the spread left blotches of
+// self-shadow all over its walls; 8 radii plus the spread leaves a few. Clean surfaces have no
+// spread, and their contact shadows start 8 radii from the occluder.
+const SURFEL_SHADOW_OFFSET: f32 = 8.0;
+const SURFEL_SPREAD_OFFSET: f32 = 1.0;
+
+struct PointOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) disc: vec2<f32>,
+}
+
+// Surfels: point `vertex_index / 6`, corner `vertex_index % 6`, the same discs as the gbuffer's.
+@vertex
+fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
+    let p = points[vi / 6u];
+    var n = point_normal(p);
+    if dot(n, n) == 0.0 {
+        // No normal: face the light, as the gbuffer's disc faces the camera.
+        if view.kind == SHADOW_ORTHO {
+            n = -view.dir;
+        } else {
+            n = normalize(view.origin - p.position);
+        }
+    }
+    let corner = surfel_corner(vi);
+    // Away from the light: by some radii, which covers the tilt of neighbouring discs, plus the
+    // point's surface spread projected onto the light direction, so that scanned points that
+    // scatter about their surface (by more than the composite's receiver-plane bias allows for)
+    // do not shadow their neighbours.
+    var away = view.dir;
+    if view.kind != SHADOW_ORTHO {
+        away = normalize(p.position - view.origin);
+    }
+    let spread = point_spread[vi / 6u] / max(abs(dot(n, away)), 0.25);
+    let offset = SURFEL_SHADOW_OFFSET * p.radius + SURFEL_SPREAD_OFFSET * spread;
+    let world = surfel_world(p, n, corner) + away * offset;
+    var out: PointOut;
+    out.clip = view.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.disc = corner;
+    return out;
+}
+
 @fragment
-fn fs_main(in: VsOut) -> @location(0) f32 {
-    if dot(view.plane.xyz, in.world) + view.plane.w < 0.0 {
+fn fs_points(in: PointOut) -> @location(0) f32 {
+    if dot(in.disc, in.disc) > 1.0 {
+        discard;
+    }
+    return occluder_distance(in.world);
+}
+
+// The occluder distance this view stores for a surface point.
+fn occluder_distance(world: vec3<f32>) -> f32 {
+    if dot(view.plane.xyz, world) + view.plane.w < 0.0 {
         discard;
     }
     if view.kind == SHADOW_ORTHO {
-        return dot(in.world - view.origin, view.dir);
+        return dot(world - view.origin, view.dir);
     }
-    return length(in.world - view.origin);
+    return length(world - view.origin);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) f32 {
+    return occluder_distance(in.world);
 }

@@ -28,7 +28,7 @@ use crate::voxel::{GpuCones, Grid};
 use crate::{Error, GpuContext, Result};
 use glam::{Mat4, Vec3};
 use std::borrow::Cow;
-use voxgi_scene::{Camera, Projection, Scene};
+use voxgi_scene::{Aabb, Camera, Projection, Scene, pointcloud};
 use wgpu::util::DeviceExt;
 
 /// Render targets of one output size.
@@ -130,6 +130,53 @@ impl FrameTargets {
     }
 }
 
+/// Fills in normals (k = 16) and disc radii (k = 8) of point clouds that lack them. Normals face
+/// the cloud's local origin when that lies outside the cloud's bounds (scanners put the sensor
+/// there), else the default camera.
+fn estimate_point_attributes(scene: &mut Scene) {
+    let camera = scene
+        .cameras
+        .first()
+        .cloned()
+        .unwrap_or_else(|| scene.default_camera())
+        .position;
+    for pc in &mut scene.point_clouds {
+        if pc.positions.is_empty() || (!pc.normals.is_empty() && !pc.radii.is_empty()) {
+            continue;
+        }
+        let start = std::time::Instant::now();
+        let mut local = Aabb::EMPTY;
+        for &p in &pc.positions {
+            local.grow(p);
+        }
+        let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
+        // `estimate_normals` takes the viewpoint in world space.
+        let viewpoint = if origin_outside {
+            pc.transform.transform_point3(Vec3::ZERO)
+        } else {
+            camera
+        };
+        let what = match (pc.normals.is_empty(), pc.radii.is_empty()) {
+            (true, true) => "normals and radii",
+            (true, false) => "normals",
+            _ => "radii",
+        };
+        pointcloud::estimate_normals(pc, 16, viewpoint);
+        pointcloud::estimate_radii(pc, 8);
+        log::info!(
+            "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
+            pc.name,
+            pc.positions.len(),
+            start.elapsed().as_secs_f64(),
+            if origin_outside {
+                "the cloud's origin"
+            } else {
+                "the default camera"
+            }
+        );
+    }
+}
+
 /// A scene uploaded to the GPU, ready to render from any camera.
 pub struct Renderer {
     device: wgpu::Device,
@@ -162,22 +209,27 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Uploads `scene`. A scene with nothing to draw is an error; a scene with no light at all
-    /// gets a default sun (when `settings.default_light`) so it does not render black.
+    /// Uploads `scene`. A scene with nothing to draw (no triangles, no points) is an error; a
+    /// scene with no light at all gets a default sun (when `settings.default_light`) so it does
+    /// not render black. Point clouds without normals or radii get estimated ones.
     pub fn new(ctx: &GpuContext, scene: &Scene, settings: Settings) -> Result<Self> {
         settings.validate()?;
         scene.validate()?;
-        if scene.triangle_count() == 0 {
+        if scene.triangle_count() == 0 && scene.point_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let scene: Cow<Scene> = if scene.is_unlit() && settings.default_light {
+        let mut scene: Cow<Scene> = Cow::Borrowed(scene);
+        if scene.is_unlit() && settings.default_light {
             log::warn!("the scene has no lights and nothing emissive: adding a default sun");
-            let mut lit = scene.clone();
-            lit.lights.push(Scene::default_sun());
-            Cow::Owned(lit)
-        } else {
-            Cow::Borrowed(scene)
-        };
+            scene.to_mut().lights.push(Scene::default_sun());
+        }
+        if scene
+            .point_clouds
+            .iter()
+            .any(|pc| !pc.positions.is_empty() && (pc.normals.is_empty() || pc.radii.is_empty()))
+        {
+            estimate_point_attributes(scene.to_mut());
+        }
         let scene = scene.as_ref();
         let device = ctx.device.clone();
         let queue = ctx.queue.clone();
@@ -462,7 +514,6 @@ impl Renderer {
     /// Renders one frame into the targets without reading it back (for benchmarks and
     /// viewers).
     pub fn render_frame(&mut self, camera: &Camera, width: u32, height: u32) -> Result<()> {
-
         validate_size(width, height)?;
         if !(camera.position.is_finite() && camera.forward.is_finite() && camera.up.is_finite()) {
             return Err(Error::Setting(
@@ -517,7 +568,10 @@ impl Renderer {
     /// Renders one frame from `camera` at `width` x `height` and reads it back.
     pub fn render(&mut self, camera: &Camera, width: u32, height: u32) -> Result<RenderOutput> {
         self.render_frame(camera, width, height)?;
-        let t = self.targets.as_ref().expect("render_frame made the targets");
+        let t = self
+            .targets
+            .as_ref()
+            .expect("render_frame made the targets");
         let hdr_bytes = readback::read_texture(&self.device, &self.queue, &t.hdr_texture)?;
         let ldr = readback::read_texture(&self.device, &self.queue, &t.ldr_texture)?;
         Ok(RenderOutput {

@@ -1,11 +1,12 @@
-//! The scene on the GPU: vertices, indices, per-instance draws, materials, textures, lights.
+//! The scene on the GPU: vertices, indices, per-instance draws, materials, textures, lights and
+//! point-cloud surfels.
 //! Every pass reads geometry from these buffers (vertex pulling), so the rasterizer, the
 //! voxelizer and the path tracer see exactly the same data.
 
 use crate::{Error, Result, Settings};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene};
+use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene, pointcloud};
 use wgpu::util::DeviceExt;
 
 /// Mirrors `Frame` in shaders/shared/scene.wgsl.
@@ -44,6 +45,100 @@ pub struct GpuDraw {
     pub material: u32,
     pub light: u32,
     pub _pad: [u32; 2],
+}
+
+/// One point-cloud sample (a surfel), in world space. Mirrors `Point` in
+/// shaders/shared/scene.wgsl: 32 bytes, std430-compatible (one vec3 + f32, then four u32).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuPoint {
+    pub position: [f32; 3],
+    /// Disc radius in metres.
+    pub radius: f32,
+    /// Unit normal, octahedral-encoded as two snorm16 (x low, y high); `POINT_NO_NORMAL` when the
+    /// point has none (the disc then faces the viewer).
+    pub normal: u32,
+    /// Linear albedo as f16: red (low half) and green (high half).
+    pub albedo_rg: u32,
+    /// Linear albedo blue (low half) and emitted radiance red (high half), f16.
+    pub albedo_b_emission_r: u32,
+    /// Emitted radiance green (low half) and blue (high half), f16, W/(m² sr).
+    pub emission_gb: u32,
+}
+
+const _: () = assert!(size_of::<GpuPoint>() == 32);
+
+/// `GpuPoint::normal` of a point without a usable normal (snorm16 -32768 twice, a value that
+/// octahedral encoding never produces).
+pub const POINT_NO_NORMAL: u32 = 0x8000_8000;
+
+impl GpuPoint {
+    pub fn new(
+        position: Vec3,
+        radius: f32,
+        normal: Vec3,
+        albedo: [f32; 3],
+        emission: [f32; 3],
+    ) -> Self {
+        let h = |v: f32| half_bits(v) as u32;
+        GpuPoint {
+            position: position.to_array(),
+            radius,
+            normal: encode_octahedral(normal),
+            albedo_rg: h(albedo[0]) | (h(albedo[1]) << 16),
+            albedo_b_emission_r: h(albedo[2]) | (h(emission[0]) << 16),
+            emission_gb: h(emission[1]) | (h(emission[2]) << 16),
+        }
+    }
+}
+
+/// Octahedral encoding of a direction into two snorm16 (WGSL `unpack2x16snorm` decodes it);
+/// zero or non-finite vectors give `POINT_NO_NORMAL`.
+pub fn encode_octahedral(n: Vec3) -> u32 {
+    let l1 = n.x.abs() + n.y.abs() + n.z.abs();
+    if !n.is_finite() || l1 < 1e-12 {
+        return POINT_NO_NORMAL;
+    }
+    let p = n / l1;
+    let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+    let (x, y) = if p.z >= 0.0 {
+        (p.x, p.y)
+    } else {
+        ((1.0 - p.y.abs()) * sign(p.x), (1.0 - p.x.abs()) * sign(p.y))
+    };
+    let snorm = |v: f32| ((v.clamp(-1.0, 1.0) * 32767.0).round() as i16) as u16 as u32;
+    snorm(x) | (snorm(y) << 16)
+}
+
+/// IEEE half-precision bits of `v` (round to nearest even), clamped to the finite range; NaN and
+/// negative values become 0 (albedo and radiance are never negative).
+pub fn half_bits(v: f32) -> u16 {
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    let v = v.min(65504.0);
+    let bits = v.to_bits();
+    let exp = ((bits >> 23) & 0xff) as i32 - 127 + 15;
+    let mant = bits & 0x7f_ffff;
+    if exp <= 0 {
+        // Subnormal half (or zero).
+        if exp < -10 {
+            return 0;
+        }
+        let m = mant | 0x80_0000;
+        let shift = (14 - exp) as u32;
+        let half = m >> shift;
+        let rem = m & ((1 << shift) - 1);
+        let mid = 1 << (shift - 1);
+        let round = rem > mid || (rem == mid && half & 1 == 1);
+        return (half + round as u32) as u16;
+    }
+    let half = ((exp as u32) << 10) | (mant >> 13);
+    let rem = mant & 0x1fff;
+    let round = rem > 0x1000 || (rem == 0x1000 && half & 1 == 1);
+    // A carry into the exponent is the correct rounding; 65504 is the largest input, so it
+    // never reaches infinity.
+    (half + round as u32) as u16
 }
 
 /// Mirrors `Material` in shaders/shared/scene.wgsl.
@@ -106,6 +201,13 @@ pub struct GpuScene {
     pub draws: wgpu::Buffer,
     pub materials: wgpu::Buffer,
     pub lights: wgpu::Buffer,
+    /// All point clouds' surfels (`GpuPoint`), in world space.
+    pub points: wgpu::Buffer,
+    /// One f32 per point (shadow pass only): how far the point's neighbours stray from its
+    /// tangent plane, in metres (`pointcloud::surface_spread`); shadow maps push the surfel
+    /// that far away from the light so noisy scans do not shadow themselves.
+    pub point_spread: wgpu::Buffer,
+    pub point_count: u32,
     pub textures: wgpu::Texture,
     pub texture_view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
@@ -239,6 +341,7 @@ impl GpuScene {
             })
             .collect();
         let lights = gpu_lights(scene);
+        let (points, spread) = gpu_points(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
             let mut data = bytes.to_vec();
@@ -260,6 +363,15 @@ impl GpuScene {
                 max_binding >> 20
             )));
         }
+        let pbytes = std::mem::size_of_val(points.as_slice());
+        if pbytes > max_binding {
+            return Err(Error::Setting(format!(
+                "the scene's {} points need {} MiB, more than this GPU's storage-buffer limit of {} MiB",
+                points.len(),
+                pbytes >> 20,
+                max_binding >> 20
+            )));
+        }
         Ok(GpuScene {
             vertices: storage("vertices", bytemuck::cast_slice(&vertices), 32),
             indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -274,6 +386,9 @@ impl GpuScene {
             draws: storage("draws", bytemuck::cast_slice(&draws), 144),
             materials: storage("materials", bytemuck::cast_slice(&materials), 64),
             lights: storage("lights", bytemuck::cast_slice(&lights), 96),
+            points: storage("points", bytemuck::cast_slice(&points), 32),
+            point_spread: storage("point spread", bytemuck::cast_slice(&spread), 4),
+            point_count: points.len() as u32,
             texture_view: textures.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
@@ -310,9 +425,62 @@ impl GpuScene {
             ("draws", self.draws.size()),
             ("materials", self.materials.size()),
             ("lights", self.lights.size()),
+            ("points", self.points.size()),
+            ("point spread", self.point_spread.size()),
             ("textures", tex),
         ]
     }
+}
+
+/// Surfels of every point cloud in world space: positions by the cloud's transform, normals by
+/// its inverse transpose, radii by its mean scale. Attributes a cloud lacks get defaults here
+/// (no normal: the disc faces the viewer; radius 0: not drawn; grey albedo; no emission); the
+/// renderer estimates normals and radii before uploading. The second result is each point's
+/// world-space surface spread (see `GpuScene::point_spread`).
+pub fn gpu_points(scene: &Scene) -> (Vec<GpuPoint>, Vec<f32>) {
+    let mut out = Vec::with_capacity(scene.point_count());
+    let mut spread_out = Vec::with_capacity(scene.point_count());
+    for pc in &scene.point_clouds {
+        if pc.positions.is_empty() {
+            continue;
+        }
+        let m = pc.transform;
+        let normal_matrix = m.inverse().transpose();
+        let normal_matrix = if normal_matrix.is_finite() {
+            normal_matrix
+        } else {
+            Mat4::IDENTITY
+        };
+        // Mean scale: the cube root of the volume scale (|det| of the linear part).
+        let scale = m.determinant().abs().cbrt();
+        let scale = if scale.is_finite() { scale } else { 1.0 };
+        let start = std::time::Instant::now();
+        // 24 neighbours (then dilated over 24 more) span a few point spacings each way.
+        let spread = pointcloud::surface_spread(pc, 24);
+        log::info!(
+            "point cloud '{}': surface spread of {} points in {:.2} s",
+            pc.name,
+            pc.positions.len(),
+            start.elapsed().as_secs_f64()
+        );
+        for (i, &p) in pc.positions.iter().enumerate() {
+            let s = spread.get(i).map_or(0.0, |&s| s * scale);
+            spread_out.push(if s.is_finite() { s } else { 0.0 });
+            let n = pc.normals.get(i).map_or(Vec3::ZERO, |&n| {
+                normal_matrix.transform_vector3(n).normalize_or_zero()
+            });
+            let r = pc.radii.get(i).map_or(0.0, |&r| r * scale);
+            let r = if r.is_finite() { r.max(0.0) } else { 0.0 };
+            out.push(GpuPoint::new(
+                m.transform_point3(p),
+                r,
+                n,
+                pc.colors.get(i).copied().unwrap_or([0.8; 3]),
+                pc.emission.get(i).copied().unwrap_or([0.0; 3]),
+            ));
+        }
+    }
+    (out, spread_out)
 }
 
 /// All material textures go into one RGBA8 sRGB 2D array at a common power-of-two size, so that
@@ -442,4 +610,53 @@ pub fn scene_bounds(scene: &Scene) -> (Vec3, f32) {
         return (Vec3::ZERO, 1.0);
     }
     (b.center(), (b.size().length() * 0.5).max(1e-3))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_bits_rounds_like_ieee() {
+        assert_eq!(half_bits(0.0), 0);
+        assert_eq!(half_bits(-1.0), 0);
+        assert_eq!(half_bits(f32::NAN), 0);
+        assert_eq!(half_bits(1.0), 0x3c00);
+        assert_eq!(half_bits(0.5), 0x3800);
+        assert_eq!(half_bits(65504.0), 0x7bff);
+        assert_eq!(half_bits(1e9), 0x7bff);
+        assert_eq!(half_bits(2f32.powi(-24)), 1);
+        assert_eq!(half_bits(2f32.powi(-14)), 0x0400);
+        // 1 + 2^-11 is halfway between 1 and the next half: ties to even.
+        assert_eq!(half_bits(1.0 + 2f32.powi(-11)), 0x3c00);
+        assert_eq!(half_bits(1.0 + 3.0 * 2f32.powi(-11)), 0x3c02);
+    }
+
+    fn decode_octahedral(e: u32) -> Vec3 {
+        let s = |v: u32| ((v & 0xffff) as u16 as i16 as f32 / 32767.0).max(-1.0);
+        let (x, y) = (s(e), s(e >> 16));
+        let mut n = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+        let t = (-n.z).max(0.0);
+        n.x += if n.x >= 0.0 { -t } else { t };
+        n.y += if n.y >= 0.0 { -t } else { t };
+        n.normalize()
+    }
+
+    #[test]
+    fn octahedral_normals_round_trip() {
+        assert_eq!(encode_octahedral(Vec3::ZERO), POINT_NO_NORMAL);
+        assert_eq!(encode_octahedral(Vec3::NAN), POINT_NO_NORMAL);
+        for n in [
+            Vec3::X,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+            Vec3::new(0.3, -0.5, -0.8).normalize(),
+            Vec3::new(-0.9, 0.1, 0.2).normalize(),
+        ] {
+            let e = encode_octahedral(n);
+            assert_ne!(e, POINT_NO_NORMAL);
+            assert!(decode_octahedral(e).dot(n) > 0.99999, "{n}");
+        }
+    }
 }

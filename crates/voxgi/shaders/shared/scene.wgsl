@@ -61,6 +61,24 @@ struct Material {
     _pad1: u32,
 }
 
+// One point-cloud sample (surfel) in world space: an oriented disc. 32 bytes; unpack with the
+// helpers in shared/surfel.wgsl.
+struct Point {
+    position: vec3<f32>,
+    // Disc radius in metres (0: not drawn).
+    radius: f32,
+    // Unit normal, octahedral-encoded as two snorm16 (unpack2x16snorm); POINT_NO_NORMAL when the
+    // point has none and the disc faces the viewer.
+    normal: u32,
+    // Linear albedo and emitted radiance (W/(m^2 sr)) as f16 pairs (unpack2x16float):
+    // (albedo.r, albedo.g), (albedo.b, emission.r), (emission.g, emission.b).
+    albedo_rg: u32,
+    albedo_b_emission_r: u32,
+    emission_gb: u32,
+}
+
+const POINT_NO_NORMAL: u32 = 0x80008000u;
+
 const LIGHT_DIRECTIONAL: u32 = 0u;
 const LIGHT_POINT: u32 = 1u;
 const LIGHT_SPOT: u32 = 2u;

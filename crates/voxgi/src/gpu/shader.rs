@@ -17,6 +17,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/fragment.wgsl",
     "shared/dense_sample.wgsl",
     "shared/cone.wgsl",
+    "shared/surfel.wgsl",
     "shadow.wgsl",
     "gbuffer.wgsl",
     "voxelize.wgsl",

@@ -1,4 +1,5 @@
-//! gbuffer: rasterizes all mesh instances into the G-buffer.
+//! gbuffer: rasterizes all mesh instances into the G-buffer, then every point-cloud sample as a
+//! surfel (an oriented disc) into the same targets, depth-tested against the meshes.
 
 use crate::frame::FrameTargets;
 use crate::gpu::timer::GpuTimer;
@@ -12,6 +13,8 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 pub struct GbufferPass {
     pipeline: wgpu::RenderPipeline,
+    /// Surfels: 6 vertices per point, no index buffer.
+    points: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -32,6 +35,7 @@ impl GbufferPass {
                     wgpu::TextureViewDimension::D2Array,
                 ),
                 layout::sampler(5, wgpu::ShaderStages::FRAGMENT),
+                layout::storage(6, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let module = shader::module(device, "gbuffer.wgsl");
@@ -40,42 +44,48 @@ impl GbufferPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            // No culling: OBJ and PLY files often mix windings; back faces flip their normal.
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[
-                    Some(ALBEDO_FORMAT.into()),
-                    Some(NORMAL_FORMAT.into()),
-                    Some(EMISSION_FORMAT.into()),
-                ],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        GbufferPass { pipeline, layout }
+        let make = |label: &str, vs: &str, fs: &str| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                // No culling: OBJ and PLY files often mix windings; back faces flip their normal.
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[
+                        Some(ALBEDO_FORMAT.into()),
+                        Some(NORMAL_FORMAT.into()),
+                        Some(EMISSION_FORMAT.into()),
+                    ],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        GbufferPass {
+            pipeline: make("gbuffer", "vs_main", "fs_main"),
+            points: make("gbuffer points", "vs_points", "fs_points"),
+            layout,
+        }
     }
 
     pub fn record(
@@ -96,6 +106,7 @@ impl GbufferPass {
                 scene.materials.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&scene.texture_view),
                 wgpu::BindingResource::Sampler(&scene.sampler),
+                scene.points.as_entire_binding(),
             ]),
         });
         let clear = |view| {
@@ -133,6 +144,10 @@ impl GbufferPass {
                 call.base_vertex,
                 call.draw..call.draw + 1,
             );
+        }
+        if scene.point_count > 0 {
+            pass.set_pipeline(&self.points);
+            pass.draw(0..scene.point_count * 6, 0..1);
         }
     }
 }

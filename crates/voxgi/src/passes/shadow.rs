@@ -264,6 +264,8 @@ impl ShadowAtlas {
 
 pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
+    /// Point-cloud surfels: 6 vertices per point, no index buffer.
+    points: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -276,6 +278,8 @@ impl ShadowPass {
                 layout::uniform(0, vs, true),
                 layout::storage(1, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(2, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(3, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(4, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let module = shader::module(device, "shadow.wgsl");
@@ -284,37 +288,43 @@ impl ShadowPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("shadow"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(ATLAS_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        ShadowPass { pipeline, layout }
+        let make = |label: &str, vs: &str, fs: &str| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: wgpu::TextureFormat::Depth32Float,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(ATLAS_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        ShadowPass {
+            pipeline: make("shadow", "vs_main", "fs_main"),
+            points: make("shadow points", "vs_points", "fs_points"),
+            layout,
+        }
     }
 
     pub fn record(
@@ -336,6 +346,8 @@ impl ShadowPass {
                 }),
                 scene.vertices.as_entire_binding(),
                 scene.draws.as_entire_binding(),
+                scene.points.as_entire_binding(),
+                scene.point_spread.as_entire_binding(),
             ]),
         });
         for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
@@ -382,6 +394,11 @@ impl ShadowPass {
                     call.base_vertex,
                     call.draw..call.draw + 1,
                 );
+            }
+            // Points are never an emitter's surface, so they shadow every light.
+            if scene.point_count > 0 {
+                pass.set_pipeline(&self.points);
+                pass.draw(0..scene.point_count * 6, 0..1);
             }
         }
     }
