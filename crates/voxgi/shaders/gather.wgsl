@@ -80,7 +80,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Cone half-angle from the GGX lobe width, no narrower than a voxel allows anyway.
         let tan_half = clamp(ggx_alpha(s.roughness), 0.01, 1.0);
         let origin = p + n * vol.voxel_size * cones.origin_offset;
-        let spec = trace_cone(origin, r, tan_half, cones.max_distance).rgb;
+        let spec = trace_cone(origin, n, r, tan_half, cones.max_distance).rgb;
         indirect += spec * env_brdf(f0, s.roughness, max(dot(n, v), 1e-4));
     }
     textureStore(indirect_out, gid.xy, vec4<f32>(indirect, g.ao));

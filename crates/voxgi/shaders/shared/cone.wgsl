@@ -1,9 +1,22 @@
 // Cone tracing, written once against sample_voxels(position, diameter, direction).
 
+// The filter size of a cone sample at distance t from a surface (normal n). A filtered voxel of
+// size d spreads its content about d around it, so a sample whose filter reached the cone's own
+// surface would see that surface: the sample's filter is narrowed until it stays
+// SELF_CLEARANCE sizes above the surface's tangent plane. A surface can neither occlude nor
+// light itself, so this removes self-intersection only; occluders in front are still seen
+// (at a finer level than the cone's width would pick).
+const SELF_CLEARANCE: f32 = 2.0;
+
+fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32) -> f32 {
+    let h = dot(p - origin, n) + vol.voxel_size * cones.origin_offset;
+    return clamp(h / SELF_CLEARANCE, vol.voxel_size, d);
+}
+
 // Front-to-back accumulation of one cone. Returns premultiplied radiance (rgb) and opacity (a).
 // Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
 // length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d).
-fn trace_cone(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -> vec4<f32> {
+fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
     var t = vol.voxel_size;
     let min_d = vol.voxel_size;
@@ -12,12 +25,16 @@ fn trace_cone(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -
             break;
         }
         let d = max(min_d, 2.0 * tan_half * t);
-        let s = sample_voxels(origin + dir * t, d, dir);
-        let step = max(d * cones.step_factor, vol.voxel_size * 0.25);
+        let p = origin + dir * t;
+        let ds = cone_sample_size(origin, n, p, d);
+        let s = sample_voxels(p, ds, dir);
+        // A narrowed sample covers less: step no further than its filter reaches, so thin
+        // walls are not stepped over.
+        let step = max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
         let a = clamp(s.a, 0.0, 1.0);
         var corrected = vec4<f32>(0.0);
         if a > 1e-5 {
-            let ca = 1.0 - pow(1.0 - min(a, 0.9999), step / d);
+            let ca = 1.0 - pow(1.0 - min(a, 0.9999), step / ds);
             corrected = vec4<f32>(s.rgb * (ca / a), ca);
         }
         acc += (1.0 - acc.a) * corrected;
@@ -27,7 +44,7 @@ fn trace_cone(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -
 }
 
 // Ambient occlusion along one cone: opacity weighted by 1/(1 + lambda r), up to ao_radius.
-fn trace_ao(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f32 {
+fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f32 {
     var occ = 0.0;
     var t = vol.voxel_size;
     for (var i = 0u; i < 256u; i++) {
@@ -35,10 +52,12 @@ fn trace_ao(origin: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f32 {
             break;
         }
         let d = max(vol.voxel_size, 2.0 * tan_half * t);
-        let s = sample_voxels(origin + dir * t, d, dir);
-        let step = max(d * cones.step_factor, vol.voxel_size * 0.25);
+        let p = origin + dir * t;
+        let ds = cone_sample_size(origin, n, p, d);
+        let s = sample_voxels(p, ds, dir);
+        let step = max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
         let a = clamp(s.a, 0.0, 0.9999);
-        let ca = 1.0 - pow(1.0 - a, step / d);
+        let ca = 1.0 - pow(1.0 - a, step / ds);
         occ += (1.0 - occ) * ca / (1.0 + cones.ao_lambda * t);
         t += step;
     }
@@ -78,12 +97,12 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool) -> Gath
         let c = cones.dirs[i];
         let d = normalize(frame * rotate_z(c.xyz, angle));
         if cones.indirect != 0u {
-            let r = trace_cone(origin, d, cones.diffuse_tan, cones.max_distance);
+            let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance);
             // Weights are fractions of the cosine-weighted hemisphere, whose integral is pi.
             e += PI * c.w * r.rgb;
         }
         if with_ao {
-            occ += c.w * trace_ao(origin, d, cones.diffuse_tan);
+            occ += c.w * trace_ao(origin, n, d, cones.diffuse_tan);
         }
     }
     return Gathered(e, 1.0 - occ);
