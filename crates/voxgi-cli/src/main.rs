@@ -77,81 +77,166 @@ struct RenderArgs {
     camera: Option<usize>,
 }
 
-/// Renderer settings shared by `render` and `bench`.
+/// Renderer settings shared by `render` and `bench`. Each flag overrides the scene file's
+/// `[settings]` table, which overrides the defaults.
 #[derive(Args)]
 struct SettingsArgs {
-    /// Exposure in stops (EV): the image is scaled by 2^EV before tone mapping.
-    #[arg(
-        long,
-        value_name = "EV",
-        default_value_t = 0.0,
-        allow_hyphen_values = true
-    )]
-    exposure: f32,
-    /// Tone-mapping curve for PNG output.
-    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
-    tonemap: TonemapArg,
-    /// What to show.
-    #[arg(long, value_enum, default_value_t = ViewArg::Final)]
-    view: ViewArg,
-    /// Shadow map resolution per view, in texels.
-    #[arg(long, value_name = "N", default_value_t = Settings::default().shadow_map_size)]
-    shadow_map_size: u32,
-    /// Voxels per side of the volume (power of two, 16..=512).
-    #[arg(long, value_name = "N", default_value_t = Settings::default().voxel_resolution)]
-    voxel_resolution: u32,
-    /// Indirect bounces: 0 (direct light only) to 8, or "unlimited".
-    #[arg(long, value_name = "N", default_value = "2", value_parser = parse_bounces)]
-    bounces: u32,
-    /// Diffuse cone set: 6x60, 7x45 or 9x45.
-    #[arg(long, value_name = "SET", default_value = "6x60", value_parser = parse_cones)]
-    cones: voxgi::ConeSet,
+    /// Exposure in stops (EV): the image is scaled by 2^EV before tone mapping. Default 0.
+    #[arg(long, value_name = "EV", allow_hyphen_values = true)]
+    exposure: Option<f32>,
+    /// Tone-mapping curve for PNG output. Default aces.
+    #[arg(long, value_enum)]
+    tonemap: Option<TonemapArg>,
+    /// What to show. Default final.
+    #[arg(long, value_enum)]
+    view: Option<ViewArg>,
+    /// Shadow map resolution per view, in texels. Default 1024.
+    #[arg(long, value_name = "N")]
+    shadow_map_size: Option<u32>,
+    /// Voxels per side of the volume (power of two, 16..=512). Default 128.
+    #[arg(long, value_name = "N")]
+    voxel_resolution: Option<u32>,
+    /// Indirect bounces: 0 (direct light only) to 8, or "unlimited". Default 2.
+    #[arg(long, value_name = "N", value_parser = parse_bounces)]
+    bounces: Option<u32>,
+    /// Diffuse cone set: 6x60, 7x45 or 9x45. Default 6x60.
+    #[arg(long, value_name = "SET", value_parser = parse_cones)]
+    cones: Option<voxgi::ConeSet>,
     /// One radiance value per voxel above the finest level instead of six directional ones.
     #[arg(long)]
     isotropic: bool,
     /// Gather indirect light at half resolution with an edge-aware upsample.
     #[arg(long)]
     half_res: bool,
-    /// Ambient-occlusion radius in metres (default: a quarter of the volume).
+    /// Ambient-occlusion radius in metres. Default: a quarter of the volume.
     #[arg(long, value_name = "M")]
     ao_radius: Option<f32>,
-    /// Ambient-occlusion falloff lambda in 1/(1 + lambda r), per metre.
-    #[arg(long, value_name = "L", default_value_t = Settings::default().ao_lambda)]
-    ao_lambda: f32,
-    /// Cone step as a fraction of the cone diameter.
-    #[arg(long, value_name = "F", default_value_t = Settings::default().step_factor)]
-    step_factor: f32,
+    /// Ambient-occlusion falloff lambda in 1/(1 + lambda r), per metre. Default 0.
+    #[arg(long, value_name = "L")]
+    ao_lambda: Option<f32>,
+    /// Cone step as a fraction of the cone diameter. Default 0.5.
+    #[arg(long, value_name = "F")]
+    step_factor: Option<f32>,
 }
 
 impl SettingsArgs {
-    fn to_settings(&self) -> Settings {
-        Settings {
-            exposure: self.exposure,
-            shadow_map_size: self.shadow_map_size,
-            tonemap: match self.tonemap {
+    /// Defaults, then the scene file's `[settings]`, then these flags.
+    fn to_settings(&self, file: Option<&toml::Table>) -> Result<Settings> {
+        let mut s = Settings::default();
+        if let Some(t) = file {
+            apply_table(&mut s, t)?;
+        }
+        if let Some(v) = self.exposure {
+            s.exposure = v;
+        }
+        if let Some(v) = self.tonemap {
+            s.tonemap = match v {
                 TonemapArg::Aces => Tonemap::Aces,
                 TonemapArg::Neutral => Tonemap::Neutral,
                 TonemapArg::Clamp => Tonemap::Clamp,
-            },
-            view: match self.view {
+            };
+        }
+        if let Some(v) = self.view {
+            s.view = match v {
                 ViewArg::Final => ViewMode::Final,
                 ViewArg::Albedo => ViewMode::Albedo,
                 ViewArg::Normal => ViewMode::Normal,
                 ViewArg::Direct => ViewMode::Direct,
                 ViewArg::Ao => ViewMode::Ao,
                 ViewArg::Indirect => ViewMode::Indirect,
-            },
-            voxel_resolution: self.voxel_resolution,
-            bounces: self.bounces,
-            cones: self.cones,
-            anisotropic: !self.isotropic,
-            half_resolution: self.half_res,
-            ao_radius: self.ao_radius,
-            ao_lambda: self.ao_lambda,
-            step_factor: self.step_factor,
-            ..Settings::default()
+            };
+        }
+        if let Some(v) = self.shadow_map_size {
+            s.shadow_map_size = v;
+        }
+        if let Some(v) = self.voxel_resolution {
+            s.voxel_resolution = v;
+        }
+        if let Some(v) = self.bounces {
+            s.bounces = v;
+        }
+        if let Some(v) = self.cones {
+            s.cones = v;
+        }
+        if self.isotropic {
+            s.anisotropic = false;
+        }
+        if self.half_res {
+            s.half_resolution = true;
+        }
+        if self.ao_radius.is_some() {
+            s.ao_radius = self.ao_radius;
+        }
+        if let Some(v) = self.ao_lambda {
+            s.ao_lambda = v;
+        }
+        if let Some(v) = self.step_factor {
+            s.step_factor = v;
+        }
+        s.validate()?;
+        Ok(s)
+    }
+}
+
+/// Applies a scene file's `[settings]` table; unknown keys and wrong types are errors.
+fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
+    for (key, value) in t {
+        let num = || {
+            value
+                .as_float()
+                .or_else(|| value.as_integer().map(|i| i as f64))
+                .with_context(|| format!("[settings] {key}: expected a number, got {value}"))
+        };
+        let int = || {
+            value
+                .as_integer()
+                .and_then(|i| u32::try_from(i).ok())
+                .with_context(|| {
+                    format!("[settings] {key}: expected a non-negative integer, got {value}")
+                })
+        };
+        let boolean = || {
+            value
+                .as_bool()
+                .with_context(|| format!("[settings] {key}: expected true or false, got {value}"))
+        };
+        let string = || {
+            value
+                .as_str()
+                .with_context(|| format!("[settings] {key}: expected a string, got {value}"))
+        };
+        match key.as_str() {
+            "exposure" => s.exposure = num()? as f32,
+            "shadow_map_size" => s.shadow_map_size = int()?,
+            "voxel_resolution" => s.voxel_resolution = int()?,
+            "bounces" => {
+                s.bounces = match value.as_str() {
+                    Some(v) => parse_bounces(v).map_err(anyhow::Error::msg)?,
+                    None => int()?,
+                }
+            }
+            "cones" => s.cones = parse_cones(string()?).map_err(anyhow::Error::msg)?,
+            "anisotropic" => s.anisotropic = boolean()?,
+            "half_resolution" => s.half_resolution = boolean()?,
+            "ao_radius" => s.ao_radius = Some(num()? as f32),
+            "ao_lambda" => s.ao_lambda = num()? as f32,
+            "step_factor" => s.step_factor = num()? as f32,
+            "tonemap" => {
+                s.tonemap = match string()? {
+                    "aces" => Tonemap::Aces,
+                    "neutral" => Tonemap::Neutral,
+                    "clamp" => Tonemap::Clamp,
+                    other => bail!("[settings] tonemap: '{other}' is not aces, neutral or clamp"),
+                }
+            }
+            other => bail!(
+                "[settings] unknown key '{other}' (known: exposure, shadow_map_size, \
+                 voxel_resolution, bounces, cones, anisotropic, half_resolution, ao_radius, \
+                 ao_lambda, step_factor, tonemap)"
+            ),
         }
     }
+    Ok(())
 }
 
 #[derive(Args)]
@@ -255,9 +340,25 @@ impl Progress {
 }
 
 fn load_scene(arg: &SceneArg) -> Result<Scene> {
+    Ok(load_scene_and_settings(arg)?.0)
+}
+
+/// The scene, and the `[settings]` table when it is a scene file that has one.
+fn load_scene_and_settings(arg: &SceneArg) -> Result<(Scene, Option<toml::Table>)> {
     match (&arg.scene, &arg.builtin) {
-        (_, Some(name)) => Ok(builtin::by_name(name)?),
-        (Some(path), None) => Ok(io::load(path)?),
+        (_, Some(name)) => Ok((builtin::by_name(name)?, None)),
+        (Some(path), None) => {
+            let is_toml = path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+            if is_toml {
+                let (scene, table) = io::scene_file::load_with_settings(path)?;
+                scene.validate().map_err(|e| e.in_file(path))?;
+                Ok((scene, table))
+            } else {
+                Ok((io::load(path)?, None))
+            }
+        }
         (None, None) => bail!("give a scene file or --builtin NAME"),
     }
 }
@@ -287,9 +388,13 @@ fn render(args: &RenderArgs) -> Result<()> {
         );
     }
     let label = scene_label(&args.scene);
-    let scene = p.stage(&format!("loading {label}"), || load_scene(&args.scene))?;
-    let settings = args.settings.to_settings();
-    settings.validate()?;
+    let (scene, table) = p.stage(&format!("loading {label}"), || {
+        load_scene_and_settings(&args.scene)
+    })?;
+    let settings = args
+        .settings
+        .to_settings(table.as_ref())
+        .with_context(|| label.clone())?;
     let ctx = p.stage("opening GPU", GpuContext::from_env)?;
     eprintln!("GPU: {} ({:?})", ctx.info.name, ctx.info.backend);
     let mut renderer = p
@@ -488,10 +593,12 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 
 fn bench(args: &BenchArgs) -> Result<()> {
     let label = scene_label(&args.scene);
-    let scene = load_scene(&args.scene)?;
-    let mut settings = args.settings.to_settings();
+    let (scene, table) = load_scene_and_settings(&args.scene)?;
+    let mut settings = args
+        .settings
+        .to_settings(table.as_ref())
+        .with_context(|| label.clone())?;
     settings.revoxelize_every_frame = args.revoxelize;
-    settings.validate()?;
     let ctx = GpuContext::from_env()?;
     if !ctx.timestamps {
         bail!(

@@ -187,3 +187,67 @@ fn info_reports_counts() {
     // 130 mm x 105 mm = 0.01365 m².
     assert!(s.contains("area 0.013"), "{s}");
 }
+
+#[test]
+fn scene_file_settings_apply_and_typos_are_errors() {
+    let bad = tmp("bad_settings.toml");
+    std::fs::write(
+        &bad,
+        "[[include]]\nbuiltin = \"cornell-box\"\n[settings]\nvoxel_resolutio = 64\n",
+    )
+    .unwrap();
+    let o = voxgi(&[
+        "render",
+        bad.to_str().unwrap(),
+        "-o",
+        tmp("c.png").to_str().unwrap(),
+        "--size",
+        "16x16",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let line = error_line(&o);
+    assert!(
+        line.contains("bad_settings.toml") && line.contains("voxel_resolutio"),
+        "{line}"
+    );
+
+    let wrong = tmp("wrong_settings.toml");
+    std::fs::write(
+        &wrong,
+        "[[include]]\nbuiltin = \"cornell-box\"\n[settings]\nvoxel_resolution = 100\n",
+    )
+    .unwrap();
+    let o = voxgi(&[
+        "render",
+        wrong.to_str().unwrap(),
+        "-o",
+        tmp("d.png").to_str().unwrap(),
+        "--size",
+        "16x16",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        error_line(&o).contains("voxel resolution 100"),
+        "{}",
+        error_line(&o)
+    );
+
+    // A valid table renders; the flag wins over the file (a resolution of 16 renders fine).
+    let ok = tmp("ok_settings.toml");
+    std::fs::write(
+        &ok,
+        "[[include]]\nbuiltin = \"cornell-box\"\n[settings]\nvoxel_resolution = 100\nbounces = 1\n",
+    )
+    .unwrap();
+    let o = voxgi(&[
+        "render",
+        ok.to_str().unwrap(),
+        "-o",
+        tmp("e.png").to_str().unwrap(),
+        "--size",
+        "16x16",
+        "--voxel-resolution",
+        "16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
