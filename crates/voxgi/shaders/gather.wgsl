@@ -33,10 +33,12 @@ fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
     return w.xyz / w.w;
 }
 
-// Jimenez's interleaved gradient noise: a per-pixel bundle rotation that is deterministic and
-// spreads the cones' directions evenly over neighbouring pixels.
-fn ign(p: vec2<f32>) -> f32 {
-    return fract(52.9829189 * fract(dot(p, vec2<f32>(0.06711056, 0.00583715))));
+// Interleaved sampling (Keller and Heidrich): each pixel of a 4x4 block rotates the cone bundle
+// by a different sixteenth of the ring's period, in Bayer order, and the upsample pass averages
+// every 4x4 window, so each pixel gets the light of sixteen rotations of the bundle.
+fn bayer4(p: vec2<u32>) -> f32 {
+    let m = array<u32, 16>(0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
+    return f32(m[(p.y & 3u) * 4u + (p.x & 3u)]);
 }
 
 // Karis's analytic fit of the split-sum environment BRDF.
@@ -71,7 +73,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = world_position(px, depth);
     let n = normalize(nr.xyz);
     let v = normalize(frame.camera_pos - p);
-    let angle = ign(vec2<f32>(gid.xy)) * 2.0 * PI;
+    // The ring of tilted cones repeats every 2 pi / (count - 1).
+    let period = 2.0 * PI / f32(max(cones.count, 2u) - 1u);
+    let angle = (bayer4(gid.xy) + 0.5) / 16.0 * period;
     let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO);
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);

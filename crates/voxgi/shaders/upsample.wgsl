@@ -1,6 +1,7 @@
-// upsample: half-resolution indirect light to full resolution. Each pixel blends its four
-// nearest low-resolution samples with bilinear weights times depth and normal similarity, so
-// light does not bleed across silhouettes and creases.
+// upsample: the gather's output (full or half resolution, one bundle rotation per pixel of each
+// 4x4 block) to full-resolution indirect light. Each pixel averages the 4x4 window of gather
+// samples around it, weighted by depth and normal similarity, so it receives all sixteen bundle
+// rotations while light does not bleed across silhouettes and creases.
 
 //!include shared/scene.wgsl
 
@@ -10,11 +11,11 @@
 @group(0) @binding(3) var gb_depth: texture_depth_2d;
 @group(0) @binding(4) var full: texture_storage_2d<rgba16float, write>;
 
-fn linear_depth(px: vec2<u32>) -> f32 {
+fn view_depth(px: vec2<u32>) -> f32 {
     let d = textureLoad(gb_depth, px, 0);
-    let w = frame.inv_view_proj * vec4<f32>(0.0, 0.0, d, 1.0);
-    let near = frame.inv_view_proj * vec4<f32>(0.0, 0.0, 0.0, 1.0);
-    return length(w.xyz / w.w - near.xyz / near.w);
+    let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
+    let w = frame.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, d, 1.0);
+    return length(w.xyz / w.w - frame.camera_pos);
 }
 
 @compute @workgroup_size(8, 8)
@@ -24,26 +25,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let low_size = textureDimensions(low);
-    let d0 = linear_depth(gid.xy);
+    let scale = max(size.x / low_size.x, 1u);
+    if textureLoad(gb_depth, gid.xy, 0) >= 1.0 {
+        textureStore(full, gid.xy, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    let d0 = view_depth(gid.xy);
     let n0 = textureLoad(gb_normal, gid.xy, 0).xyz;
-    // Position in the low-resolution grid, whose sample i sits at full-res pixel 2i.
-    let q = vec2<f32>(gid.xy) * 0.5;
-    let base = vec2<i32>(floor(q));
-    let f = q - vec2<f32>(base);
+    let base = vec2<i32>(gid.xy / scale) - 1;
     var sum = vec4<f32>(0.0);
     var wsum = 0.0;
-    for (var i = 0; i < 4; i++) {
-        let o = vec2<i32>(i & 1, i >> 1);
-        let c = clamp(base + o, vec2<i32>(0), vec2<i32>(low_size) - 1);
-        let bil = select(1.0 - f.x, f.x, o.x == 1) * select(1.0 - f.y, f.y, o.y == 1);
-        let full_px = min(vec2<u32>(c) * 2u, size - 1u);
-        let d = linear_depth(full_px);
-        let n = textureLoad(gb_normal, full_px, 0).xyz;
-        let wd = exp(-abs(d - d0) / max(0.02 * d0, 1e-4));
+    for (var i = 0; i < 16; i++) {
+        let c = clamp(base + vec2<i32>(i & 3, i >> 2), vec2<i32>(0), vec2<i32>(low_size) - 1);
+        let px = min(vec2<u32>(c) * scale, size - 1u);
+        if textureLoad(gb_depth, px, 0) >= 1.0 {
+            continue;
+        }
+        let d = view_depth(px);
+        let n = textureLoad(gb_normal, px, 0).xyz;
+        // Depth within 5 % and normals within ~30 degrees count fully; beyond, weights fall fast.
+        let wd = exp(-abs(d - d0) / max(0.05 * d0, 1e-4));
         let wn = pow(max(dot(n, n0), 0.0), 8.0);
-        let w = max(bil, 1e-3) * wd * wn + 1e-6;
+        let w = wd * wn + 1e-6;
         sum += w * textureLoad(low, c, 0);
         wsum += w;
     }
-    textureStore(full, gid.xy, sum / wsum);
+    textureStore(full, gid.xy, sum / max(wsum, 1e-6));
 }

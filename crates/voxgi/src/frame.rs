@@ -44,8 +44,9 @@ pub struct FrameTargets {
     pub ldr: wgpu::TextureView,
     /// Indirect light at full resolution (rgb) and ambient occlusion (a).
     pub indirect: wgpu::TextureView,
-    /// The gather's half-resolution target, when gathering at half resolution.
-    pub indirect_low: Option<wgpu::TextureView>,
+    /// The gather's target, at full or half resolution; `upsample` filters it into `indirect`.
+    pub indirect_low: wgpu::TextureView,
+    half: bool,
     hdr_texture: wgpu::Texture,
     ldr_texture: wgpu::Texture,
 }
@@ -89,12 +90,17 @@ impl FrameTargets {
             emission: view(make("gbuffer emission", gbuffer::EMISSION_FORMAT, rt)),
             depth: view(make("gbuffer depth", gbuffer::DEPTH_FORMAT, rt)),
             indirect: view(make("indirect", INDIRECT_FORMAT, st)),
-            indirect_low: half.then(|| {
+            indirect_low: {
+                let (lw, lh) = if half {
+                    (width.div_ceil(2), height.div_ceil(2))
+                } else {
+                    (width, height)
+                };
                 let low = device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("indirect half"),
+                    label: Some("indirect gather"),
                     size: wgpu::Extent3d {
-                        width: width.div_ceil(2),
-                        height: height.div_ceil(2),
+                        width: lw,
+                        height: lh,
                         depth_or_array_layers: 1,
                     },
                     mip_level_count: 1,
@@ -105,7 +111,8 @@ impl FrameTargets {
                     view_formats: &[],
                 });
                 low.create_view(&Default::default())
-            }),
+            },
+            half,
             hdr: hdr_texture.create_view(&Default::default()),
             ldr: ldr_texture.create_view(&Default::default()),
             hdr_texture,
@@ -114,15 +121,15 @@ impl FrameTargets {
     }
 
     /// Bytes per pixel of all full-resolution targets together.
-    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8;
+    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8;
 
     /// Where the gather writes: the half-resolution target or the full one.
     pub fn gather_target(&self) -> &wgpu::TextureView {
-        self.indirect_low.as_ref().unwrap_or(&self.indirect)
+        &self.indirect_low
     }
 
     pub fn gather_size(&self) -> (u32, u32) {
-        if self.indirect_low.is_some() {
+        if self.half {
             (self.width.div_ceil(2), self.height.div_ceil(2))
         } else {
             (self.width, self.height)
@@ -521,9 +528,11 @@ impl Renderer {
             ));
         }
         let half = self.settings.half_resolution;
-        if self.targets.as_ref().is_none_or(|t| {
-            t.width != width || t.height != height || t.indirect_low.is_some() != half
-        }) {
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| t.width != width || t.height != height || t.half != half)
+        {
             self.targets = Some(FrameTargets::new(&self.device, width, height, half));
         }
         if self.dirty || self.settings.revoxelize_every_frame {

@@ -1,4 +1,5 @@
-//! upsample: half-resolution indirect light to full resolution, edge-aware.
+//! upsample: the gather's interleaved samples (full or half resolution) to full-resolution
+//! indirect light, edge-aware.
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
@@ -42,9 +43,7 @@ impl UpsamplePass {
         t: &FrameTargets,
         timer: &mut GpuTimer,
     ) {
-        let Some(low) = &t.indirect_low else {
-            return;
-        };
+        let low = &t.indirect_low;
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("upsample"),
             layout: &self.layout,
