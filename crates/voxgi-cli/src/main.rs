@@ -108,6 +108,9 @@ struct SettingsArgs {
     /// Gather indirect light at half resolution with an edge-aware upsample.
     #[arg(long)]
     half_res: bool,
+    /// Shadows of area lights by a cone traced through the voxels instead of the shadow map.
+    #[arg(long)]
+    cone_shadows: bool,
     /// Ambient-occlusion radius in metres. Default: a quarter of the volume.
     #[arg(long, value_name = "M")]
     ao_radius: Option<f32>,
@@ -164,6 +167,9 @@ impl SettingsArgs {
         if self.half_res {
             s.half_resolution = true;
         }
+        if self.cone_shadows {
+            s.cone_shadows = true;
+        }
         if self.ao_radius.is_some() {
             s.ao_radius = self.ao_radius;
         }
@@ -218,6 +224,7 @@ fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
             "cones" => s.cones = parse_cones(string()?).map_err(anyhow::Error::msg)?,
             "anisotropic" => s.anisotropic = boolean()?,
             "half_resolution" => s.half_resolution = boolean()?,
+            "cone_shadows" => s.cone_shadows = boolean()?,
             "ao_radius" => s.ao_radius = Some(num()? as f32),
             "ao_lambda" => s.ao_lambda = num()? as f32,
             "step_factor" => s.step_factor = num()? as f32,
@@ -231,8 +238,8 @@ fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
             }
             other => bail!(
                 "[settings] unknown key '{other}' (known: exposure, shadow_map_size, \
-                 voxel_resolution, bounces, cones, anisotropic, half_resolution, ao_radius, \
-                 ao_lambda, step_factor, tonemap)"
+                 voxel_resolution, bounces, cones, anisotropic, half_resolution, cone_shadows, \
+                 ao_radius, ao_lambda, step_factor, tonemap)"
             ),
         }
     }

@@ -403,6 +403,8 @@ impl Renderer {
                 ViewMode::Indirect => 5,
             },
             background: [s.background[0], s.background[1], s.background[2], 1.0],
+            cone_shadows: s.cone_shadows as u32,
+            _pad: [0; 3],
         }
     }
 
@@ -565,6 +567,8 @@ impl Renderer {
             t,
             &self.scene,
             &self.atlas,
+            &self.volume,
+            &self.cones,
             timer,
         );
         self.tonemap.record(&self.device, &mut encoder, t, timer);

@@ -24,6 +24,8 @@ pub struct GpuFrame {
     pub shadow_softness: f32,
     pub view_mode: u32,
     pub background: [f32; 4],
+    pub cone_shadows: u32,
+    pub _pad: [u32; 3],
 }
 
 /// Mirrors `Vertex` in shaders/shared/scene.wgsl.

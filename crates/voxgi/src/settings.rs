@@ -81,6 +81,9 @@ pub struct Settings {
     pub max_distance: Option<f32>,
     /// Gather indirect light at half resolution and upsample it edge-aware. Default false.
     pub half_resolution: bool,
+    /// Shadows of area lights by a cone traced through the voxels towards the light (aperture:
+    /// the light's size) instead of PCSS on the shadow map. Default false.
+    pub cone_shadows: bool,
     /// Voxelize, inject, filter and bounce every frame, not only when the scene changed
     /// (for benchmarks of fully dynamic scenes).
     pub revoxelize_every_frame: bool,
@@ -107,6 +110,7 @@ impl Default for Settings {
             origin_offset: 1.5,
             max_distance: None,
             half_resolution: false,
+            cone_shadows: false,
             revoxelize_every_frame: false,
         }
     }

@@ -21,6 +21,11 @@ struct Frame {
     // Output selection for debugging (0 = final).
     view_mode: u32,
     background: vec4<f32>,
+    // 1: area lights' shadows by a cone traced through the voxels instead of the shadow map.
+    cone_shadows: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One vertex, pulled from a storage buffer (no vertex buffers: every pass reads the same data).

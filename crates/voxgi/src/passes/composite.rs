@@ -5,6 +5,7 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::passes::shadow::ShadowAtlas;
+use crate::voxel::dense::DenseVolume;
 
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
@@ -19,27 +20,33 @@ impl CompositePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
             entries: &[
-                layout::uniform(0, c, false),
-                layout::storage(1, c, true),
-                layout::storage(2, c, true),
-                layout::texture(
-                    3,
-                    c,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                layout::texture_2d_load(4, c),
-                layout::texture_2d_load(5, c),
-                layout::texture_2d_load(6, c),
-                layout::texture(
-                    7,
-                    c,
-                    wgpu::TextureSampleType::Depth,
-                    wgpu::TextureViewDimension::D2,
-                ),
-                layout::storage_texture(8, HDR_FORMAT),
-                layout::texture_2d_load(9, c),
-            ],
+                vec![
+                    layout::uniform(0, c, false),
+                    layout::storage(1, c, true),
+                    layout::storage(2, c, true),
+                    layout::texture(
+                        3,
+                        c,
+                        wgpu::TextureSampleType::Float { filterable: false },
+                        wgpu::TextureViewDimension::D2Array,
+                    ),
+                    layout::texture_2d_load(4, c),
+                    layout::texture_2d_load(5, c),
+                    layout::texture_2d_load(6, c),
+                    layout::texture(
+                        7,
+                        c,
+                        wgpu::TextureSampleType::Depth,
+                        wgpu::TextureViewDimension::D2,
+                    ),
+                    layout::storage_texture(8, HDR_FORMAT),
+                    layout::texture_2d_load(9, c),
+                    layout::uniform(10, c, false),
+                    layout::uniform(11, c, false),
+                ],
+                DenseVolume::sampling_layout(12, c),
+            ]
+            .concat(),
         });
         let pipeline = compute_pipeline(device, "composite", "composite.wgsl", &layout);
         CompositePass { pipeline, layout }
@@ -52,23 +59,31 @@ impl CompositePass {
         t: &FrameTargets,
         scene: &GpuScene,
         atlas: &ShadowAtlas,
+        vol: &DenseVolume,
+        cones: &wgpu::Buffer,
         timer: &mut GpuTimer,
     ) {
+        let views = vol.sampling_views();
+        let mut resources = vec![
+            t.frame.as_entire_binding(),
+            scene.lights.as_entire_binding(),
+            atlas.views_buffer.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&atlas.array_view),
+            wgpu::BindingResource::TextureView(&t.albedo),
+            wgpu::BindingResource::TextureView(&t.normal),
+            wgpu::BindingResource::TextureView(&t.emission),
+            wgpu::BindingResource::TextureView(&t.depth),
+            wgpu::BindingResource::TextureView(&t.hdr),
+            wgpu::BindingResource::TextureView(&t.indirect),
+            vol.volume.as_entire_binding(),
+            cones.as_entire_binding(),
+        ];
+        resources.extend(views.iter().map(wgpu::BindingResource::TextureView));
+        resources.push(wgpu::BindingResource::Sampler(&vol.sampler));
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),
             layout: &self.layout,
-            entries: &layout::entries(vec![
-                t.frame.as_entire_binding(),
-                scene.lights.as_entire_binding(),
-                atlas.views_buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&atlas.array_view),
-                wgpu::BindingResource::TextureView(&t.albedo),
-                wgpu::BindingResource::TextureView(&t.normal),
-                wgpu::BindingResource::TextureView(&t.emission),
-                wgpu::BindingResource::TextureView(&t.depth),
-                wgpu::BindingResource::TextureView(&t.hdr),
-                wgpu::BindingResource::TextureView(&t.indirect),
-            ]),
+            entries: &layout::entries(resources),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("composite"),
