@@ -6,7 +6,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 use voxgi::scene::glam::Vec3;
 use voxgi::scene::{Camera, LightKind, Projection, Scene, builtin, io};
-use voxgi::{GpuContext, Renderer, Settings, Tonemap, ViewMode};
+use voxgi::compare::{self, Image};
+use voxgi::{
+    Bounces, GpuContext, PathTracer, ReferenceMode, ReferenceOptions, Renderer, Settings, Tonemap,
+    ViewMode,
+};
 
 #[derive(Parser)]
 #[command(
@@ -37,6 +41,20 @@ enum Command {
     Render(RenderArgs),
     /// Print what a scene contains: counts, bounds, materials, lights, cameras.
     Info(SceneArg),
+    /// Compare a test image with a reference: mean FLIP (LDR-FLIP for PNG, HDR-FLIP for EXR),
+    /// RMSE and relative MSE on linear values, printed as one JSON line.
+    Compare(CompareArgs),
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    /// The reference image (.png or .exr).
+    reference: PathBuf,
+    /// The image to judge (same size and kind as the reference).
+    test: PathBuf,
+    /// Also write the per-pixel FLIP error as a PNG (magma colour map).
+    #[arg(long, value_name = "FILE.png")]
+    error_map: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -88,6 +106,36 @@ struct RenderArgs {
     /// Shadow map resolution per view, in texels.
     #[arg(long, value_name = "N", default_value_t = Settings::default().shadow_map_size)]
     shadow_map_size: u32,
+    /// Renderer: the real-time rasterizer, the reference path tracer, or the AO reference.
+    #[arg(long, value_enum, default_value_t = ModeArg::Raster)]
+    mode: ModeArg,
+    /// Reference modes: samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    spp: u32,
+    /// Reference mode: indirect bounces (direct = what the rasterizer computes).
+    #[arg(long, value_enum, default_value_t = BouncesArg::Unlimited)]
+    bounces: BouncesArg,
+    /// AO reference: how far (metres) a ray must travel unblocked to count as unoccluded.
+    #[arg(long, value_name = "METRES", default_value_t = 1.0)]
+    ao_radius: f32,
+    /// Reference modes: random seed (the same seed gives the same image).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    seed: u32,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ModeArg {
+    Raster,
+    Reference,
+    AoReference,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BouncesArg {
+    Direct,
+    #[value(name = "1")]
+    One,
+    Unlimited,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -198,14 +246,65 @@ fn render(args: &RenderArgs) -> Result<()> {
     settings.validate()?;
     let ctx = p.stage("opening GPU", GpuContext::from_env)?;
     eprintln!("GPU: {} ({:?})", ctx.info.name, ctx.info.backend);
-    let mut renderer = p
-        .stage("uploading scene", || Renderer::new(&ctx, &scene, settings))
-        .with_context(|| label.clone())?;
-    let camera = pick_camera(&scene, renderer.default_camera(), args)?;
     let (w, h) = args.size;
-    let out = p.stage(&format!("rendering {w}x{h}"), || {
-        renderer.render(&camera, w, h)
-    })?;
+    let out = if args.mode == ModeArg::Raster {
+        let mut renderer = p
+            .stage("uploading scene", || Renderer::new(&ctx, &scene, settings))
+            .with_context(|| label.clone())?;
+        let camera = pick_camera(&scene, renderer.default_camera(), args)?;
+        p.stage(&format!("rendering {w}x{h}"), || {
+            renderer.render(&camera, w, h)
+        })?
+    } else {
+        let opts = ReferenceOptions {
+            spp: args.spp,
+            bounces: match args.bounces {
+                BouncesArg::Direct => Bounces::DirectOnly,
+                BouncesArg::One => Bounces::One,
+                BouncesArg::Unlimited => Bounces::Unlimited,
+            },
+            mode: if args.mode == ModeArg::AoReference {
+                ReferenceMode::Ao {
+                    radius: args.ao_radius,
+                }
+            } else {
+                ReferenceMode::Radiance
+            },
+            seed: args.seed,
+        };
+        let mut tracer = p
+            .stage("uploading scene and building the BVH", || {
+                PathTracer::new(&ctx, &scene, &settings)
+            })
+            .with_context(|| label.clone())?;
+        let default = scene
+            .cameras
+            .first()
+            .cloned()
+            .unwrap_or_else(|| scene.default_camera());
+        let camera = pick_camera(&scene, &default, args)?;
+        eprintln!(
+            "path tracing {w}x{h}, {} spp, {} triangles",
+            opts.spp,
+            tracer.triangle_count()
+        );
+        let t = Instant::now();
+        let mut last = 0.0;
+        let out = tracer.render(&camera, w, h, &opts, &mut |done, total| {
+            let el = t.elapsed().as_secs_f64();
+            if el - last >= 1.0 || done == total {
+                last = el;
+                let eta = el / done as f64 * (total - done) as f64;
+                eprint!("\r  {done}/{total} spp  {el:.1} s elapsed  ETA {eta:.1} s   ");
+            }
+        })?;
+        eprintln!(
+            "\nrendered {} spp in {:.2} s",
+            opts.spp,
+            t.elapsed().as_secs_f64()
+        );
+        out
+    };
     out.save(&args.output)?;
     eprintln!(
         "wrote {} ({w}x{h}) in {:.2} s",
@@ -248,6 +347,33 @@ fn pick_camera(scene: &Scene, default: &Camera, args: &RenderArgs) -> Result<Cam
         };
     }
     Ok(cam)
+}
+
+fn compare_images(args: &CompareArgs) -> Result<()> {
+    let reference = Image::load(&args.reference)?;
+    let test = Image::load(&args.test)?;
+    let (c, map) = compare::compare_with_map(&reference, &test).with_context(|| {
+        format!(
+            "comparing {} with {}",
+            args.test.display(),
+            args.reference.display()
+        )
+    })?;
+    if let Some(path) = &args.error_map {
+        compare::save_error_map(path, reference.width, reference.height, &map)?;
+    }
+    println!(
+        "{}",
+        serde_json::json!({
+            "flip_mean": c.flip_mean,
+            "rmse": c.rmse,
+            "rel_mse": c.rel_mse,
+            "reference": args.reference.display().to_string(),
+            "test": args.test.display().to_string(),
+            "hdr": c.hdr,
+        })
+    );
+    Ok(())
 }
 
 fn info(arg: &SceneArg) -> Result<()> {
@@ -364,6 +490,7 @@ fn main() {
     let result = match &cli.command {
         Command::Render(a) => render(a),
         Command::Info(a) => info(a),
+        Command::Compare(a) => compare_images(a),
     };
     if let Err(e) = result {
         eprintln!("voxgi: error: {e:#}");

@@ -104,14 +104,7 @@ impl Renderer {
         if scene.triangle_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let scene: Cow<Scene> = if scene.is_unlit() && settings.default_light {
-            log::warn!("the scene has no lights and nothing emissive: adding a default sun");
-            let mut lit = scene.clone();
-            lit.lights.push(Scene::default_sun());
-            Cow::Owned(lit)
-        } else {
-            Cow::Borrowed(scene)
-        };
+        let scene = lit_scene(scene, &settings);
         let scene = scene.as_ref();
         let device = ctx.device.clone();
         let queue = ctx.queue.clone();
@@ -198,27 +191,7 @@ impl Renderer {
     }
 
     fn frame_uniforms(&self, camera: &Camera, width: u32, height: u32) -> GpuFrame {
-        let aspect = width as f32 / height as f32;
-        let dist = (camera.position - self.center).length();
-        let zfar = camera
-            .zfar
-            .unwrap_or(dist + self.radius * 1.05)
-            .max(camera.znear * 2.0);
-        let view = Mat4::look_to_rh(camera.position, camera.forward, camera.up);
-        let proj = match camera.projection {
-            Projection::Perspective { yfov } => {
-                Mat4::perspective_rh(yfov, aspect, camera.znear, zfar)
-            }
-            Projection::Orthographic { ymag, .. } => Mat4::orthographic_rh(
-                -ymag * aspect,
-                ymag * aspect,
-                -ymag,
-                ymag,
-                camera.znear,
-                zfar,
-            ),
-        };
-        let view_proj = proj * view;
+        let view_proj = camera_view_proj(camera, width, height, self.center, self.radius);
         let s = &self.settings;
         GpuFrame {
             view_proj: view_proj.to_cols_array_2d(),
@@ -286,5 +259,49 @@ impl Renderer {
             hdr: bytemuck::cast_slice(&hdr_bytes).to_vec(),
             ldr,
         })
+    }
+}
+
+/// The camera's view-projection matrix for a `width` x `height` image of a scene with bounding
+/// sphere (`center`, `radius`): right-handed, depth 0..1, the far plane just past the scene.
+/// The rasterizer and the path tracer both use it, so they see exactly the same view.
+pub(crate) fn camera_view_proj(
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    center: Vec3,
+    radius: f32,
+) -> Mat4 {
+    let aspect = width as f32 / height as f32;
+    let dist = (camera.position - center).length();
+    let zfar = camera
+        .zfar
+        .unwrap_or(dist + radius * 1.05)
+        .max(camera.znear * 2.0);
+    let view = Mat4::look_to_rh(camera.position, camera.forward, camera.up);
+    let proj = match camera.projection {
+        Projection::Perspective { yfov } => Mat4::perspective_rh(yfov, aspect, camera.znear, zfar),
+        Projection::Orthographic { ymag, .. } => Mat4::orthographic_rh(
+            -ymag * aspect,
+            ymag * aspect,
+            -ymag,
+            ymag,
+            camera.znear,
+            zfar,
+        ),
+    };
+    proj * view
+}
+
+/// The scene as rendered: with a default sun added when it has no light at all and
+/// `settings.default_light` is set, so it does not render black.
+pub(crate) fn lit_scene<'a>(scene: &'a Scene, settings: &Settings) -> Cow<'a, Scene> {
+    if scene.is_unlit() && settings.default_light {
+        log::warn!("the scene has no lights and nothing emissive: adding a default sun");
+        let mut lit = scene.clone();
+        lit.lights.push(Scene::default_sun());
+        Cow::Owned(lit)
+    } else {
+        Cow::Borrowed(scene)
     }
 }

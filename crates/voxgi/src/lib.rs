@@ -9,18 +9,21 @@
 //! # Ok::<(), voxgi::Error>(())
 //! ```
 
+pub mod compare;
 mod error;
 mod frame;
 pub mod gpu;
 pub mod gpu_scene;
 pub mod output;
 pub mod passes;
+pub mod reference;
 mod settings;
 
 pub use error::{Error, Result};
 pub use frame::{FrameTargets, Renderer};
 pub use gpu::GpuContext;
 pub use output::RenderOutput;
+pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
 pub use settings::{MAX_IMAGE_SIZE, Settings, Tonemap, ViewMode, validate_size};
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;

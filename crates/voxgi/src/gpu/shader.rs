@@ -13,6 +13,10 @@ const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/brdf.wgsl"),
     ),
     (
+        "shared/light_model.wgsl",
+        include_str!("../../shaders/shared/light_model.wgsl"),
+    ),
+    (
         "shared/lights.wgsl",
         include_str!("../../shaders/shared/lights.wgsl"),
     ),
@@ -23,6 +27,10 @@ const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/composite.wgsl"),
     ),
     ("tonemap.wgsl", include_str!("../../shaders/tonemap.wgsl")),
+    (
+        "reference.wgsl",
+        include_str!("../../shaders/reference.wgsl"),
+    ),
 ];
 
 fn raw(name: &str) -> &'static str {

@@ -6,4 +6,5 @@ mod analytic;
 mod common;
 mod errors;
 mod golden;
+mod reference;
 mod shaders;
