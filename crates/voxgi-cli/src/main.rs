@@ -4,9 +4,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
+use voxgi::compare::{self, Image};
 use voxgi::scene::glam::Vec3;
 use voxgi::scene::{Camera, LightKind, Projection, Scene, builtin, io};
-use voxgi::compare::{self, Image};
 use voxgi::{
     Bounces, GpuContext, PathTracer, ReferenceMode, ReferenceOptions, Renderer, Settings, Tonemap,
     ViewMode,

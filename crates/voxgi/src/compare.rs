@@ -39,7 +39,10 @@ impl Image {
 
     /// An LDR image from sRGB-encoded RGBA8 (as `RenderOutput::ldr`).
     pub fn from_ldr_rgba8(width: u32, height: u32, rgba: &[u8]) -> Self {
-        let srgb8: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        let srgb8: Vec<u8> = rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
         Image {
             width,
             height,
@@ -83,7 +86,11 @@ impl Image {
                 let img = image::open(path)
                     .map_err(|e| fail(e.to_string()))?
                     .to_rgba8();
-                Ok(Image::from_ldr_rgba8(img.width(), img.height(), img.as_raw()))
+                Ok(Image::from_ldr_rgba8(
+                    img.width(),
+                    img.height(),
+                    img.as_raw(),
+                ))
             }
             _ => Err(fail(format!(
                 "unknown image type '.{ext}' (use .png or .exr)"

@@ -4,6 +4,7 @@
 
 mod analytic;
 mod common;
+mod compare;
 mod errors;
 mod golden;
 mod reference;

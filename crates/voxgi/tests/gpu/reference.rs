@@ -8,9 +8,17 @@ use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Light, LightKind, Material, Mesh, Scene, builtin};
 use voxgi::{Bounces, PathTracer, ReferenceMode, ReferenceOptions, RenderOutput, Settings};
 
-fn trace(scene: &Scene, settings: &Settings, cam: &Camera, w: u32, h: u32, opts: ReferenceOptions) -> RenderOutput {
+fn trace(
+    scene: &Scene,
+    settings: &Settings,
+    cam: &Camera,
+    w: u32,
+    h: u32,
+    opts: ReferenceOptions,
+) -> RenderOutput {
     let mut pt = PathTracer::new(ctx(), scene, settings).expect("path tracer");
-    pt.render(cam, w, h, &opts, &mut |_, _| {}).expect("reference render")
+    pt.render(cam, w, h, &opts, &mut |_, _| {})
+        .expect("reference render")
 }
 
 fn opts(spp: u32, bounces: Bounces) -> ReferenceOptions {
@@ -42,12 +50,12 @@ fn reference_furnace_matches_closed_forms() {
         (Bounces::Unlimited, (le / (1.0 - albedo)) as f64),
     ];
     for (bounces, expected) in cases {
-        // 16x16 px at 64 spp: 16384 paths. Direct-only and one bounce have no variance at all
+        // 16x16 px at 256 spp: 65536 paths. Direct-only and one bounce have no variance at all
         // (Lambertian walls, cosine sampling: every path carries exactly Le and rho*Le). With
         // unlimited bounces only Russian roulette adds noise; we measure the standard error of
         // the image mean from the pixels and require it to be under 0.25 % so that 1 % is four
         // standard errors away.
-        let out = trace(&scene, &measuring(), &cam, 16, 16, opts(64, bounces));
+        let out = trace(&scene, &measuring(), &cam, 16, 16, opts(256, bounces));
         let (mean, err) = mean_and_error(&out);
         assert!(
             err / expected < 0.0025,
@@ -80,7 +88,14 @@ fn reference_lambertian_plane_under_a_point_light() {
     let cam = Camera::look_at(Vec3::new(0.0, 2.5, 0.0), Vec3::ZERO, 70.0);
     // Direct light from a point light has no noise but the pixel jitter (box filter): the mean
     // over a pixel differs from the value at its centre only to second order (< 0.1 % here).
-    let out = trace(&scene, &measuring(), &cam, W, W, opts(16, Bounces::DirectOnly));
+    let out = trace(
+        &scene,
+        &measuring(),
+        &cam,
+        W,
+        W,
+        opts(16, Bounces::DirectOnly),
+    );
     for (x, y) in [(32, 32), (10, 12), (52, 9), (14, 50), (55, 54)] {
         let p = pixel_on_ground(&cam, W, W, x, y);
         let to = lp - p;
@@ -107,17 +122,34 @@ fn reference_direct_light_matches_the_rasterizer_on_the_cornell_box() {
     )
     .unwrap();
     eprintln!("Cornell box, direct only, PT (64 spp) vs raster: {c:?}");
-    // Measured: see the threshold's justification in the report; PCSS penumbrae, the pixel
-    // centre vs box-filtered edges and the path tracer's remaining noise make up the error.
-    assert!(c.flip_mean < 0.2, "mean FLIP {} too large", c.flip_mean);
+    // Measured on lavapipe at 64x64 (LDR-FLIP, ACES): 0.067 at 64 spp, 0.068 at 256 and 0.067
+    // at 1024 spp, so the difference is systematic, not noise: the rasterizer samples pixel
+    // centres while the path tracer box-filters the pixel (the bright emitter's edges carry most
+    // of the error), and PCSS approximates the true penumbrae. 0.09 leaves room for other
+    // drivers; a real radiometric error (a wrong light or BRDF term) gives far more.
+    assert!(c.flip_mean < 0.09, "mean FLIP {} too large", c.flip_mean);
 }
 
 #[test]
 fn reference_is_deterministic() {
     let scene = builtin::cornell_box();
     let cam = scene.cameras[0].clone();
-    let a = trace(&scene, &measuring(), &cam, 16, 16, opts(4, Bounces::Unlimited));
-    let b = trace(&scene, &measuring(), &cam, 16, 16, opts(4, Bounces::Unlimited));
+    let a = trace(
+        &scene,
+        &measuring(),
+        &cam,
+        16,
+        16,
+        opts(4, Bounces::Unlimited),
+    );
+    let b = trace(
+        &scene,
+        &measuring(),
+        &cam,
+        16,
+        16,
+        opts(4, Bounces::Unlimited),
+    );
     assert!(a.hdr == b.hdr, "two renders with the same seed differ");
 }
 
@@ -166,7 +198,11 @@ fn reference_ao_at_the_foot_of_a_wall_is_one_half() {
     // Look straight down at a 2 mm patch 5 mm from the wall's base: every pixel sees a floor
     // point whose upper hemisphere the wall cuts in half, so cosine-weighted AO is 1/2 (rays
     // missing the wall within the 1 m radius would need |dz/dx| > 200: negligible).
-    let mut cam = Camera::look_at(Vec3::new(-0.005, 0.1, 0.0), Vec3::new(-0.005, 0.0, 0.0), 1.0);
+    let mut cam = Camera::look_at(
+        Vec3::new(-0.005, 0.1, 0.0),
+        Vec3::new(-0.005, 0.0, 0.0),
+        1.0,
+    );
     cam.znear = 0.001;
     let (size, spp) = (16u32, 64u32);
     let out = ao(&scene, &cam, size, spp, 1.0);
