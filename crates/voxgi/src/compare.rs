@@ -200,7 +200,12 @@ pub fn hdr_exposures(reference: &[[f32; 3]]) -> (f32, f32) {
     lum.sort_by(f32::total_cmp);
     let y_max = *lum.last().unwrap_or(&0.0);
     let mid = (lum.len() / 2).saturating_sub(1);
-    let y_median = (lum[mid] + lum[(mid + 1).min(lum.len() - 1)]) * 0.5;
+    let mut y_median = (lum[mid] + lum[(mid + 1).min(lum.len() - 1)]) * 0.5;
+    if y_median <= 0.0 {
+        // Mostly black references: FLIP's stop exposure would be infinite; use the dimmest
+        // non-black pixel instead.
+        y_median = lum.iter().copied().find(|&y| y > 0.0).unwrap_or(0.0);
+    }
     let start = (x_max / y_max).log2();
     let stop = (x_max / y_median).log2();
     (start, stop)

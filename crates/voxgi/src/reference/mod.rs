@@ -41,7 +41,8 @@ pub enum ReferenceMode {
     #[default]
     Radiance,
     /// Ambient occlusion: the fraction of cosine-weighted rays from the first hit that travel
-    /// `radius` metres without hitting anything, as grey radiance in [0, 1].
+    /// `radius` metres without hitting anything, as grey radiance in [0, 1] (pixels that see
+    /// nothing are 1). Its LDR output is that value, without exposure or tone curve.
     Ao { radius: f32 },
 }
 
@@ -433,7 +434,11 @@ impl PathTracer {
             .iter()
             .flat_map(|p| [p[0] * inv, p[1] * inv, p[2] * inv, 1.0])
             .collect();
-        let ldr = tonemap(&hdr, self.settings.exposure, self.settings.tonemap);
+        let ldr = match opts.mode {
+            // AO is a fraction in [0, 1]: shown as is.
+            ReferenceMode::Ao { .. } => tonemap(&hdr, 0.0, crate::Tonemap::Clamp),
+            ReferenceMode::Radiance => tonemap(&hdr, self.settings.exposure, self.settings.tonemap),
+        };
         Ok(RenderOutput {
             width,
             height,
