@@ -216,6 +216,25 @@ pub fn flatten(scene: &Scene) -> FlatScene {
     }
 }
 
+/// Depth of the flattened BVH (a single leaf has depth 1).
+pub fn bvh_depth(nodes: &[GpuNode]) -> u32 {
+    let mut max = 0;
+    let mut stack = vec![(0usize, 1u32)];
+    while let Some((i, d)) = stack.pop() {
+        max = max.max(d);
+        let n = &nodes[i];
+        if n.count == 0 {
+            stack.push((n.first as usize, d + 1));
+            stack.push((n.first as usize + 1, d + 1));
+        }
+    }
+    max
+}
+
+/// Entries of the shader's traversal stack (`STACK_SIZE` in reference.wgsl): a BVH up to this
+/// deep is always traversed exactly.
+pub const MAX_BVH_DEPTH: u32 = 64;
+
 impl PathTracer {
     /// Uploads `scene` (the same data the rasterizer gets, plus triangles and their BVH). Like
     /// the rasterizer, an unlit scene gets a default sun when `settings.default_light`.
@@ -231,6 +250,18 @@ impl PathTracer {
         let queue = ctx.queue.clone();
         let (center, radius) = scene_bounds(scene);
         let flat = flatten(scene);
+        let depth = bvh_depth(&flat.nodes);
+        if depth > MAX_BVH_DEPTH {
+            return Err(Error::Setting(format!(
+                "the path tracer's BVH is {depth} levels deep, more than its traversal stack's \
+                 {MAX_BVH_DEPTH}"
+            )));
+        }
+        log::info!(
+            "reference: {} triangles, BVH of {} nodes, depth {depth}",
+            flat.tris.len(),
+            flat.nodes.len()
+        );
         let (gpu_scene, buffers) = ctx.checked("reference scene upload", || -> Result<_> {
             let gpu_scene = GpuScene::new(&device, &queue, scene, settings)?;
             let storage = |label: &str, bytes: &[u8]| {
