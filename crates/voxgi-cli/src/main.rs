@@ -4,9 +4,13 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
+use voxgi::compare::{self, Image};
 use voxgi::scene::glam::Vec3;
 use voxgi::scene::{Camera, LightKind, Projection, Scene, builtin, io};
-use voxgi::{GpuContext, Renderer, Settings, Tonemap, ViewMode};
+use voxgi::{
+    Bounces, GpuContext, PathTracer, ReferenceMode, ReferenceOptions, Renderer, Settings, Tonemap,
+    ViewMode,
+};
 
 #[derive(Parser)]
 #[command(
@@ -39,6 +43,20 @@ enum Command {
     Info(SceneArg),
     /// Time every pass with GPU timestamps over many frames; print a table, write JSON.
     Bench(BenchArgs),
+    /// Compare a test image with a reference: mean FLIP (LDR-FLIP for PNG, HDR-FLIP for EXR),
+    /// RMSE and relative MSE on linear values, printed as one JSON line.
+    Compare(CompareArgs),
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    /// The reference image (.png or .exr).
+    reference: PathBuf,
+    /// The image to judge (same size and kind as the reference).
+    test: PathBuf,
+    /// Also write the per-pixel FLIP error as a PNG (magma colour map).
+    #[arg(long, value_name = "FILE.png")]
+    error_map: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -75,6 +93,15 @@ struct RenderArgs {
     /// Which of the scene's cameras to use (by index, see `voxgi info`).
     #[arg(long, value_name = "N")]
     camera: Option<usize>,
+    /// Renderer: the real-time rasterizer, the reference path tracer, or the AO reference.
+    #[arg(long, value_enum, default_value_t = ModeArg::Raster)]
+    mode: ModeArg,
+    /// Reference modes: samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    spp: u32,
+    /// Reference modes: random seed (the same seed gives the same image).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    seed: u32,
 }
 
 /// Renderer settings shared by `render` and `bench`. Each flag overrides the scene file's
@@ -96,7 +123,7 @@ struct SettingsArgs {
     /// Voxels per side of the volume (power of two, 16..=512). Default 128.
     #[arg(long, value_name = "N")]
     voxel_resolution: Option<u32>,
-    /// Indirect bounces: 0 (direct light only) to 8, or "unlimited". Default 2.
+    /// Indirect bounces: 0 ("direct": direct light only) to 8, or "unlimited". Default 2.
     #[arg(long, value_name = "N", value_parser = parse_bounces)]
     bounces: Option<u32>,
     /// Diffuse cone set: 6x60, 7x45 or 9x45. Default 6x60.
@@ -273,6 +300,9 @@ fn parse_bounces(s: &str) -> Result<u32, String> {
     if s == "unlimited" || s == "inf" {
         return Ok(voxgi::UNLIMITED_BOUNCES);
     }
+    if s == "direct" {
+        return Ok(0);
+    }
     let n: u32 = s
         .parse()
         .map_err(|_| format!("'{s}' is not 0..=8 or 'unlimited'"))?;
@@ -287,6 +317,13 @@ fn parse_bounces(s: &str) -> Result<u32, String> {
 
 fn parse_cones(s: &str) -> Result<voxgi::ConeSet, String> {
     voxgi::ConeSet::parse(s).ok_or_else(|| format!("'{s}' is not a cone set (6x60, 7x45, 9x45)"))
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ModeArg {
+    Raster,
+    Reference,
+    AoReference,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -404,14 +441,71 @@ fn render(args: &RenderArgs) -> Result<()> {
         .with_context(|| label.clone())?;
     let ctx = p.stage("opening GPU", GpuContext::from_env)?;
     eprintln!("GPU: {} ({:?})", ctx.info.name, ctx.info.backend);
-    let mut renderer = p
-        .stage("uploading scene", || Renderer::new(&ctx, &scene, settings))
-        .with_context(|| label.clone())?;
-    let camera = pick_camera(&scene, renderer.default_camera(), args)?;
     let (w, h) = args.size;
-    let out = p.stage(&format!("rendering {w}x{h}"), || {
-        renderer.render(&camera, w, h)
-    })?;
+    let out = if args.mode == ModeArg::Raster {
+        let mut renderer = p
+            .stage("uploading scene", || Renderer::new(&ctx, &scene, settings))
+            .with_context(|| label.clone())?;
+        let camera = pick_camera(&scene, renderer.default_camera(), args)?;
+        p.stage(&format!("rendering {w}x{h}"), || {
+            renderer.render(&camera, w, h)
+        })?
+    } else {
+        let opts = ReferenceOptions {
+            spp: args.spp,
+            bounces: match settings.bounces {
+                0 => Bounces::DirectOnly,
+                1 => Bounces::One,
+                voxgi::UNLIMITED_BOUNCES => Bounces::Unlimited,
+                n => Bounces::Exactly(n),
+            },
+            mode: if args.mode == ModeArg::AoReference {
+                ReferenceMode::Ao {
+                    // The cone tracer's AO radius, so the two are comparable.
+                    radius: settings.ao_radius.unwrap_or_else(|| {
+                        let b = scene.bounds();
+                        voxgi::voxel::Grid::around(b.min, b.max, settings.voxel_resolution).extent()
+                            * 0.25
+                    }),
+                }
+            } else {
+                ReferenceMode::Radiance
+            },
+            seed: args.seed,
+        };
+        let mut tracer = p
+            .stage("uploading scene and building the BVH", || {
+                PathTracer::new(&ctx, &scene, &settings)
+            })
+            .with_context(|| label.clone())?;
+        let default = scene
+            .cameras
+            .first()
+            .cloned()
+            .unwrap_or_else(|| scene.default_camera());
+        let camera = pick_camera(&scene, &default, args)?;
+        eprintln!(
+            "path tracing {w}x{h}, {} spp, {} triangles",
+            opts.spp,
+            tracer.triangle_count()
+        );
+        let t = Instant::now();
+        let mut last = 0.0;
+        let out = tracer.render(&camera, w, h, &opts, &mut |done, total| {
+            let el = t.elapsed().as_secs_f64();
+            if el - last >= 1.0 || done == total {
+                last = el;
+                let eta = el / done as f64 * (total - done) as f64;
+                eprint!("\r  {done}/{total} spp  {el:.1} s elapsed  ETA {eta:.1} s   ");
+            }
+        })?;
+        eprintln!(
+            "\nrendered {} spp in {:.2} s",
+            opts.spp,
+            t.elapsed().as_secs_f64()
+        );
+        out
+    };
     out.save(&args.output)?;
     eprintln!(
         "wrote {} ({w}x{h}) in {:.2} s",
@@ -466,6 +560,33 @@ fn pick_camera(scene: &Scene, default: &Camera, args: &RenderArgs) -> Result<Cam
         };
     }
     Ok(cam)
+}
+
+fn compare_images(args: &CompareArgs) -> Result<()> {
+    let reference = Image::load(&args.reference)?;
+    let test = Image::load(&args.test)?;
+    let (c, map) = compare::compare_with_map(&reference, &test).with_context(|| {
+        format!(
+            "comparing {} with {}",
+            args.test.display(),
+            args.reference.display()
+        )
+    })?;
+    if let Some(path) = &args.error_map {
+        compare::save_error_map(path, reference.width, reference.height, &map)?;
+    }
+    println!(
+        "{}",
+        serde_json::json!({
+            "flip_mean": c.flip_mean,
+            "rmse": c.rmse,
+            "rel_mse": c.rel_mse,
+            "reference": args.reference.display().to_string(),
+            "test": args.test.display().to_string(),
+            "hdr": c.hdr,
+        })
+    );
+    Ok(())
 }
 
 fn info(arg: &SceneArg) -> Result<()> {
@@ -583,6 +704,7 @@ fn main() {
         Command::Render(a) => render(a),
         Command::Info(a) => info(a),
         Command::Bench(a) => bench(a),
+        Command::Compare(a) => compare_images(a),
     };
     if let Err(e) = result {
         eprintln!("voxgi: error: {e:#}");

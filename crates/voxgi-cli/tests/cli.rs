@@ -251,3 +251,72 @@ fn scene_file_settings_apply_and_typos_are_errors() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+#[test]
+fn reference_render_reports_progress_and_compare_prints_one_json_line() {
+    let a = tmp("ref_a.exr");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--mode",
+        "reference",
+        "--spp",
+        "4",
+        "--bounces",
+        "direct",
+        "-o",
+        a.to_str().unwrap(),
+        "--size",
+        "16x16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("4/4 spp"), "progress: {}", stderr(&o));
+    assert!(stderr(&o).contains("rendered 4 spp in"), "{}", stderr(&o));
+    let ao = tmp("ref_ao.png");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--mode",
+        "ao-reference",
+        "--ao-radius",
+        "0.2",
+        "--spp",
+        "2",
+        "-o",
+        ao.to_str().unwrap(),
+        "--size",
+        "16x16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let map = tmp("err.png");
+    let o = voxgi(&[
+        "compare",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--error-map",
+        map.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(out.lines().count(), 1, "one line: {out}");
+    let v: serde_json::Value = serde_json::from_str(out.trim()).expect("JSON");
+    assert_eq!(v["flip_mean"], 0.0);
+    assert_eq!(v["rmse"], 0.0);
+    assert_eq!(v["hdr"], true);
+    assert!(map.exists());
+
+    let missing = tmp("does_not_exist.png");
+    let o = voxgi(&["compare", missing.to_str().unwrap(), ao.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        error_line(&o).contains("does_not_exist.png"),
+        "{}",
+        stderr(&o)
+    );
+    let o = voxgi(&["compare", a.to_str().unwrap(), ao.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(error_line(&o).contains("ref_ao.png"), "{}", stderr(&o));
+}

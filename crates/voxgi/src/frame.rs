@@ -225,11 +225,7 @@ impl Renderer {
         if scene.triangle_count() == 0 && scene.point_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let mut scene: Cow<Scene> = Cow::Borrowed(scene);
-        if scene.is_unlit() && settings.default_light {
-            log::warn!("the scene has no lights and nothing emissive: adding a default sun");
-            scene.to_mut().lights.push(Scene::default_sun());
-        }
+        let mut scene = lit_scene(scene, &settings);
         if scene
             .point_clouds
             .iter()
@@ -358,27 +354,7 @@ impl Renderer {
     }
 
     fn frame_uniforms(&self, camera: &Camera, width: u32, height: u32) -> GpuFrame {
-        let aspect = width as f32 / height as f32;
-        let dist = (camera.position - self.center).length();
-        let zfar = camera
-            .zfar
-            .unwrap_or(dist + self.radius * 1.05)
-            .max(camera.znear * 2.0);
-        let view = Mat4::look_to_rh(camera.position, camera.forward, camera.up);
-        let proj = match camera.projection {
-            Projection::Perspective { yfov } => {
-                Mat4::perspective_rh(yfov, aspect, camera.znear, zfar)
-            }
-            Projection::Orthographic { ymag, .. } => Mat4::orthographic_rh(
-                -ymag * aspect,
-                ymag * aspect,
-                -ymag,
-                ymag,
-                camera.znear,
-                zfar,
-            ),
-        };
-        let view_proj = proj * view;
+        let view_proj = camera_view_proj(camera, width, height, self.center, self.radius);
         let s = &self.settings;
         GpuFrame {
             view_proj: view_proj.to_cols_array_2d(),
@@ -598,8 +574,8 @@ impl Renderer {
 
 /// Checks a fragment capacity against the device's storage-buffer limit.
 fn fragment_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
-    let limit = device.limits().max_storage_buffer_binding_size as u64
-        / crate::voxel::dense::FRAGMENT_BYTES;
+    let limit =
+        device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES;
     let cap = wanted.max(1024);
     if cap > limit.min(u32::MAX as u64) {
         return Err(Error::Setting(format!(
@@ -646,5 +622,49 @@ pub fn cone_uniforms(settings: &Settings, grid: &Grid) -> GpuCones {
         ao_radius: settings.ao_radius.unwrap_or(grid.extent() * 0.25),
         origin_offset: settings.origin_offset,
         indirect: (settings.bounces > 0) as u32,
+    }
+}
+
+/// The camera's view-projection matrix for a `width` x `height` image of a scene with bounding
+/// sphere (`center`, `radius`): right-handed, depth 0..1, the far plane just past the scene.
+/// The rasterizer and the path tracer both use it, so they see exactly the same view.
+pub(crate) fn camera_view_proj(
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    center: Vec3,
+    radius: f32,
+) -> Mat4 {
+    let aspect = width as f32 / height as f32;
+    let dist = (camera.position - center).length();
+    let zfar = camera
+        .zfar
+        .unwrap_or(dist + radius * 1.05)
+        .max(camera.znear * 2.0);
+    let view = Mat4::look_to_rh(camera.position, camera.forward, camera.up);
+    let proj = match camera.projection {
+        Projection::Perspective { yfov } => Mat4::perspective_rh(yfov, aspect, camera.znear, zfar),
+        Projection::Orthographic { ymag, .. } => Mat4::orthographic_rh(
+            -ymag * aspect,
+            ymag * aspect,
+            -ymag,
+            ymag,
+            camera.znear,
+            zfar,
+        ),
+    };
+    proj * view
+}
+
+/// The scene as rendered: with a default sun added when it has no light at all and
+/// `settings.default_light` is set, so it does not render black.
+pub(crate) fn lit_scene<'a>(scene: &'a Scene, settings: &Settings) -> Cow<'a, Scene> {
+    if scene.is_unlit() && settings.default_light {
+        log::warn!("the scene has no lights and nothing emissive: adding a default sun");
+        let mut lit = scene.clone();
+        lit.lights.push(Scene::default_sun());
+        Cow::Owned(lit)
+    } else {
+        Cow::Borrowed(scene)
     }
 }

@@ -9,12 +9,14 @@
 //! # Ok::<(), voxgi::Error>(())
 //! ```
 
+pub mod compare;
 mod error;
 mod frame;
 pub mod gpu;
 pub mod gpu_scene;
 pub mod output;
 pub mod passes;
+pub mod reference;
 mod settings;
 pub mod voxel;
 
@@ -22,6 +24,7 @@ pub use error::{Error, Result};
 pub use frame::{FrameTargets, Renderer};
 pub use gpu::GpuContext;
 pub use output::RenderOutput;
+pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
 pub use settings::{
     MAX_BOUNCES, MAX_IMAGE_SIZE, Settings, Tonemap, UNLIMITED_BOUNCES, ViewMode, validate_size,
 };

@@ -1,6 +1,6 @@
 //! Rendered images and writing them: PNG (sRGB, tone mapped) and EXR (linear HDR).
 
-use crate::{Error, Result};
+use crate::{Error, Result, Tonemap};
 use std::path::Path;
 
 /// What one render produced.
@@ -76,6 +76,48 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     } else {
         1.055 * c.powf(1.0 / 2.4) - 0.055
     }
+}
+
+/// Narkowicz's fit of the ACES reference rendering transform (as tonemap.wgsl).
+fn aces(x: f32) -> f32 {
+    ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+}
+
+/// Khronos PBR Neutral (as tonemap.wgsl).
+fn pbr_neutral(c: [f32; 3]) -> [f32; 3] {
+    let start = 0.8 - 0.04;
+    let desaturation = 0.15;
+    let x = c[0].min(c[1]).min(c[2]);
+    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    let mut c = c.map(|v| v - offset);
+    let peak = c[0].max(c[1]).max(c[2]);
+    if peak < start {
+        return c;
+    }
+    let d = 1.0 - start;
+    let new_peak = 1.0 - d * d / (peak + d - start);
+    c = c.map(|v| v * new_peak / peak);
+    let g = 1.0 - 1.0 / (desaturation * (peak - new_peak) + 1.0);
+    c.map(|v| v + (new_peak - v) * g)
+}
+
+/// The CPU twin of `shaders/tonemap.wgsl`: linear RGBA f32 radiance -> exposure (2^EV), tone
+/// curve, sRGB encoding -> RGBA8 with opaque alpha. Used for images made without the
+/// rasterizer (the path tracer); agrees with the GPU pass within one unit per channel.
+pub fn tonemap(hdr: &[f32], exposure_ev: f32, curve: Tonemap) -> Vec<u8> {
+    let scale = 2f32.powf(exposure_ev);
+    hdr.chunks_exact(4)
+        .flat_map(|p| {
+            let c = [p[0], p[1], p[2]].map(|v| (v * scale).max(0.0));
+            let t = match curve {
+                Tonemap::Aces => c.map(aces),
+                Tonemap::Neutral => pbr_neutral(c),
+                Tonemap::Clamp => c,
+            };
+            let e = t.map(|v| (linear_to_srgb(v) * 255.0 + 0.5) as u8);
+            [e[0], e[1], e[2], 255]
+        })
+        .collect()
 }
 
 /// Reads an image as linear RGB f32: EXR as stored, PNG/JPEG sRGB-decoded.

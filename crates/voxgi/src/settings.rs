@@ -144,6 +144,45 @@ impl Settings {
                 self.max_texture_size
             ));
         }
+        let r = self.voxel_resolution;
+        if !(16..=512).contains(&r) || !r.is_power_of_two() {
+            return fail(format!(
+                "voxel resolution {r} is not a power of two in 16..=512"
+            ));
+        }
+        if self.bounces > MAX_BOUNCES && self.bounces != UNLIMITED_BOUNCES {
+            return fail(format!(
+                "{} bounces: use 0..={MAX_BOUNCES} or unlimited",
+                self.bounces
+            ));
+        }
+        if let Some(a) = self.ao_radius
+            && !(a.is_finite() && a > 0.0)
+        {
+            return fail(format!("AO radius {a} must be a positive number of metres"));
+        }
+        if !(self.ao_lambda.is_finite() && self.ao_lambda >= 0.0) {
+            return fail(format!("AO lambda {} must be >= 0", self.ao_lambda));
+        }
+        if !(0.05..=2.0).contains(&self.step_factor) {
+            return fail(format!(
+                "step factor {} is outside 0.05..=2",
+                self.step_factor
+            ));
+        }
+        if !(0.0..=8.0).contains(&self.origin_offset) {
+            return fail(format!(
+                "cone origin offset {} is outside 0..=8 voxels",
+                self.origin_offset
+            ));
+        }
+        if let Some(d) = self.max_distance
+            && !(d.is_finite() && d > 0.0)
+        {
+            return fail(format!(
+                "max cone distance {d} must be a positive number of metres"
+            ));
+        }
         Ok(())
     }
 }

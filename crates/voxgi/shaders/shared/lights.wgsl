@@ -3,6 +3,7 @@
 
 //!include shared/scene.wgsl
 //!include shared/brdf.wgsl
+//!include shared/light_model.wgsl
 
 // Golden-angle (Vogel) disc: even coverage for any tap count, the same pattern every pixel so
 // images are deterministic.
@@ -185,23 +186,6 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     return lit / f32(PCF_TAPS);
 }
 
-// glTF KHR_lights_punctual range window: smooth fall to zero at `range`.
-fn range_window(dist: f32, range: f32) -> f32 {
-    if range <= 0.0 {
-        return 1.0;
-    }
-    let r = dist / range;
-    let w = clamp(1.0 - r * r * r * r, 0.0, 1.0);
-    return w * w;
-}
-
-// Spot cone: 1 inside the inner angle, 0 outside the outer, and in between the square of the
-// linear ramp in cosine (the KHR_lights_punctual reference implementation).
-fn spot_falloff(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    let t = clamp((cos_angle - cos_outer) / max(cos_inner - cos_outer, 1e-4), 0.0, 1.0);
-    return t * t;
-}
-
 const MAX_POLY: u32 = 18u;
 
 // Irradiance at p (normal n) from a uniform one-sided polygonal emitter of unit radiance: the
@@ -301,21 +285,9 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
         return (brdf_diffuse(s) + spec) * light.radiance * e * vis;
     }
 
-    var l: vec3<f32>;
-    var e: vec3<f32>;
-    if light.kind == LIGHT_DIRECTIONAL {
-        l = -light.direction;
-        e = light.radiance;
-    } else {
-        let to = light.position - p;
-        let d2 = max(dot(to, to), 1e-8);
-        let d = sqrt(d2);
-        l = to / d;
-        e = light.radiance / d2 * range_window(d, light.range);
-        if light.kind == LIGHT_SPOT {
-            e *= spot_falloff(dot(-l, light.direction), light.cos_inner, light.cos_outer);
-        }
-    }
+    let ls = punctual_light(light, p);
+    let l = ls.l;
+    let e = ls.e;
     let n_dot_l = dot(n, l);
     if n_dot_l <= 0.0 || all(e <= vec3<f32>(0.0)) {
         return vec3<f32>(0.0);

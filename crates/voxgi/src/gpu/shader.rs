@@ -12,6 +12,7 @@ macro_rules! wgsl {
 const SOURCES: &[(&str, &str)] = wgsl![
     "shared/scene.wgsl",
     "shared/brdf.wgsl",
+    "shared/light_model.wgsl",
     "shared/lights.wgsl",
     "shared/volume.wgsl",
     "shared/fragment.wgsl",
@@ -30,6 +31,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "upsample.wgsl",
     "composite.wgsl",
     "tonemap.wgsl",
+    "reference.wgsl",
 ];
 
 fn raw(name: &str) -> &'static str {

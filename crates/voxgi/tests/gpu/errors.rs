@@ -66,6 +66,41 @@ fn absurd_settings_are_errors() {
                 ..Default::default()
             },
         ),
+        (
+            "voxels 100",
+            Settings {
+                voxel_resolution: 100,
+                ..Default::default()
+            },
+        ),
+        (
+            "voxels 1024",
+            Settings {
+                voxel_resolution: 1024,
+                ..Default::default()
+            },
+        ),
+        (
+            "9 bounces",
+            Settings {
+                bounces: 9,
+                ..Default::default()
+            },
+        ),
+        (
+            "AO radius 0",
+            Settings {
+                ao_radius: Some(0.0),
+                ..Default::default()
+            },
+        ),
+        (
+            "step 0",
+            Settings {
+                step_factor: 0.0,
+                ..Default::default()
+            },
+        ),
     ];
     for (what, s) in cases {
         match Renderer::new(ctx(), &scene, s) {

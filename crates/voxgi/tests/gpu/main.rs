@@ -4,8 +4,10 @@
 
 mod analytic;
 mod common;
+mod compare;
 mod errors;
 mod golden;
 mod points;
+mod reference;
 mod shaders;
 mod vct;

@@ -2,7 +2,7 @@
 //! the size naga computes for it.
 
 use voxgi::gpu::shader;
-use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuVertex};
+use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
 use voxgi::passes::shadow::GpuShadowView;
 use voxgi::voxel::{GpuCones, GpuVolume};
 
@@ -30,8 +30,8 @@ fn every_shader_validates() {
 
 #[test]
 fn wgsl_struct_sizes() {
-    // gather.wgsl includes every shared struct file.
-    let module = parse("gather.wgsl");
+    // composite.wgsl includes every shared file that defines structs.
+    let module = parse("composite.wgsl");
     let size_of_wgsl = |name: &str| -> u32 {
         module
             .types
@@ -50,6 +50,8 @@ fn wgsl_struct_sizes() {
         ("Light", size_of::<GpuLight>()),
         ("Volume", size_of::<GpuVolume>()),
         ("Cones", size_of::<GpuCones>()),
+        ("ShadowView", size_of::<GpuShadowView>()),
+        ("Point", size_of::<GpuPoint>()),
     ];
     for (name, rust) in cases {
         assert_eq!(

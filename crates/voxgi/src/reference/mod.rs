@@ -1,0 +1,483 @@
+//! The ground truth: a GPU path tracer over the same scene, materials and lights as the
+//! rasterizer, and an ambient-occlusion reference.
+//!
+//! All mesh instances are flattened into world-space triangles, a BVH is built on the CPU
+//! (obvhs' PLOC builder) and flattened into a node array the compute shader
+//! (`shaders/reference.wgsl`) walks with a stack. Samples accumulate in an f32 buffer, a batch
+//! per submit, so long renders report progress and never hold the GPU for long.
+
+use crate::frame::{camera_view_proj, lit_scene};
+use crate::gpu::{layout, readback, shader};
+use crate::gpu_scene::{GpuScene, NO_INDEX, scene_bounds};
+use crate::output::{RenderOutput, tonemap};
+use crate::settings::validate_size;
+use crate::{Error, GpuContext, Result, Settings};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat3, Vec3};
+use voxgi_scene::{Camera, Scene};
+use wgpu::util::DeviceExt;
+
+/// How many indirect bounces the reference simulates (as the cone tracer counts them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Bounces {
+    /// Direct light from the lights (with visibility) plus emission seen directly: what the
+    /// rasterizer computes.
+    DirectOnly,
+    /// Direct light plus one indirect bounce.
+    One,
+    /// Full global illumination: paths end by Russian roulette from depth 3 on, or at
+    /// [`MAX_BOUNCES`].
+    #[default]
+    Unlimited,
+    /// Exactly this many indirect bounces (no Russian roulette).
+    Exactly(u32),
+}
+
+/// Path-length cap for [`Bounces::Unlimited`].
+pub const MAX_BOUNCES: u32 = 64;
+
+/// What the reference computes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum ReferenceMode {
+    /// Radiance (the path tracer).
+    #[default]
+    Radiance,
+    /// Ambient occlusion: the fraction of cosine-weighted rays from the first hit that travel
+    /// `radius` metres without hitting anything, as grey radiance in [0, 1] (pixels that see
+    /// nothing are 1). Its LDR output is that value, without exposure or tone curve.
+    Ao { radius: f32 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceOptions {
+    /// Samples per pixel.
+    pub spp: u32,
+    pub bounces: Bounces,
+    pub mode: ReferenceMode,
+    /// The same seed gives the same image.
+    pub seed: u32,
+}
+
+impl Default for ReferenceOptions {
+    fn default() -> Self {
+        ReferenceOptions {
+            spp: 256,
+            bounces: Bounces::Unlimited,
+            mode: ReferenceMode::Radiance,
+            seed: 0,
+        }
+    }
+}
+
+/// Mirrors `Params` in shaders/reference.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct GpuParams {
+    inv_view_proj: [[f32; 4]; 4],
+    background: [f32; 3],
+    light_count: u32,
+    width: u32,
+    height: u32,
+    sample_base: u32,
+    sample_count: u32,
+    seed: u32,
+    bounces: u32,
+    mode: u32,
+    ao_radius: f32,
+    rr_depth: u32,
+    _pad: [u32; 3],
+}
+
+/// Mirrors `Node` in shaders/reference.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuNode {
+    pub lo: [f32; 3],
+    pub first: u32,
+    pub hi: [f32; 3],
+    pub count: u32,
+}
+
+/// Mirrors `Tri` in shaders/reference.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuTri {
+    pub p0: [f32; 3],
+    pub material: u32,
+    pub p1: [f32; 3],
+    pub light: u32,
+    pub p2: [f32; 3],
+    pub _pad: u32,
+}
+
+/// Mirrors `TriShading` in shaders/reference.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuTriShading {
+    pub n0: [f32; 4],
+    pub n1: [f32; 4],
+    pub n2: [f32; 4],
+    pub uv: [f32; 4],
+}
+
+/// Pixel-samples per submit: small enough that one submit stays well under a GPU watchdog
+/// (a second or so on lavapipe for simple scenes), large enough to keep the GPU busy.
+const PATHS_PER_SUBMIT: u64 = 1 << 18;
+
+/// A scene uploaded for path tracing.
+pub struct PathTracer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    settings: Settings,
+    scene: GpuScene,
+    light_count: u32,
+    center: Vec3,
+    radius: f32,
+    triangles: usize,
+    nodes: wgpu::Buffer,
+    tris: wgpu::Buffer,
+    shading: wgpu::Buffer,
+    params: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+/// World-space triangles in BVH order, and the flattened BVH over them.
+pub struct FlatScene {
+    pub nodes: Vec<GpuNode>,
+    pub tris: Vec<GpuTri>,
+    pub shading: Vec<GpuTriShading>,
+}
+
+/// Flattens every mesh instance into world-space triangles and builds their BVH.
+pub fn flatten(scene: &Scene) -> FlatScene {
+    let mut tris = Vec::new();
+    let mut shading = Vec::new();
+    for inst in &scene.instances {
+        let mesh = &scene.meshes[inst.mesh];
+        let m = inst.transform;
+        let nm = {
+            let n = Mat3::from_mat4(m).inverse().transpose();
+            if n.is_finite() { n } else { Mat3::IDENTITY }
+        };
+        let light = inst.light.map_or(NO_INDEX, |l| l as u32);
+        for t in mesh.indices.chunks_exact(3) {
+            let idx = [t[0] as usize, t[1] as usize, t[2] as usize];
+            let p = idx.map(|i| m.transform_point3(mesh.positions[i]));
+            let n = idx.map(|i| {
+                let n = nm * mesh.normals[i];
+                n.normalize_or_zero()
+            });
+            let uv = idx.map(|i| mesh.uvs.get(i).copied().unwrap_or_default());
+            tris.push(GpuTri {
+                p0: p[0].to_array(),
+                material: mesh.material as u32,
+                p1: p[1].to_array(),
+                light,
+                p2: p[2].to_array(),
+                _pad: 0,
+            });
+            shading.push(GpuTriShading {
+                n0: n[0].extend(uv[0].x).to_array(),
+                n1: n[1].extend(uv[0].y).to_array(),
+                n2: n[2].extend(uv[1].x).to_array(),
+                uv: [uv[1].y, uv[2].x, uv[2].y, 0.0],
+            });
+        }
+    }
+    let v = |a: [f32; 3]| glam_obvhs::Vec3A::from_array(a);
+    let prims: Vec<obvhs::triangle::Triangle> = tris
+        .iter()
+        .map(|t| obvhs::triangle::Triangle {
+            v0: v(t.p0),
+            v1: v(t.p1),
+            v2: v(t.p2),
+        })
+        .collect();
+    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
+        &prims,
+        obvhs::BvhBuildParams::medium_build(),
+        &mut std::time::Duration::default(),
+    );
+    let nodes: Vec<GpuNode> = bvh
+        .nodes
+        .iter()
+        .map(|n| GpuNode {
+            lo: n.aabb.min.to_array(),
+            first: n.first_index,
+            hi: n.aabb.max.to_array(),
+            count: n.prim_count,
+        })
+        .collect();
+    // Leaves index `primitive_indices`: store the triangles in that order so a leaf is a range.
+    let order = &bvh.primitive_indices;
+    FlatScene {
+        nodes,
+        tris: order.iter().map(|&i| tris[i as usize]).collect(),
+        shading: order.iter().map(|&i| shading[i as usize]).collect(),
+    }
+}
+
+/// Depth of the flattened BVH (a single leaf has depth 1).
+pub fn bvh_depth(nodes: &[GpuNode]) -> u32 {
+    let mut max = 0;
+    let mut stack = vec![(0usize, 1u32)];
+    while let Some((i, d)) = stack.pop() {
+        max = max.max(d);
+        let n = &nodes[i];
+        if n.count == 0 {
+            stack.push((n.first as usize, d + 1));
+            stack.push((n.first as usize + 1, d + 1));
+        }
+    }
+    max
+}
+
+/// Entries of the shader's traversal stack (`STACK_SIZE` in reference.wgsl): a BVH up to this
+/// deep is always traversed exactly.
+pub const MAX_BVH_DEPTH: u32 = 64;
+
+impl PathTracer {
+    /// Uploads `scene` (the same data the rasterizer gets, plus triangles and their BVH). Like
+    /// the rasterizer, an unlit scene gets a default sun when `settings.default_light`.
+    pub fn new(ctx: &GpuContext, scene: &Scene, settings: &Settings) -> Result<Self> {
+        settings.validate()?;
+        scene.validate()?;
+        if scene.triangle_count() == 0 {
+            return Err(Error::EmptyScene);
+        }
+        let scene = lit_scene(scene, settings);
+        let scene = scene.as_ref();
+        let device = ctx.device.clone();
+        let queue = ctx.queue.clone();
+        let (center, radius) = scene_bounds(scene);
+        let flat = flatten(scene);
+        let depth = bvh_depth(&flat.nodes);
+        if depth > MAX_BVH_DEPTH {
+            return Err(Error::Setting(format!(
+                "the path tracer's BVH is {depth} levels deep, more than its traversal stack's \
+                 {MAX_BVH_DEPTH}"
+            )));
+        }
+        log::info!(
+            "reference: {} triangles, BVH of {} nodes, depth {depth}",
+            flat.tris.len(),
+            flat.nodes.len()
+        );
+        let (gpu_scene, buffers) = ctx.checked("reference scene upload", || -> Result<_> {
+            let gpu_scene = GpuScene::new(&device, &queue, scene, settings)?;
+            let storage = |label: &str, bytes: &[u8]| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+            };
+            Ok((
+                gpu_scene,
+                (
+                    storage("reference bvh", bytemuck::cast_slice(&flat.nodes)),
+                    storage("reference triangles", bytemuck::cast_slice(&flat.tris)),
+                    storage("reference shading", bytemuck::cast_slice(&flat.shading)),
+                ),
+            ))
+        })??;
+        let (layout, pipeline) = ctx.checked("reference pipeline creation", || {
+            use wgpu::ShaderStages as S;
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("reference"),
+                entries: &[
+                    layout::uniform(0, S::COMPUTE, false),
+                    layout::storage(1, S::COMPUTE, true),
+                    layout::storage(2, S::COMPUTE, true),
+                    layout::storage(3, S::COMPUTE, true),
+                    layout::storage(4, S::COMPUTE, true),
+                    layout::storage(5, S::COMPUTE, true),
+                    layout::texture(
+                        6,
+                        S::COMPUTE,
+                        wgpu::TextureSampleType::Float { filterable: true },
+                        wgpu::TextureViewDimension::D2Array,
+                    ),
+                    layout::sampler(7, S::COMPUTE),
+                    layout::storage(8, S::COMPUTE, false),
+                ],
+            });
+            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("reference"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+            let module = shader::module(&device, "reference.wgsl");
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("reference"),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            (layout, pipeline)
+        })?;
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("reference params"),
+            size: size_of::<GpuParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(PathTracer {
+            device,
+            queue,
+            settings: settings.clone(),
+            light_count: gpu_scene.light_count,
+            scene: gpu_scene,
+            center,
+            radius,
+            triangles: flat.tris.len(),
+            nodes: buffers.0,
+            tris: buffers.1,
+            shading: buffers.2,
+            params,
+            layout,
+            pipeline,
+        })
+    }
+
+    /// Number of world-space triangles traced.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles
+    }
+
+    /// Renders `opts.spp` samples per pixel, calling `progress(done, total)` after each batch.
+    /// The HDR output is the mean radiance (or AO); the LDR output is tone mapped on the CPU
+    /// with the settings' exposure and curve, as the rasterizer's tonemap pass does.
+    pub fn render(
+        &mut self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        opts: &ReferenceOptions,
+        progress: &mut dyn FnMut(u32, u32),
+    ) -> Result<RenderOutput> {
+        validate_size(width, height)?;
+        if !(camera.position.is_finite() && camera.forward.is_finite() && camera.up.is_finite()) {
+            return Err(Error::Setting(
+                "camera position and direction must be finite".into(),
+            ));
+        }
+        if opts.spp == 0 {
+            return Err(Error::Setting("spp must be at least 1".into()));
+        }
+        let (mode, ao_radius) = match opts.mode {
+            ReferenceMode::Radiance => (0, 0.0),
+            ReferenceMode::Ao { radius } => {
+                if !(radius.is_finite() && radius > 0.0) {
+                    return Err(Error::Setting(format!(
+                        "AO radius {radius} must be positive and finite"
+                    )));
+                }
+                (1, radius)
+            }
+        };
+        let (bounces, rr_depth) = match opts.bounces {
+            Bounces::DirectOnly => (0, u32::MAX),
+            Bounces::One => (1, u32::MAX),
+            Bounces::Unlimited => (MAX_BOUNCES - 1, 3),
+            Bounces::Exactly(n) => (n.min(MAX_BOUNCES - 1), u32::MAX),
+        };
+        let view_proj = camera_view_proj(camera, width, height, self.center, self.radius);
+        let pixels = width as u64 * height as u64;
+        let accum = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("reference accumulation"),
+            size: pixels * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("reference"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                self.params.as_entire_binding(),
+                self.nodes.as_entire_binding(),
+                self.tris.as_entire_binding(),
+                self.shading.as_entire_binding(),
+                self.scene.materials.as_entire_binding(),
+                self.scene.lights.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&self.scene.texture_view),
+                wgpu::BindingResource::Sampler(&self.scene.sampler),
+                accum.as_entire_binding(),
+            ]),
+        });
+        let batch = (PATHS_PER_SUBMIT / pixels).clamp(1, 64) as u32;
+        let mut done = 0u32;
+        while done < opts.spp {
+            let count = batch.min(opts.spp - done);
+            let params = GpuParams {
+                inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+                background: self.settings.background,
+                light_count: self.light_count,
+                width,
+                height,
+                sample_base: done,
+                sample_count: count,
+                seed: opts.seed,
+                bounces,
+                mode,
+                ao_radius,
+                rr_depth,
+                _pad: [0; 3],
+            };
+            self.queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            let mut enc = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("reference"),
+                });
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("reference"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind_group, &[]);
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+            }
+            self.queue.submit([enc.finish()]);
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| Error::Gpu {
+                    context: "reference".into(),
+                    reason: e.to_string(),
+                })?;
+            done += count;
+            progress(done, opts.spp);
+        }
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("reference readback"),
+            size: pixels * 16,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&accum, 0, &staging, 0, pixels * 16);
+        self.queue.submit([enc.finish()]);
+        let bytes = readback::read_buffer(&self.device, &staging)?;
+        let inv = 1.0 / opts.spp as f32;
+        let hdr: Vec<f32> = bytemuck::cast_slice::<u8, [f32; 4]>(&bytes)
+            .iter()
+            .flat_map(|p| [p[0] * inv, p[1] * inv, p[2] * inv, 1.0])
+            .collect();
+        let ldr = match opts.mode {
+            // AO is a fraction in [0, 1]: shown as is.
+            ReferenceMode::Ao { .. } => tonemap(&hdr, 0.0, crate::Tonemap::Clamp),
+            ReferenceMode::Radiance => tonemap(&hdr, self.settings.exposure, self.settings.tonemap),
+        };
+        Ok(RenderOutput {
+            width,
+            height,
+            hdr,
+            ldr,
+        })
+    }
+}
