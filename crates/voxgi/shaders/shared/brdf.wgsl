@@ -32,9 +32,13 @@ fn v_smith(n_dot_v: f32, n_dot_l: f32, a: f32) -> f32 {
     return 0.5 / max(gv + gl, 1e-7);
 }
 
+// Schlick's Fresnel with the grazing reflectance F90 tied to F0 (as Unreal does): no real
+// material reflects under 2 % at normal incidence, so a smaller F0 means "no specular layer"
+// and the lobe fades to zero, making specular = 0 a pure Lambertian surface at all angles.
 fn f_schlick(f0: vec3<f32>, v_dot_h: f32) -> vec3<f32> {
     let f = pow(1.0 - v_dot_h, 5.0);
-    return f0 + (vec3<f32>(1.0) - f0) * f;
+    let f90 = clamp(50.0 * max(f0.r, max(f0.g, f0.b)), 0.0, 1.0);
+    return f0 + (vec3<f32>(f90) - f0) * f;
 }
 
 fn brdf_diffuse(s: Surface) -> vec3<f32> {
