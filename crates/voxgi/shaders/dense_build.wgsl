@@ -63,13 +63,13 @@ fn prepare_fragments() {
 
 @compute @workgroup_size(1)
 fn prepare_slots() {
-    write_args(0u, atomicLoad(&counters[1]));
+    write_args(0u, min(atomicLoad(&counters[1]), arrayLength(&slot_voxel)));
 }
 
 @compute @workgroup_size(64)
 fn clear_previous(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = flat(gid, nwg);
-    if s >= atomicLoad(&counters[2]) {
+    if s >= min(atomicLoad(&counters[2]), arrayLength(&slot_voxel)) {
         return;
     }
     let c = voxel_coord(slot_voxel[s], vol.resolution);
@@ -91,9 +91,13 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     for (var tries = 0u; tries < 64u; tries++) {
         let r = atomicCompareExchangeWeak(&occupancy[v], 1u, LOCKED);
         if r.exchanged {
+            // Counted even past the capacity, so the host can see how many slots it needs;
+            // voxels beyond it stay unallocated (LOCKED) and are skipped.
             let s = atomicAdd(&counters[1], 1u);
-            slot_voxel[s] = v;
-            atomicStore(&occupancy[v], s + 2u);
+            if s < arrayLength(&slot_voxel) {
+                slot_voxel[s] = v;
+                atomicStore(&occupancy[v], s + 2u);
+            }
             return;
         }
         if r.old_value != 1u {
@@ -110,7 +114,11 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
     let f = fragments[i];
     let v = voxel_index(unpack_coord(f.coord), vol.resolution);
-    let s = atomicLoad(&occupancy[v]) - 2u;
+    let o = atomicLoad(&occupancy[v]);
+    if o < 2u || o == LOCKED {
+        return;
+    }
+    let s = o - 2u;
     let base = s * ACCUM_STRIDE;
     let albedo = unpack4x8unorm(f.albedo);
     let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * 32767.0));
@@ -130,7 +138,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = flat(gid, nwg);
-    if s >= atomicLoad(&counters[1]) {
+    if s >= min(atomicLoad(&counters[1]), arrayLength(&slot_voxel)) {
         return;
     }
     let base = s * ACCUM_STRIDE;

@@ -209,6 +209,7 @@ pub struct Renderer {
     /// The voxels (and shadow maps) must be rebuilt before the next frame.
     dirty: bool,
     timer: GpuTimer,
+    errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
     targets: Option<FrameTargets>,
     center: Vec3,
     radius: f32,
@@ -265,7 +266,17 @@ impl Renderer {
         })?;
         let b = scene.bounds();
         let grid = Grid::around(b.min, b.max, settings.voxel_resolution);
-        let capacity = fragment_capacity(&device, estimate_fragments(scene, &grid))?;
+        let estimate = estimate_fragments(scene, &grid);
+        let capacity = fragment_capacity(&device, estimate.min(max_fragments(&device)))?;
+        check_volume_fits(&device, &grid)?;
+        // Slots: at most one per voxel, usually far fewer than fragments (Sponza at 128³ has
+        // 3.5 fragments per occupied voxel); the build reports when more are needed.
+        let slots = slot_capacity(
+            &device,
+            estimate
+                .min((grid.resolution as u64).pow(3))
+                .min(max_slots(&device)),
+        )?;
         let voxel_passes = ctx.checked("voxel pipelines", || {
             (
                 VoxelizePass::new(&device),
@@ -274,7 +285,7 @@ impl Renderer {
                 BouncePass::new(&device),
                 GatherPass::new(&device),
                 UpsamplePass::new(&device),
-                DenseVolume::new(&device, grid, settings.anisotropic, capacity),
+                DenseVolume::new(&device, grid, settings.anisotropic, capacity, slots),
                 triangle_table(&device, &gpu_scene),
             )
         })?;
@@ -312,6 +323,7 @@ impl Renderer {
             voxel_bounces,
             dirty: true,
             timer,
+            errors: ctx.errors.clone(),
             targets: None,
             center,
             radius,
@@ -408,21 +420,27 @@ impl Renderer {
             );
             self.volume.record_build(&self.device, &mut encoder, timer);
             self.queue.submit([encoder.finish()]);
-            // More fragments than room: grow to fit and voxelize again (never overrun).
-            let (emitted, _) = self.voxel_counts()?;
-            if emitted <= self.volume.fragment_capacity as u64 {
+            // More fragments or occupied voxels than room: grow to fit and voxelize again
+            // (the kernels never write past their buffers, they only count).
+            let (emitted, occupied) = self.voxel_counts()?;
+            let v = &self.volume;
+            if emitted <= v.fragment_capacity as u64 && occupied <= v.slot_capacity as u64 {
                 break;
             }
             if attempt == 1 {
                 return Err(Error::Gpu {
                     context: "voxelize".into(),
-                    reason: format!("{emitted} fragments still overflow after growing"),
+                    reason: format!(
+                        "{emitted} fragments / {occupied} voxels still overflow after growing"
+                    ),
                 });
             }
-            let capacity = fragment_capacity(&self.device, emitted + emitted / 8)?;
-            log::info!("voxel fragments: {emitted} > capacity, growing to {capacity}");
-            let grid = self.volume.grid;
-            self.volume = DenseVolume::new(&self.device, grid, self.volume.anisotropic, capacity);
+            let capacity =
+                fragment_capacity(&self.device, emitted.max(v.fragment_capacity as u64))?;
+            let slots = slot_capacity(&self.device, occupied.max(v.slot_capacity as u64))?;
+            log::info!("voxels: {emitted} fragments, {occupied} occupied: growing the buffers");
+            let (grid, aniso) = (v.grid, v.anisotropic);
+            self.volume = DenseVolume::new(&self.device, grid, aniso, capacity, slots);
         }
         let mut encoder = self
             .device
@@ -562,6 +580,7 @@ impl Renderer {
             .as_ref()
             .expect("render_frame made the targets");
         let hdr_bytes = readback::read_texture(&self.device, &self.queue, &t.hdr_texture)?;
+        GpuContext::take_error(&self.errors, "frame")?;
         let ldr = readback::read_texture(&self.device, &self.queue, &t.ldr_texture)?;
         Ok(RenderOutput {
             width,
@@ -570,6 +589,56 @@ impl Renderer {
             ldr,
         })
     }
+}
+
+/// The most fragments one storage binding can hold on this device.
+fn max_fragments(device: &wgpu::Device) -> u64 {
+    device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES
+}
+
+/// The most slots one storage binding can hold on this device.
+fn max_slots(device: &wgpu::Device) -> u64 {
+    device.limits().max_storage_buffer_binding_size / crate::voxel::dense::SLOT_BYTES
+}
+
+/// Checks a slot capacity against the device's storage-buffer limit.
+fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
+    let limit = device.limits().max_storage_buffer_binding_size / crate::voxel::dense::SLOT_BYTES;
+    let cap = wanted.max(1024);
+    if cap > limit.min(u32::MAX as u64) {
+        return Err(Error::Setting(format!(
+            "the scene occupies about {cap} voxels at this resolution, more than this GPU's \
+             storage-buffer limit allows ({limit}); lower the voxel resolution"
+        )));
+    }
+    Ok(cap as u32)
+}
+
+/// Checks that the volume's per-voxel buffers fit the device's limits.
+fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
+    let l = device.limits();
+    let occupancy = (grid.resolution as u64).pow(3) * 4;
+    if occupancy > l.max_storage_buffer_binding_size {
+        return Err(Error::Setting(format!(
+            "a {r}³ volume needs a {} MiB occupancy buffer, more than this GPU's {} MiB \
+             storage-buffer limit; use a voxel resolution of at most {}",
+            occupancy >> 20,
+            l.max_storage_buffer_binding_size >> 20,
+            ((l.max_storage_buffer_binding_size / 4) as f64)
+                .cbrt()
+                .log2()
+                .floor()
+                .exp2() as u32,
+            r = grid.resolution
+        )));
+    }
+    if grid.resolution > l.max_texture_dimension_3d {
+        return Err(Error::Setting(format!(
+            "a {}³ volume exceeds this GPU's 3D texture limit of {}",
+            grid.resolution, l.max_texture_dimension_3d
+        )));
+    }
+    Ok(())
 }
 
 /// Checks a fragment capacity against the device's storage-buffer limit.

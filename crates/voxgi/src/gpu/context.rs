@@ -9,6 +9,9 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Timestamp queries inside passes are available (for `voxgi bench`).
     pub timestamps: bool,
+    /// GPU errors no error scope caught. wgpu's default is to panic; voxgi collects them here
+    /// and turns them into an `Error` at the end of the frame.
+    pub errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
 }
 
 impl GpuContext {
@@ -113,16 +116,42 @@ impl GpuContext {
             info.backend,
             info.device_type
         );
+        let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            log::error!("GPU error: {e}");
+            if let Ok(mut v) = sink.lock() {
+                v.push(e.to_string());
+            }
+        }));
         Ok(GpuContext {
             device,
             queue,
             info,
             timestamps,
+            errors,
         })
     }
 
     /// Runs `f`, turning any validation or out-of-memory error it triggers into an `Error`
     /// instead of wgpu's default panic.
+    /// Takes the errors collected since the last call, as one `Error`.
+    pub fn take_error(errors: &std::sync::Mutex<Vec<String>>, context: &str) -> Result<()> {
+        let mut v = errors.lock().map_err(|_| Error::Gpu {
+            context: context.into(),
+            reason: "error log poisoned".into(),
+        })?;
+        if v.is_empty() {
+            return Ok(());
+        }
+        let reason = v.join("; ");
+        v.clear();
+        Err(Error::Gpu {
+            context: context.into(),
+            reason,
+        })
+    }
+
     pub fn checked<T>(&self, context: &str, f: impl FnOnce() -> T) -> Result<T> {
         let scope_oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let scope_val = self.device.push_error_scope(wgpu::ErrorFilter::Validation);

@@ -20,6 +20,8 @@ pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Floa
 pub const FRAGMENT_BYTES: u64 = 16;
 /// u32 sums per slot (`ACCUM_STRIDE` in dense_build.wgsl).
 const ACCUM_STRIDE: u64 = 10;
+/// Bytes of the largest per-slot buffer (the sums).
+pub const SLOT_BYTES: u64 = ACCUM_STRIDE * 4;
 /// Directions of the anisotropic chains, in the order of `filter.wgsl`.
 pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
 
@@ -28,6 +30,8 @@ pub struct DenseVolume {
     pub anisotropic: bool,
     pub volume: wgpu::Buffer,
     pub fragment_capacity: u32,
+    /// Occupied voxels the slot buffers hold.
+    pub slot_capacity: u32,
     pub fragments: wgpu::Buffer,
     /// [0] fragments emitted, [1] occupied voxels (slots), [2] slots of the previous build.
     pub counters: wgpu::Buffer,
@@ -119,10 +123,11 @@ impl DenseVolume {
         grid: Grid,
         anisotropic: bool,
         fragment_capacity: u32,
+        slot_capacity: u32,
     ) -> Self {
         let res = grid.resolution;
         let levels = grid.levels();
-        let slots = (fragment_capacity as u64).min((res as u64).pow(3));
+        let slots = slot_capacity.max(1) as u64;
         let volume = GpuVolume {
             origin: grid.origin.to_array(),
             resolution: res,
@@ -193,6 +198,7 @@ impl DenseVolume {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             }),
             fragment_capacity,
+            slot_capacity: slots as u32,
             fragments: storage_buffer(
                 device,
                 "voxel fragments",
