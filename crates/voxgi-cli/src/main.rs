@@ -121,6 +121,12 @@ struct SettingsArgs {
     /// Cone step as a fraction of the cone diameter.
     #[arg(long, value_name = "F", default_value_t = Settings::default().step_factor)]
     step_factor: f32,
+    /// Mip level the voxel views show (0 = finest).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    voxel_level: u32,
+    /// Directional chain the voxel views read above the finest level: +x, -x, +y, -y, +z, -z.
+    #[arg(long, value_name = "DIR", default_value = "+x", value_parser = parse_voxel_dir, allow_hyphen_values = true)]
+    voxel_dir: u32,
 }
 
 impl SettingsArgs {
@@ -140,7 +146,12 @@ impl SettingsArgs {
                 ViewArg::Direct => ViewMode::Direct,
                 ViewArg::Ao => ViewMode::Ao,
                 ViewArg::Indirect => ViewMode::Indirect,
+                ViewArg::VoxelAlbedo => ViewMode::VoxelAlbedo,
+                ViewArg::VoxelOpacity => ViewMode::VoxelOpacity,
+                ViewArg::VoxelRadiance => ViewMode::VoxelRadiance,
             },
+            debug_level: self.voxel_level,
+            debug_direction: self.voxel_dir,
             voxel_resolution: self.voxel_resolution,
             bounces: self.bounces,
             cones: self.cones,
@@ -212,6 +223,20 @@ enum ViewArg {
     Direct,
     Ao,
     Indirect,
+    /// The voxel volume's albedo (first voxel with opacity > 0.5 at --voxel-level).
+    VoxelAlbedo,
+    /// The voxel volume's opacity as grey.
+    VoxelOpacity,
+    /// The voxel volume's radiance (un-premultiplied).
+    VoxelRadiance,
+}
+
+fn parse_voxel_dir(s: &str) -> Result<u32, String> {
+    voxgi::voxel::dense::DIRECTIONS
+        .iter()
+        .position(|d| d.eq_ignore_ascii_case(s))
+        .map(|i| i as u32)
+        .ok_or_else(|| format!("'{s}' is not a direction (+x, -x, +y, -y, +z, -z)"))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {

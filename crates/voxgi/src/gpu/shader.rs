@@ -29,6 +29,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "gather.wgsl",
     "upsample.wgsl",
     "composite.wgsl",
+    "debug.wgsl",
     "tonemap.wgsl",
 ];
 

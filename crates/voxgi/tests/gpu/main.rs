@@ -8,3 +8,4 @@ mod errors;
 mod golden;
 mod points;
 mod shaders;
+mod voxels;
