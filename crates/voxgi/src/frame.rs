@@ -611,7 +611,7 @@ impl Renderer {
 
 /// Checks a fragment capacity against the device's storage-buffer limit.
 fn fragment_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
-    let limit = device.limits().max_storage_buffer_binding_size as u64
+    let limit = device.limits().max_storage_buffer_binding_size
         / crate::voxel::dense::FRAGMENT_BYTES;
     let cap = wanted.max(1024);
     if cap > limit.min(u32::MAX as u64) {

@@ -3,7 +3,6 @@
 
 use voxgi::gpu::shader;
 use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuVertex};
-use voxgi::passes::shadow::GpuShadowView;
 use voxgi::voxel::{GpuCones, GpuVolume};
 
 fn parse(name: &str) -> naga::Module {
