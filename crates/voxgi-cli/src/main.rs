@@ -147,6 +147,12 @@ struct SettingsArgs {
     /// Cone step as a fraction of the cone diameter. Default 0.5.
     #[arg(long, value_name = "F")]
     step_factor: Option<f32>,
+    /// Mip level the voxel views show (0 = finest).
+    #[arg(long, value_name = "N")]
+    voxel_level: Option<u32>,
+    /// Directional chain the voxel views read above the finest level: +x, -x, +y, -y, +z, -z.
+    #[arg(long, value_name = "DIR", value_parser = parse_voxel_dir, allow_hyphen_values = true)]
+    voxel_dir: Option<u32>,
 }
 
 impl SettingsArgs {
@@ -174,6 +180,9 @@ impl SettingsArgs {
                 ViewArg::Direct => ViewMode::Direct,
                 ViewArg::Ao => ViewMode::Ao,
                 ViewArg::Indirect => ViewMode::Indirect,
+                ViewArg::VoxelAlbedo => ViewMode::VoxelAlbedo,
+                ViewArg::VoxelOpacity => ViewMode::VoxelOpacity,
+                ViewArg::VoxelRadiance => ViewMode::VoxelRadiance,
             };
         }
         if let Some(v) = self.shadow_map_size {
@@ -205,6 +214,12 @@ impl SettingsArgs {
         }
         if let Some(v) = self.step_factor {
             s.step_factor = v;
+        }
+        if let Some(v) = self.voxel_level {
+            s.debug_level = v;
+        }
+        if let Some(v) = self.voxel_dir {
+            s.debug_direction = v;
         }
         s.validate()?;
         Ok(s)
@@ -255,6 +270,7 @@ fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
             "ao_radius" => s.ao_radius = Some(num()? as f32),
             "ao_lambda" => s.ao_lambda = num()? as f32,
             "step_factor" => s.step_factor = num()? as f32,
+            "voxel_level" => s.debug_level = int()?,
             "tonemap" => {
                 s.tonemap = match string()? {
                     "aces" => Tonemap::Aces,
@@ -266,7 +282,7 @@ fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
             other => bail!(
                 "[settings] unknown key '{other}' (known: exposure, shadow_map_size, \
                  voxel_resolution, bounces, cones, anisotropic, half_resolution, cone_shadows, \
-                 ao_radius, ao_lambda, step_factor, tonemap)"
+                 ao_radius, ao_lambda, step_factor, voxel_level, tonemap)"
             ),
         }
     }
@@ -341,6 +357,20 @@ enum ViewArg {
     Direct,
     Ao,
     Indirect,
+    /// The voxel volume's albedo (first voxel with opacity > 0.5 at --voxel-level).
+    VoxelAlbedo,
+    /// The voxel volume's opacity as grey.
+    VoxelOpacity,
+    /// The voxel volume's radiance (un-premultiplied).
+    VoxelRadiance,
+}
+
+fn parse_voxel_dir(s: &str) -> Result<u32, String> {
+    voxgi::voxel::dense::DIRECTIONS
+        .iter()
+        .position(|d| d.eq_ignore_ascii_case(s))
+        .map(|i| i as u32)
+        .ok_or_else(|| format!("'{s}' is not a direction (+x, -x, +y, -y, +z, -z)"))
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -2,7 +2,10 @@
 //! order from `Renderer::render`:
 //!
 //! shadow → voxelize → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
-//!        → gbuffer → gather → upsample → composite → tonemap
+//!        → gbuffer → gather → upsample → composite → [debug] → tonemap
+//!
+//! `debug` runs only for the voxel views (`ViewMode::is_voxel`) and replaces the composite's
+//! output with the ray-marched volume.
 //!
 //! The voxel passes (and the shadow maps they read) run when the scene changed — on the first
 //! frame, or every frame with `Settings::revoxelize_every_frame`.
@@ -13,6 +16,7 @@ use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
 use crate::output::RenderOutput;
 use crate::passes::bounce::BouncePass;
 use crate::passes::composite::{CompositePass, HDR_FORMAT};
+use crate::passes::debug::DebugPass;
 use crate::passes::filter::FilterPass;
 use crate::passes::gather::{GatherPass, INDIRECT_FORMAT};
 use crate::passes::gbuffer::{self, GbufferPass};
@@ -194,6 +198,7 @@ pub struct Renderer {
     shadow: ShadowPass,
     gbuffer: GbufferPass,
     composite: CompositePass,
+    debug: DebugPass,
     tonemap: TonemapPass,
     voxelize: VoxelizePass,
     inject: InjectPass,
@@ -262,6 +267,7 @@ impl Renderer {
                 GbufferPass::new(&device),
                 CompositePass::new(&device),
                 TonemapPass::new(&device),
+                DebugPass::new(&device),
             )
         })?;
         let b = scene.bounds();
@@ -311,6 +317,7 @@ impl Renderer {
             gbuffer: passes.1,
             composite: passes.2,
             tonemap: passes.3,
+            debug: passes.4,
             voxelize: voxel_passes.0,
             inject: voxel_passes.1,
             filter: voxel_passes.2,
@@ -348,6 +355,8 @@ impl Renderer {
         self.settings.view = s.view;
         self.settings.shadow_softness = s.shadow_softness;
         self.settings.background = s.background;
+        self.settings.debug_level = s.debug_level;
+        self.settings.debug_direction = s.debug_direction;
         Ok(())
     }
 
@@ -389,6 +398,10 @@ impl Renderer {
                 ViewMode::Direct => 3,
                 ViewMode::Ao => 4,
                 ViewMode::Indirect => 5,
+                // The debug pass draws these; composite writes the lit image underneath.
+                ViewMode::VoxelAlbedo => 6,
+                ViewMode::VoxelOpacity => 7,
+                ViewMode::VoxelRadiance => 8,
             },
             background: [s.background[0], s.background[1], s.background[2], 1.0],
             cone_shadows: s.cone_shadows as u32,
@@ -565,6 +578,19 @@ impl Renderer {
             &self.cones,
             timer,
         );
+        // Only for the voxel views: replaces the composite's output.
+        if self.settings.view.is_voxel() {
+            self.debug.record(
+                &self.device,
+                &mut encoder,
+                t,
+                &self.volume,
+                self.settings.view,
+                self.settings.debug_level,
+                self.settings.debug_direction,
+                timer,
+            );
+        }
         self.tonemap.record(&self.device, &mut encoder, t, timer);
         timer.resolve(&mut encoder);
         self.queue.submit([encoder.finish()]);

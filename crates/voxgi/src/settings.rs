@@ -31,6 +31,23 @@ pub enum ViewMode {
     Ao,
     /// Indirect light only.
     Indirect,
+    /// The voxel volume ray-marched at `Settings::debug_level`: the finest albedo under the
+    /// first voxel with opacity > 0.5.
+    VoxelAlbedo,
+    /// The opacity of the first voxel with opacity > 0.5 at `debug_level`, as grey.
+    VoxelOpacity,
+    /// The radiance (un-premultiplied) of the first voxel with opacity > 0.5 at `debug_level`.
+    VoxelRadiance,
+}
+
+impl ViewMode {
+    /// The views the `debug` pass draws by ray-marching the voxel volume.
+    pub fn is_voxel(&self) -> bool {
+        matches!(
+            self,
+            ViewMode::VoxelAlbedo | ViewMode::VoxelOpacity | ViewMode::VoxelRadiance
+        )
+    }
 }
 
 /// `Settings::bounces` value for "until converged": voxel bounces are repeated until the
@@ -87,6 +104,12 @@ pub struct Settings {
     /// Voxelize, inject, filter and bounce every frame, not only when the scene changed
     /// (for benchmarks of fully dynamic scenes).
     pub revoxelize_every_frame: bool,
+    /// Mip level the voxel views show, 0 = finest (< the volume's level count,
+    /// log2(voxel_resolution) + 1). Default 0.
+    pub debug_level: u32,
+    /// Directional chain the voxel views read above the finest level: 0..6 for +X, -X, +Y, -Y,
+    /// +Z, -Z (ignored with `anisotropic: false`). Default 0.
+    pub debug_direction: u32,
 }
 
 impl Default for Settings {
@@ -112,6 +135,8 @@ impl Default for Settings {
             half_resolution: false,
             cone_shadows: false,
             revoxelize_every_frame: false,
+            debug_level: 0,
+            debug_direction: 0,
         }
     }
 }
@@ -181,6 +206,21 @@ impl Settings {
         {
             return fail(format!(
                 "max cone distance {d} must be a positive number of metres"
+            ));
+        }
+        if self.voxel_resolution.is_power_of_two() {
+            let levels = self.voxel_resolution.ilog2() + 1;
+            if self.debug_level >= levels {
+                return fail(format!(
+                    "voxel debug level {} is outside 0..{levels} (voxel resolution {})",
+                    self.debug_level, self.voxel_resolution
+                ));
+            }
+        }
+        if self.debug_direction >= 6 {
+            return fail(format!(
+                "voxel debug direction {} is outside 0..6 (+X, -X, +Y, -Y, +Z, -Z)",
+                self.debug_direction
             ));
         }
         Ok(())

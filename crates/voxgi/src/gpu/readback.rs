@@ -53,6 +53,101 @@ pub fn read_texture(
     })
 }
 
+/// Reads one mip level of a 3D texture into tightly packed bytes (x fastest, then y, then z).
+pub fn read_texture_3d(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    mip: u32,
+) -> Result<Vec<u8>> {
+    let fail = |reason: String| Error::Gpu {
+        context: "readback".into(),
+        reason,
+    };
+    if texture.dimension() != wgpu::TextureDimension::D3 || mip >= texture.mip_level_count() {
+        return Err(fail(format!(
+            "mip {mip} of a {:?} texture with {} levels",
+            texture.dimension(),
+            texture.mip_level_count()
+        )));
+    }
+    let size = texture
+        .size()
+        .mip_level_size(mip, wgpu::TextureDimension::D3);
+    let (w, h, d) = (size.width, size.height, size.depth_or_array_layers);
+    let bpp = texture
+        .format()
+        .block_copy_size(None)
+        .ok_or_else(|| fail(format!("cannot read back format {:?}", texture.format())))?;
+    let row = w * bpp;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback 3d"),
+        size: (padded * h * d) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: mip,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        size,
+    );
+    queue.submit([enc.finish()]);
+    read_buffer(device, &buffer).map(|bytes| {
+        let mut out = Vec::with_capacity((row * h * d) as usize);
+        for y in 0..(h * d) as usize {
+            let start = y * padded as usize;
+            out.extend_from_slice(&bytes[start..start + row as usize]);
+        }
+        out
+    })
+}
+
+/// Reads a whole buffer (which needs COPY_SRC) into bytes.
+pub fn read_buffer_copy(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    source: &wgpu::Buffer,
+) -> Result<Vec<u8>> {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback buffer"),
+        size: source.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
+    queue.submit([enc.finish()]);
+    read_buffer(device, &buffer)
+}
+
+/// An IEEE binary16 value (as read back from an rgba16float texture) as f32.
+pub fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0f32 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let mant = (h & 0x3ff) as f32;
+    match exp {
+        0 => sign * mant * 2f32.powi(-24),
+        31 if mant == 0.0 => sign * f32::INFINITY,
+        31 => f32::NAN,
+        _ => sign * (1.0 + mant / 1024.0) * 2f32.powi(exp - 15),
+    }
+}
+
 /// Maps a MAP_READ buffer and copies its contents out, waiting for the GPU.
 pub fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();

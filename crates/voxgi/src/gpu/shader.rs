@@ -30,6 +30,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "gather.wgsl",
     "upsample.wgsl",
     "composite.wgsl",
+    "debug.wgsl",
     "tonemap.wgsl",
     "reference.wgsl",
 ];

@@ -3,6 +3,7 @@
 
 pub mod bounce;
 pub mod composite;
+pub mod debug;
 pub mod filter;
 pub mod gather;
 pub mod gbuffer;

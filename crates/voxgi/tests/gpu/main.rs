@@ -11,3 +11,4 @@ mod points;
 mod reference;
 mod shaders;
 mod vct;
+mod voxels;

@@ -1,0 +1,92 @@
+//! debug: the voxel views (`ViewMode::VoxelAlbedo`, `VoxelOpacity`, `VoxelRadiance`). Ray-marches
+//! the volume at `Settings::debug_level` and overwrites the HDR target; runs after composite and
+//! before tonemap, only when such a view is selected.
+
+use crate::frame::FrameTargets;
+use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
+use crate::passes::composite::{HDR_FORMAT, compute_pipeline};
+use crate::settings::ViewMode;
+use crate::voxel::dense::DenseVolume;
+use wgpu::util::DeviceExt;
+
+pub struct DebugPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl DebugPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("debug"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::uniform(1, c, false),
+                layout::uniform(2, c, false),
+                layout::texture_3d_load(3, c),
+                layout::texture_3d_load(4, c),
+                layout::texture_3d_load(5, c),
+                layout::storage_texture(6, HDR_FORMAT),
+            ],
+        });
+        DebugPass {
+            pipeline: compute_pipeline(device, "debug", "debug.wgsl", &layout),
+            layout,
+        }
+    }
+
+    /// Records the view `view` (a voxel view) of mip `level` (0 = finest), reading directional
+    /// chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) above the finest level.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        vol: &DenseVolume,
+        view: ViewMode,
+        level: u32,
+        direction: u32,
+        timer: &mut GpuTimer,
+    ) {
+        let mode: u32 = match view {
+            ViewMode::VoxelAlbedo => 0,
+            ViewMode::VoxelOpacity => 1,
+            _ => 2,
+        };
+        let level = level.min(vol.grid.levels() - 1);
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("debug params"),
+            contents: bytemuck::cast_slice(&[mode, level, 0u32, 0u32]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let chain = vol
+            .aniso
+            .get(direction as usize)
+            .unwrap_or(&vol.aniso[0])
+            .create_view(&Default::default());
+        let albedo = vol.albedo.create_view(&Default::default());
+        let radiance = vol.radiance.create_view(&Default::default());
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("debug"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                t.frame.as_entire_binding(),
+                vol.volume.as_entire_binding(),
+                params.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&albedo),
+                wgpu::BindingResource::TextureView(&radiance),
+                wgpu::BindingResource::TextureView(&chain),
+                wgpu::BindingResource::TextureView(&t.hdr),
+            ]),
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("debug"),
+            timestamp_writes: timer.compute("debug"),
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+    }
+}

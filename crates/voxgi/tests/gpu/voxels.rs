@@ -1,0 +1,375 @@
+//! The voxel kernels against their plain-Rust twins in `voxel::cpu` (voxelization exactly,
+//! filtering within fp16 rounding), and the voxel debug views.
+
+use crate::common::*;
+use std::collections::BTreeSet;
+use voxgi::gpu::readback::{f16_to_f32, read_buffer_copy, read_texture_3d};
+use voxgi::scene::glam::{Mat4, Vec3, Vec4};
+use voxgi::scene::{Material, Mesh, Scene, builtin};
+use voxgi::voxel::{Grid, cpu};
+use voxgi::{Renderer, Settings, ViewMode};
+
+/// One mesh holding `tris` (world space), each with its own vertices and face normal.
+fn triangle_scene(tris: &[[Vec3; 3]]) -> Scene {
+    let mut mesh = Mesh {
+        name: "triangles".into(),
+        positions: Vec::new(),
+        normals: Vec::new(),
+        uvs: Vec::new(),
+        indices: Vec::new(),
+        material: 0,
+    };
+    for t in tris {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        for p in t {
+            mesh.indices.push(mesh.positions.len() as u32);
+            mesh.positions.push(*p);
+            mesh.normals.push(n);
+        }
+    }
+    let mut s = Scene::default();
+    s.add_mesh(mesh, Material::diffuse("grey", [0.5; 3]), Mat4::IDENTITY);
+    s
+}
+
+/// Voxel coordinates of the non-zero entries of the occupancy buffer (x fastest), and the
+/// values themselves.
+fn occupied(r: &Renderer) -> (BTreeSet<[u32; 3]>, Vec<u32>) {
+    let (device, queue) = r.device();
+    let vol = r.volume();
+    let bytes = read_buffer_copy(device, queue, &vol.occupancy).expect("occupancy readback");
+    let words: &[u32] = bytemuck::cast_slice(&bytes);
+    let res = vol.grid.resolution;
+    let mut set = BTreeSet::new();
+    let mut values = Vec::new();
+    for (i, &w) in words.iter().take((res * res * res) as usize).enumerate() {
+        if w != 0 {
+            let i = i as u32;
+            set.insert([i % res, (i / res) % res, i / (res * res)]);
+            values.push(w);
+        }
+    }
+    (set, values)
+}
+
+#[test]
+fn voxelize_matches_cpu_exactly() {
+    const RES: u32 = 16;
+    // The large triangle spans [0, 0.875]^3, so `Grid::around` gives a side of exactly
+    // 0.875 * 16 / 14 = 1 m: voxel size 1/16, origin -1/16 on every axis. World -> voxel space
+    // is then exact in f32 on both sides (the GPU multiplies by 1/size, the CPU divides).
+    let e = 0.875;
+    let large = [
+        Vec3::new(0.0, 0.13, e),
+        Vec3::new(e, 0.0, 0.31),
+        Vec3::new(0.23, e, 0.0),
+    ];
+    // A long sliver, about 12 voxels long and 1/200 voxel wide, in general position.
+    let sliver = [
+        Vec3::new(0.1017, 0.2093, 0.3071),
+        Vec3::new(0.7013, 0.6029, 0.5047),
+        Vec3::new(0.7016, 0.6032, 0.5049),
+    ];
+    // Axis-aligned, exactly in the face plane z = 0.25 m (voxel z = 5.0) between the voxel
+    // centres of layers 4 and 5: a deliberate tie. It is chosen because its arithmetic is exact
+    // on both sides (z = 0.25 and the grid are dyadic, the cross product's x and y are exactly
+    // 0, every dot product along Z is exactly ±0.5), so the GPU and CPU float paths must agree.
+    // Both kernels take candidates from floor(min)..=floor(max) of the triangle's bounds, so a
+    // triangle lying in a face plane lands in the layer above the plane only (5, not 4).
+    let in_face = [
+        Vec3::new(0.3011, 0.2027, 0.25),
+        Vec3::new(0.6043, 0.2519, 0.25),
+        Vec3::new(0.3537, 0.7049, 0.25),
+    ];
+    // Tiny, inside voxel (7, 8, 9) (voxel coordinates 7.56.., 8.52.., 9.48..).
+    let tiny = [
+        Vec3::new(0.4101, 0.4702, 0.5303),
+        Vec3::new(0.4131, 0.4709, 0.5311),
+        Vec3::new(0.4113, 0.4731, 0.5297),
+    ];
+    let tris = [large, sliver, in_face, tiny];
+    let scene = triangle_scene(&tris);
+    let b = scene.bounds();
+    let grid = Grid::around(b.min, b.max, RES);
+    assert_eq!(
+        grid.voxel_size,
+        1.0 / 16.0,
+        "the grid is not the dyadic one"
+    );
+    assert_eq!(grid.origin, Vec3::splat(-1.0 / 16.0));
+
+    let settings = Settings {
+        voxel_resolution: RES,
+        bounces: 0,
+        ..measuring()
+    };
+    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    assert_eq!(r.volume().grid, grid);
+    let cam = r.default_camera().clone();
+    r.render(&cam, 16, 16).expect("render");
+
+    let (gpu, values) = occupied(&r);
+    let expected = cpu::voxelize(&tris, &grid);
+    // The test scene does what it claims.
+    let single: BTreeSet<[u32; 3]> = [[7, 8, 9]].into();
+    assert_eq!(cpu::voxelize(&[tiny], &grid), single, "tiny triangle");
+    let face = cpu::voxelize(&[in_face], &grid);
+    assert!(
+        face.contains(&[6, 6, 5]) && face.iter().all(|v| v[2] == 5),
+        "the in-face triangle is in layer 5 only: {face:?}"
+    );
+    assert!(cpu::voxelize(&[sliver], &grid).len() >= 12, "sliver");
+    let missing: Vec<_> = expected.difference(&gpu).collect();
+    let extra: Vec<_> = gpu.difference(&expected).collect();
+    assert!(
+        missing.is_empty() && extra.is_empty(),
+        "GPU voxelization differs from the CPU's ({} voxels): missing on the GPU {:?}, extra \
+         on the GPU {:?}",
+        expected.len(),
+        missing,
+        extra
+    );
+
+    let (fragments, count) = r.voxel_counts().expect("counts");
+    assert_eq!(
+        count,
+        gpu.len() as u64,
+        "occupied voxels vs the slot counter"
+    );
+    assert!(
+        fragments >= count,
+        "{fragments} fragments < {count} occupied voxels"
+    );
+    // After the build every occupied voxel holds 2 + its slot, and the slots are 0..count.
+    let mut slots: Vec<u32> = values
+        .iter()
+        .map(|&v| {
+            assert!(v >= 2, "occupancy value {v}");
+            v - 2
+        })
+        .collect();
+    slots.sort_unstable();
+    assert!(
+        slots.iter().enumerate().all(|(i, &s)| s == i as u32),
+        "slots are not 0..{count}"
+    );
+}
+
+/// One mip level of a rgba16float 3D texture as f32 texels (x fastest), and its side.
+fn read_level(r: &Renderer, t: &wgpu::Texture, mip: u32) -> (Vec<Vec4>, u32) {
+    let (device, queue) = r.device();
+    let bytes = read_texture_3d(device, queue, t, mip).expect("3D readback");
+    let halves: &[u16] = bytemuck::cast_slice(&bytes);
+    let texels = halves
+        .chunks_exact(4)
+        .map(|h| {
+            Vec4::new(
+                f16_to_f32(h[0]),
+                f16_to_f32(h[1]),
+                f16_to_f32(h[2]),
+                f16_to_f32(h[3]),
+            )
+        })
+        .collect();
+    (texels, (t.width() >> mip).max(1))
+}
+
+/// Checks every parent of `parent` (side n) against `cpu::filter_parent` of its children in
+/// `child` (side 2n). Returns (parents checked, parents with 0 < opacity < 1).
+fn check_filter_step(
+    child: &[Vec4],
+    parent: &[Vec4],
+    n: u32,
+    dir: Option<u32>,
+    what: &str,
+) -> (u32, u32) {
+    let m = 2 * n;
+    assert_eq!(
+        child.len(),
+        (m * m * m) as usize,
+        "{what}: child level size"
+    );
+    assert_eq!(
+        parent.len(),
+        (n * n * n) as usize,
+        "{what}: parent level size"
+    );
+    let mut partial = 0;
+    let mut worst = (0.0f32, [0u32; 3]);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let children: [Vec4; 8] = std::array::from_fn(|i| {
+                    let (cx, cy, cz) = (
+                        2 * x + (i as u32 & 1),
+                        2 * y + ((i as u32 >> 1) & 1),
+                        2 * z + (i as u32 >> 2),
+                    );
+                    child[(cx + m * (cy + m * cz)) as usize]
+                });
+                let want = cpu::filter_parent(&children, dir);
+                let got = parent[(x + n * (y + n * z)) as usize];
+                // rgba16float keeps 11 significant bits: storing the GPU's f32 result rounds
+                // it by at most 2^-11 ≈ 4.9e-4 relative; both sides compute in f32 from the
+                // same fp16 children, so anything beyond 1e-3 relative is a real difference.
+                // The absolute floor, 2^-14, is fp16's smallest normal (a GPU may flush fp16
+                // subnormals).
+                for c in 0..4 {
+                    let err = (got[c] - want[c]).abs();
+                    let tol = 1e-3 * want[c].abs() + 6.2e-5;
+                    assert!(
+                        err <= tol,
+                        "{what}: parent ({x}, {y}, {z}) channel {c}: GPU {got}, CPU {want} \
+                         (children {children:?})"
+                    );
+                    if err / tol > worst.0 {
+                        worst = (err / tol, [x, y, z]);
+                    }
+                }
+                if got.w > 0.01 && got.w < 0.99 {
+                    partial += 1;
+                }
+            }
+        }
+    }
+    (n * n * n, partial)
+}
+
+fn check_filtering(anisotropic: bool) {
+    let scene = builtin::cornell_box();
+    let settings = Settings {
+        voxel_resolution: 16,
+        anisotropic,
+        ..measuring()
+    };
+    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    let cam = r.default_camera().clone();
+    r.render(&cam, 16, 16).expect("render");
+    let vol = r.volume();
+    let levels = vol.grid.levels();
+    let (finest, res) = read_level(&r, &vol.radiance, 0);
+    assert_eq!(res, 16);
+    // The test can only fail if the volume has structure: lit and unlit voxels, coloured ones.
+    let lit = finest
+        .iter()
+        .filter(|v| v.w > 0.0 && v.x + v.y + v.z > 1e-3)
+        .count();
+    let empty = finest.iter().filter(|v| v.w == 0.0).count();
+    let reddish = finest
+        .iter()
+        .filter(|v| v.w > 0.0 && v.x > 2.0 * v.y + 1e-4)
+        .count();
+    assert!(
+        lit > 50 && empty > 100 && reddish > 5,
+        "lit {lit}, empty {empty}, red {reddish}"
+    );
+
+    let dirs: Vec<Option<u32>> = if anisotropic {
+        (0..6).map(Some).collect()
+    } else {
+        vec![None]
+    };
+    assert_eq!(vol.aniso.len(), dirs.len());
+    let mut partial = 0;
+    for (chain, dir) in vol.aniso.iter().zip(dirs) {
+        let mut child = finest.clone();
+        for mip in 0..levels - 1 {
+            let (parent, n) = read_level(&r, chain, mip);
+            let what = format!("chain {dir:?}, level {}", mip + 1);
+            partial += check_filter_step(&child, &parent, n, dir, &what).1;
+            child = parent;
+        }
+    }
+    // Partly transparent parents: the directional compositing (not just the mean) is tested.
+    assert!(partial > 20, "only {partial} partly transparent parents");
+}
+
+#[test]
+fn voxel_filter_matches_cpu_anisotropic() {
+    check_filtering(true);
+}
+
+#[test]
+fn voxel_filter_matches_cpu_isotropic() {
+    check_filtering(false);
+}
+
+const SIZE: u32 = 48;
+
+fn voxel_view(r: &mut Renderer, view: ViewMode, level: u32, dir: u32) -> voxgi::RenderOutput {
+    let s = Settings {
+        view,
+        debug_level: level,
+        debug_direction: dir,
+        ..r.settings().clone()
+    };
+    r.set_display_settings(&s).expect("display settings");
+    let cam = r.default_camera().clone();
+    r.render(&cam, SIZE, SIZE).expect("render")
+}
+
+#[test]
+fn voxel_debug_views_are_plausible() {
+    let scene = builtin::cornell_box();
+    let settings = Settings {
+        voxel_resolution: 32,
+        ..measuring()
+    };
+    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    let (c, mid) = (SIZE / 2, SIZE / 2);
+    // Seen from the standard camera, the red wall is on the left, the green one on the right.
+    let (left, right) = (SIZE / 10, SIZE - 1 - SIZE / 10);
+    for level in [0, 2] {
+        // Opacity: the centre sees an opaque surface (the tall block or the back wall).
+        let out = voxel_view(&mut r, ViewMode::VoxelOpacity, level, 4);
+        let o = out.radiance(c, mid);
+        assert!(
+            o[0] > 0.5 && o[0] <= 1.0 + 1e-3 && o[0] == o[1],
+            "level {level}: opacity {o:?}"
+        );
+        // Albedo: the finest albedo under the hit.
+        let out = voxel_view(&mut r, ViewMode::VoxelAlbedo, level, 0);
+        let red = out.radiance(left, mid);
+        let green = out.radiance(right, mid);
+        let white = out.radiance(c, SIZE / 5);
+        assert!(
+            red[0] > 0.4 && red[0] > 3.0 * red[1] && red[0] > 3.0 * red[2],
+            "level {level}: red wall {red:?}"
+        );
+        assert!(
+            green[1] > 0.3 && green[1] > 2.0 * green[0],
+            "level {level}: green wall {green:?}"
+        );
+        assert!(
+            white.iter().all(|&v| (0.6..0.8).contains(&v)),
+            "level {level}: back wall {white:?}"
+        );
+        // Radiance: finite and non-negative everywhere; the red wall reflects mostly red.
+        let out = voxel_view(&mut r, ViewMode::VoxelRadiance, level, 0);
+        assert!(
+            out.hdr.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "level {level}"
+        );
+        let m = out.mean_radiance();
+        assert!(
+            m.iter().all(|&v| v > 0.0),
+            "level {level}: mean radiance {m:?}"
+        );
+        let red = out.radiance(left, mid);
+        assert!(
+            red[0] > red[1] && red[0] > red[2],
+            "level {level}: red wall radiance {red:?}"
+        );
+    }
+    // Out-of-range levels and directions are errors, not clamps.
+    let bad = Settings {
+        debug_level: 6,
+        ..r.settings().clone()
+    };
+    assert!(r.set_display_settings(&bad).is_err());
+    let bad = Settings {
+        debug_direction: 6,
+        ..r.settings().clone()
+    };
+    assert!(r.set_display_settings(&bad).is_err());
+}
