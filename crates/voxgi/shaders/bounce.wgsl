@@ -39,11 +39,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let n = normalize(nw.xyz);
         // A fixed bundle orientation per voxel, varied between voxels to break up patterns.
         let angle = fract(f32(s) * 0.6180339887) * 2.0 * PI;
-        e = gather_diffuse(center, n, angle, false).irradiance;
+        e = gather_diffuse(center, n, angle, false, ALL_CONES).irradiance;
     } else {
         // Two-sided voxel: half the light from each side.
         let n = vec3<f32>(0.0, 1.0, 0.0);
-        e = 0.5 * (gather_diffuse(center, n, 0.0, false).irradiance + gather_diffuse(center, -n, 0.0, false).irradiance);
+        e = 0.5 * (gather_diffuse(center, n, 0.0, false, ALL_CONES).irradiance + gather_diffuse(center, -n, 0.0, false, ALL_CONES).irradiance);
     }
     let direct = slot_direct[s];
     slot_next[s] = vec4<f32>(direct.rgb + albedo.rgb / PI * e * direct.a, direct.a);

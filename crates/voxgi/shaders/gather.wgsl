@@ -76,7 +76,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // The ring of tilted cones repeats every 2 pi / (count - 1).
     let period = 2.0 * PI / f32(max(cones.count, 2u) - 1u);
     let angle = (bayer4(gid.xy) + 0.5) / 16.0 * period;
-    let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO);
+    // Even and odd Bayer ranks trace the two halves of the ring: each half then meets eight
+    // rotations spread over the whole period.
+    let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO, u32(bayer4(gid.xy)) & 1u);
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);
     if cones.indirect != 0u && max(f0.r, max(f0.g, f0.b)) > 0.0 {

@@ -11,6 +11,12 @@
 @group(0) @binding(3) var gb_depth: texture_depth_2d;
 @group(0) @binding(4) var full: texture_storage_2d<rgba16float, write>;
 
+// The gather's cone half of a sample (the parity of its Bayer rank).
+fn cone_half(p: vec2<u32>) -> u32 {
+    let m = array<u32, 16>(0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
+    return m[(p.y & 3u) * 4u + (p.x & 3u)] & 1u;
+}
+
 fn view_depth(px: vec2<u32>) -> f32 {
     let d = textureLoad(gb_depth, px, 0);
     let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
@@ -32,11 +38,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let d0 = view_depth(gid.xy);
     let n0 = textureLoad(gb_normal, gid.xy, 0).xyz;
-    let base = vec2<i32>(gid.xy / scale) - 1;
-    var sum = vec4<f32>(0.0);
-    var wsum = 0.0;
+    // The window moves inside the image rather than clamping, so it always holds all sixteen
+    // rotations and both halves of the cone set.
+    let base = clamp(vec2<i32>(gid.xy / scale) - 1, vec2<i32>(0), max(vec2<i32>(low_size) - 4, vec2<i32>(0)));
+    // Even and odd Bayer ranks traced different halves of the cones: average each half on its
+    // own, then the two, so rejected neighbours at edges cannot tip the balance.
+    var sum = array<vec4<f32>, 2>(vec4<f32>(0.0), vec4<f32>(0.0));
+    var wsum = array<f32, 2>(0.0, 0.0);
     for (var i = 0; i < 16; i++) {
-        let c = clamp(base + vec2<i32>(i & 3, i >> 2), vec2<i32>(0), vec2<i32>(low_size) - 1);
+        let c = min(base + vec2<i32>(i & 3, i >> 2), vec2<i32>(low_size) - 1);
         let px = min(vec2<u32>(c) * scale, size - 1u);
         if textureLoad(gb_depth, px, 0) >= 1.0 {
             continue;
@@ -47,8 +57,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let wd = exp(-abs(d - d0) / max(0.05 * d0, 1e-4));
         let wn = pow(max(dot(n, n0), 0.0), 8.0);
         let w = wd * wn + 1e-6;
-        sum += w * textureLoad(low, c, 0);
-        wsum += w;
+        let k = cone_half(vec2<u32>(c));
+        sum[k] += w * textureLoad(low, c, 0);
+        wsum[k] += w;
     }
-    textureStore(full, gid.xy, sum / max(wsum, 1e-6));
+    var out: vec4<f32>;
+    if wsum[0] > 1e-5 && wsum[1] > 1e-5 {
+        out = 0.5 * (sum[0] / wsum[0] + sum[1] / wsum[1]);
+    } else {
+        out = (sum[0] + sum[1]) / max(wsum[0] + wsum[1], 1e-6);
+    }
+    textureStore(full, gid.xy, out);
 }
