@@ -10,19 +10,14 @@
 @group(0) @binding(0) var<uniform> vol: Volume;
 @group(0) @binding(1) var<uniform> cones: Cones;
 @group(0) @binding(2) var radiance0: texture_3d<f32>;
-@group(0) @binding(3) var aniso_px: texture_3d<f32>;
-@group(0) @binding(4) var aniso_nx: texture_3d<f32>;
-@group(0) @binding(5) var aniso_py: texture_3d<f32>;
-@group(0) @binding(6) var aniso_ny: texture_3d<f32>;
-@group(0) @binding(7) var aniso_pz: texture_3d<f32>;
-@group(0) @binding(8) var aniso_nz: texture_3d<f32>;
-@group(0) @binding(9) var voxel_sampler: sampler;
-@group(0) @binding(10) var albedo_tex: texture_3d<f32>;
-@group(0) @binding(11) var normal_tex: texture_3d<f32>;
-@group(0) @binding(12) var<storage, read> slot_voxel: array<u32>;
-@group(0) @binding(13) var<storage, read> counters: array<u32>;
-@group(0) @binding(14) var<storage, read> slot_direct: array<vec4<f32>>;
-@group(0) @binding(15) var<storage, read_write> slot_next: array<vec4<f32>>;
+@group(0) @binding(3) var chains: texture_3d<f32>;
+@group(0) @binding(4) var voxel_sampler: sampler;
+@group(0) @binding(5) var albedo_tex: texture_3d<f32>;
+@group(0) @binding(6) var normal_tex: texture_3d<f32>;
+@group(0) @binding(7) var<storage, read> slot_voxel: array<u32>;
+@group(0) @binding(8) var<storage, read> counters: array<u32>;
+@group(0) @binding(9) var<storage, read> slot_direct: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read_write> slot_next: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {

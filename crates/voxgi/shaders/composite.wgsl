@@ -3,9 +3,6 @@
 
 //!include shared/scene.wgsl
 //!include shared/lights.wgsl
-//!include shared/volume.wgsl
-//!include shared/dense_sample.wgsl
-//!include shared/cone.wgsl
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
@@ -18,30 +15,8 @@
 @group(0) @binding(8) var hdr: texture_storage_2d<rgba32float, write>;
 // rgb: indirect radiance, a: ambient occlusion (from the gather pass).
 @group(0) @binding(9) var indirect: texture_2d<f32>;
-@group(0) @binding(10) var<uniform> vol: Volume;
-@group(0) @binding(11) var<uniform> cones: Cones;
-@group(0) @binding(12) var radiance0: texture_3d<f32>;
-@group(0) @binding(13) var aniso_px: texture_3d<f32>;
-@group(0) @binding(14) var aniso_nx: texture_3d<f32>;
-@group(0) @binding(15) var aniso_py: texture_3d<f32>;
-@group(0) @binding(16) var aniso_ny: texture_3d<f32>;
-@group(0) @binding(17) var aniso_pz: texture_3d<f32>;
-@group(0) @binding(18) var aniso_nz: texture_3d<f32>;
-@group(0) @binding(19) var voxel_sampler: sampler;
-
-// Visibility of an area light by one cone from p to its centre, as wide as the light looks
-// from p: 1 - the opacity the cone gathers before reaching the light.
-fn cone_visibility(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let to = light.position - p;
-    let dist = length(to);
-    let dir = to / dist;
-    let tan_half = clamp(light.size / dist, 0.01, 1.0);
-    let origin = p + n * vol.voxel_size * cones.origin_offset;
-    // Stop where the cone's footprint would reach the emitter's plane: the light hangs on (or
-    // in) other geometry, which must not count as its own occluder.
-    let stop = dist / (1.0 + 2.0 * tan_half) - 2.0 * vol.voxel_size;
-    return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0)).a;
-}
+// Cone-traced visibility of the first CONE_SHADOW_LIGHTS area lights (gather pass, upsampled).
+@group(0) @binding(10) var visibility: texture_2d<f32>;
 
 const VIEW_FINAL: u32 = 0u;
 const VIEW_ALBEDO: u32 = 1u;
@@ -77,16 +52,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let s = Surface(am.rgb, am.a, nr.w, em.a);
 
     var direct = vec3<f32>(0.0);
+    let vis = textureLoad(visibility, px, 0);
+    var area = 0u;
     for (var i = 0u; i < frame.light_count; i++) {
         let light = lights[i];
-        if frame.cone_shadows != 0u && (light.kind == LIGHT_RECT || light.kind == LIGHT_DISC) {
-            // The shadow map's visibility is replaced: shade unshadowed, scale by the cone's.
-            var open = light;
-            open.shadow_count = 0u;
-            direct += shade_light(open, s, p, n, v, frame.shadow_softness) * cone_visibility(light, p, n);
-        } else {
-            direct += shade_light(light, s, p, n, v, frame.shadow_softness);
-        }
+        let is_area = light.kind == LIGHT_RECT || light.kind == LIGHT_DISC;
+        // With a cone's visibility the shadow map's is replaced: shade unshadowed, scale by the
+        // cone's. One call site: CPU drivers pay for every inlined copy of shade_light.
+        let cone = frame.cone_shadows != 0u && is_area && area < CONE_SHADOW_LIGHTS;
+        var l = light;
+        l.shadow_count = select(light.shadow_count, 0u, cone);
+        direct += shade_light(l, s, p, n, v, frame.shadow_softness) * select(1.0, vis[min(area, 3u)], cone);
+        area += u32(is_area);
     }
     let ind = textureLoad(indirect, px, 0);
     var out = direct + em.rgb + ind.rgb;

@@ -18,7 +18,8 @@ struct DebugParams {
     mode: u32,
     // Mip level, 0 = finest.
     level: u32,
-    _pad0: u32,
+    // The block of the chains shown (+X, -X, +Y, -Y, +Z, -Z).
+    block: u32,
     _pad1: u32,
 }
 
@@ -27,7 +28,7 @@ struct DebugParams {
 @group(0) @binding(2) var<uniform> params: DebugParams;
 @group(0) @binding(3) var albedo: texture_3d<f32>;
 @group(0) @binding(4) var radiance0: texture_3d<f32>;
-// The directional chain shown (its mip 0 is the volume's level 1).
+// The directional chains (their mip 0 is the volume's level 1), blocks stacked along z.
 @group(0) @binding(5) var chain: texture_3d<f32>;
 @group(0) @binding(6) var hdr: texture_storage_2d<rgba32float, write>;
 
@@ -39,7 +40,8 @@ fn cell_value(c: vec3<i32>) -> vec4<f32> {
     if params.level == 0u {
         return textureLoad(radiance0, c, 0);
     }
-    return textureLoad(chain, c, i32(params.level) - 1);
+    let n = i32(vol.resolution) >> params.level;
+    return textureLoad(chain, c + vec3<i32>(0, 0, n * i32(params.block)), i32(params.level) - 1);
 }
 
 // Ray / box [lo, hi] entry and exit distances (t_enter > t_exit: miss).

@@ -2,15 +2,17 @@
 // children. Anisotropic (Crassin et al. 2011, section 9): per direction, the children are first
 // composited front to back along it, two at a time, then the four results are averaged, so a
 // one-voxel wall stays opaque across itself at coarser levels instead of turning half
-// transparent.
+// transparent. One dispatch writes one level of every direction's block (+X, -X, +Y, -Y, +Z,
+// -Z stacked along z: the direction the cone travels).
 
 struct FilterParams {
     // 0: isotropic mean, 1: directional.
     mode: u32,
-    // 0 +X, 1 -X, 2 +Y, 3 -Y, 4 +Z, 5 -Z: the direction the cone travels.
-    dir: u32,
-    // Voxels per side of the level written.
+    // Voxels per side of a block of the level written.
     dst_res: u32,
+    // 1: the source is the chains' previous level (blocks stacked like the destination's),
+    // 0: the finest level (one block, shared by every direction).
+    src_blocked: u32,
     _pad: u32,
 }
 
@@ -23,21 +25,25 @@ fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
 }
 
 @compute @workgroup_size(4, 4, 4)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if any(gid >= vec3<u32>(params.dst_res)) {
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = params.dst_res;
+    let block = id.z / n;
+    let gid = vec3<u32>(id.xy, id.z % n);
+    if any(id.xy >= vec2<u32>(n)) || block >= select(1u, 6u, params.mode == 1u) {
         return;
     }
-    let base = vec3<i32>(gid) * 2;
+    var base = vec3<i32>(gid) * 2;
+    base.z += i32(block * 2u * n * params.src_blocked);
     if params.mode == 0u {
         var sum = vec4<f32>(0.0);
         for (var i = 0; i < 8; i++) {
             sum += child(base, vec3<i32>(i & 1, (i >> 1) & 1, (i >> 2) & 1));
         }
-        textureStore(dst, gid, sum * 0.125);
+        textureStore(dst, id, sum * 0.125);
         return;
     }
-    let axis = i32(params.dir / 2u);
-    let positive = (params.dir & 1u) == 0u;
+    let axis = i32(block / 2u);
+    let positive = (block & 1u) == 0u;
     var sum = vec4<f32>(0.0);
     for (var i = 0; i < 4; i++) {
         var front = vec3<i32>(0);
@@ -52,5 +58,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let b = child(base, back);
         sum += f + (1.0 - f.a) * b;
     }
-    textureStore(dst, gid, sum * 0.25);
+    textureStore(dst, id, sum * 0.25);
 }

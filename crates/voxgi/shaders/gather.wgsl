@@ -1,30 +1,60 @@
 // gather: per pixel (or per 2x2 block at half resolution), indirect light from the voxels:
 // diffuse cones (irradiance and ambient occlusion) and one glossy cone along the mirror
-// direction whose aperture follows the roughness.
+// direction whose aperture follows the roughness; with cone shadows, the visibility of the
+// first area lights by one cone each.
 
 //!include shared/scene.wgsl
 //!include shared/volume.wgsl
 //!include shared/brdf.wgsl
 //!include shared/dense_sample.wgsl
 //!include shared/cone.wgsl
+//!include shared/interleave.wgsl
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> vol: Volume;
 @group(0) @binding(2) var<uniform> cones: Cones;
 @group(0) @binding(3) var radiance0: texture_3d<f32>;
-@group(0) @binding(4) var aniso_px: texture_3d<f32>;
-@group(0) @binding(5) var aniso_nx: texture_3d<f32>;
-@group(0) @binding(6) var aniso_py: texture_3d<f32>;
-@group(0) @binding(7) var aniso_ny: texture_3d<f32>;
-@group(0) @binding(8) var aniso_pz: texture_3d<f32>;
-@group(0) @binding(9) var aniso_nz: texture_3d<f32>;
-@group(0) @binding(10) var voxel_sampler: sampler;
-@group(0) @binding(11) var gb_albedo: texture_2d<f32>;
-@group(0) @binding(12) var gb_normal: texture_2d<f32>;
-@group(0) @binding(13) var gb_emission: texture_2d<f32>;
-@group(0) @binding(14) var gb_depth: texture_depth_2d;
+@group(0) @binding(4) var chains: texture_3d<f32>;
+@group(0) @binding(5) var voxel_sampler: sampler;
+@group(0) @binding(6) var gb_albedo: texture_2d<f32>;
+@group(0) @binding(7) var gb_normal: texture_2d<f32>;
+@group(0) @binding(8) var gb_emission: texture_2d<f32>;
+@group(0) @binding(9) var gb_depth: texture_depth_2d;
 // rgb: indirect radiance towards the camera, a: ambient occlusion.
-@group(0) @binding(15) var indirect_out: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(10) var indirect_out: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(11) var<storage, read> lights: array<Light>;
+// Visibility of the first CONE_SHADOW_LIGHTS area lights, one per channel.
+@group(0) @binding(12) var visibility_out: texture_storage_2d<rgba8unorm, write>;
+
+// Visibility of an area light by one cone from p to its centre, as wide as the light looks
+// from p: 1 - the opacity the cone gathers before reaching the light.
+fn cone_visibility(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let to = light.position - p;
+    let dist = length(to);
+    let dir = to / dist;
+    let tan_half = clamp(light.size / dist, 0.01, 1.0);
+    let origin = p + n * vol.voxel_size * cones.origin_offset;
+    // Stop before the samples' filters reach the emitter's plane: the light hangs on (or in)
+    // other geometry, which must not count as its occluder. A sample of diameter d filters
+    // trilinearly over the next coarser level too, so its support reaches 2d: stop where the
+    // plane is 2d away, (dist - t) cos = 4 tan t.
+    let cos_plane = max(abs(dot(dir, light.direction)), 0.1);
+    let stop = dist * cos_plane / (cos_plane + 4.0 * tan_half) - vol.voxel_size;
+    return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0)).a;
+}
+
+fn area_visibility(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+    var vis = vec4<f32>(1.0);
+    var area = 0u;
+    for (var i = 0u; i < frame.light_count && area < CONE_SHADOW_LIGHTS; i++) {
+        let light = lights[i];
+        if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+            vis[area] = cone_visibility(light, p, n);
+            area += 1u;
+        }
+    }
+    return vis;
+}
 
 fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
     let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
@@ -33,13 +63,9 @@ fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
     return w.xyz / w.w;
 }
 
-// Interleaved sampling (Keller and Heidrich): each pixel of a 4x4 block rotates the cone bundle
-// by a different sixteenth of the ring's period, in Bayer order, and the upsample pass averages
-// every 4x4 window, so each pixel gets the light of sixteen rotations of the bundle.
-fn bayer4(p: vec2<u32>) -> f32 {
-    let m = array<u32, 16>(0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
-    return f32(m[(p.y & 3u) * 4u + (p.x & 3u)]);
-}
+// Interleaved sampling: each pixel of a 4x4 block rotates the cone bundle by a different
+// sixteenth of the ring's period, in Bayer order, and the upsample pass averages every 4x4
+// window, so each pixel gets the light of sixteen rotations of the bundle.
 
 // Karis's analytic fit of the split-sum environment BRDF.
 fn env_brdf(f0: vec3<f32>, roughness: f32, n_dot_v: f32) -> vec3<f32> {
@@ -64,6 +90,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let depth = textureLoad(gb_depth, px, 0);
     if depth >= 1.0 {
         textureStore(indirect_out, gid.xy, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        textureStore(visibility_out, gid.xy, vec4<f32>(1.0));
         return;
     }
     let am = textureLoad(gb_albedo, px, 0);
@@ -75,10 +102,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = normalize(frame.camera_pos - p);
     // The ring of tilted cones repeats every 2 pi / (count - 1).
     let period = 2.0 * PI / f32(max(cones.count, 2u) - 1u);
-    let angle = (bayer4(gid.xy) + 0.5) / 16.0 * period;
+    let angle = (f32(bayer4(gid.xy)) + 0.5) / 16.0 * period;
     // Even and odd Bayer ranks trace the two halves of the ring: each half then meets eight
     // rotations spread over the whole period.
-    let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO, u32(bayer4(gid.xy)) & 1u);
+    let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO, cone_half(gid.xy));
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);
     if cones.indirect != 0u && max(f0.r, max(f0.g, f0.b)) > 0.0 {
@@ -90,4 +117,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         indirect += spec * env_brdf(f0, s.roughness, max(dot(n, v), 1e-4));
     }
     textureStore(indirect_out, gid.xy, vec4<f32>(indirect, g.ao));
+    var vis = vec4<f32>(1.0);
+    if frame.cone_shadows != 0u {
+        vis = area_visibility(p, n);
+    }
+    textureStore(visibility_out, gid.xy, vis);
 }

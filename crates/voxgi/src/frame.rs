@@ -18,7 +18,7 @@ use crate::passes::bounce::BouncePass;
 use crate::passes::composite::{CompositePass, HDR_FORMAT};
 use crate::passes::debug::DebugPass;
 use crate::passes::filter::FilterPass;
-use crate::passes::gather::{GatherPass, INDIRECT_FORMAT};
+use crate::passes::gather::{GatherPass, INDIRECT_FORMAT, VISIBILITY_FORMAT};
 use crate::passes::gbuffer::{self, GbufferPass};
 use crate::passes::inject::InjectPass;
 use crate::passes::shadow::{self, ShadowAtlas, ShadowPass};
@@ -50,6 +50,10 @@ pub struct FrameTargets {
     pub indirect: wgpu::TextureView,
     /// The gather's target, at full or half resolution; `upsample` filters it into `indirect`.
     pub indirect_low: wgpu::TextureView,
+    /// Cone-traced visibility of the first four area lights (one channel each), at full
+    /// resolution and as the gather traced it.
+    pub visibility: wgpu::TextureView,
+    pub visibility_low: wgpu::TextureView,
     half: bool,
     hdr_texture: wgpu::Texture,
     ldr_texture: wgpu::Texture,
@@ -78,6 +82,27 @@ impl FrameTargets {
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let view = |t: wgpu::Texture| t.create_view(&Default::default());
+        let (lw, lh) = if half {
+            (width.div_ceil(2), height.div_ceil(2))
+        } else {
+            (width, height)
+        };
+        let low = |label: &str, format: wgpu::TextureFormat| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: lw,
+                    height: lh,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: st,
+                view_formats: &[],
+            })
+        };
         let hdr_texture = make("hdr", HDR_FORMAT, st);
         let ldr_texture = make("ldr", LDR_FORMAT, st);
         FrameTargets {
@@ -94,28 +119,9 @@ impl FrameTargets {
             emission: view(make("gbuffer emission", gbuffer::EMISSION_FORMAT, rt)),
             depth: view(make("gbuffer depth", gbuffer::DEPTH_FORMAT, rt)),
             indirect: view(make("indirect", INDIRECT_FORMAT, st)),
-            indirect_low: {
-                let (lw, lh) = if half {
-                    (width.div_ceil(2), height.div_ceil(2))
-                } else {
-                    (width, height)
-                };
-                let low = device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("indirect gather"),
-                    size: wgpu::Extent3d {
-                        width: lw,
-                        height: lh,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: INDIRECT_FORMAT,
-                    usage: st,
-                    view_formats: &[],
-                });
-                low.create_view(&Default::default())
-            },
+            indirect_low: view(low("indirect gather", INDIRECT_FORMAT)),
+            visibility: view(make("visibility", VISIBILITY_FORMAT, st)),
+            visibility_low: view(low("visibility gather", VISIBILITY_FORMAT)),
             half,
             hdr: hdr_texture.create_view(&Default::default()),
             ldr: ldr_texture.create_view(&Default::default()),
@@ -125,7 +131,7 @@ impl FrameTargets {
     }
 
     /// Bytes per pixel of all full-resolution targets together.
-    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8;
+    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8 + 4 + 4;
 
     /// Where the gather writes: the half-resolution target or the full one.
     pub fn gather_target(&self) -> &wgpu::TextureView {
@@ -565,6 +571,7 @@ impl Renderer {
             &self.device,
             &mut encoder,
             t,
+            &self.scene,
             &self.volume,
             &self.cones,
             timer,
@@ -576,8 +583,6 @@ impl Renderer {
             t,
             &self.scene,
             &self.atlas,
-            &self.volume,
-            &self.cones,
             timer,
         );
         // Only for the voxel views: replaces the composite's output.

@@ -13,6 +13,11 @@ fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32) -> f3
     return clamp(h / SELF_CLEARANCE, vol.voxel_size, d);
 }
 
+fn outside_volume(p: vec3<f32>) -> bool {
+    let u = (p - vol.origin) / (vol.voxel_size * f32(vol.resolution));
+    return any(u < vec3<f32>(0.0)) || any(u > vec3<f32>(1.0));
+}
+
 // Front-to-back accumulation of one cone. Returns premultiplied radiance (rgb) and opacity (a).
 // Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
 // length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d).
@@ -21,22 +26,21 @@ fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, ma
     var t = vol.voxel_size;
     let min_d = vol.voxel_size;
     for (var i = 0u; i < 512u; i++) {
-        if t >= max_dist || acc.a >= 0.995 {
+        let p = origin + dir * t;
+        // The volume is convex: a cone that has left it meets nothing more.
+        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) {
             break;
         }
         let d = max(min_d, 2.0 * tan_half * t);
-        let p = origin + dir * t;
         let ds = cone_sample_size(origin, n, p, d);
         let s = sample_voxels(p, ds, dir);
         // A narrowed sample covers less: step no further than its filter reaches, so thin
         // walls are not stepped over.
         let step = max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
-        let a = clamp(s.a, 0.0, 1.0);
-        var corrected = vec4<f32>(0.0);
-        if a > 1e-5 {
-            let ca = 1.0 - pow(1.0 - min(a, 0.9999), step / ds);
-            corrected = vec4<f32>(s.rgb * (ca / a), ca);
-        }
+        let a = clamp(s.a, 0.0, 0.9999);
+        let ca = 1.0 - pow(1.0 - a, step / ds);
+        // Radiance is premultiplied: it scales with the corrected opacity.
+        let corrected = vec4<f32>(s.rgb * (ca / max(a, 1e-6)), ca);
         acc += (1.0 - acc.a) * corrected;
         t += step;
     }
@@ -48,11 +52,11 @@ fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f
     var occ = 0.0;
     var t = vol.voxel_size;
     for (var i = 0u; i < 256u; i++) {
-        if t >= cones.ao_radius || occ >= 0.995 {
+        let p = origin + dir * t;
+        if t >= cones.ao_radius || occ >= 0.995 || outside_volume(p) {
             break;
         }
         let d = max(vol.voxel_size, 2.0 * tan_half * t);
-        let p = origin + dir * t;
         let ds = cone_sample_size(origin, n, p, d);
         let s = sample_voxels(p, ds, dir);
         let step = max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);

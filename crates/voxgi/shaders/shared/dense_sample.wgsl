@@ -1,54 +1,44 @@
 // sample_voxels for the dense mip-mapped volume: premultiplied radiance and opacity of the
 // volume filtered to `diameter` around `pos`, as seen travelling along `dir`. The including
-// shader declares `vol`, `radiance0` (finest level, isotropic), `aniso_*` (six directional mip
-// chains starting one level above the finest) and `voxel_sampler` (trilinear, clamp to zero).
-
-fn sample_aniso(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
-    // Three fetches, one per axis, weighted by the squared direction cosines (they sum to 1).
-    let w = dir * dir;
-    var x: vec4<f32>;
-    var y: vec4<f32>;
-    var z: vec4<f32>;
-    if dir.x >= 0.0 {
-        x = textureSampleLevel(aniso_px, voxel_sampler, uvw, lod);
-    } else {
-        x = textureSampleLevel(aniso_nx, voxel_sampler, uvw, lod);
-    }
-    if dir.y >= 0.0 {
-        y = textureSampleLevel(aniso_py, voxel_sampler, uvw, lod);
-    } else {
-        y = textureSampleLevel(aniso_ny, voxel_sampler, uvw, lod);
-    }
-    if dir.z >= 0.0 {
-        z = textureSampleLevel(aniso_pz, voxel_sampler, uvw, lod);
-    } else {
-        z = textureSampleLevel(aniso_nz, voxel_sampler, uvw, lod);
-    }
-    return w.x * x + w.y * y + w.z * z;
-}
+// shader declares `vol`, `radiance0` (finest level, isotropic), `chains` (the directional mip
+// chains, one level above the finest, as blocks stacked along z: +X, -X, +Y, -Y, +Z, -Z; in
+// isotropic mode one block) and `voxel_sampler` (trilinear, clamp to edge).
+//
+// No branch: CPU drivers run every side of a branch that differs between SIMD lanes, and
+// even a branch no lane takes costs more on lavapipe than the fetch it would skip.
 
 fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let extent = vol.voxel_size * f32(vol.resolution);
     let uvw = (pos - vol.origin) / extent;
     // Outside the volume there is nothing (no clamp-to-border sampler in core WebGPU).
-    if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
-        return vec4<f32>(0.0);
-    }
+    let inside = all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0));
     let lod = clamp(log2(max(diameter / vol.voxel_size, 1.0)), 0.0, f32(vol.levels - 1u));
-    if lod <= 0.0 {
-        return textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
-    }
-    // Levels above the finest live in the directional (or, in isotropic mode, the +X) chain,
-    // whose level 0 is the volume's level 1.
-    var coarse: vec4<f32>;
-    if vol.anisotropic != 0u {
-        coarse = sample_aniso(uvw, max(lod - 1.0, 0.0), dir);
-    } else {
-        coarse = textureSampleLevel(aniso_px, voxel_sampler, uvw, max(lod - 1.0, 0.0));
-    }
-    if lod < 1.0 {
-        // Only between the finest level and the first coarse one is the finest level read.
-        return mix(textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0), coarse, lod);
-    }
-    return coarse;
+    let fine = textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
+    let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir);
+    // Only between the finest level and the first coarse one is the finest level read.
+    return select(vec4<f32>(0.0), mix(fine, coarse, min(lod, 1.0)), inside);
+}
+
+// The directional chains at chain level `cl` (the volume's level cl + 1).
+fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>) -> vec4<f32> {
+    // Keep z half a texel inside the block at the coarser of the two levels read, so the
+    // trilinear filter never blends a neighbouring direction's block.
+    let upper = min(floor(cl) + 1.0, f32(vol.levels - 2u));
+    let texels = max(f32(vol.resolution / 2u) * exp2(-upper), 1.0);
+    let z = clamp(uvw.z, 0.5 / texels, 1.0 - 0.5 / texels);
+    // In isotropic mode the one block serves every axis (three equal fetches: the mode exists
+    // for comparison, not speed).
+    let aniso = vol.anisotropic != 0u;
+    let block = select(
+        vec3<f32>(0.0),
+        vec3<f32>(select(1.0, 0.0, dir.x >= 0.0), select(3.0, 2.0, dir.y >= 0.0), select(5.0, 4.0, dir.z >= 0.0)),
+        aniso,
+    );
+    let blocks = select(1.0, 6.0, aniso);
+    let x = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + block.x) / blocks), cl);
+    let y = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + block.y) / blocks), cl);
+    let zz = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + block.z) / blocks), cl);
+    // Weighted by the squared direction cosines (they sum to 1).
+    let w = dir * dir;
+    return w.x * x + w.y * y + w.z * zz;
 }

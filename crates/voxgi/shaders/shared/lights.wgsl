@@ -186,62 +186,77 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     return lit / f32(PCF_TAPS);
 }
 
-const MAX_POLY: u32 = 18u;
+// Vertex i of an area light's polygon, relative to p: a rectangle's four corners, or a 16-gon
+// with a disc's area.
+fn polygon_vertex(light: Light, p: vec3<f32>, i: u32) -> vec3<f32> {
+    let c = light.position - p;
+    if light.kind == LIGHT_RECT {
+        let su = select(-1.0, 1.0, i == 1u || i == 2u);
+        let sv = select(-1.0, 1.0, i >= 2u);
+        return c + su * light.axis_u + sv * light.axis_v;
+    }
+    let k = f32(DISC_SIDES);
+    let scale = sqrt(PI / (k * 0.5 * sin(2.0 * PI / k)));
+    let a = f32(i) / k * 2.0 * PI;
+    return c + scale * (cos(a) * light.axis_u + sin(a) * light.axis_v);
+}
+
+const DISC_SIDES: u32 = 16u;
 
 // Irradiance at p (normal n) from a uniform one-sided polygonal emitter of unit radiance: the
 // Lambert formula E = 1/2 sum_i angle_i (n . unit(v_i x v_i+1)) over the polygon clipped to the
-// upper hemisphere. Exact for unoccluded Lambertian receivers.
+// upper hemisphere. Exact for unoccluded Lambertian receivers. The clipping (Sutherland-
+// Hodgman) streams its vertices into the sum: no local arrays, which CPU drivers
+// zero-initialise in memory on every call whether or not a pixel clips.
 fn polygon_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    var src: array<vec3<f32>, MAX_POLY>;
-    var count = 0u;
     if light.kind == LIGHT_RECT {
-        let c = light.position - p;
-        src[0] = c - light.axis_u - light.axis_v;
-        src[1] = c + light.axis_u - light.axis_v;
-        src[2] = c + light.axis_u + light.axis_v;
-        src[3] = c - light.axis_u + light.axis_v;
-        count = 4u;
-    } else {
-        // A 16-gon with the disc's area.
-        let k = 16u;
-        let scale = sqrt(PI / (f32(k) * 0.5 * sin(2.0 * PI / f32(k))));
-        for (var i = 0u; i < k; i++) {
-            let a = f32(i) / f32(k) * 2.0 * PI;
-            src[i] = light.position - p + scale * (cos(a) * light.axis_u + sin(a) * light.axis_v);
+        let v0 = normalize(polygon_vertex(light, p, 0u));
+        let v1 = normalize(polygon_vertex(light, p, 1u));
+        let v2 = normalize(polygon_vertex(light, p, 2u));
+        let v3 = normalize(polygon_vertex(light, p, 3u));
+        if min(min(dot(v0, n), dot(v1, n)), min(dot(v2, n), dot(v3, n))) >= 0.0 {
+            return 0.5 * abs(edge_integral(v0, v1, n) + edge_integral(v1, v2, n) + edge_integral(v2, v3, n) + edge_integral(v3, v0, n));
         }
-        count = k;
     }
-    // Clip against the receiver's tangent plane (Sutherland-Hodgman).
-    var poly: array<vec3<f32>, MAX_POLY>;
+    let count = select(DISC_SIDES, 4u, light.kind == LIGHT_RECT);
+    var sum = 0.0;
+    var first = vec3<f32>(0.0);
+    var prev = vec3<f32>(0.0);
     var m = 0u;
+    var b = polygon_vertex(light, p, 0u);
     for (var i = 0u; i < count; i++) {
-        let a = src[i];
-        let b = src[(i + 1u) % count];
+        let a = b;
+        b = polygon_vertex(light, p, (i + 1u) % count);
         let da = dot(a, n);
         let db = dot(b, n);
-        if da >= 0.0 {
-            poly[m] = a;
-            m++;
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            poly[m] = a + (b - a) * (da / (da - db));
-            m++;
+        // Up to two vertices per edge: its start if above the horizon, and where it crosses.
+        for (var k = 0u; k < 2u; k++) {
+            let emit = select((da >= 0.0) != (db >= 0.0), da >= 0.0, k == 0u);
+            if emit {
+                let q = normalize(select(a + (b - a) * (da / (da - db)), a, k == 0u));
+                if m == 0u {
+                    first = q;
+                } else {
+                    sum += edge_integral(prev, q, n);
+                }
+                prev = q;
+                m++;
+            }
         }
     }
     if m < 3u {
         return 0.0;
     }
-    var sum = 0.0;
-    for (var i = 0u; i < m; i++) {
-        let a = normalize(poly[i]);
-        let b = normalize(poly[(i + 1u) % m]);
-        let c = cross(a, b);
-        let len = length(c);
-        if len > 1e-9 {
-            sum += atan2(len, dot(a, b)) * dot(c / len, n);
-        }
-    }
+    sum += edge_integral(prev, first, n);
     return 0.5 * abs(sum);
+}
+
+// One edge's term of the Lambert formula: the angle the edge (a, b unit vectors) subtends
+// times the cosine of its great circle's normal with n.
+fn edge_integral(a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
+    let c = cross(a, b);
+    let len = length(c);
+    return select(0.0, atan2(len, dot(a, b)) * dot(c, n) / len, len > 1e-9);
 }
 
 // Outgoing radiance towards v from one light.

@@ -90,6 +90,9 @@ const LIGHT_SPOT: u32 = 2u;
 const LIGHT_RECT: u32 = 3u;
 const LIGHT_DISC: u32 = 4u;
 
+// Area lights (the first ones, in light order) whose shadows `cone_shadows` traces as cones.
+const CONE_SHADOW_LIGHTS: u32 = 4u;
+
 struct Light {
     position: vec3<f32>,
     kind: u32,

@@ -19,6 +19,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/dense_sample.wgsl",
     "shared/cone.wgsl",
     "shared/surfel.wgsl",
+    "shared/interleave.wgsl",
     "shadow.wgsl",
     "gbuffer.wgsl",
     "voxelize.wgsl",

@@ -20,12 +20,12 @@ impl BouncePass {
         let mut entries = vec![layout::uniform(0, c, false), layout::uniform(1, c, false)];
         entries.extend(DenseVolume::sampling_layout(2, c));
         entries.extend([
-            layout::texture_3d_load(10, c),
-            layout::texture_3d_load(11, c),
-            layout::storage(12, c, true),
-            layout::storage(13, c, true),
-            layout::storage(14, c, true),
-            layout::storage(15, c, false),
+            layout::texture_3d_load(5, c),
+            layout::texture_3d_load(6, c),
+            layout::storage(7, c, true),
+            layout::storage(8, c, true),
+            layout::storage(9, c, true),
+            layout::storage(10, c, false),
         ]);
         let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bounce"),

@@ -5,7 +5,6 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::passes::shadow::ShadowAtlas;
-use crate::voxel::dense::DenseVolume;
 
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
@@ -20,33 +19,28 @@ impl CompositePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
             entries: &[
-                vec![
-                    layout::uniform(0, c, false),
-                    layout::storage(1, c, true),
-                    layout::storage(2, c, true),
-                    layout::texture(
-                        3,
-                        c,
-                        wgpu::TextureSampleType::Float { filterable: false },
-                        wgpu::TextureViewDimension::D2Array,
-                    ),
-                    layout::texture_2d_load(4, c),
-                    layout::texture_2d_load(5, c),
-                    layout::texture_2d_load(6, c),
-                    layout::texture(
-                        7,
-                        c,
-                        wgpu::TextureSampleType::Depth,
-                        wgpu::TextureViewDimension::D2,
-                    ),
-                    layout::storage_texture(8, HDR_FORMAT),
-                    layout::texture_2d_load(9, c),
-                    layout::uniform(10, c, false),
-                    layout::uniform(11, c, false),
-                ],
-                DenseVolume::sampling_layout(12, c),
-            ]
-            .concat(),
+                layout::uniform(0, c, false),
+                layout::storage(1, c, true),
+                layout::storage(2, c, true),
+                layout::texture(
+                    3,
+                    c,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                layout::texture_2d_load(4, c),
+                layout::texture_2d_load(5, c),
+                layout::texture_2d_load(6, c),
+                layout::texture(
+                    7,
+                    c,
+                    wgpu::TextureSampleType::Depth,
+                    wgpu::TextureViewDimension::D2,
+                ),
+                layout::storage_texture(8, HDR_FORMAT),
+                layout::texture_2d_load(9, c),
+                layout::texture_2d_load(10, c),
+            ],
         });
         let pipeline = compute_pipeline(device, "composite", "composite.wgsl", &layout);
         CompositePass { pipeline, layout }
@@ -61,12 +55,9 @@ impl CompositePass {
         t: &FrameTargets,
         scene: &GpuScene,
         atlas: &ShadowAtlas,
-        vol: &DenseVolume,
-        cones: &wgpu::Buffer,
         timer: &mut GpuTimer,
     ) {
-        let views = vol.sampling_views();
-        let mut resources = vec![
+        let resources = vec![
             t.frame.as_entire_binding(),
             scene.lights.as_entire_binding(),
             atlas.views_buffer.as_entire_binding(),
@@ -77,11 +68,8 @@ impl CompositePass {
             wgpu::BindingResource::TextureView(&t.depth),
             wgpu::BindingResource::TextureView(&t.hdr),
             wgpu::BindingResource::TextureView(&t.indirect),
-            vol.volume.as_entire_binding(),
-            cones.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&t.visibility),
         ];
-        resources.extend(views.iter().map(wgpu::BindingResource::TextureView));
-        resources.push(wgpu::BindingResource::Sampler(&vol.sampler));
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),
             layout: &self.layout,

@@ -56,16 +56,14 @@ impl DebugPass {
             _ => 2,
         };
         let level = level.min(vol.grid.levels() - 1);
+        // In isotropic mode the one block serves every direction.
+        let block = direction.min(vol.chain_blocks - 1);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("debug params"),
-            contents: bytemuck::cast_slice(&[mode, level, 0u32, 0u32]),
+            contents: bytemuck::cast_slice(&[mode, level, block, 0u32]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let chain = vol
-            .aniso
-            .get(direction as usize)
-            .unwrap_or(&vol.aniso[0])
-            .create_view(&Default::default());
+        let chain = vol.chains.create_view(&Default::default());
         let albedo = vol.albedo.create_view(&Default::default());
         let radiance = vol.radiance.create_view(&Default::default());
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -13,10 +13,11 @@ pub struct FilterPass {
     layout: wgpu::BindGroupLayout,
 }
 
-/// One dispatch: read `src` (texture, mip), write `dst` (texture index in `aniso`, mip).
+/// One dispatch: read mip `src` of the chains (None: the finest level), write mip `dst` of
+/// every block of the chains.
 struct Step {
-    src: Option<(usize, u32)>,
-    dst: (usize, u32),
+    src: Option<u32>,
+    dst: u32,
     params: [u32; 4],
 }
 
@@ -40,25 +41,19 @@ impl FilterPass {
     fn steps(vol: &DenseVolume) -> Vec<Step> {
         let res = vol.grid.resolution;
         let levels = vol.grid.levels();
-        let mut steps = Vec::new();
-        let dirs = if vol.anisotropic { 6 } else { 1 };
-        for d in 0..dirs {
-            for level in 1..levels {
-                // Level 1 reads the finest (isotropic) level; later ones their own chain.
-                let src = if level == 1 {
-                    None
-                } else {
-                    Some((d, level - 2))
-                };
-                let mode = if vol.anisotropic { 1 } else { 0 };
-                steps.push(Step {
+        let mode = if vol.anisotropic { 1 } else { 0 };
+        (1..levels)
+            .map(|level| {
+                // Level 1 reads the finest (isotropic) level, one block; later ones their own
+                // blocks.
+                let src = (level > 1).then(|| level - 2);
+                Step {
                     src,
-                    dst: (d, level - 1),
-                    params: [mode, d as u32, res >> level, 0],
-                });
-            }
-        }
-        steps
+                    dst: level - 1,
+                    params: [mode, res >> level, src.is_some() as u32, 0],
+                }
+            })
+            .collect()
     }
 
     pub fn record(
@@ -84,9 +79,9 @@ impl FilterPass {
             .map(|s| {
                 let src = match s.src {
                     None => mip_view(&vol.radiance, 0),
-                    Some((t, m)) => mip_view(&vol.aniso[t], m),
+                    Some(m) => mip_view(&vol.chains, m),
                 };
-                let dst = mip_view(&vol.aniso[s.dst.0], s.dst.1);
+                let dst = mip_view(&vol.chains, s.dst);
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("filter"),
                     layout: &self.layout,
@@ -109,8 +104,9 @@ impl FilterPass {
         pass.set_pipeline(&self.pipeline);
         for (i, (s, b)) in steps.iter().zip(&binds).enumerate() {
             pass.set_bind_group(0, b, &[(i as u64 * STRIDE) as u32]);
-            let n = s.params[2].div_ceil(4);
-            pass.dispatch_workgroups(n, n, n);
+            let n = s.params[1].div_ceil(4);
+            let depth = (s.params[1] * vol.chain_blocks).div_ceil(4);
+            pass.dispatch_workgroups(n, n, depth);
         }
     }
 }

@@ -1,13 +1,16 @@
-//! gather: per-pixel indirect light from the voxels (diffuse cones with AO, glossy cone), at
-//! full or half resolution.
+//! gather: per-pixel indirect light from the voxels (diffuse cones with AO, glossy cone) and,
+//! with `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
+use crate::gpu_scene::GpuScene;
 use crate::passes::composite::compute_pipeline;
 use crate::voxel::dense::DenseVolume;
 
 pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Cone-traced visibility of up to four area lights.
+pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
@@ -24,16 +27,18 @@ impl GatherPass {
         ];
         entries.extend(DenseVolume::sampling_layout(3, c));
         entries.extend([
-            layout::texture_2d_load(11, c),
-            layout::texture_2d_load(12, c),
-            layout::texture_2d_load(13, c),
+            layout::texture_2d_load(6, c),
+            layout::texture_2d_load(7, c),
+            layout::texture_2d_load(8, c),
             layout::texture(
-                14,
+                9,
                 c,
                 wgpu::TextureSampleType::Depth,
                 wgpu::TextureViewDimension::D2,
             ),
-            layout::storage_texture(15, INDIRECT_FORMAT),
+            layout::storage_texture(10, INDIRECT_FORMAT),
+            layout::storage(11, c, true),
+            layout::storage_texture(12, VISIBILITY_FORMAT),
         ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather"),
@@ -45,11 +50,14 @@ impl GatherPass {
         }
     }
 
+    // The pass reads what the frame and the volume hold; a struct for it would only rename.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
+        scene: &GpuScene,
         vol: &DenseVolume,
         cones: &wgpu::Buffer,
         timer: &mut GpuTimer,
@@ -68,6 +76,8 @@ impl GatherPass {
             wgpu::BindingResource::TextureView(&t.emission),
             wgpu::BindingResource::TextureView(&t.depth),
             wgpu::BindingResource::TextureView(t.gather_target()),
+            scene.lights.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&t.visibility_low),
         ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather"),

@@ -1,11 +1,11 @@
 //! upsample: the gather's interleaved samples (full or half resolution) to full-resolution
-//! indirect light, edge-aware.
+//! indirect light and area-light visibility, edge-aware.
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::passes::composite::compute_pipeline;
-use crate::passes::gather::INDIRECT_FORMAT;
+use crate::passes::gather::{INDIRECT_FORMAT, VISIBILITY_FORMAT};
 
 pub struct UpsamplePass {
     pipeline: wgpu::ComputePipeline,
@@ -28,6 +28,8 @@ impl UpsamplePass {
                     wgpu::TextureViewDimension::D2,
                 ),
                 layout::storage_texture(4, INDIRECT_FORMAT),
+                layout::texture_2d_load(5, c),
+                layout::storage_texture(6, VISIBILITY_FORMAT),
             ],
         });
         UpsamplePass {
@@ -53,6 +55,8 @@ impl UpsamplePass {
                 wgpu::BindingResource::TextureView(&t.normal),
                 wgpu::BindingResource::TextureView(&t.depth),
                 wgpu::BindingResource::TextureView(&t.indirect),
+                wgpu::BindingResource::TextureView(&t.visibility_low),
+                wgpu::BindingResource::TextureView(&t.visibility),
             ]),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -30,12 +30,12 @@ fn every_shader_validates() {
 
 #[test]
 fn wgsl_struct_sizes() {
-    // composite.wgsl includes every shared file that defines structs.
-    let module = parse("composite.wgsl");
+    // Between them these include every shared file that defines structs.
+    let modules = [parse("composite.wgsl"), parse("gather.wgsl")];
     let size_of_wgsl = |name: &str| -> u32 {
-        module
-            .types
+        modules
             .iter()
+            .flat_map(|m| m.types.iter())
             .find_map(|(_, t)| match (&t.name, &t.inner) {
                 (Some(n), naga::TypeInner::Struct { span, .. }) if n == name => Some(*span),
                 _ => None,

@@ -269,12 +269,18 @@ fn check_filtering(anisotropic: bool) {
     } else {
         vec![None]
     };
-    assert_eq!(vol.aniso.len(), dirs.len());
+    assert_eq!(vol.chain_blocks as usize, dirs.len());
+    let chains: Vec<Vec<Vec4>> = (0..levels - 1)
+        .map(|mip| read_level(&r, &vol.chains, mip).0)
+        .collect();
     let mut partial = 0;
-    for (chain, dir) in vol.aniso.iter().zip(dirs) {
+    for (block, dir) in dirs.into_iter().enumerate() {
         let mut child = finest.clone();
-        for mip in 0..levels - 1 {
-            let (parent, n) = read_level(&r, chain, mip);
+        for (mip, level) in chains.iter().enumerate() {
+            // Blocks are stacked along z, so each is a contiguous run of n^3 texels.
+            let n = (res >> (mip + 1)).max(1);
+            let cube = (n * n * n) as usize;
+            let parent = level[block * cube..(block + 1) * cube].to_vec();
             let what = format!("chain {dir:?}, level {}", mip + 1);
             partial += check_filter_step(&child, &parent, n, dir, &what).1;
             child = parent;
