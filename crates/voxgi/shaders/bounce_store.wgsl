@@ -14,5 +14,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if s >= min(counters[1], arrayLength(&slot_voxel)) {
         return;
     }
-    textureStore(radiance_out, voxel_coord(slot_voxel[s], vol.resolution), slot_next[s]);
+    textureStore(radiance_out, voxel_coord(slot_voxel[s], vol.resolution), to_depth(slot_next[s]));
 }

@@ -38,10 +38,10 @@ const MODE_RADIANCE: u32 = 2u;
 
 fn cell_value(c: vec3<i32>) -> vec4<f32> {
     if params.level == 0u {
-        return textureLoad(radiance0, c, 0);
+        return from_depth(textureLoad(radiance0, c, 0));
     }
     let n = i32(vol.resolution) >> params.level;
-    return textureLoad(chain, c + vec3<i32>(0, 0, n * i32(params.block)), i32(params.level) - 1);
+    return from_depth(textureLoad(chain, c + vec3<i32>(0, 0, n * i32(params.block)), i32(params.level) - 1));
 }
 
 // Ray / box [lo, hi] entry and exit distances (t_enter > t_exit: miss).

@@ -5,6 +5,8 @@
 // transparent. One dispatch writes one level of every direction's block (+X, -X, +Y, -Y, +Z,
 // -Z stacked along z: the direction the cone travels).
 
+//!include shared/volume.wgsl
+
 struct FilterParams {
     // 0: isotropic mean, 1: directional.
     mode: u32,
@@ -21,7 +23,7 @@ struct FilterParams {
 @group(0) @binding(2) var dst: texture_storage_3d<rgba16float, write>;
 
 fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
-    return textureLoad(src, base + o, 0);
+    return from_depth(textureLoad(src, base + o, 0));
 }
 
 @compute @workgroup_size(4, 4, 4)
@@ -39,7 +41,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var i = 0; i < 8; i++) {
             sum += child(base, vec3<i32>(i & 1, (i >> 1) & 1, (i >> 2) & 1));
         }
-        textureStore(dst, id, sum * 0.125);
+        textureStore(dst, id, to_depth(sum * 0.125));
         return;
     }
     let axis = i32(block / 2u);
@@ -58,5 +60,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let b = child(base, back);
         sum += f + (1.0 - f.a) * b;
     }
-    textureStore(dst, id, sum * 0.25);
+    textureStore(dst, id, to_depth(sum * 0.25));
 }

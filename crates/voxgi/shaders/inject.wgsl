@@ -60,5 +60,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let c = voxel_coord(slot_voxel[s], vol.resolution);
     let r = voxel_direct(c);
     slot_direct[s] = r;
-    textureStore(radiance_out, c, r);
+    textureStore(radiance_out, c, to_depth(r));
 }

@@ -1,16 +1,18 @@
 // Cone tracing, written once against sample_voxels(position, diameter, direction).
 
-// The filter size of a cone sample at distance t from a surface (normal n). A filtered voxel of
-// size d spreads its content about d around it, so a sample whose filter reached the cone's own
-// surface would see that surface: the sample's filter is narrowed until it stays
-// SELF_CLEARANCE sizes above the surface's tangent plane. A surface can neither occlude nor
-// light itself, so this removes self-intersection only; occluders in front are still seen
-// (at a finer level than the cone's width would pick).
-const SELF_CLEARANCE: f32 = 2.0;
+// The filter size of a cone sample at distance t from a surface (normal n). A surface can
+// neither occlude nor light itself, so a sample must not read the voxels of its cone's own
+// surface: those reach up to a voxel above the surface's plane (conservative voxelization
+// marks both sides of a plane on a voxel boundary). A sample of diameter ds reads texels up to
+// 2 ds wide (trilinear between two levels), and such a texel touches everything within 1.5 of
+// its widths below the sample: so ds <= (h - 1 voxel) / 3 at height h above the plane. Only
+// the cone's own surface is cleared this way; occluders in front are still seen (at a finer
+// level than the cone's width would pick).
+const SELF_CLEARANCE: f32 = 3.0;
 
 fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32) -> f32 {
     let h = dot(p - origin, n) + vol.voxel_size * cones.origin_offset;
-    return clamp(h / SELF_CLEARANCE, vol.voxel_size, d);
+    return clamp((h - vol.voxel_size) / SELF_CLEARANCE, vol.voxel_size, d);
 }
 
 fn outside_volume(p: vec3<f32>) -> bool {

@@ -16,7 +16,7 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let fine = textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
     let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir);
     // Only between the finest level and the first coarse one is the finest level read.
-    return select(vec4<f32>(0.0), mix(fine, coarse, min(lod, 1.0)), inside);
+    return select(vec4<f32>(0.0), from_depth(mix(fine, coarse, min(lod, 1.0))), inside);
 }
 
 // The directional chains at chain level `cl` (the volume's level cl + 1).

@@ -59,7 +59,25 @@ pub fn voxelize(triangles: &[[Vec3; 3]], grid: &Grid) -> BTreeSet<[u32; 3]> {
     out
 }
 
-/// One filtering step for one parent voxel, as `filter.wgsl` does it. `children[i]` is the
+/// Largest opacity a radiance texel stores (`MAX_OPACITY` in shaders/shared/volume.wgsl).
+pub const MAX_OPACITY: f32 = 0.999;
+
+/// Premultiplied (L alpha, alpha) to the stored (L sigma, sigma), as `to_depth` in volume.wgsl.
+pub fn to_depth(v: Vec4) -> Vec4 {
+    let a = v.w.clamp(0.0, MAX_OPACITY);
+    let sigma = -(1.0 - a).ln();
+    (v.truncate() * (sigma / a.max(1e-6))).extend(sigma)
+}
+
+/// Stored (L sigma, sigma) to premultiplied (L alpha, alpha), as `from_depth` in volume.wgsl.
+pub fn from_depth(v: Vec4) -> Vec4 {
+    let sigma = v.w.max(0.0);
+    let a = 1.0 - (-sigma).exp();
+    (v.truncate() * (a / sigma.max(1e-6))).extend(a)
+}
+
+/// One filtering step for one parent voxel, as `filter.wgsl` does it, on premultiplied
+/// values (the textures store optical depth: convert with `from_depth` and `to_depth`). `children[i]` is the
 /// child at offset (i & 1, (i >> 1) & 1, i >> 2); `dir` is None for the isotropic mean or
 /// Some(0..6) for +X, -X, +Y, -Y, +Z, -Z.
 pub fn filter_parent(children: &[Vec4; 8], dir: Option<u32>) -> Vec4 {
