@@ -56,7 +56,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var area = 0u;
     for (var i = 0u; i < frame.light_count; i++) {
         let light = lights[i];
-        let is_area = light.kind == LIGHT_RECT || light.kind == LIGHT_DISC;
+        let is_area = is_area_light(light);
         // With a cone's visibility the shadow map's is replaced: shade unshadowed, scale by the
         // cone's. One call site: CPU drivers pay for every inlined copy of shade_light.
         let cone = frame.cone_shadows != 0u && is_area && area < CONE_SHADOW_LIGHTS;

@@ -48,7 +48,7 @@ fn area_visibility(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
     var area = 0u;
     for (var i = 0u; i < frame.light_count && area < CONE_SHADOW_LIGHTS; i++) {
         let light = lights[i];
-        if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+        if is_area_light(light) {
             vis[area] = cone_visibility(light, p, n);
             area += 1u;
         }

@@ -433,7 +433,7 @@ fn direct_light(x: SurfaceHit, v: vec3<f32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < params.light_count; i++) {
         let light = lights[i];
-        if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+        if is_area_light(light) {
             // One-sided: nothing behind the emitter's plane is lit.
             if dot(x.p - light.position, light.direction) <= 0.0 {
                 continue;

@@ -61,7 +61,11 @@ pub struct FrameTargets {
 
 impl FrameTargets {
     fn new(device: &wgpu::Device, width: u32, height: u32, half: bool) -> Self {
-        let make = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+        let (lw, lh) = gather_size(width, height, half);
+        let sized = |label: &str,
+                     format: wgpu::TextureFormat,
+                     usage: wgpu::TextureUsages,
+                     (width, height): (u32, u32)| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d {
@@ -82,27 +86,8 @@ impl FrameTargets {
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         let view = |t: wgpu::Texture| t.create_view(&Default::default());
-        let (lw, lh) = if half {
-            (width.div_ceil(2), height.div_ceil(2))
-        } else {
-            (width, height)
-        };
-        let low = |label: &str, format: wgpu::TextureFormat| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: lw,
-                    height: lh,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: st,
-                view_formats: &[],
-            })
-        };
+        let make = |label: &str, format, usage| sized(label, format, usage, (width, height));
+        let low = |label: &str, format| sized(label, format, st, (lw, lh));
         let hdr_texture = make("hdr", HDR_FORMAT, st);
         let ldr_texture = make("ldr", LDR_FORMAT, st);
         FrameTargets {
@@ -139,11 +124,16 @@ impl FrameTargets {
     }
 
     pub fn gather_size(&self) -> (u32, u32) {
-        if self.half {
-            (self.width.div_ceil(2), self.height.div_ceil(2))
-        } else {
-            (self.width, self.height)
-        }
+        gather_size(self.width, self.height, self.half)
+    }
+}
+
+/// The gather's resolution: full, or half rounded up.
+fn gather_size(width: u32, height: u32, half: bool) -> (u32, u32) {
+    if half {
+        (width.div_ceil(2), height.div_ceil(2))
+    } else {
+        (width, height)
     }
 }
 

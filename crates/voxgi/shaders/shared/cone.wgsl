@@ -20,6 +20,17 @@ fn outside_volume(p: vec3<f32>) -> bool {
     return any(u < vec3<f32>(0.0)) || any(u > vec3<f32>(1.0));
 }
 
+// A narrowed sample covers less: step no further than its filter reaches, so thin walls are
+// not stepped over.
+fn cone_step(d: f32, ds: f32) -> f32 {
+    return max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
+}
+
+// Opacity a of a sample of size ds, corrected for a step of length `step`.
+fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
+    return 1.0 - pow(1.0 - a, step / ds);
+}
+
 // Front-to-back accumulation of one cone. Returns premultiplied radiance (rgb) and opacity (a).
 // Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
 // length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d).
@@ -36,11 +47,9 @@ fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, ma
         let d = max(min_d, 2.0 * tan_half * t);
         let ds = cone_sample_size(origin, n, p, d);
         let s = sample_voxels(p, ds, dir);
-        // A narrowed sample covers less: step no further than its filter reaches, so thin
-        // walls are not stepped over.
-        let step = max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
+        let step = cone_step(d, ds);
         let a = clamp(s.a, 0.0, 0.9999);
-        let ca = 1.0 - pow(1.0 - a, step / ds);
+        let ca = step_opacity(a, step, ds);
         // Radiance is premultiplied: it scales with the corrected opacity.
         let corrected = vec4<f32>(s.rgb * (ca / max(a, 1e-6)), ca);
         acc += (1.0 - acc.a) * corrected;
@@ -61,9 +70,8 @@ fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f
         let d = max(vol.voxel_size, 2.0 * tan_half * t);
         let ds = cone_sample_size(origin, n, p, d);
         let s = sample_voxels(p, ds, dir);
-        let step = max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
-        let a = clamp(s.a, 0.0, 0.9999);
-        let ca = 1.0 - pow(1.0 - a, step / ds);
+        let step = cone_step(d, ds);
+        let ca = step_opacity(clamp(s.a, 0.0, 0.9999), step, ds);
         occ += (1.0 - occ) * ca / (1.0 + cones.ao_lambda * t);
         t += step;
     }

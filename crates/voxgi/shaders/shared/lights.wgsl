@@ -149,7 +149,7 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     let texel_uv = 1.0 / view.resolution;
     let rp = receiver_plane(view, uv, p, n);
 
-    if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+    if is_area_light(light) {
         // Percentage-closer soft shadows: the penumbra width follows the light's size and the
         // blocker/receiver distances, as similar triangles give it.
         let tan_to_uv = 1.0 / (view.texel * view.resolution);
@@ -261,7 +261,7 @@ fn edge_integral(a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
 
 // Outgoing radiance towards v from one light.
 fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, softness: f32) -> vec3<f32> {
-    if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+    if is_area_light(light) {
         // One-sided emitter: nothing behind its plane is lit.
         if dot(p - light.position, light.direction) <= 0.0 {
             return vec3<f32>(0.0);
@@ -314,7 +314,7 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
 // Irradiance (W/m^2) arriving at p with normal n from one light, shadows included. Used where
 // only Lambertian reflection matters (light injection into voxels).
 fn light_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> vec3<f32> {
-    if light.kind == LIGHT_RECT || light.kind == LIGHT_DISC {
+    if is_area_light(light) {
         if dot(p - light.position, light.direction) <= 0.0 {
             return vec3<f32>(0.0);
         }

@@ -90,6 +90,10 @@ const LIGHT_SPOT: u32 = 2u;
 const LIGHT_RECT: u32 = 3u;
 const LIGHT_DISC: u32 = 4u;
 
+fn is_area_light(light: Light) -> bool {
+    return light.kind == LIGHT_RECT || light.kind == LIGHT_DISC;
+}
+
 // Area lights (the first ones, in light order) whose shadows `cone_shadows` traces as cones.
 const CONE_SHADOW_LIGHTS: u32 = 4u;
 

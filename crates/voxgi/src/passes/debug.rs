@@ -57,7 +57,7 @@ impl DebugPass {
         };
         let level = level.min(vol.grid.levels() - 1);
         // In isotropic mode the one block serves every direction.
-        let block = direction.min(vol.chain_blocks - 1);
+        let block = direction.min(vol.chain_blocks() - 1);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("debug params"),
             contents: bytemuck::cast_slice(&[mode, level, block, 0u32]),

@@ -105,7 +105,7 @@ impl FilterPass {
         for (i, (s, b)) in steps.iter().zip(&binds).enumerate() {
             pass.set_bind_group(0, b, &[(i as u64 * STRIDE) as u32]);
             let n = s.params[1].div_ceil(4);
-            let depth = (s.params[1] * vol.chain_blocks).div_ceil(4);
+            let depth = (s.params[1] * vol.chain_blocks()).div_ceil(4);
             pass.dispatch_workgroups(n, n, depth);
         }
     }

@@ -51,11 +51,10 @@ pub struct DenseVolume {
     pub normal: wgpu::Texture,
     pub emission: wgpu::Texture,
     pub radiance: wgpu::Texture,
-    /// The directional chains (+X, -X, +Y, -Y, +Z, -Z) as `chain_blocks` blocks stacked along z,
+    /// The directional chains (+X, -X, +Y, -Y, +Z, -Z) as `chain_blocks()` blocks stacked along z,
     /// each block one level coarser than the finest. In isotropic mode one block, the isotropic
     /// chain.
     pub chains: wgpu::Texture,
-    pub chain_blocks: u32,
     pub sampler: wgpu::Sampler,
     build_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
@@ -110,6 +109,10 @@ fn texture_3d_blocks(
     })
 }
 
+fn chain_blocks(anisotropic: bool) -> u32 {
+    if anisotropic { 6 } else { 1 }
+}
+
 fn storage_buffer(
     device: &wgpu::Device,
     label: &str,
@@ -155,12 +158,11 @@ impl DenseVolume {
             anisotropic: anisotropic as u32,
             fragment_capacity,
         };
-        let chain_blocks = if anisotropic { 6 } else { 1 };
         let chains = texture_3d_blocks(
             device,
             "voxel radiance mips",
             res / 2,
-            chain_blocks,
+            chain_blocks(anisotropic),
             levels - 1,
             RADIANCE_FORMAT,
         );
@@ -238,7 +240,6 @@ impl DenseVolume {
             emission: texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT),
             radiance: texture_3d(device, "voxel radiance", res, 1, RADIANCE_FORMAT),
             chains,
-            chain_blocks,
             sampler: device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("voxels"),
                 address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -253,6 +254,11 @@ impl DenseVolume {
             args_layout,
             build,
         }
+    }
+
+    /// Blocks (directions) of `chains`: six, or one in isotropic mode.
+    pub fn chain_blocks(&self) -> u32 {
+        chain_blocks(self.anisotropic)
     }
 
     /// Bytes per GPU resource.
@@ -279,7 +285,7 @@ impl DenseVolume {
                 } else {
                     "voxel radiance mips"
                 },
-                self.chain_blocks as u64 * texture_bytes(res / 2, 8, aniso_mips),
+                self.chain_blocks() as u64 * texture_bytes(res / 2, 8, aniso_mips),
             ),
         ]
     }

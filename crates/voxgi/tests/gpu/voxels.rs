@@ -269,7 +269,7 @@ fn check_filtering(anisotropic: bool) {
     } else {
         vec![None]
     };
-    assert_eq!(vol.chain_blocks as usize, dirs.len());
+    assert_eq!(vol.chain_blocks() as usize, dirs.len());
     let chains: Vec<Vec<Vec4>> = (0..levels - 1)
         .map(|mip| read_level(&r, &vol.chains, mip).0)
         .collect();
