@@ -139,8 +139,12 @@ fn main(
             zmin = min(zmin, z);
             zmax = max(zmax, z);
         }
-        let z0 = max(i32(floor(zmin)), lo[w]);
-        let z1 = min(i32(floor(zmax)), hi[w]);
+        // Clamped into the triangle's own depth range, not intersected with it: a triangle
+        // within rounding of a voxel face (a wall on the scene bounds) can get a plane depth a
+        // float step outside its vertices' range, and the intersection is then empty. Extra
+        // candidates are harmless, the box test decides.
+        let z0 = clamp(i32(floor(zmin)), lo[w], hi[w]);
+        let z1 = clamp(i32(floor(zmax)), lo[w], hi[w]);
         for (var cz = z0; cz <= min(z1, z0 + 3); cz++) {
             var cell = vec3<i32>(0);
             cell[u] = cu;

@@ -430,10 +430,8 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 pub fn estimate_fragments(scene: &voxgi_scene::Scene, grid: &Grid) -> u64 {
     let inv = 1.0 / grid.voxel_size;
     let mut total = 0u64;
+    // Area-light emitters count too: voxelize keeps them as occluders.
     for inst in &scene.instances {
-        if inst.light.is_some() {
-            continue;
-        }
         let m = &scene.meshes[inst.mesh];
         for t in m.indices.chunks_exact(3) {
             let [a, b, c] = [t[0], t[1], t[2]]
