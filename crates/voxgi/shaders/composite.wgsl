@@ -57,13 +57,20 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < frame.light_count; i++) {
         let light = lights[i];
         let is_area = is_area_light(light);
-        // With a cone's visibility the shadow map's is replaced: shade unshadowed, scale by the
-        // cone's. One call site: CPU drivers pay for every inlined copy of shade_light.
         let cone = frame.cone_shadows != 0u && is_area && area < CONE_SHADOW_LIGHTS;
-        var l = light;
-        l.shadow_count = select(light.shadow_count, 0u, cone);
-        direct += shade_light(l, s, p, n, v, frame.shadow_softness) * select(1.0, vis[min(area, 3u)], cone);
         area += u32(is_area);
+        let c = shade_light(light, s, p, n, v);
+        if all(c <= vec3<f32>(0.0)) {
+            continue;
+        }
+        // A cone-traced visibility replaces the shadow map's.
+        var w = 1.0;
+        if cone {
+            w = vis[min(area - 1u, 3u)];
+        } else {
+            w = light_visibility(light, p, n, frame.shadow_softness);
+        }
+        direct += c * w;
     }
     let ind = textureLoad(indirect, px, 0);
     var out = direct + em.rgb + ind.rgb;

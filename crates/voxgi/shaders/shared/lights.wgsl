@@ -259,8 +259,10 @@ fn edge_integral(a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
     return select(0.0, atan2(len, dot(a, b)) * dot(c, n) / len, len > 1e-9);
 }
 
-// Outgoing radiance towards v from one light.
-fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, softness: f32) -> vec3<f32> {
+// Outgoing radiance towards v from one light, unshadowed: the caller multiplies by a
+// visibility (`light_visibility`, or a cone-traced one) where this is not zero, so that no
+// shadow lookup is paid for pixels a light cannot reach.
+fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
     if is_area_light(light) {
         // One-sided emitter: nothing behind its plane is lit.
         if dot(p - light.position, light.direction) <= 0.0 {
@@ -270,7 +272,6 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
         if e <= 0.0 {
             return vec3<f32>(0.0);
         }
-        let vis = light_visibility(light, p, n, softness);
         // Specular: GGX evaluated towards the point of the light nearest the mirror ray
         // (representative point), normalised for the lobe widening a light of this size causes.
         let r = reflect(-v, n);
@@ -297,7 +298,7 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
         let a2 = clamp(a + light.size / (2.0 * max(dist, 1e-4)), 0.0, 1.0);
         let norm = (a / a2) * (a / a2);
         let spec = brdf_specular(s, n, v, l) * norm;
-        return (brdf_diffuse(s) + spec) * light.radiance * e * vis;
+        return (brdf_diffuse(s) + spec) * light.radiance * e;
     }
 
     let ls = punctual_light(light, p);
@@ -307,8 +308,7 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
     if n_dot_l <= 0.0 || all(e <= vec3<f32>(0.0)) {
         return vec3<f32>(0.0);
     }
-    let vis = light_visibility(light, p, n, softness);
-    return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l * vis;
+    return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l;
 }
 
 // Irradiance (W/m^2) arriving at p with normal n from one light, shadows included. Used where
