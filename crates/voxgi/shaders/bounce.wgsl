@@ -32,8 +32,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var e = vec3<f32>(0.0);
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
-        // A fixed bundle orientation per voxel, varied between voxels to break up patterns.
-        let angle = fract(f32(s) * 0.6180339887) * 2.0 * PI;
+        // A fixed bundle orientation per voxel, varied between voxels to break up patterns. It
+        // follows the voxel's coordinates, not its slot: slots are handed out by atomics in
+        // whatever order the GPU runs, and renders must not change from run to run. (The
+        // constants are Roberts' R3 sequence: neighbouring voxels get well spread angles.)
+        let angle = fract(dot(vec3<f32>(c), vec3<f32>(0.8191725134, 0.6710436067, 0.5497004779))) * 2.0 * PI;
         e = gather_diffuse(center, n, angle, false, ALL_CONES).irradiance;
     } else {
         // Two-sided voxel: half the light from each side.
