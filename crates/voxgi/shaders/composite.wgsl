@@ -58,6 +58,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let light = lights[i];
         let is_area = is_area_light(light);
         let cone = frame.cone_shadows != 0u && is_area && area < CONE_SHADOW_LIGHTS;
+        let channel = min(area, 3u);
         area += u32(is_area);
         let c = shade_light(light, s, p, n, v);
         if all(c <= vec3<f32>(0.0)) {
@@ -66,7 +67,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         // A cone-traced visibility replaces the shadow map's.
         var w = 1.0;
         if cone {
-            w = vis[min(area - 1u, 3u)];
+            w = vis[channel];
         } else {
             w = light_visibility(light, p, n, frame.shadow_softness);
         }

@@ -10,8 +10,8 @@
 //! The voxel passes (and the shadow maps they read) run when the scene changed — on the first
 //! frame, or every frame with `Settings::revoxelize_every_frame`.
 
-use crate::gpu::readback;
 use crate::gpu::timer::GpuTimer;
+use crate::gpu::{layout, readback};
 use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
 use crate::output::RenderOutput;
 use crate::passes::bounce::BouncePass;
@@ -117,6 +117,32 @@ impl FrameTargets {
 
     /// Bytes per pixel of all full-resolution targets together.
     pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8 + 4 + 4;
+
+    /// Four consecutive bindings from `first` for the passes that shade from the g-buffer:
+    /// albedo, normal and emission (loaded) and depth.
+    pub fn gbuffer_layout(first: u32, c: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 4] {
+        [
+            layout::texture_2d_load(first, c),
+            layout::texture_2d_load(first + 1, c),
+            layout::texture_2d_load(first + 2, c),
+            layout::texture(
+                first + 3,
+                c,
+                wgpu::TextureSampleType::Depth,
+                wgpu::TextureViewDimension::D2,
+            ),
+        ]
+    }
+
+    /// The resources for `gbuffer_layout`, in its order.
+    pub fn gbuffer_resources(&self) -> [wgpu::BindingResource<'_>; 4] {
+        [
+            wgpu::BindingResource::TextureView(&self.albedo),
+            wgpu::BindingResource::TextureView(&self.normal),
+            wgpu::BindingResource::TextureView(&self.emission),
+            wgpu::BindingResource::TextureView(&self.depth),
+        ]
+    }
 
     /// Where the gather writes: the half-resolution target or the full one.
     pub fn gather_target(&self) -> &wgpu::TextureView {

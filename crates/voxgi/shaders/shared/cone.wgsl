@@ -120,6 +120,15 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool, half: u
     if half != ALL_CONES {
         n_cones = 1u + (ring + 1u) / 2u;
     }
+    // The normal's cone is tilted by two thirds of its aperture (about the cosine-weighted mean
+    // angle of its cell) towards an azimuth that goes once round as the ring's angle covers
+    // its period: the sixteen pixels of a 4x4 block spread it over its cell. Untilted, every
+    // pixel of a plane traced the same direction, and a sample narrowed near its own surface
+    // imaged what lies straight ahead like a pinhole (a sharp bright patch on the Cornell
+    // box's ceiling above the tall block).
+    let az = angle * f32(max(ring, 1u));
+    let tilt = (2.0 / 3.0) * atan(cones.diffuse_tan);
+    let tilted = vec3<f32>(sin(tilt) * cos(az), sin(tilt) * sin(az), cos(tilt));
     for (var k = 0u; k < n_cones; k++) {
         var i = k;
         var w_scale = 1.0;
@@ -131,15 +140,6 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool, half: u
             continue;
         }
         let w = cones.dirs[i].w * w_scale;
-        // The normal's cone is tilted by two thirds of its aperture (about the cosine-weighted
-        // mean angle of its cell) towards an azimuth that goes once round as the ring's angle
-        // covers its period: the sixteen pixels of a 4x4 block spread it over its cell.
-        // Untilted, every pixel of a plane traced the same direction, and a sample narrowed
-        // near its own surface imaged what lies straight ahead like a pinhole (a sharp bright
-        // patch on the Cornell box's ceiling above the tall block).
-        let az = angle * f32(max(ring, 1u));
-        let tilt = (2.0 / 3.0) * atan(cones.diffuse_tan);
-        let tilted = vec3<f32>(sin(tilt) * cos(az), sin(tilt) * sin(az), cos(tilt));
         let d = normalize(frame * select(rotate_z(cones.dirs[i].xyz, angle), tilted, i == 0u));
         if cones.indirect != 0u {
             let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance);

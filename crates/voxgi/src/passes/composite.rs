@@ -16,31 +16,17 @@ pub struct CompositePass {
 impl CompositePass {
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![layout::uniform(0, c, false)];
+        entries.extend(ShadowAtlas::lighting_layout(c));
+        entries.extend(FrameTargets::gbuffer_layout(4, c));
+        entries.extend([
+            layout::storage_texture(8, HDR_FORMAT),
+            layout::texture_2d_load(9, c),
+            layout::texture_2d_load(10, c),
+        ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::storage(1, c, true),
-                layout::storage(2, c, true),
-                layout::texture(
-                    3,
-                    c,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                layout::texture_2d_load(4, c),
-                layout::texture_2d_load(5, c),
-                layout::texture_2d_load(6, c),
-                layout::texture(
-                    7,
-                    c,
-                    wgpu::TextureSampleType::Depth,
-                    wgpu::TextureViewDimension::D2,
-                ),
-                layout::storage_texture(8, HDR_FORMAT),
-                layout::texture_2d_load(9, c),
-                layout::texture_2d_load(10, c),
-            ],
+            entries: &entries,
         });
         let pipeline = compute_pipeline(device, "composite", "composite.wgsl", &layout);
         CompositePass { pipeline, layout }
@@ -57,19 +43,14 @@ impl CompositePass {
         atlas: &ShadowAtlas,
         timer: &mut GpuTimer,
     ) {
-        let resources = vec![
-            t.frame.as_entire_binding(),
-            scene.lights.as_entire_binding(),
-            atlas.views_buffer.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&atlas.array_view),
-            wgpu::BindingResource::TextureView(&t.albedo),
-            wgpu::BindingResource::TextureView(&t.normal),
-            wgpu::BindingResource::TextureView(&t.emission),
-            wgpu::BindingResource::TextureView(&t.depth),
+        let mut resources = vec![t.frame.as_entire_binding()];
+        resources.extend(atlas.lighting_resources(scene));
+        resources.extend(t.gbuffer_resources());
+        resources.extend([
             wgpu::BindingResource::TextureView(&t.hdr),
             wgpu::BindingResource::TextureView(&t.indirect),
             wgpu::BindingResource::TextureView(&t.visibility),
-        ];
+        ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),
             layout: &self.layout,

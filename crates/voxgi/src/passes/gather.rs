@@ -26,16 +26,8 @@ impl GatherPass {
             layout::uniform(2, c, false),
         ];
         entries.extend(DenseVolume::sampling_layout(3, c));
+        entries.extend(FrameTargets::gbuffer_layout(6, c));
         entries.extend([
-            layout::texture_2d_load(6, c),
-            layout::texture_2d_load(7, c),
-            layout::texture_2d_load(8, c),
-            layout::texture(
-                9,
-                c,
-                wgpu::TextureSampleType::Depth,
-                wgpu::TextureViewDimension::D2,
-            ),
             layout::storage_texture(10, INDIRECT_FORMAT),
             layout::storage(11, c, true),
             layout::storage_texture(12, VISIBILITY_FORMAT),
@@ -69,12 +61,9 @@ impl GatherPass {
             cones.as_entire_binding(),
         ];
         res.extend(views.iter().map(wgpu::BindingResource::TextureView));
+        res.push(wgpu::BindingResource::Sampler(&vol.sampler));
+        res.extend(t.gbuffer_resources());
         res.extend([
-            wgpu::BindingResource::Sampler(&vol.sampler),
-            wgpu::BindingResource::TextureView(&t.albedo),
-            wgpu::BindingResource::TextureView(&t.normal),
-            wgpu::BindingResource::TextureView(&t.emission),
-            wgpu::BindingResource::TextureView(&t.depth),
             wgpu::BindingResource::TextureView(t.gather_target()),
             scene.lights.as_entire_binding(),
             wgpu::BindingResource::TextureView(&t.visibility_low),

@@ -17,27 +17,21 @@ pub struct InjectPass {
 impl InjectPass {
     pub fn new(device: &wgpu::Device, light_count: u32) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
+        let mut entries = vec![layout::uniform(0, c, false)];
+        entries.extend(ShadowAtlas::lighting_layout(c));
+        entries.extend([
+            layout::texture_3d_load(4, c),
+            layout::texture_3d_load(5, c),
+            layout::texture_3d_load(6, c),
+            layout::storage(7, c, true),
+            layout::storage(8, c, true),
+            layout::storage(9, c, false),
+            layout::storage_texture_3d(10, RADIANCE_FORMAT),
+            layout::uniform(11, c, false),
+        ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("inject"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::storage(1, c, true),
-                layout::storage(2, c, true),
-                layout::texture(
-                    3,
-                    c,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                layout::texture_3d_load(4, c),
-                layout::texture_3d_load(5, c),
-                layout::texture_3d_load(6, c),
-                layout::storage(7, c, true),
-                layout::storage(8, c, true),
-                layout::storage(9, c, false),
-                layout::storage_texture_3d(10, RADIANCE_FORMAT),
-                layout::uniform(11, c, false),
-            ],
+            entries: &entries,
         });
         InjectPass {
             pipeline: compute_pipeline(device, "inject", "inject.wgsl", &layout),
@@ -66,23 +60,22 @@ impl InjectPass {
             v(&vol.emission),
             v(&vol.radiance),
         );
+        let mut resources = vec![vol.volume.as_entire_binding()];
+        resources.extend(atlas.lighting_resources(scene));
+        resources.extend([
+            wgpu::BindingResource::TextureView(&a),
+            wgpu::BindingResource::TextureView(&n),
+            wgpu::BindingResource::TextureView(&e),
+            vol.slot_voxel.as_entire_binding(),
+            vol.counters.as_entire_binding(),
+            vol.slot_direct.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&r),
+            self.light_count.as_entire_binding(),
+        ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("inject"),
             layout: &self.layout,
-            entries: &layout::entries(vec![
-                vol.volume.as_entire_binding(),
-                scene.lights.as_entire_binding(),
-                atlas.views_buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&atlas.array_view),
-                wgpu::BindingResource::TextureView(&a),
-                wgpu::BindingResource::TextureView(&n),
-                wgpu::BindingResource::TextureView(&e),
-                vol.slot_voxel.as_entire_binding(),
-                vol.counters.as_entire_binding(),
-                vol.slot_direct.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&r),
-                self.light_count.as_entire_binding(),
-            ]),
+            entries: &layout::entries(resources),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("inject"),

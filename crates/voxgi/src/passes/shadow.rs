@@ -256,6 +256,30 @@ impl ShadowAtlas {
         }
     }
 
+    /// Bindings 1, 2 and 3 of every shader that includes `shared/lights.wgsl`: the lights, the
+    /// shadow views and this atlas's maps.
+    pub fn lighting_layout(c: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 3] {
+        [
+            layout::storage(1, c, true),
+            layout::storage(2, c, true),
+            layout::texture(
+                3,
+                c,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2Array,
+            ),
+        ]
+    }
+
+    /// The resources for `lighting_layout`, in its order.
+    pub fn lighting_resources<'a>(&'a self, scene: &'a GpuScene) -> [wgpu::BindingResource<'a>; 3] {
+        [
+            scene.lights.as_entire_binding(),
+            self.views_buffer.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.array_view),
+        ]
+    }
+
     pub fn bytes(&self) -> u64 {
         let t = &self.texture;
         (t.width() * t.height() * t.depth_or_array_layers()) as u64 * 8
