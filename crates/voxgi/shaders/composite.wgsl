@@ -18,6 +18,11 @@
 // Cone-traced visibility of the first CONE_SHADOW_LIGHTS area lights (gather pass, upsampled).
 @group(0) @binding(10) var visibility: texture_2d<f32>;
 
+// False when every light's visibility is cone-traced: the shadow-map code is then compiled
+// out. CPU drivers run a branch's code even when no lane takes it, and the shadow-map lookup
+// left in an untaken branch nearly doubled this pass on lavapipe.
+override SHADOW_MAPS: bool = true;
+
 const VIEW_FINAL: u32 = 0u;
 const VIEW_ALBEDO: u32 = 1u;
 const VIEW_NORMAL: u32 = 2u;
@@ -68,7 +73,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         var w = 1.0;
         if cone {
             w = vis[channel];
-        } else {
+        } else if SHADOW_MAPS {
             w = light_visibility(light, p, n, frame.shadow_softness);
         }
         direct += c * w;

@@ -268,19 +268,15 @@ impl Renderer {
         let (gpu_scene, atlas) = ctx.checked("scene upload", || -> Result<_> {
             let mut gpu_scene = GpuScene::new(&device, &queue, scene, &settings)?;
             let casts: Vec<bool> = scene.lights.iter().map(|l| l.cast_shadows).collect();
-            let (views, owners) = shadow::plan_views(
-                &mut gpu_scene.gpu_lights,
-                &casts,
-                center,
-                radius,
-                settings.shadow_map_size,
-            );
+            let res = shadow::atlas_resolution(&settings, &gpu_scene.gpu_lights);
+            let (views, owners) =
+                shadow::plan_views(&mut gpu_scene.gpu_lights, &casts, center, radius, res);
             queue.write_buffer(
                 &gpu_scene.lights,
                 0,
                 bytemuck::cast_slice(&gpu_scene.gpu_lights),
             );
-            let atlas = ShadowAtlas::new(&device, views, owners, settings.shadow_map_size);
+            let atlas = ShadowAtlas::new(&device, views, owners, res);
             Ok((gpu_scene, atlas))
         })??;
         let passes = ctx.checked("pipeline creation", || {
@@ -599,6 +595,7 @@ impl Renderer {
             t,
             &self.scene,
             &self.atlas,
+            self.settings.cone_shadows,
             timer,
         );
         // Only for the voxel views: replaces the composite's output.

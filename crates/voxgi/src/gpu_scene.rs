@@ -185,6 +185,9 @@ pub const LIGHT_SPOT: u32 = 2;
 pub const LIGHT_RECT: u32 = 3;
 pub const LIGHT_DISC: u32 = 4;
 pub const NO_INDEX: u32 = u32::MAX;
+/// Area lights whose visibility the gather can cone-trace (one channel each). Twin of
+/// `CONE_SHADOW_LIGHTS` in shaders/shared/scene.wgsl.
+pub const CONE_SHADOW_LIGHTS: usize = 4;
 
 /// One indexed draw: a mesh instance.
 #[derive(Clone, Debug)]

@@ -36,11 +36,21 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "reference.wgsl",
 ];
 
-fn raw(name: &str) -> &'static str {
+/// Shader development: with `VOXGI_SHADER_DIR` set, WGSL is read from that directory (laid out
+/// like `crates/voxgi/shaders`) at pipeline creation, so a shader change needs no rebuild. A
+/// file missing there falls back to the built-in copy.
+const SHADER_DIR_VAR: &str = "VOXGI_SHADER_DIR";
+
+fn raw(name: &str) -> std::borrow::Cow<'static, str> {
+    if let Some(dir) = std::env::var_os(SHADER_DIR_VAR)
+        && let Ok(text) = std::fs::read_to_string(std::path::Path::new(&dir).join(name))
+    {
+        return text.into();
+    }
     SOURCES
         .iter()
         .find(|(n, _)| *n == name)
-        .map(|(_, s)| *s)
+        .map(|(_, s)| (*s).into())
         .unwrap_or_else(|| panic!("unknown shader file {name}"))
 }
 

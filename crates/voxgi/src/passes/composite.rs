@@ -4,12 +4,14 @@ use crate::frame::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
-use crate::passes::shadow::ShadowAtlas;
+use crate::passes::shadow::{ShadowAtlas, composite_reads_shadow_maps};
 
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 pub struct CompositePass {
-    pipeline: wgpu::ComputePipeline,
+    /// Index `SHADOW_MAPS as usize`: the variant without shadow-map lookups serves scenes whose
+    /// every light is cone-shadowed; each is compiled when first needed.
+    pipelines: [std::sync::OnceLock<wgpu::ComputePipeline>; 2],
     layout: wgpu::BindGroupLayout,
 }
 
@@ -28,8 +30,10 @@ impl CompositePass {
             label: Some("composite"),
             entries: &entries,
         });
-        let pipeline = compute_pipeline(device, "composite", "composite.wgsl", &layout);
-        CompositePass { pipeline, layout }
+        CompositePass {
+            pipelines: Default::default(),
+            layout,
+        }
     }
 
     // The pass reads everything the frame has made so far; a struct for it would only rename.
@@ -41,8 +45,20 @@ impl CompositePass {
         t: &FrameTargets,
         scene: &GpuScene,
         atlas: &ShadowAtlas,
+        cone_shadows: bool,
         timer: &mut GpuTimer,
     ) {
+        let shadow_maps = composite_reads_shadow_maps(&scene.gpu_lights, cone_shadows);
+        let pipeline = self.pipelines[shadow_maps as usize].get_or_init(|| {
+            let constants = [("SHADOW_MAPS", f64::from(u8::from(shadow_maps)))];
+            specialized_pipeline(
+                device,
+                "composite",
+                "composite.wgsl",
+                &self.layout,
+                &constants,
+            )
+        });
         let mut resources = vec![t.frame.as_entire_binding()];
         resources.extend(atlas.lighting_resources(scene));
         resources.extend(t.gbuffer_resources());
@@ -60,7 +76,7 @@ impl CompositePass {
             label: Some("composite"),
             timestamp_writes: timer.compute("composite"),
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
     }
@@ -73,6 +89,17 @@ pub fn compute_pipeline(
     file: &str,
     layout: &wgpu::BindGroupLayout,
 ) -> wgpu::ComputePipeline {
+    specialized_pipeline(device, label, file, layout, &[])
+}
+
+/// `compute_pipeline` with values for the shader's `override` constants.
+pub fn specialized_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    layout: &wgpu::BindGroupLayout,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let module = shader::module(device, file);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
@@ -84,7 +111,10 @@ pub fn compute_pipeline(
         layout: Some(&pipeline_layout),
         module: &module,
         entry_point: Some("main"),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
         cache: None,
     })
 }

@@ -5,8 +5,10 @@
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::{
-    GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT, LIGHT_SPOT,
+    CONE_SHADOW_LIGHTS, GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT,
+    LIGHT_SPOT,
 };
+use crate::settings::Settings;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
@@ -176,6 +178,46 @@ pub fn plan_views(
         v.layer = i as u32;
     }
     (views, owner)
+}
+
+/// Whether a cube face of an area light sees only what lies behind the emitter's plane, which
+/// the light cannot reach and so nobody looks up (the face opposite a one-sided emitter's
+/// direction): such a face is not rendered.
+pub fn behind_emitter(view: &GpuShadowView) -> bool {
+    let n = Vec3::new(view.plane[0], view.plane[1], view.plane[2]);
+    if view.kind != SHADOW_PERSPECTIVE || n == Vec3::ZERO {
+        return false;
+    }
+    // The face's frustum spans its axis a plus up to tan_half times the two other (coordinate)
+    // axes; its highest point over the plane is a.n + tan_half (|n|_1 - |a.n|).
+    let a = Vec3::from(view.dir);
+    let tan_half = 0.5 * view.texel * view.resolution;
+    let reach = a.dot(n) + tan_half * (n.abs().element_sum() - a.dot(n).abs());
+    reach <= 0.0
+}
+
+/// Shadow-map size: the setting, or, when every light's visibility on screen is cone-traced
+/// and the maps serve only the voxel injection, four texels per voxel of the volume (the
+/// injection reads them at voxel centres; finer maps only cost rendering time).
+pub fn atlas_resolution(settings: &Settings, lights: &[GpuLight]) -> u32 {
+    if composite_reads_shadow_maps(lights, settings.cone_shadows) {
+        settings.shadow_map_size
+    } else {
+        settings
+            .shadow_map_size
+            .min((4 * settings.voxel_resolution).max(256))
+    }
+}
+
+/// Whether the composite looks up shadow maps: not when every light is an area light whose
+/// visibility the gather cone-traces (the first `CONE_SHADOW_LIGHTS` area lights).
+pub fn composite_reads_shadow_maps(lights: &[GpuLight], cone_shadows: bool) -> bool {
+    let cone_traced = cone_shadows
+        && lights.len() <= CONE_SHADOW_LIGHTS
+        && lights
+            .iter()
+            .all(|l| l.kind == LIGHT_RECT || l.kind == LIGHT_DISC);
+    !cone_traced
 }
 
 impl ShadowAtlas {
@@ -375,6 +417,9 @@ impl ShadowPass {
             ]),
         });
         for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
+            if behind_emitter(&atlas.views[i]) {
+                continue;
+            }
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
