@@ -25,6 +25,9 @@
 @group(0) @binding(11) var<storage, read> lights: array<Light>;
 // Visibility of the first CONE_SHADOW_LIGHTS area lights, one per channel.
 @group(0) @binding(12) var visibility_out: texture_storage_2d<rgba8unorm, write>;
+// Normal and distance to the camera (0: background), for the upsample's edge weights: one
+// fetch there instead of the g-buffer's depth and normal and an unprojection per tap.
+@group(0) @binding(13) var guide_out: texture_storage_2d<rgba16float, write>;
 
 // Visibility of an area light by one cone from p to its centre, as wide as the light looks
 // from p: 1 - the opacity the cone gathers before reaching the light.
@@ -91,6 +94,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if depth >= 1.0 {
         textureStore(indirect_out, gid.xy, vec4<f32>(0.0, 0.0, 0.0, 1.0));
         textureStore(visibility_out, gid.xy, vec4<f32>(1.0));
+        textureStore(guide_out, gid.xy, vec4<f32>(0.0));
         return;
     }
     let am = textureLoad(gb_albedo, px, 0);
@@ -100,6 +104,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = world_position(px, depth);
     let n = normalize(nr.xyz);
     let v = normalize(frame.camera_pos - p);
+    textureStore(guide_out, gid.xy, vec4<f32>(nr.xyz, length(frame.camera_pos - p)));
     // The ring of tilted cones repeats every 2 pi / (count - 1).
     let period = 2.0 * PI / f32(max(cones.count, 2u) - 1u);
     let angle = (f32(bayer4(gid.xy)) + 0.5) / 16.0 * period;

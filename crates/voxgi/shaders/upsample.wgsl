@@ -14,6 +14,8 @@
 // Area-light visibility as the gather traced it, and at full resolution.
 @group(0) @binding(5) var vis_low: texture_2d<f32>;
 @group(0) @binding(6) var vis_full: texture_storage_2d<rgba8unorm, write>;
+// Each gather sample's normal (rgb) and distance to the camera (a, 0 for background).
+@group(0) @binding(7) var guide: texture_2d<f32>;
 
 fn view_depth(px: vec2<u32>, d: f32) -> f32 {
     let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
@@ -54,14 +56,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var i = 0; i < 16; i++) {
         let c = min(base + vec2<i32>(i & 3, i >> 2), vec2<i32>(low_size) - 1);
         let px = min(vec2<u32>(c) * scale, size - 1u);
-        let depth = textureLoad(gb_depth, px, 0);
-        let d = view_depth(px, depth);
-        let n = textureLoad(gb_normal, px, 0).xyz;
+        let g = textureLoad(guide, c, 0);
+        let d = g.a;
+        let n = g.xyz;
         // Depth within 5 % and normals within ~30 degrees count fully; beyond, weights fall
         // fast. Background samples count nothing.
         let wd = exp(-abs(d - d0) / max(0.05 * d0, 1e-4));
-        let wn = pow(max(dot(n, n0), 0.0), 8.0);
-        let w = select(wd * wn + 1e-6, 0.0, depth >= 1.0);
+        let c1 = max(dot(n, n0), 0.0);
+        let c2 = c1 * c1;
+        let c4 = c2 * c2;
+        let wn = c4 * c4;
+        let w = select(wd * wn + 1e-6, 0.0, d <= 0.0);
         let k = f32(cone_half(vec2<u32>(c)));
         let value = textureLoad(low, c, 0);
         sum0 += (w * (1.0 - k)) * value;

@@ -18,7 +18,7 @@ use crate::passes::bounce::BouncePass;
 use crate::passes::composite::{CompositePass, HDR_FORMAT};
 use crate::passes::debug::DebugPass;
 use crate::passes::filter::FilterPass;
-use crate::passes::gather::{GatherPass, INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::passes::gather::{GUIDE_FORMAT, GatherPass, INDIRECT_FORMAT, VISIBILITY_FORMAT};
 use crate::passes::gbuffer::{self, GbufferPass};
 use crate::passes::inject::InjectPass;
 use crate::passes::shadow::{self, ShadowAtlas, ShadowPass};
@@ -54,6 +54,8 @@ pub struct FrameTargets {
     /// resolution and as the gather traced it.
     pub visibility: wgpu::TextureView,
     pub visibility_low: wgpu::TextureView,
+    /// Normal and camera distance of each gather pixel (the upsample's edge weights).
+    pub guide_low: wgpu::TextureView,
     half: bool,
     hdr_texture: wgpu::Texture,
     ldr_texture: wgpu::Texture,
@@ -107,6 +109,7 @@ impl FrameTargets {
             indirect_low: view(low("indirect gather", INDIRECT_FORMAT)),
             visibility: view(make("visibility", VISIBILITY_FORMAT, st)),
             visibility_low: view(low("visibility gather", VISIBILITY_FORMAT)),
+            guide_low: view(low("gather guide", GUIDE_FORMAT)),
             half,
             hdr: hdr_texture.create_view(&Default::default()),
             ldr: ldr_texture.create_view(&Default::default()),
@@ -116,7 +119,7 @@ impl FrameTargets {
     }
 
     /// Bytes per pixel of all full-resolution targets together.
-    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8 + 4 + 4;
+    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8 + 4 + 4 + 8;
 
     /// Four consecutive bindings from `first` for the passes that shade from the g-buffer:
     /// albedo, normal and emission (loaded) and depth.

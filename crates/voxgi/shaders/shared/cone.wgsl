@@ -1,4 +1,7 @@
-// Cone tracing, written once against sample_voxels(position, diameter, direction).
+// Cone tracing, written once against the voxel structure's samplers: sample_depth(position,
+// diameter, direction), optical depth (L sigma, sigma) of the volume filtered to `diameter`,
+// and sample_depth_wide, the same for diameters of at least WIDE_SAMPLE voxels (a structure
+// whose wide samples cost no less may implement it as sample_depth).
 
 // The filter size of a cone sample at distance t from a surface (normal n). A surface can
 // neither occlude nor light itself, so a sample must not read the voxels of its cone's own
@@ -33,29 +36,47 @@ fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
 
 // Front-to-back accumulation of one cone. Returns premultiplied radiance (rgb) and opacity (a).
 // Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
-// length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d).
+// length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d), which in
+// optical depth is 1 - e^(-sigma d'/d).
 fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
     var t = vol.voxel_size;
-    let min_d = vol.voxel_size;
+    // Two loops: samples widen monotonically along a cone that leaves its surface, and once
+    // they are WIDE_SAMPLE voxels across they no longer read the finest level (a quarter of the
+    // fetches per step; 8 % of the gather on lavapipe).
+    for (var i = 0u; i < 512u; i++) {
+        let p = origin + dir * t;
+        let d = max(vol.voxel_size, 2.0 * tan_half * t);
+        let ds = cone_sample_size(origin, n, p, d);
+        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || ds >= WIDE_SAMPLE * vol.voxel_size {
+            break;
+        }
+        let step = cone_step(d, ds);
+        acc = composite_sample(acc, sample_depth(p, ds, dir), step / ds);
+        t += step;
+    }
     for (var i = 0u; i < 512u; i++) {
         let p = origin + dir * t;
         // The volume is convex: a cone that has left it meets nothing more.
         if t >= max_dist || acc.a >= 0.995 || outside_volume(p) {
             break;
         }
-        let d = max(min_d, 2.0 * tan_half * t);
+        let d = max(vol.voxel_size, 2.0 * tan_half * t);
         let ds = cone_sample_size(origin, n, p, d);
-        let s = sample_voxels(p, ds, dir);
         let step = cone_step(d, ds);
-        let a = clamp(s.a, 0.0, 0.9999);
-        let ca = step_opacity(a, step, ds);
-        // Radiance is premultiplied: it scales with the corrected opacity.
-        let corrected = vec4<f32>(s.rgb * (ca / max(a, 1e-6)), ca);
-        acc += (1.0 - acc.a) * corrected;
+        acc = composite_sample(acc, sample_depth_wide(p, ds, dir), step / ds);
         t += step;
     }
     return acc;
+}
+
+// Front-to-back compositing of a sample of optical depth (L sigma, sigma) per sample diameter
+// over `k` diameters: opacity 1 - e^(-sigma k), premultiplied radiance L times that.
+fn composite_sample(acc: vec4<f32>, s: vec4<f32>, k: f32) -> vec4<f32> {
+    // At most the depth of opacity 0.9999, as the opacity form clamped.
+    let sigma = clamp(s.a, 0.0, 9.2);
+    let a = 1.0 - exp(-sigma * k);
+    return acc + (1.0 - acc.a) * vec4<f32>(s.rgb * (a / max(sigma, 1e-6)), a);
 }
 
 // Ambient occlusion along one cone: opacity weighted by 1/(1 + lambda r), up to ao_radius.

@@ -1,5 +1,6 @@
-// sample_voxels for the dense mip-mapped volume: premultiplied radiance and opacity of the
-// volume filtered to `diameter` around `pos`, as seen travelling along `dir`. The including
+// The samplers of the dense mip-mapped volume: the volume filtered to `diameter` around `pos`,
+// as seen travelling along `dir`, as optical depth (sample_depth, sample_depth_wide) or as
+// premultiplied radiance and opacity (sample_voxels). The including
 // shader declares `vol`, `radiance0` (finest level, isotropic), `chains` (the directional mip
 // chains, one level above the finest, as blocks stacked along z: +X, -X, +Y, -Y, +Z, -Z; in
 // isotropic mode one block) and `voxel_sampler` (trilinear, clamp to edge).
@@ -8,6 +9,14 @@
 // even a branch no lane takes costs more on lavapipe than the fetch it would skip.
 
 fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
+    return from_depth(sample_depth(pos, diameter, dir));
+}
+
+// Samples at least WIDE_SAMPLE voxels across read only the directional chains.
+const WIDE_SAMPLE: f32 = 2.0;
+
+// Optical depth per sample diameter: (L sigma, sigma).
+fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let extent = vol.voxel_size * f32(vol.resolution);
     let uvw = (pos - vol.origin) / extent;
     // Outside the volume there is nothing (no clamp-to-border sampler in core WebGPU).
@@ -16,7 +25,16 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let fine = textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
     let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir);
     // Only between the finest level and the first coarse one is the finest level read.
-    return select(vec4<f32>(0.0), from_depth(mix(fine, coarse, min(lod, 1.0))), inside);
+    return select(vec4<f32>(0.0), mix(fine, coarse, min(lod, 1.0)), inside);
+}
+
+// sample_depth for a diameter of at least WIDE_SAMPLE voxels.
+fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
+    let extent = vol.voxel_size * f32(vol.resolution);
+    let uvw = (pos - vol.origin) / extent;
+    let inside = all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0));
+    let lod = clamp(log2(diameter / vol.voxel_size), 1.0, f32(vol.levels - 1u));
+    return select(vec4<f32>(0.0), sample_chains(uvw, lod - 1.0, dir), inside);
 }
 
 // The directional chains at chain level `cl` (the volume's level cl + 1).

@@ -11,6 +11,9 @@ use crate::voxel::dense::DenseVolume;
 pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Cone-traced visibility of up to four area lights.
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// The gather pixels' geometry for the upsample's edge weights: normal (rgb) and distance to
+/// the camera (a; 0 for background).
+pub const GUIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
@@ -31,6 +34,7 @@ impl GatherPass {
             layout::storage_texture(10, INDIRECT_FORMAT),
             layout::storage(11, c, true),
             layout::storage_texture(12, VISIBILITY_FORMAT),
+            layout::storage_texture(13, GUIDE_FORMAT),
         ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather"),
@@ -67,6 +71,7 @@ impl GatherPass {
             wgpu::BindingResource::TextureView(t.gather_target()),
             scene.lights.as_entire_binding(),
             wgpu::BindingResource::TextureView(&t.visibility_low),
+            wgpu::BindingResource::TextureView(&t.guide_low),
         ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather"),

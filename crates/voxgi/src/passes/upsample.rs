@@ -30,6 +30,7 @@ impl UpsamplePass {
                 layout::storage_texture(4, INDIRECT_FORMAT),
                 layout::texture_2d_load(5, c),
                 layout::storage_texture(6, VISIBILITY_FORMAT),
+                layout::texture_2d_load(7, c),
             ],
         });
         UpsamplePass {
@@ -57,6 +58,7 @@ impl UpsamplePass {
                 wgpu::BindingResource::TextureView(&t.indirect),
                 wgpu::BindingResource::TextureView(&t.visibility_low),
                 wgpu::BindingResource::TextureView(&t.visibility),
+                wgpu::BindingResource::TextureView(&t.guide_low),
             ]),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
