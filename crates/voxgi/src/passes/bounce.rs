@@ -4,7 +4,7 @@
 
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::composite::compute_pipeline;
+use crate::passes::composite::{compute_pipeline, specialized_pipeline};
 use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
 
 pub struct BouncePass {
@@ -15,7 +15,7 @@ pub struct BouncePass {
 }
 
 impl BouncePass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub fn new(device: &wgpu::Device, anisotropic: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false), layout::uniform(1, c, false)];
         entries.extend(DenseVolume::sampling_layout(2, c));
@@ -42,7 +42,13 @@ impl BouncePass {
             ],
         });
         BouncePass {
-            gather: compute_pipeline(device, "bounce", "bounce.wgsl", &gather_layout),
+            gather: specialized_pipeline(
+                device,
+                "bounce",
+                "bounce.wgsl",
+                &gather_layout,
+                &DenseVolume::sampling_constants(anisotropic),
+            ),
             store: compute_pipeline(device, "bounce", "bounce_store.wgsl", &store_layout),
             gather_layout,
             store_layout,

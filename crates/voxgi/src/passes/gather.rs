@@ -5,7 +5,7 @@ use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::composite::compute_pipeline;
+use crate::passes::composite::specialized_pipeline;
 use crate::voxel::dense::DenseVolume;
 
 pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -21,7 +21,7 @@ pub struct GatherPass {
 }
 
 impl GatherPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub fn new(device: &wgpu::Device, anisotropic: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![
             layout::uniform(0, c, false),
@@ -41,7 +41,13 @@ impl GatherPass {
             entries: &entries,
         });
         GatherPass {
-            pipeline: compute_pipeline(device, "gather", "gather.wgsl", &layout),
+            pipeline: specialized_pipeline(
+                device,
+                "gather",
+                "gather.wgsl",
+                &layout,
+                &DenseVolume::sampling_constants(anisotropic),
+            ),
             layout,
         }
     }
