@@ -229,7 +229,7 @@ fn isotropic_mode_keeps_about_half_the_indirect_light() {
     let (iso, aniso) = (mean_indirect(false), mean_indirect(true));
     eprintln!("mean indirect: isotropic {iso}, anisotropic {aniso}");
     // An isotropic voxel averages a wall's lit face with its unlit views, so cones see about
-    // half the light (measured 0.53, identical with the one-fetch isotropic pipeline and the
+    // half the light (measured 0.58, the same to 1e-4 with the one-fetch isotropic pipeline and the
     // three-fetch run-time path it replaces). A fetch from the wrong block would read another
     // direction's data or nothing: far outside 0.4..0.65.
     let ratio = iso / aniso;
