@@ -132,6 +132,9 @@ struct SettingsArgs {
     /// One radiance value per voxel above the finest level instead of six directional ones.
     #[arg(long)]
     isotropic: bool,
+    /// Directional blocks per cone sample in the per-pixel gather: 3 (default) or 2 (faster).
+    #[arg(long, value_name = "N")]
+    gather_axes: Option<u32>,
     /// Gather indirect light at half resolution with an edge-aware upsample.
     #[arg(long)]
     half_res: bool,
@@ -200,6 +203,9 @@ impl SettingsArgs {
         if self.isotropic {
             s.anisotropic = false;
         }
+        if let Some(v) = self.gather_axes {
+            s.gather_axes = v;
+        }
         if self.half_res {
             s.half_resolution = true;
         }
@@ -265,6 +271,7 @@ fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
             }
             "cones" => s.cones = parse_cones(string()?).map_err(anyhow::Error::msg)?,
             "anisotropic" => s.anisotropic = boolean()?,
+            "gather_axes" => s.gather_axes = int()?,
             "half_resolution" => s.half_resolution = boolean()?,
             "cone_shadows" => s.cone_shadows = boolean()?,
             "ao_radius" => s.ao_radius = Some(num()? as f32),
@@ -281,8 +288,8 @@ fn apply_table(s: &mut Settings, t: &toml::Table) -> Result<()> {
             }
             other => bail!(
                 "[settings] unknown key '{other}' (known: exposure, shadow_map_size, \
-                 voxel_resolution, bounces, cones, anisotropic, half_resolution, cone_shadows, \
-                 ao_radius, ao_lambda, step_factor, voxel_level, tonemap)"
+                 voxel_resolution, bounces, cones, anisotropic, gather_axes, half_resolution, \
+                 cone_shadows, ao_radius, ao_lambda, step_factor, voxel_level, tonemap)"
             ),
         }
     }
@@ -850,7 +857,9 @@ fn bench(args: &BenchArgs) -> Result<()> {
                 "anisotropic": settings.anisotropic,
                 "cones": settings.cones.name(),
                 "bounces": settings.bounces,
+                "gather_axes": settings.gather_axes,
                 "half_resolution": settings.half_resolution,
+                "cone_shadows": settings.cone_shadows,
                 "revoxelize_every_frame": settings.revoxelize_every_frame,
                 "shadow_map_size": settings.shadow_map_size,
                 "step_factor": settings.step_factor,

@@ -312,7 +312,7 @@ impl Renderer {
                 InjectPass::new(&device, gpu_scene.light_count),
                 FilterPass::new(&device),
                 BouncePass::new(&device, settings.anisotropic),
-                GatherPass::new(&device, settings.anisotropic),
+                GatherPass::new(&device, settings.anisotropic, settings.gather_axes),
                 UpsamplePass::new(&device),
                 DenseVolume::new(&device, grid, settings.anisotropic, capacity, slots),
                 triangle_table(&device, &gpu_scene),

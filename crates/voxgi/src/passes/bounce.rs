@@ -47,7 +47,7 @@ impl BouncePass {
                 "bounce",
                 "bounce.wgsl",
                 &gather_layout,
-                &DenseVolume::sampling_constants(anisotropic),
+                &DenseVolume::sampling_constants(anisotropic, 3),
             ),
             store: compute_pipeline(device, "bounce", "bounce_store.wgsl", &store_layout),
             gather_layout,

@@ -21,7 +21,7 @@ pub struct GatherPass {
 }
 
 impl GatherPass {
-    pub fn new(device: &wgpu::Device, anisotropic: bool) -> Self {
+    pub fn new(device: &wgpu::Device, anisotropic: bool, axes: u32) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![
             layout::uniform(0, c, false),
@@ -46,7 +46,7 @@ impl GatherPass {
                 "gather",
                 "gather.wgsl",
                 &layout,
-                &DenseVolume::sampling_constants(anisotropic),
+                &DenseVolume::sampling_constants(anisotropic, axes),
             ),
             layout,
         }

@@ -292,8 +292,11 @@ impl DenseVolume {
 
     /// Values for dense_sample.wgsl's `override` constants, for the pipelines that sample a
     /// volume of this mode.
-    pub fn sampling_constants(anisotropic: bool) -> [(&'static str, f64); 1] {
-        [("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 })]
+    pub fn sampling_constants(anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
+        [
+            ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
+            ("SAMPLE_AXES", f64::from(axes)),
+        ]
     }
 
     /// Bindings cone tracing reads, from `first`: radiance0, the chains, and the sampler.

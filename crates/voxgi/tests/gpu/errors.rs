@@ -95,6 +95,13 @@ fn absurd_settings_are_errors() {
             },
         ),
         (
+            "4 gather axes",
+            Settings {
+                gather_axes: 4,
+                ..Default::default()
+            },
+        ),
+        (
             "step 0",
             Settings {
                 step_factor: 0.0,
