@@ -286,7 +286,13 @@ impl Renderer {
             (
                 ShadowPass::new(&device),
                 GbufferPass::new(&device),
-                CompositePass::new(&device),
+                CompositePass::new(
+                    &device,
+                    shadow::composite_reads_shadow_maps(
+                        &gpu_scene.gpu_lights,
+                        settings.cone_shadows,
+                    ),
+                ),
                 TonemapPass::new(&device),
                 DebugPass::new(&device),
             )
@@ -598,7 +604,6 @@ impl Renderer {
             t,
             &self.scene,
             &self.atlas,
-            self.settings.cone_shadows,
             timer,
         );
         // Only for the voxel views: replaces the composite's output.

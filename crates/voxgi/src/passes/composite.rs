@@ -4,19 +4,19 @@ use crate::frame::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
-use crate::passes::shadow::{ShadowAtlas, composite_reads_shadow_maps};
+use crate::passes::shadow::ShadowAtlas;
 
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 pub struct CompositePass {
-    /// Index `SHADOW_MAPS as usize`: the variant without shadow-map lookups serves scenes whose
-    /// every light is cone-shadowed; each is compiled when first needed.
-    pipelines: [std::sync::OnceLock<wgpu::ComputePipeline>; 2],
+    pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 impl CompositePass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// `shadow_maps`: whether any light's visibility comes from the shadow maps
+    /// (`composite_reads_shadow_maps`); without, the shader is compiled without their lookup.
+    pub fn new(device: &wgpu::Device, shadow_maps: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
         entries.extend(ShadowAtlas::lighting_layout(c));
@@ -30,10 +30,10 @@ impl CompositePass {
             label: Some("composite"),
             entries: &entries,
         });
-        CompositePass {
-            pipelines: Default::default(),
-            layout,
-        }
+        let constants = [("SHADOW_MAPS", f64::from(u8::from(shadow_maps)))];
+        let pipeline =
+            specialized_pipeline(device, "composite", "composite.wgsl", &layout, &constants);
+        CompositePass { pipeline, layout }
     }
 
     // The pass reads everything the frame has made so far; a struct for it would only rename.
@@ -45,20 +45,8 @@ impl CompositePass {
         t: &FrameTargets,
         scene: &GpuScene,
         atlas: &ShadowAtlas,
-        cone_shadows: bool,
         timer: &mut GpuTimer,
     ) {
-        let shadow_maps = composite_reads_shadow_maps(&scene.gpu_lights, cone_shadows);
-        let pipeline = self.pipelines[shadow_maps as usize].get_or_init(|| {
-            let constants = [("SHADOW_MAPS", f64::from(u8::from(shadow_maps)))];
-            specialized_pipeline(
-                device,
-                "composite",
-                "composite.wgsl",
-                &self.layout,
-                &constants,
-            )
-        });
         let mut resources = vec![t.frame.as_entire_binding()];
         resources.extend(atlas.lighting_resources(scene));
         resources.extend(t.gbuffer_resources());
@@ -76,7 +64,7 @@ impl CompositePass {
             label: Some("composite"),
             timestamp_writes: timer.compute("composite"),
         });
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
     }
