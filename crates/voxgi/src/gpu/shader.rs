@@ -42,10 +42,21 @@ const SOURCES: &[(&str, &str)] = wgsl![
 const SHADER_DIR_VAR: &str = "VOXGI_SHADER_DIR";
 
 fn raw(name: &str) -> std::borrow::Cow<'static, str> {
-    if let Some(dir) = std::env::var_os(SHADER_DIR_VAR)
-        && let Ok(text) = std::fs::read_to_string(std::path::Path::new(&dir).join(name))
-    {
-        return text.into();
+    if let Some(dir) = std::env::var_os(SHADER_DIR_VAR) {
+        let dir = std::path::Path::new(&dir);
+        if let Ok(text) = std::fs::read_to_string(dir.join(name)) {
+            log::info!("shader {name} read from {}", dir.display());
+            return text.into();
+        }
+        if !dir.is_dir() {
+            static WARNED: std::sync::Once = std::sync::Once::new();
+            WARNED.call_once(|| {
+                log::warn!(
+                    "{SHADER_DIR_VAR}={} is not a directory: using the built-in shaders",
+                    dir.display()
+                )
+            });
+        }
     }
     SOURCES
         .iter()
