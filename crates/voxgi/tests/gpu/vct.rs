@@ -214,24 +214,25 @@ fn mean_indirect_is_consistent_between_64_and_256() {
     assert!(rel(l, h) < 0.10, "64³ {l} vs 256³ {h}");
 }
 
+/// Mean indirect radiance of the Cornell box at 32³ and 32×32, one bounce, with `change`
+/// applied to the settings.
+fn cornell_mean_indirect(change: impl FnOnce(&mut Settings)) -> f32 {
+    let scene = builtin::cornell_box();
+    let mut s = vct(ViewMode::Indirect, 32, 1);
+    change(&mut s);
+    let m = render(&scene, s, &scene.cameras[0], 32, 32).mean_radiance();
+    (m[0] + m[1] + m[2]) / 3.0
+}
+
 #[test]
 fn isotropic_mode_keeps_about_half_the_indirect_light() {
-    let scene = builtin::cornell_box();
-    let cam = scene.cameras[0].clone();
-    let mean_indirect = |anisotropic: bool| {
-        let s = Settings {
-            anisotropic,
-            ..vct(ViewMode::Indirect, 32, 1)
-        };
-        let m = render(&scene, s, &cam, 32, 32).mean_radiance();
-        (m[0] + m[1] + m[2]) / 3.0
-    };
-    let (iso, aniso) = (mean_indirect(false), mean_indirect(true));
+    let iso = cornell_mean_indirect(|s| s.anisotropic = false);
+    let aniso = cornell_mean_indirect(|_| {});
     eprintln!("mean indirect: isotropic {iso}, anisotropic {aniso}");
     // An isotropic voxel averages a wall's lit face with its unlit views, so cones see about
-    // half the light (measured 0.58, the same to 1e-4 with the one-fetch isotropic pipeline and the
-    // three-fetch run-time path it replaces). A fetch from the wrong block would read another
-    // direction's data or nothing: far outside 0.4..0.65.
+    // half the light (measured 0.58, the same to 1e-4 with the one-fetch isotropic pipeline
+    // and the three-fetch run-time path it replaces). A fetch from the wrong block would read
+    // another direction's data or nothing: far outside 0.4..0.65.
     let ratio = iso / aniso;
     assert!(
         (0.4..0.65).contains(&ratio),
@@ -241,18 +242,8 @@ fn isotropic_mode_keeps_about_half_the_indirect_light() {
 
 #[test]
 fn two_gather_axes_keep_the_indirect_light() {
-    let scene = builtin::cornell_box();
-    let cam = scene.cameras[0].clone();
-    let indirect = |gather_axes: u32| {
-        let s = Settings {
-            gather_axes,
-            ..vct(ViewMode::Indirect, 32, 1)
-        };
-        render(&scene, s, &cam, 32, 32)
-    };
-    let (three, two) = (indirect(3), indirect(2));
-    let lum = |o: &voxgi::RenderOutput| o.mean_radiance().iter().sum::<f32>() / 3.0;
-    let (l3, l2) = (lum(&three), lum(&two));
+    let l3 = cornell_mean_indirect(|s| s.gather_axes = 3);
+    let l2 = cornell_mean_indirect(|s| s.gather_axes = 2);
     eprintln!("mean indirect: 3 axes {l3}, 2 axes {l2}");
     // Dropping the axis of least weight (at most a third) moves the mean by about 1 % (the
     // furnace after one bounce: 1.496 with three, 1.490 with two); a wrong block or weight
