@@ -18,7 +18,7 @@ use crate::passes::bounce::BouncePass;
 use crate::passes::composite::{CompositePass, HDR_FORMAT};
 use crate::passes::debug::DebugPass;
 use crate::passes::filter::FilterPass;
-use crate::passes::gather::{GUIDE_FORMAT, GatherPass, INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::passes::gather::{self, GUIDE_FORMAT, GatherPass, INDIRECT_FORMAT, VISIBILITY_FORMAT};
 use crate::passes::gbuffer::{self, GbufferPass};
 use crate::passes::inject::InjectPass;
 use crate::passes::shadow::{self, ShadowAtlas, ShadowPass};
@@ -318,7 +318,11 @@ impl Renderer {
                 InjectPass::new(&device, gpu_scene.light_count),
                 FilterPass::new(&device),
                 BouncePass::new(&device, settings.anisotropic),
-                GatherPass::new(&device, settings.anisotropic, settings.gather_axes),
+                GatherPass::new(
+                    &device,
+                    &settings,
+                    gather::has_glossy(scene, gpu_scene.point_count),
+                ),
                 UpsamplePass::new(&device),
                 DenseVolume::new(&device, grid, settings.anisotropic, capacity, slots),
                 triangle_table(&device, &gpu_scene),

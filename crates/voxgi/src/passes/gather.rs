@@ -6,7 +6,9 @@ use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::passes::composite::specialized_pipeline;
+use crate::settings::Settings;
 use crate::voxel::dense::DenseVolume;
+use voxgi_scene::Scene;
 
 pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Cone-traced visibility of up to four area lights.
@@ -15,13 +17,24 @@ pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Uno
 /// the camera (a; 0 for background).
 pub const GUIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
+/// Whether anything on screen can have a specular lobe: a material with specular or metallic
+/// reflectance, or a point cloud (surfels shade with half the dielectric specular).
+pub fn has_glossy(scene: &Scene, point_count: u32) -> bool {
+    point_count > 0
+        || scene
+            .materials
+            .iter()
+            .any(|m| m.specular > 0.0 || m.metallic > 0.0)
+}
+
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 impl GatherPass {
-    pub fn new(device: &wgpu::Device, anisotropic: bool, axes: u32) -> Self {
+    /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
+    pub fn new(device: &wgpu::Device, settings: &Settings, glossy: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![
             layout::uniform(0, c, false),
@@ -40,14 +53,11 @@ impl GatherPass {
             label: Some("gather"),
             entries: &entries,
         });
+        let [iso, axes] =
+            DenseVolume::sampling_constants(settings.anisotropic, settings.gather_axes);
+        let constants = [iso, axes, ("GLOSSY", f64::from(u8::from(glossy)))];
         GatherPass {
-            pipeline: specialized_pipeline(
-                device,
-                "gather",
-                "gather.wgsl",
-                &layout,
-                &DenseVolume::sampling_constants(anisotropic, axes),
-            ),
+            pipeline: specialized_pipeline(device, "gather", "gather.wgsl", &layout, &constants),
             layout,
         }
     }
