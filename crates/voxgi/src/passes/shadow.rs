@@ -472,3 +472,62 @@ impl ShadowPass {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn light(kind: u32, direction: [f32; 3]) -> GpuLight {
+        GpuLight {
+            kind,
+            position: [0.0, 1.0, 0.0],
+            direction,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn only_cone_shadowed_area_lights_skip_the_shadow_maps() {
+        let rect = light(LIGHT_RECT, [0.0, -1.0, 0.0]);
+        let disc = light(LIGHT_DISC, [0.0, -1.0, 0.0]);
+        let point = light(LIGHT_POINT, [0.0, -1.0, 0.0]);
+        assert!(!composite_reads_shadow_maps(&[rect, disc], true));
+        assert!(composite_reads_shadow_maps(&[rect, disc], false));
+        // A point light keeps its shadow map beside cone-shadowed area lights.
+        assert!(composite_reads_shadow_maps(&[rect, point], true));
+        // Only the first CONE_SHADOW_LIGHTS area lights get a cone.
+        assert!(composite_reads_shadow_maps(
+            &[rect; CONE_SHADOW_LIGHTS + 1],
+            true
+        ));
+        let settings = |cone_shadows| Settings {
+            cone_shadows,
+            voxel_resolution: 64,
+            ..Settings::default()
+        };
+        assert_eq!(atlas_resolution(&settings(true), &[rect]), 256);
+        assert_eq!(atlas_resolution(&settings(false), &[rect]), 1024);
+        assert_eq!(atlas_resolution(&settings(true), &[rect, point]), 1024);
+    }
+
+    #[test]
+    fn a_down_facing_emitter_skips_only_its_upward_cube_face() {
+        let mut lights = [light(LIGHT_RECT, [0.0, -1.0, 0.0])];
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        let skipped: Vec<[f32; 3]> = views
+            .iter()
+            .filter(|v| behind_emitter(v))
+            .map(|v| v.dir)
+            .collect();
+        assert_eq!(skipped, vec![[0.0, 1.0, 0.0]]);
+        // A point light sees all round: no face is skipped.
+        let mut lights = [light(LIGHT_POINT, [0.0, -1.0, 0.0])];
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        assert!(views.iter().all(|v| !behind_emitter(v)));
+        // A tilted emitter sees a little of every side face, so none is skipped but the back.
+        let d = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let mut lights = [light(LIGHT_RECT, d.to_array())];
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        assert_eq!(views.iter().filter(|v| behind_emitter(v)).count(), 1);
+    }
+}
