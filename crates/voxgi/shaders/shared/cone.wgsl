@@ -19,8 +19,7 @@ fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32) -> f3
 }
 
 fn outside_volume(p: vec3<f32>) -> bool {
-    let u = (p - vol.origin) / (vol.voxel_size * f32(vol.resolution));
-    return any(u < vec3<f32>(0.0)) || any(u > vec3<f32>(1.0));
+    return !inside_volume(volume_uvw(p));
 }
 
 // A narrowed sample covers less: step no further than its filter reaches, so thin walls are

@@ -17,24 +17,29 @@ const WIDE_SAMPLE: f32 = 2.0;
 
 // Optical depth per sample diameter: (L sigma, sigma).
 fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
-    let extent = vol.voxel_size * f32(vol.resolution);
-    let uvw = (pos - vol.origin) / extent;
-    // Outside the volume there is nothing (no clamp-to-border sampler in core WebGPU).
-    let inside = all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0));
+    let uvw = volume_uvw(pos);
     let lod = clamp(log2(max(diameter / vol.voxel_size, 1.0)), 0.0, f32(vol.levels - 1u));
     let fine = textureSampleLevel(radiance0, voxel_sampler, uvw, 0.0);
     let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir);
     // Only between the finest level and the first coarse one is the finest level read.
-    return select(vec4<f32>(0.0), mix(fine, coarse, min(lod, 1.0)), inside);
+    return select(vec4<f32>(0.0), mix(fine, coarse, min(lod, 1.0)), inside_volume(uvw));
 }
 
 // sample_depth for a diameter of at least WIDE_SAMPLE voxels.
 fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
-    let extent = vol.voxel_size * f32(vol.resolution);
-    let uvw = (pos - vol.origin) / extent;
-    let inside = all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0));
+    let uvw = volume_uvw(pos);
     let lod = clamp(log2(diameter / vol.voxel_size), 1.0, f32(vol.levels - 1u));
-    return select(vec4<f32>(0.0), sample_chains(uvw, lod - 1.0, dir), inside);
+    return select(vec4<f32>(0.0), sample_chains(uvw, lod - 1.0, dir), inside_volume(uvw));
+}
+
+// Texture coordinates of a world position over the whole volume.
+fn volume_uvw(pos: vec3<f32>) -> vec3<f32> {
+    return (pos - vol.origin) / (vol.voxel_size * f32(vol.resolution));
+}
+
+// Outside the volume there is nothing (no clamp-to-border sampler in core WebGPU).
+fn inside_volume(uvw: vec3<f32>) -> bool {
+    return all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0));
 }
 
 // True when the pipeline serves an isotropic volume: each sample then makes one fetch, not

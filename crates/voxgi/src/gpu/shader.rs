@@ -96,6 +96,43 @@ pub fn module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
     })
 }
 
+/// A compute pipeline whose label is the pass name, from the WGSL file's `main`.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    layout: &wgpu::BindGroupLayout,
+) -> wgpu::ComputePipeline {
+    specialized_pipeline(device, label, file, layout, &[])
+}
+
+/// `compute_pipeline` with values for the shader's `override` constants.
+pub fn specialized_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    layout: &wgpu::BindGroupLayout,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    let module = module(device, file);
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
+        cache: None,
+    })
+}
+
 /// The names of all pass shaders (for tests that validate every one).
 pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
     SOURCES

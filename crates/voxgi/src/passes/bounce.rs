@@ -3,8 +3,8 @@
 //! and written in one).
 
 use crate::gpu::layout;
+use crate::gpu::shader::{compute_pipeline, specialized_pipeline};
 use crate::gpu::timer::GpuTimer;
-use crate::passes::composite::{compute_pipeline, specialized_pipeline};
 use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
 
 pub struct BouncePass {

@@ -1,8 +1,9 @@
 //! composite: deferred shading of direct light and emission into the HDR target.
 
 use crate::frame::FrameTargets;
+use crate::gpu::layout;
+use crate::gpu::shader::specialized_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::passes::shadow::ShadowAtlas;
 
@@ -68,41 +69,4 @@ impl CompositePass {
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
     }
-}
-
-/// A compute pipeline whose label is the pass name, from the WGSL file's `main`.
-pub fn compute_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    file: &str,
-    layout: &wgpu::BindGroupLayout,
-) -> wgpu::ComputePipeline {
-    specialized_pipeline(device, label, file, layout, &[])
-}
-
-/// `compute_pipeline` with values for the shader's `override` constants.
-pub fn specialized_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    file: &str,
-    layout: &wgpu::BindGroupLayout,
-    constants: &[(&str, f64)],
-) -> wgpu::ComputePipeline {
-    let module = shader::module(device, file);
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(layout)],
-        immediate_size: 0,
-    });
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(&pipeline_layout),
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: wgpu::PipelineCompilationOptions {
-            constants,
-            ..Default::default()
-        },
-        cache: None,
-    })
 }

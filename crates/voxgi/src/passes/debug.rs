@@ -4,8 +4,9 @@
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
+use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::composite::{HDR_FORMAT, compute_pipeline};
+use crate::passes::composite::HDR_FORMAT;
 use crate::settings::ViewMode;
 use crate::voxel::dense::DenseVolume;
 use wgpu::util::DeviceExt;

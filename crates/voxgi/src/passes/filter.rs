@@ -1,8 +1,8 @@
 //! filter: the volume's mip levels above the finest, isotropic or six-directional.
 
 use crate::gpu::layout;
+use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::composite::compute_pipeline;
 use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT, mip_view};
 use wgpu::util::DeviceExt;
 

@@ -3,9 +3,9 @@
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
+use crate::gpu::shader::specialized_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::composite::specialized_pipeline;
 use crate::settings::Settings;
 use crate::voxel::dense::DenseVolume;
 use voxgi_scene::Scene;

@@ -1,9 +1,9 @@
 //! inject: direct light and emission into the finest voxels.
 
 use crate::gpu::layout;
+use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::composite::compute_pipeline;
 use crate::passes::shadow::ShadowAtlas;
 use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
 use wgpu::util::DeviceExt;

@@ -2,8 +2,8 @@
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
+use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::composite::compute_pipeline;
 
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 

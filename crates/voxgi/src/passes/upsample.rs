@@ -3,8 +3,8 @@
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
+use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::composite::compute_pipeline;
 use crate::passes::gather::{INDIRECT_FORMAT, VISIBILITY_FORMAT};
 
 pub struct UpsamplePass {

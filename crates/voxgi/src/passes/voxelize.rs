@@ -34,12 +34,8 @@ impl VoxelizePass {
                 layout::storage(10, c, false),
             ],
         });
-        let pipeline = crate::passes::composite::compute_pipeline(
-            device,
-            "voxelize",
-            "voxelize.wgsl",
-            &layout,
-        );
+        let pipeline =
+            crate::gpu::shader::compute_pipeline(device, "voxelize", "voxelize.wgsl", &layout);
         VoxelizePass { pipeline, layout }
     }
 

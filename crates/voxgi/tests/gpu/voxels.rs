@@ -163,12 +163,7 @@ fn voxelize_matches_cpu_exactly() {
 /// this test guards the real GPUs the suite is also run on.
 #[test]
 fn walls_on_voxel_faces_leave_no_holes() {
-    let scene = builtin::cornell_box();
-    let settings = Settings {
-        voxel_resolution: 256,
-        ..measuring()
-    };
-    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    let mut r = cornell(256, true);
     let cam = r.default_camera().clone();
     r.render(&cam, 8, 8).expect("render");
     let (gpu, _) = occupied(&r);
@@ -304,14 +299,18 @@ fn check_filter_step(
     (n * n * n, partial)
 }
 
-fn check_filtering(anisotropic: bool) {
-    let scene = builtin::cornell_box();
+/// A measuring renderer of the Cornell box at `voxel_resolution`.
+fn cornell(voxel_resolution: u32, anisotropic: bool) -> Renderer {
     let settings = Settings {
-        voxel_resolution: 16,
+        voxel_resolution,
         anisotropic,
         ..measuring()
     };
-    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    Renderer::new(ctx(), &builtin::cornell_box(), settings).expect("renderer")
+}
+
+fn check_filtering(anisotropic: bool) {
+    let mut r = cornell(16, anisotropic);
     let cam = r.default_camera().clone();
     r.render(&cam, 16, 16).expect("render");
     let vol = r.volume();
@@ -385,12 +384,7 @@ fn voxel_view(r: &mut Renderer, view: ViewMode, level: u32, dir: u32) -> voxgi::
 
 #[test]
 fn voxel_debug_views_are_plausible() {
-    let scene = builtin::cornell_box();
-    let settings = Settings {
-        voxel_resolution: 32,
-        ..measuring()
-    };
-    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    let mut r = cornell(32, true);
     let (c, mid) = (SIZE / 2, SIZE / 2);
     // Seen from the standard camera, the red wall is on the left, the green one on the right.
     let (left, right) = (SIZE / 10, SIZE - 1 - SIZE / 10);
