@@ -3,6 +3,7 @@
 
 //!include shared/scene.wgsl
 //!include shared/lights.wgsl
+//!include shared/upsample.wgsl
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
@@ -13,10 +14,12 @@
 @group(0) @binding(6) var gb_emission: texture_2d<f32>;
 @group(0) @binding(7) var gb_depth: texture_depth_2d;
 @group(0) @binding(8) var hdr: texture_storage_2d<rgba32float, write>;
-// rgb: indirect radiance, a: ambient occlusion (from the gather pass).
+// At the gather's resolution: rgb indirect radiance, a ambient occlusion (upsample stage one).
 @group(0) @binding(9) var indirect: texture_2d<f32>;
-// Cone-traced visibility of the first CONE_SHADOW_LIGHTS area lights (gather pass, upsampled).
+// Cone-traced visibility of the first CONE_SHADOW_LIGHTS area lights, as the gather traced it.
 @group(0) @binding(10) var visibility: texture_2d<f32>;
+// Each gather sample's normal and camera distance.
+@group(0) @binding(11) var guide: texture_2d<f32>;
 
 // False when every light's visibility is cone-traced: the shadow-map code is then compiled
 // out. CPU drivers run a branch's code even when no lane takes it, and the shadow-map lookup
@@ -35,6 +38,37 @@ fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
     let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
     let w = frame.inv_view_proj * ndc;
     return w.xyz / w.w;
+}
+
+struct Upsampled {
+    indirect: vec4<f32>,
+    visibility: vec4<f32>,
+}
+
+// Upsample stage two: the 2x2 gather samples around the pixel (sample c was traced at pixel
+// c * scale), bilinear weights times edge weights, so light and shadow do not bleed across
+// silhouettes and creases. Where no sample shares the pixel's surface, the nearest stands in.
+fn upsampled(px: vec2<u32>, n0: vec3<f32>, d0: f32) -> Upsampled {
+    let low_size = textureDimensions(indirect);
+    let scale = max(u32(frame.size.x) / low_size.x, 1u);
+    let c0 = min(px / scale, low_size - 1u);
+    let f = vec2<f32>(px - c0 * scale) / f32(scale);
+    var ind = vec4<f32>(0.0);
+    var vis = vec4<f32>(0.0);
+    var sum = 0.0;
+    for (var i = 0u; i < 4u; i++) {
+        let o = vec2<u32>(i & 1u, i >> 1u);
+        let c = min(c0 + o, low_size - 1u);
+        let bilinear = select(1.0 - f, f, o == vec2<u32>(1u));
+        let w = bilinear.x * bilinear.y * edge_weight(textureLoad(guide, c, 0), n0, d0);
+        ind += w * textureLoad(indirect, c, 0);
+        vis += w * textureLoad(visibility, c, 0);
+        sum += w;
+    }
+    if sum <= 1e-7 {
+        return Upsampled(textureLoad(indirect, c0, 0), textureLoad(visibility, c0, 0));
+    }
+    return Upsampled(ind / sum, vis / sum);
 }
 
 @compute @workgroup_size(8, 8)
@@ -57,7 +91,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let s = Surface(am.rgb, am.a, nr.w, em.a);
 
     var direct = vec3<f32>(0.0);
-    let vis = textureLoad(visibility, px, 0);
+    let up = upsampled(px, n, length(frame.camera_pos - p));
+    let vis = up.visibility;
     var area = 0u;
     for (var i = 0u; i < frame.light_count; i++) {
         let light = lights[i];
@@ -78,7 +113,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         direct += c * w;
     }
-    let ind = textureLoad(indirect, px, 0);
+    let ind = up.indirect;
     var out = direct + em.rgb + ind.rgb;
     switch frame.view_mode {
         case VIEW_ALBEDO: {

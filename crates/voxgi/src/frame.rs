@@ -46,13 +46,13 @@ pub struct FrameTargets {
     pub depth: wgpu::TextureView,
     pub hdr: wgpu::TextureView,
     pub ldr: wgpu::TextureView,
-    /// Indirect light at full resolution (rgb) and ambient occlusion (a).
+    /// Indirect light (rgb) and ambient occlusion (a) at the gather's resolution, every
+    /// pixel's interleaved samples filtered together (`upsample`); the composite upsamples it.
     pub indirect: wgpu::TextureView,
     /// The gather's target, at full or half resolution; `upsample` filters it into `indirect`.
     pub indirect_low: wgpu::TextureView,
-    /// Cone-traced visibility of the first four area lights (one channel each), at full
-    /// resolution and as the gather traced it.
-    pub visibility: wgpu::TextureView,
+    /// Cone-traced visibility of the first four area lights (one channel each), as the gather
+    /// traced it.
     pub visibility_low: wgpu::TextureView,
     /// Normal and camera distance of each gather pixel (the upsample's edge weights).
     pub guide_low: wgpu::TextureView,
@@ -105,9 +105,8 @@ impl FrameTargets {
             normal: view(make("gbuffer normal", gbuffer::NORMAL_FORMAT, rt)),
             emission: view(make("gbuffer emission", gbuffer::EMISSION_FORMAT, rt)),
             depth: view(make("gbuffer depth", gbuffer::DEPTH_FORMAT, rt)),
-            indirect: view(make("indirect", INDIRECT_FORMAT, st)),
+            indirect: view(low("indirect", INDIRECT_FORMAT)),
             indirect_low: view(low("indirect gather", INDIRECT_FORMAT)),
-            visibility: view(make("visibility", VISIBILITY_FORMAT, st)),
             visibility_low: view(low("visibility gather", VISIBILITY_FORMAT)),
             guide_low: view(low("gather guide", GUIDE_FORMAT)),
             half,
@@ -118,8 +117,16 @@ impl FrameTargets {
         }
     }
 
-    /// Bytes per pixel of all full-resolution targets together.
-    pub const BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4 + 8 + 8 + 4 + 4 + 8;
+    /// Bytes per pixel of the full-resolution targets (g-buffer, HDR, LDR) and of those at the
+    /// gather's resolution (gathered and filtered indirect light, visibility, guide).
+    const FULL_BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16 + 4;
+    const LOW_BYTES_PER_PIXEL: u64 = 8 + 8 + 4 + 8;
+
+    pub fn bytes(&self) -> u64 {
+        let (lw, lh) = self.gather_size();
+        self.width as u64 * self.height as u64 * Self::FULL_BYTES_PER_PIXEL
+            + lw as u64 * lh as u64 * Self::LOW_BYTES_PER_PIXEL
+    }
 
     /// Four consecutive bindings from `first` for the passes that shade from the g-buffer:
     /// albedo, normal and emission (loaded) and depth.
@@ -399,10 +406,7 @@ impl Renderer {
         m.push(("shadow atlas", self.atlas.bytes()));
         m.extend(self.volume.memory());
         if let Some(t) = &self.targets {
-            m.push((
-                "render targets",
-                t.width as u64 * t.height as u64 * FrameTargets::BYTES_PER_PIXEL,
-            ));
+            m.push(("render targets", t.bytes()));
         }
         m
     }

@@ -20,6 +20,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/cone.wgsl",
     "shared/surfel.wgsl",
     "shared/interleave.wgsl",
+    "shared/upsample.wgsl",
     "shadow.wgsl",
     "gbuffer.wgsl",
     "voxelize.wgsl",

@@ -1,4 +1,5 @@
-//! composite: deferred shading of direct light and emission into the HDR target.
+//! composite: deferred shading of direct light and emission into the HDR target, with the
+//! indirect light and cone-traced visibility upsampled from the gather's resolution.
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
@@ -26,6 +27,7 @@ impl CompositePass {
             layout::storage_texture(8, HDR_FORMAT),
             layout::texture_2d_load(9, c),
             layout::texture_2d_load(10, c),
+            layout::texture_2d_load(11, c),
         ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
@@ -54,7 +56,8 @@ impl CompositePass {
         resources.extend([
             wgpu::BindingResource::TextureView(&t.hdr),
             wgpu::BindingResource::TextureView(&t.indirect),
-            wgpu::BindingResource::TextureView(&t.visibility),
+            wgpu::BindingResource::TextureView(&t.visibility_low),
+            wgpu::BindingResource::TextureView(&t.guide_low),
         ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),

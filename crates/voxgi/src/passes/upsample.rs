@@ -1,11 +1,13 @@
-//! upsample: the gather's interleaved samples (full or half resolution) to full-resolution
-//! indirect light and area-light visibility, edge-aware.
+//! upsample, stage one of two: the gather's interleaved samples filtered at the gather's own
+//! resolution (full or half), edge-aware, so each holds every rotation of the cone bundle. The
+//! composite finishes the upsample with an edge-aware 2x2 filter at full resolution (joint
+//! bilateral upsampling): the wide window runs on a quarter of the pixels at half resolution.
 
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::gather::{INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::passes::gather::INDIRECT_FORMAT;
 
 pub struct UpsamplePass {
     pipeline: wgpu::ComputePipeline,
@@ -21,16 +23,7 @@ impl UpsamplePass {
                 layout::uniform(0, c, false),
                 layout::texture_2d_load(1, c),
                 layout::texture_2d_load(2, c),
-                layout::texture(
-                    3,
-                    c,
-                    wgpu::TextureSampleType::Depth,
-                    wgpu::TextureViewDimension::D2,
-                ),
-                layout::storage_texture(4, INDIRECT_FORMAT),
-                layout::texture_2d_load(5, c),
-                layout::storage_texture(6, VISIBILITY_FORMAT),
-                layout::texture_2d_load(7, c),
+                layout::storage_texture(3, INDIRECT_FORMAT),
             ],
         });
         UpsamplePass {
@@ -46,19 +39,14 @@ impl UpsamplePass {
         t: &FrameTargets,
         timer: &mut GpuTimer,
     ) {
-        let low = &t.indirect_low;
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("upsample"),
             layout: &self.layout,
             entries: &layout::entries(vec![
                 t.frame.as_entire_binding(),
-                wgpu::BindingResource::TextureView(low),
-                wgpu::BindingResource::TextureView(&t.normal),
-                wgpu::BindingResource::TextureView(&t.depth),
-                wgpu::BindingResource::TextureView(&t.indirect),
-                wgpu::BindingResource::TextureView(&t.visibility_low),
-                wgpu::BindingResource::TextureView(&t.visibility),
+                wgpu::BindingResource::TextureView(&t.indirect_low),
                 wgpu::BindingResource::TextureView(&t.guide_low),
+                wgpu::BindingResource::TextureView(&t.indirect),
             ]),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -67,6 +55,7 @@ impl UpsamplePass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+        let (w, h) = t.gather_size();
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
 }
