@@ -327,6 +327,7 @@ impl Renderer {
                 BouncePass::new(&device, settings.anisotropic),
                 GatherPass::new(
                     &device,
+                    &queue,
                     &settings,
                     gather::has_glossy(scene, gpu_scene.point_count),
                 ),

@@ -9,6 +9,7 @@
 //! # Ok::<(), voxgi::Error>(())
 //! ```
 
+pub mod brdf;
 pub mod compare;
 mod error;
 mod frame;

@@ -223,26 +223,21 @@ fn reference_ao_at_the_foot_of_a_wall_is_one_half() {
     );
 }
 
-/// The shared BRDF (shaders/shared/brdf.wgsl) on the CPU, grey, in f64.
+/// The shared BRDF (shaders/shared/brdf.wgsl) on the CPU, grey, in f64: Lambert plus the
+/// specular lobe of `voxgi::brdf`.
 fn brdf(albedo: f64, metallic: f64, roughness: f64, n_dot_v: f64, l: [f64; 3], v: [f64; 3]) -> f64 {
-    let n_dot_l = l[2];
+    use voxgi::brdf::{d_ggx, ggx_alpha, v_smith};
     let h = {
         let s = [v[0] + l[0], v[1] + l[1], v[2] + l[2]];
         let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
         [s[0] / len, s[1] / len, s[2] / len]
     };
-    let a = roughness.clamp(0.045, 1.0).powi(2);
-    let a2 = a * a;
-    let n_dot_h = h[2];
-    let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
-    let dist = a2 / (std::f64::consts::PI * d * d);
-    let gv = n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt();
-    let gl = n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt();
-    let vis = 0.5 / (gv + gl);
+    let a = ggx_alpha(roughness);
     let f0 = 0.04 * (1.0 - metallic) + albedo * metallic;
     let v_dot_h = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
     let f = f0 + (1.0 - f0) * (1.0 - v_dot_h).powi(5);
-    albedo * (1.0 - metallic) / std::f64::consts::PI + dist * vis * f
+    albedo * (1.0 - metallic) / std::f64::consts::PI
+        + d_ggx(h[2], a) * v_smith(n_dot_v, l[2], a) * f
 }
 
 #[test]

@@ -424,3 +424,35 @@ fn half_resolution_gather_matches_full_and_keeps_edges() {
         "half vs full on edges: relative RMS {edge_rms}"
     );
 }
+
+#[test]
+fn a_glossy_floor_in_a_glowing_box_reflects_its_directional_albedo() {
+    // A closed metal box whose every wall emits radiance 1 (the furnace, made glossy): the
+    // metal reflects nothing diffusely, so the floor's indirect light is all the glossy
+    // cone's, and whatever direction the cone takes it sees radiance 1. The floor then reflects
+    // the lobe's directional albedo: f0 a + f90 b of `brdf::specular_albedo`.
+    let f0 = 0.8f32;
+    for roughness in [0.2f32, 0.5] {
+        let mut scene = builtin::closed_box(f0, 1.0);
+        for m in &mut scene.materials {
+            m.metallic = 1.0;
+            m.roughness = roughness;
+        }
+        // A narrow view of the floor's centre at 60 degrees from its normal: n.v = 0.5.
+        let theta = 60f32.to_radians();
+        let eye = Vec3::new(0.0, 0.5 * theta.cos(), 0.5 * theta.sin());
+        let cam = Camera::look_at(eye, Vec3::ZERO, 2.0);
+        let out = render(&scene, vct(ViewMode::Indirect, 32, 1), &cam, 8, 8);
+        let got = out.mean_radiance()[0];
+        let [a, b] = voxgi::brdf::specular_albedo(0.5, roughness as f64, 64);
+        let want = (f0 as f64 * a + b) as f32;
+        eprintln!("glossy furnace, roughness {roughness}: {got} (directional albedo {want})");
+        // Measured 0.4 % and 1.4 % low: the table's interpolation and fp16 storage, and the
+        // emitters' 0.999 opacity cap. 3 % allows other drivers; Karis's analytic fit, used
+        // before the table, is 10 % and 16 % low here.
+        assert!(
+            rel(got, want) < 0.03,
+            "roughness {roughness}: {got} vs {want}"
+        );
+    }
+}
