@@ -20,11 +20,21 @@
 @group(0) @binding(10) var visibility: texture_2d<f32>;
 // Each gather sample's normal and camera distance.
 @group(0) @binding(11) var guide: texture_2d<f32>;
+// Over (n.v, roughness): the inverse matrices of the linearly transformed cosines fitted to the
+// GGX lobe (m00, m02, m20, m22, with m11 = 1; tools/fit_ltc.py; f32, interpolated here), and
+// the lobe's directional albedo (a, b: f0 a + f90 b), both from voxgi::brdf.
+@group(0) @binding(12) var ltc_table: texture_2d<f32>;
+@group(0) @binding(13) var specular_table: texture_2d<f32>;
+@group(0) @binding(14) var table_sampler: sampler;
 
 // False when every light's visibility is cone-traced: the shadow-map code is then compiled
 // out. CPU drivers run a branch's code even when no lane takes it, and the shadow-map lookup
 // left in an untaken branch nearly doubled this pass on lavapipe.
 override SHADOW_MAPS: bool = true;
+
+// False when no surface has a specular lobe: the area lights' specular integral is then
+// compiled out (as SHADOW_MAPS, for CPU drivers).
+override SPECULAR: bool = true;
 
 const VIEW_FINAL: u32 = 0u;
 const VIEW_ALBEDO: u32 = 1u;
@@ -70,6 +80,70 @@ fn upsampled(px: vec2<u32>, n0: vec3<f32>, d0: f32) -> Upsampled {
     }
     return Upsampled(ind / sum, vis / sum);
 }
+
+// The LTC table bilinearly interpolated between texel centres, as the sampler would.
+fn ltc_entries(uv: vec2<f32>) -> vec4<f32> {
+    let size = vec2<i32>(textureDimensions(ltc_table));
+    let x = clamp(uv * vec2<f32>(size) - 0.5, vec2<f32>(0.0), vec2<f32>(size - 1));
+    let i = vec2<i32>(floor(x));
+    let f = x - vec2<f32>(i);
+    let j = min(i + 1, size - 1);
+    let top = mix(textureLoad(ltc_table, i, 0), textureLoad(ltc_table, vec2<i32>(j.x, i.y), 0), f.x);
+    let bottom = mix(textureLoad(ltc_table, vec2<i32>(i.x, j.y), 0), textureLoad(ltc_table, j, 0), f.x);
+    return mix(top, bottom, f.y);
+}
+
+// The GGX lobe's reflection of a uniform polygonal light (unit radiance times the light's),
+// by linearly transformed cosines (Heitz, Dupuy, Hill and Neubelt 2016): the lobe's shape is
+// a cosine distribution mapped by a matrix fitted per (n.v, roughness), so its integral over
+// the polygon is the Lambert formula over the polygon mapped back by the inverse matrix, and
+// the Fresnel-weighted directional albedo scales it.
+fn area_specular(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let f0 = f0_of(s);
+    let n_dot_v = max(dot(n, v), 1e-4);
+    let uv = vec2<f32>(n_dot_v, s.roughness);
+    let t = ltc_entries(uv);
+    let ab = textureSampleLevel(specular_table, table_sampler, uv, 0.0).rg;
+    let f90 = clamp(50.0 * max(f0.r, max(f0.g, f0.b)), 0.0, 1.0);
+    // The fit's frame: z the normal, x towards the view (any tangent when looking straight on).
+    let tv = v - n * dot(n, v);
+    let x = select(tangent_frame(n)[0], tv / max(length(tv), 1e-8), dot(tv, tv) > 1e-10);
+    let to_frame = transpose(mat3x3<f32>(x, cross(n, x), n));
+    let minv = mat3x3<f32>(vec3<f32>(t.x, 0.0, t.z), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(t.y, 0.0, t.w));
+    let integral = polygon_integral(light, p, minv * to_frame) / PI;
+    return (f0 * ab.x + vec3<f32>(f90 * ab.y)) * light.radiance * integral;
+}
+
+// Outgoing radiance towards v from one light, unshadowed: the caller multiplies by a
+// visibility (`light_visibility`, or a cone-traced one) where this is not zero, so that no
+// shadow lookup is paid for pixels a light cannot reach.
+fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    if is_area_light(light) {
+        // One-sided emitter: nothing behind its plane is lit.
+        if dot(p - light.position, light.direction) <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        let e = polygon_irradiance(light, p, n);
+        if e <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        var spec = vec3<f32>(0.0);
+        if SPECULAR {
+            spec = area_specular(light, s, p, n, v);
+        }
+        return brdf_diffuse(s) * light.radiance * e + spec;
+    }
+
+    let ls = punctual_light(light, p);
+    let l = ls.l;
+    let e = ls.e;
+    let n_dot_l = dot(n, l);
+    if n_dot_l <= 0.0 || all(e <= vec3<f32>(0.0)) {
+        return vec3<f32>(0.0);
+    }
+    return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l;
+}
+
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -249,16 +249,6 @@ fn visible(p: vec3<f32>, ng: vec3<f32>, dir: vec3<f32>, dist: f32) -> bool {
 // ---------------------------------------------------------------------------------------------
 // Sampling.
 
-fn tangent_frame(n: vec3<f32>) -> mat3x3<f32> {
-    // Duff et al. 2017, "Building an Orthonormal Basis, Revisited".
-    let s = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    let t = vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
-    let bt = vec3<f32>(b, s + n.y * n.y * a, -n.y);
-    return mat3x3<f32>(t, bt, n);
-}
-
 fn cosine_hemisphere(u: vec2<f32>) -> vec3<f32> {
     let r = sqrt(u.x);
     let phi = 2.0 * PI * u.y;

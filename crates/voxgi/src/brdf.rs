@@ -1,7 +1,8 @@
-//! The specular lobe of shaders/shared/brdf.wgsl on the CPU, and its directional albedo: the
-//! fraction of uniform incident radiance the GGX lobe reflects towards a viewer. The gather
-//! scales its glossy cone by it (a table of it, `specular_albedo_table`), so that a glossy
-//! surface in a uniformly bright room reflects exactly what the path tracer computes.
+//! The specular lobe of shaders/shared/brdf.wgsl on the CPU, and the two tables the shaders
+//! read it through (`BrdfTables`): its directional albedo, the fraction of uniform incident
+//! radiance the GGX lobe reflects towards a viewer (the glossy cone's weight and the area
+//! lights' specular magnitude), and the linearly transformed cosines fitted to its shape
+//! (tools/fit_ltc.py), with which the composite integrates it over area lights.
 
 use std::f64::consts::PI;
 
@@ -79,6 +80,89 @@ pub fn specular_albedo_table() -> Vec<[f32; 2]> {
     out
 }
 
+/// The fitted LTC inverse matrices over the same grid as `specular_albedo_table`: per cell
+/// m00, m02, m20, m22 of M^-1 (row-major, m11 = 1, view in the xz plane), little-endian f32.
+const LTC_TABLE: &[u8] = include_bytes!("ltc_table.bin");
+
+/// The tables as textures with the albedo table's bilinear clamp-to-edge sampler.
+pub struct BrdfTables {
+    /// `specular_albedo_table`: (a, b) over (n.v, roughness), fp16, filterable.
+    pub specular_albedo: wgpu::TextureView,
+    /// `LTC_TABLE` in f32: near-mirror lobes seen at grazing angles have entries down to 1e-6,
+    /// below fp16's precision, so the shader interpolates it itself (f32 textures need not be
+    /// filterable).
+    pub ltc: wgpu::TextureView,
+    pub sampler: wgpu::Sampler,
+}
+
+impl BrdfTables {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let albedo: Vec<f32> = specular_albedo_table().into_iter().flatten().collect();
+        let ltc: Vec<f32> = bytemuck::pod_collect_to_vec(LTC_TABLE);
+        debug_assert_eq!(ltc.len(), (TABLE_SIZE * TABLE_SIZE * 4) as usize);
+        BrdfTables {
+            specular_albedo: table_texture(device, queue, "specular albedo", Table::Rg16(&albedo)),
+            ltc: table_texture(device, queue, "ltc", Table::Rgba32(&ltc)),
+            sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("brdf tables"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                ..Default::default()
+            }),
+        }
+    }
+}
+
+enum Table<'a> {
+    Rg16(&'a [f32]),
+    Rgba32(&'a [f32]),
+}
+
+fn table_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    table: Table,
+) -> wgpu::TextureView {
+    use wgpu::util::DeviceExt;
+    let (format, bytes): (_, Vec<u8>) = match table {
+        Table::Rg16(values) => {
+            let texels: Vec<u16> = values
+                .iter()
+                .map(|&x| half::f16::from_f32(x).to_bits())
+                .collect();
+            (
+                wgpu::TextureFormat::Rg16Float,
+                bytemuck::cast_slice(&texels).to_vec(),
+            )
+        }
+        Table::Rgba32(values) => (
+            wgpu::TextureFormat::Rgba32Float,
+            bytemuck::cast_slice(values).to_vec(),
+        ),
+    };
+    let texture = device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: TABLE_SIZE,
+                height: TABLE_SIZE,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &bytes,
+    );
+    texture.create_view(&Default::default())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,6 +209,19 @@ mod tests {
                 ((got - want) / want).abs() < 0.01,
                 "n.v {nv}, roughness {r}, f0 {f0}: {got} vs {want}"
             );
+        }
+    }
+
+    #[test]
+    fn the_ltc_table_holds_a_finite_matrix_per_cell() {
+        let t: Vec<f32> = bytemuck::pod_collect_to_vec(LTC_TABLE);
+        assert_eq!(t.len(), (TABLE_SIZE * TABLE_SIZE * 4) as usize);
+        for (i, m) in t.chunks_exact(4).enumerate() {
+            // m00 and m22 of M^-1 (with m11 = 1) stay positive: the fit's matrices keep the
+            // cosine's orientation and are invertible.
+            assert!(m.iter().all(|x| x.is_finite()), "cell {i}: {m:?}");
+            assert!(m[0] > 0.0 && m[3] > 0.0, "cell {i}: {m:?}");
+            assert!(m[0] * m[3] - m[1] * m[2] > 0.0, "cell {i}: {m:?}");
         }
     }
 

@@ -10,6 +10,7 @@
 //! The voxel passes (and the shadow maps they read) run when the scene changed — on the first
 //! frame, or every frame with `Settings::revoxelize_every_frame`.
 
+use crate::brdf::BrdfTables;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, readback};
 use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
@@ -238,6 +239,7 @@ pub struct Renderer {
     bounce: BouncePass,
     gather: GatherPass,
     upsample: UpsamplePass,
+    brdf_tables: BrdfTables,
     volume: DenseVolume,
     triangles: (wgpu::Buffer, u32),
     cones: wgpu::Buffer,
@@ -299,6 +301,7 @@ impl Renderer {
                         &gpu_scene.gpu_lights,
                         settings.cone_shadows,
                     ),
+                    gather::has_glossy(scene, gpu_scene.point_count),
                 ),
                 TonemapPass::new(&device),
                 DebugPass::new(&device),
@@ -327,7 +330,6 @@ impl Renderer {
                 BouncePass::new(&device, settings.anisotropic),
                 GatherPass::new(
                     &device,
-                    &queue,
                     &settings,
                     gather::has_glossy(scene, gpu_scene.point_count),
                 ),
@@ -336,6 +338,7 @@ impl Renderer {
                 triangle_table(&device, &gpu_scene),
             )
         })?;
+        let brdf_tables = BrdfTables::new(&device, &queue);
         let voxel_bounces = voxel_bounce_count(scene, settings.bounces);
         let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("cones"),
@@ -365,6 +368,7 @@ impl Renderer {
             bounce: voxel_passes.3,
             gather: voxel_passes.4,
             upsample: voxel_passes.5,
+            brdf_tables,
             volume: voxel_passes.6,
             triangles: voxel_passes.7,
             cones,
@@ -604,6 +608,7 @@ impl Renderer {
             &self.scene,
             &self.volume,
             &self.cones,
+            &self.brdf_tables,
             timer,
         );
         self.upsample.record(&self.device, &mut encoder, t, timer);
@@ -613,6 +618,7 @@ impl Renderer {
             t,
             &self.scene,
             &self.atlas,
+            &self.brdf_tables,
             timer,
         );
         // Only for the voxel views: replaces the composite's output.

@@ -189,6 +189,13 @@ pub const NO_INDEX: u32 = u32::MAX;
 /// `CONE_SHADOW_LIGHTS` in shaders/shared/scene.wgsl.
 pub const CONE_SHADOW_LIGHTS: usize = 4;
 
+impl GpuLight {
+    /// A rectangle or disc emitter.
+    pub fn is_area(&self) -> bool {
+        self.kind == LIGHT_RECT || self.kind == LIGHT_DISC
+    }
+}
+
 /// One indexed draw: a mesh instance.
 #[derive(Clone, Debug)]
 pub struct DrawCall {

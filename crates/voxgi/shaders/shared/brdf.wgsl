@@ -55,3 +55,14 @@ fn brdf_specular(s: Surface, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> vec3<f
     return d_ggx(max(dot(n, h), 0.0), a) * v_smith(n_dot_v, n_dot_l, a)
         * f_schlick(f0_of(s), max(dot(v, h), 0.0));
 }
+
+// An orthonormal frame whose third column is n (Duff et al. 2017, "Building an Orthonormal
+// Basis, Revisited"): branchless.
+fn tangent_frame(n: vec3<f32>) -> mat3x3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    let t = vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+    let bt = vec3<f32>(b, s + n.y * n.y * a, -n.y);
+    return mat3x3<f32>(t, bt, n);
+}

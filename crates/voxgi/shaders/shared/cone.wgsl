@@ -1,3 +1,5 @@
+//!include shared/brdf.wgsl
+
 // Cone tracing, written once against the voxel structure's samplers: sample_depth(position,
 // diameter, direction), optical depth (L sigma, sigma) of the volume filtered to `diameter`,
 // and sample_depth_wide, the same for diameters of at least WIDE_SAMPLE voxels (a structure
@@ -96,16 +98,6 @@ fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f
         t += step;
     }
     return occ;
-}
-
-fn tangent_frame(n: vec3<f32>) -> mat3x3<f32> {
-    // Duff et al.'s branchless orthonormal basis.
-    let s = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    let t = vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
-    let bt = vec3<f32>(b, s + n.y * n.y * a, -n.y);
-    return mat3x3<f32>(t, bt, n);
 }
 
 fn rotate_z(v: vec3<f32>, angle: f32) -> vec3<f32> {

@@ -204,111 +204,67 @@ fn polygon_vertex(light: Light, p: vec3<f32>, i: u32) -> vec3<f32> {
 const DISC_SIDES: u32 = 16u;
 
 // Irradiance at p (normal n) from a uniform one-sided polygonal emitter of unit radiance: the
-// Lambert formula E = 1/2 sum_i angle_i (n . unit(v_i x v_i+1)) over the polygon clipped to the
-// upper hemisphere. Exact for unoccluded Lambertian receivers. The clipping (Sutherland-
-// Hodgman) streams its vertices into the sum: no local arrays, which CPU drivers
-// zero-initialise in memory on every call whether or not a pixel clips.
+// Lambert formula over the polygon clipped to the upper hemisphere. Exact for unoccluded
+// Lambertian receivers.
 fn polygon_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    return polygon_integral(light, p, transpose(tangent_frame(n)));
+}
+
+// The Lambert formula E = 1/2 sum_i angle_i (z . unit(v_i x v_i+1)) for the light's polygon
+// relative to p, each vertex mapped by m, clipped to z >= 0: with m a rotation taking n to z,
+// the irradiance; with the inverse of a linearly transformed cosine's matrix (in the frame of
+// n and v), pi times the integral of that distribution over the light. The clipping
+// (Sutherland-Hodgman) streams its vertices into the sum: no local arrays, which CPU drivers
+// zero-initialise in memory on every call whether or not a pixel clips.
+fn polygon_integral(light: Light, p: vec3<f32>, m: mat3x3<f32>) -> f32 {
     if light.kind == LIGHT_RECT {
-        let v0 = normalize(polygon_vertex(light, p, 0u));
-        let v1 = normalize(polygon_vertex(light, p, 1u));
-        let v2 = normalize(polygon_vertex(light, p, 2u));
-        let v3 = normalize(polygon_vertex(light, p, 3u));
-        if min(min(dot(v0, n), dot(v1, n)), min(dot(v2, n), dot(v3, n))) >= 0.0 {
-            return 0.5 * abs(edge_integral(v0, v1, n) + edge_integral(v1, v2, n) + edge_integral(v2, v3, n) + edge_integral(v3, v0, n));
+        let v0 = normalize(m * polygon_vertex(light, p, 0u));
+        let v1 = normalize(m * polygon_vertex(light, p, 1u));
+        let v2 = normalize(m * polygon_vertex(light, p, 2u));
+        let v3 = normalize(m * polygon_vertex(light, p, 3u));
+        if min(min(v0.z, v1.z), min(v2.z, v3.z)) >= 0.0 {
+            return 0.5 * abs(edge_integral(v0, v1) + edge_integral(v1, v2) + edge_integral(v2, v3) + edge_integral(v3, v0));
         }
     }
     let count = select(DISC_SIDES, 4u, light.kind == LIGHT_RECT);
     var sum = 0.0;
     var first = vec3<f32>(0.0);
     var prev = vec3<f32>(0.0);
-    var m = 0u;
-    var b = polygon_vertex(light, p, 0u);
+    var k_out = 0u;
+    var b = m * polygon_vertex(light, p, 0u);
     for (var i = 0u; i < count; i++) {
         let a = b;
-        b = polygon_vertex(light, p, (i + 1u) % count);
-        let da = dot(a, n);
-        let db = dot(b, n);
+        b = m * polygon_vertex(light, p, (i + 1u) % count);
+        let da = a.z;
+        let db = b.z;
         // Up to two vertices per edge: its start if above the horizon, and where it crosses.
         for (var k = 0u; k < 2u; k++) {
             let emit = select((da >= 0.0) != (db >= 0.0), da >= 0.0, k == 0u);
             if emit {
                 let q = normalize(select(a + (b - a) * (da / (da - db)), a, k == 0u));
-                if m == 0u {
+                if k_out == 0u {
                     first = q;
                 } else {
-                    sum += edge_integral(prev, q, n);
+                    sum += edge_integral(prev, q);
                 }
                 prev = q;
-                m++;
+                k_out++;
             }
         }
     }
-    if m < 3u {
+    if k_out < 3u {
         return 0.0;
     }
-    sum += edge_integral(prev, first, n);
+    sum += edge_integral(prev, first);
     return 0.5 * abs(sum);
 }
 
 // One edge's term of the Lambert formula: the angle the edge (a, b unit vectors) subtends
-// times the cosine of its great circle's normal with n.
-fn edge_integral(a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
+// times the cosine of its great circle's normal with z.
+fn edge_integral(a: vec3<f32>, b: vec3<f32>) -> f32 {
     let c = cross(a, b);
     let len = length(c);
-    return select(0.0, atan2(len, dot(a, b)) * dot(c, n) / len, len > 1e-9);
-}
-
-// Outgoing radiance towards v from one light, unshadowed: the caller multiplies by a
-// visibility (`light_visibility`, or a cone-traced one) where this is not zero, so that no
-// shadow lookup is paid for pixels a light cannot reach.
-fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
-    if is_area_light(light) {
-        // One-sided emitter: nothing behind its plane is lit.
-        if dot(p - light.position, light.direction) <= 0.0 {
-            return vec3<f32>(0.0);
-        }
-        let e = polygon_irradiance(light, p, n);
-        if e <= 0.0 {
-            return vec3<f32>(0.0);
-        }
-        // Specular: GGX evaluated towards the point of the light nearest the mirror ray
-        // (representative point), normalised for the lobe widening a light of this size causes.
-        let r = reflect(-v, n);
-        let denom = dot(r, light.direction);
-        var q = light.position;
-        if denom < -1e-4 {
-            let hit = p + r * (dot(light.position - p, light.direction) / denom);
-            let rel = hit - light.position;
-            if light.kind == LIGHT_RECT {
-                let uu = dot(light.axis_u, light.axis_u);
-                let vv = dot(light.axis_v, light.axis_v);
-                let cu = clamp(dot(rel, light.axis_u) / uu, -1.0, 1.0);
-                let cv = clamp(dot(rel, light.axis_v) / vv, -1.0, 1.0);
-                q = light.position + cu * light.axis_u + cv * light.axis_v;
-            } else {
-                let rad = length(light.axis_u);
-                let l = length(rel);
-                q = light.position + rel * min(1.0, rad / max(l, 1e-6));
-            }
-        }
-        let l = normalize(q - p);
-        let dist = length(q - p);
-        let a = ggx_alpha(s.roughness);
-        let a2 = clamp(a + light.size / (2.0 * max(dist, 1e-4)), 0.0, 1.0);
-        let norm = (a / a2) * (a / a2);
-        let spec = brdf_specular(s, n, v, l) * norm;
-        return (brdf_diffuse(s) + spec) * light.radiance * e;
-    }
-
-    let ls = punctual_light(light, p);
-    let l = ls.l;
-    let e = ls.e;
-    let n_dot_l = dot(n, l);
-    if n_dot_l <= 0.0 || all(e <= vec3<f32>(0.0)) {
-        return vec3<f32>(0.0);
-    }
-    return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l;
+    return select(0.0, atan2(len, dot(a, b)) * c.z / len, len > 1e-9);
 }
 
 // Irradiance (W/m^2) arriving at p with normal n from one light, shadows included. Used where

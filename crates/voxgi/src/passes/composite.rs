@@ -1,12 +1,15 @@
 //! composite: deferred shading of direct light and emission into the HDR target, with the
 //! indirect light and cone-traced visibility upsampled from the gather's resolution.
 
+use crate::brdf::BrdfTables;
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::specialized_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::passes::shadow::ShadowAtlas;
+
+const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };
 
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
@@ -18,7 +21,11 @@ pub struct CompositePass {
 impl CompositePass {
     /// `shadow_maps`: whether any light's visibility comes from the shadow maps
     /// (`composite_reads_shadow_maps`); without, the shader is compiled without their lookup.
-    pub fn new(device: &wgpu::Device, shadow_maps: bool) -> Self {
+    /// `specular`: whether any surface has a specular lobe (`gather::has_glossy`); without, the
+    /// area lights' specular integral is compiled out. (Compiling it out also where no light is
+    /// an area light made a glossy emissive box's indirect light read 0 on lavapipe, cause not
+    /// found: kept equal to the gather's GLOSSY.)
+    pub fn new(device: &wgpu::Device, shadow_maps: bool, specular: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
         entries.extend(ShadowAtlas::lighting_layout(c));
@@ -28,12 +35,18 @@ impl CompositePass {
             layout::texture_2d_load(9, c),
             layout::texture_2d_load(10, c),
             layout::texture_2d_load(11, c),
+            layout::texture_2d_load(12, c),
+            layout::texture(13, c, FILTERABLE, wgpu::TextureViewDimension::D2),
+            layout::sampler(14, c),
         ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
             entries: &entries,
         });
-        let constants = [("SHADOW_MAPS", f64::from(u8::from(shadow_maps)))];
+        let constants = [
+            ("SHADOW_MAPS", f64::from(u8::from(shadow_maps))),
+            ("SPECULAR", f64::from(u8::from(specular))),
+        ];
         let pipeline =
             specialized_pipeline(device, "composite", "composite.wgsl", &layout, &constants);
         CompositePass { pipeline, layout }
@@ -48,6 +61,7 @@ impl CompositePass {
         t: &FrameTargets,
         scene: &GpuScene,
         atlas: &ShadowAtlas,
+        tables: &BrdfTables,
         timer: &mut GpuTimer,
     ) {
         let mut resources = vec![t.frame.as_entire_binding()];
@@ -58,6 +72,9 @@ impl CompositePass {
             wgpu::BindingResource::TextureView(&t.indirect),
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),
+            wgpu::BindingResource::TextureView(&tables.ltc),
+            wgpu::BindingResource::TextureView(&tables.specular_albedo),
+            wgpu::BindingResource::Sampler(&tables.sampler),
         ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),

@@ -1,7 +1,7 @@
 //! gather: per-pixel indirect light from the voxels (diffuse cones with AO, glossy cone) and,
 //! with `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
 
-use crate::brdf;
+use crate::brdf::BrdfTables;
 use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::specialized_pipeline;
@@ -10,7 +10,6 @@ use crate::gpu_scene::GpuScene;
 use crate::settings::Settings;
 use crate::voxel::dense::DenseVolume;
 use voxgi_scene::Scene;
-use wgpu::util::DeviceExt;
 
 pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Cone-traced visibility of up to four area lights.
@@ -32,48 +31,11 @@ pub fn has_glossy(scene: &Scene, point_count: u32) -> bool {
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    /// The specular lobe's directional albedo over (n.v, roughness), `brdf::specular_albedo`:
-    /// the glossy cone's weight.
-    specular_albedo: wgpu::TextureView,
-}
-
-/// `brdf::specular_albedo_table` as a filterable texture (two fp16 channels).
-fn specular_albedo_texture(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::TextureView {
-    let size = brdf::TABLE_SIZE;
-    let texels: Vec<u16> = brdf::specular_albedo_table()
-        .iter()
-        .flat_map(|ab| ab.map(|x| half::f16::from_f32(x).to_bits()))
-        .collect();
-    let texture = device.create_texture_with_data(
-        queue,
-        &wgpu::TextureDescriptor {
-            label: Some("specular albedo"),
-            size: wgpu::Extent3d {
-                width: size,
-                height: size,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rg16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        bytemuck::cast_slice(&texels),
-    );
-    texture.create_view(&Default::default())
 }
 
 impl GatherPass {
     /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
-    pub fn new(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        settings: &Settings,
-        glossy: bool,
-    ) -> Self {
+    pub fn new(device: &wgpu::Device, settings: &Settings, glossy: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![
             layout::uniform(0, c, false),
@@ -104,7 +66,6 @@ impl GatherPass {
         GatherPass {
             pipeline: specialized_pipeline(device, "gather", "gather.wgsl", &layout, &constants),
             layout,
-            specular_albedo: specular_albedo_texture(device, queue),
         }
     }
 
@@ -118,6 +79,7 @@ impl GatherPass {
         scene: &GpuScene,
         vol: &DenseVolume,
         cones: &wgpu::Buffer,
+        tables: &BrdfTables,
         timer: &mut GpuTimer,
     ) {
         let views = vol.sampling_views();
@@ -134,7 +96,7 @@ impl GatherPass {
             scene.lights.as_entire_binding(),
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),
-            wgpu::BindingResource::TextureView(&self.specular_albedo),
+            wgpu::BindingResource::TextureView(&tables.specular_albedo),
         ]);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather"),

@@ -212,11 +212,8 @@ pub fn atlas_resolution(settings: &Settings, lights: &[GpuLight]) -> u32 {
 /// Whether the composite looks up shadow maps: not when every light is an area light whose
 /// visibility the gather cone-traces (the first `CONE_SHADOW_LIGHTS` area lights).
 pub fn composite_reads_shadow_maps(lights: &[GpuLight], cone_shadows: bool) -> bool {
-    let cone_traced = cone_shadows
-        && lights.len() <= CONE_SHADOW_LIGHTS
-        && lights
-            .iter()
-            .all(|l| l.kind == LIGHT_RECT || l.kind == LIGHT_DISC);
+    let cone_traced =
+        cone_shadows && lights.len() <= CONE_SHADOW_LIGHTS && lights.iter().all(GpuLight::is_area);
     !cone_traced
 }
 

@@ -274,3 +274,94 @@ fn rendering_is_deterministic() {
     let b = render(&scene, measuring(), &cam, 48, 48);
     assert!(a.hdr == b.hdr, "two renders of the same frame differ");
 }
+
+#[test]
+fn glossy_plane_reflects_area_lights_as_their_ggx_integral() {
+    // A metal plane under a rectangle and under a disc: the specular reflection must be the
+    // GGX lobe integrated over the light, for sharp and rough lobes alike.
+    let (half_u, half_v, radius) = (0.3f32, 0.2f32, 0.25f32);
+    let center = Vec3::new(0.1, 0.8, -0.6);
+    let radiance = 1.5;
+    let f0 = 0.8f32;
+    let cam = Camera::look_at(Vec3::new(0.0, 1.2, 1.6), Vec3::new(0.0, 0.0, -0.2), 50.0);
+    let mut worst = 0.0f32;
+    for disc in [false, true] {
+        for roughness in [0.2f32, 0.4, 0.7] {
+            let mut scene = plane_scene(f0);
+            scene.materials[0].metallic = 1.0;
+            scene.materials[0].roughness = roughness;
+            let shape = if disc {
+                AreaShape::Disc { radius }
+            } else {
+                AreaShape::Rect {
+                    u: Vec3::X * half_u,
+                    v: Vec3::Z * half_v,
+                }
+            };
+            scene.add_area_light(Light {
+                name: "panel".into(),
+                kind: LightKind::Area { shape },
+                color: [1.0; 3],
+                intensity: radiance,
+                position: center,
+                direction: Vec3::NEG_Y,
+                range: None,
+                cast_shadows: true,
+            });
+            let out = render(&scene, measuring(), &cam, W, H);
+            // The GGX lobe (voxgi::brdf, Schlick's Fresnel with f90 = 1) times L cos over the
+            // light, by midpoint quadrature over its bounding square (300 x 300 cells).
+            let (ext_u, ext_v) = if disc {
+                (radius, radius)
+            } else {
+                (half_u, half_v)
+            };
+            let reflected = |p: Vec3| {
+                let a = voxgi::brdf::ggx_alpha(roughness as f64);
+                let v = (cam.position - p).normalize();
+                let n = 300;
+                let da = (4.0 * ext_u * ext_v) as f64 / (n * n) as f64;
+                let mut sum = 0.0f64;
+                for i in 0..n {
+                    for j in 0..n {
+                        let (su, sv) = (
+                            (i as f32 + 0.5) / n as f32 * 2.0 - 1.0,
+                            (j as f32 + 0.5) / n as f32 * 2.0 - 1.0,
+                        );
+                        if disc && su * su + sv * sv > 1.0 {
+                            continue;
+                        }
+                        let q = center + Vec3::X * ext_u * su + Vec3::Z * ext_v * sv;
+                        let d = q - p;
+                        let r2 = d.length_squared() as f64;
+                        let l = d.normalize();
+                        let h = (l + v).normalize();
+                        let (nl, nv, nh, vh) =
+                            (l.y as f64, v.y as f64, h.y as f64, v.dot(h) as f64);
+                        let f = f0 as f64 + (1.0 - f0 as f64) * (1.0 - vh).powi(5);
+                        let spec = voxgi::brdf::d_ggx(nh, a) * voxgi::brdf::v_smith(nv, nl, a) * f;
+                        // cos at the receiver, cos at the light (its normal is -y), 1/d^2.
+                        sum += spec * nl * nl / r2 * da;
+                    }
+                }
+                (radiance as f64 * sum) as f32
+            };
+            for (x, y) in [(32u32, 40u32), (28, 46), (36, 36), (20, 44), (44, 44)] {
+                let p = pixel_on_ground(&cam, W, H, x, y);
+                let expected = reflected(p);
+                let got = out.radiance(x, y)[0];
+                eprintln!(
+                    "{} roughness {roughness}, pixel ({x},{y}): got {got}, expected {expected}",
+                    if disc { "disc" } else { "rect" }
+                );
+                worst = worst.max(rel(got, expected));
+            }
+        }
+    }
+    eprintln!("worst relative error {worst}");
+    // Measured 8.2 % at worst (linearly transformed cosines fitted to this lobe, interpolated
+    // over a 32 x 32 table in fp16; most pixels within 3 %). The representative-point
+    // approximation used before was off by up to 67 % here. 12 % leaves room for other
+    // drivers' filtering.
+    assert!(worst < 0.12, "worst relative error {worst}");
+}
