@@ -22,9 +22,7 @@ impl CompositePass {
     /// `shadow_maps`: whether any light's visibility comes from the shadow maps
     /// (`composite_reads_shadow_maps`); without, the shader is compiled without their lookup.
     /// `specular`: whether any surface has a specular lobe (`gather::has_glossy`); without, the
-    /// area lights' specular integral is compiled out. (Compiling it out also where no light is
-    /// an area light made a glossy emissive box's indirect light read 0 on lavapipe, cause not
-    /// found: kept equal to the gather's GLOSSY.)
+    /// area lights' specular integral is compiled out.
     pub fn new(device: &wgpu::Device, shadow_maps: bool, specular: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
