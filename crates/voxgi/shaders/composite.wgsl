@@ -119,11 +119,7 @@ fn area_specular(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f
 // shadow lookup is paid for pixels a light cannot reach.
 fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
     if is_area_light(light) {
-        // One-sided emitter: nothing behind its plane is lit.
-        if dot(p - light.position, light.direction) <= 0.0 {
-            return vec3<f32>(0.0);
-        }
-        let e = polygon_irradiance(light, p, n);
+        let e = area_irradiance(light, p, n);
         if e <= 0.0 {
             return vec3<f32>(0.0);
         }

@@ -267,14 +267,20 @@ fn edge_integral(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return select(0.0, atan2(len, dot(a, b)) * c.z / len, len > 1e-9);
 }
 
+// Irradiance at p (normal n) from an area light of unit radiance, unshadowed: the polygon's,
+// and none behind the one-sided emitter's plane.
+fn area_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    if dot(p - light.position, light.direction) <= 0.0 {
+        return 0.0;
+    }
+    return polygon_irradiance(light, p, n);
+}
+
 // Irradiance (W/m^2) arriving at p with normal n from one light, shadows included. Used where
 // only Lambertian reflection matters (light injection into voxels).
 fn light_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> vec3<f32> {
     if is_area_light(light) {
-        if dot(p - light.position, light.direction) <= 0.0 {
-            return vec3<f32>(0.0);
-        }
-        let e = polygon_irradiance(light, p, n);
+        let e = area_irradiance(light, p, n);
         if e <= 0.0 {
             return vec3<f32>(0.0);
         }
