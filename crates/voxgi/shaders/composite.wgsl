@@ -99,19 +99,17 @@ fn ltc_entries(uv: vec2<f32>) -> vec4<f32> {
 // the polygon is the Lambert formula over the polygon mapped back by the inverse matrix, and
 // the Fresnel-weighted directional albedo scales it.
 fn area_specular(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
-    let f0 = f0_of(s);
     let n_dot_v = max(dot(n, v), 1e-4);
     let uv = vec2<f32>(n_dot_v, s.roughness);
     let t = ltc_entries(uv);
     let ab = textureSampleLevel(specular_table, table_sampler, uv, 0.0).rg;
-    let f90 = clamp(50.0 * max(f0.r, max(f0.g, f0.b)), 0.0, 1.0);
     // The fit's frame: z the normal, x towards the view (any tangent when looking straight on).
     let tv = v - n * dot(n, v);
     let x = select(tangent_frame(n)[0], tv / max(length(tv), 1e-8), dot(tv, tv) > 1e-10);
     let to_frame = transpose(mat3x3<f32>(x, cross(n, x), n));
     let minv = mat3x3<f32>(vec3<f32>(t.x, 0.0, t.z), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(t.y, 0.0, t.w));
     let integral = polygon_integral(light, p, minv * to_frame) / PI;
-    return (f0 * ab.x + vec3<f32>(f90 * ab.y)) * light.radiance * integral;
+    return specular_albedo(f0_of(s), ab) * light.radiance * integral;
 }
 
 // Outgoing radiance towards v from one light, unshadowed: the caller multiplies by a
@@ -139,7 +137,6 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
     }
     return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l;
 }
-
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

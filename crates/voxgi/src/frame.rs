@@ -291,6 +291,7 @@ impl Renderer {
             let atlas = ShadowAtlas::new(&device, views, owners, res);
             Ok((gpu_scene, atlas))
         })??;
+        let glossy = gather::has_glossy(scene, gpu_scene.point_count);
         let passes = ctx.checked("pipeline creation", || {
             (
                 ShadowPass::new(&device),
@@ -301,7 +302,7 @@ impl Renderer {
                         &gpu_scene.gpu_lights,
                         settings.cone_shadows,
                     ),
-                    gather::has_glossy(scene, gpu_scene.point_count),
+                    glossy,
                 ),
                 TonemapPass::new(&device),
                 DebugPass::new(&device),
@@ -328,11 +329,7 @@ impl Renderer {
                 InjectPass::new(&device, gpu_scene.light_count),
                 FilterPass::new(&device),
                 BouncePass::new(&device, settings.anisotropic),
-                GatherPass::new(
-                    &device,
-                    &settings,
-                    gather::has_glossy(scene, gpu_scene.point_count),
-                ),
+                GatherPass::new(&device, &settings, glossy),
                 UpsamplePass::new(&device),
                 DenseVolume::new(&device, grid, settings.anisotropic, capacity, slots),
                 triangle_table(&device, &gpu_scene),

@@ -37,8 +37,17 @@ fn v_smith(n_dot_v: f32, n_dot_l: f32, a: f32) -> f32 {
 // and the lobe fades to zero, making specular = 0 a pure Lambertian surface at all angles.
 fn f_schlick(f0: vec3<f32>, v_dot_h: f32) -> vec3<f32> {
     let f = pow(1.0 - v_dot_h, 5.0);
-    let f90 = clamp(50.0 * max(f0.r, max(f0.g, f0.b)), 0.0, 1.0);
-    return f0 + (vec3<f32>(f90) - f0) * f;
+    return f0 + (vec3<f32>(f90_of(f0)) - f0) * f;
+}
+
+fn f90_of(f0: vec3<f32>) -> f32 {
+    return clamp(50.0 * max(f0.r, max(f0.g, f0.b)), 0.0, 1.0);
+}
+
+// The specular lobe's directional albedo from the table's (a, b) at the view's (n.v,
+// roughness) (voxgi::brdf::specular_albedo): Schlick's Fresnel splits it as f0 a + f90 b.
+fn specular_albedo(f0: vec3<f32>, ab: vec2<f32>) -> vec3<f32> {
+    return f0 * ab.x + vec3<f32>(f90_of(f0) * ab.y);
 }
 
 fn brdf_diffuse(s: Surface) -> vec3<f32> {

@@ -230,7 +230,7 @@ fn polygon_integral(light: Light, p: vec3<f32>, m: mat3x3<f32>) -> f32 {
     var sum = 0.0;
     var first = vec3<f32>(0.0);
     var prev = vec3<f32>(0.0);
-    var k_out = 0u;
+    var emitted = 0u;
     var b = m * polygon_vertex(light, p, 0u);
     for (var i = 0u; i < count; i++) {
         let a = b;
@@ -242,17 +242,17 @@ fn polygon_integral(light: Light, p: vec3<f32>, m: mat3x3<f32>) -> f32 {
             let emit = select((da >= 0.0) != (db >= 0.0), da >= 0.0, k == 0u);
             if emit {
                 let q = normalize(select(a + (b - a) * (da / (da - db)), a, k == 0u));
-                if k_out == 0u {
+                if emitted == 0u {
                     first = q;
                 } else {
                     sum += edge_integral(prev, q);
                 }
                 prev = q;
-                k_out++;
+                emitted++;
             }
         }
     }
-    if k_out < 3u {
+    if emitted < 3u {
         return 0.0;
     }
     sum += edge_integral(prev, first);

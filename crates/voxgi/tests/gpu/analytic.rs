@@ -298,16 +298,12 @@ fn glossy_plane_reflects_area_lights_as_their_ggx_integral() {
                     v: Vec3::Z * half_v,
                 }
             };
-            scene.add_area_light(Light {
-                name: "panel".into(),
-                kind: LightKind::Area { shape },
-                color: [1.0; 3],
-                intensity: radiance,
-                position: center,
-                direction: Vec3::NEG_Y,
-                range: None,
-                cast_shadows: true,
-            });
+            scene.add_area_light(light(
+                LightKind::Area { shape },
+                radiance,
+                center,
+                Vec3::NEG_Y,
+            ));
             let out = render(&scene, measuring(), &cam, W, H);
             // The GGX lobe (voxgi::brdf, Schlick's Fresnel with f90 = 1) times L cos over the
             // light, by midpoint quadrature over its bounding square (300 x 300 cells).
