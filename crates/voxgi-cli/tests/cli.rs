@@ -3,6 +3,10 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+#[path = "../../voxgi/examples/embed.rs"]
+#[allow(dead_code)]
+mod embed;
+
 fn voxgi(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_voxgi"))
         .args(args)
@@ -319,4 +323,49 @@ fn reference_render_reports_progress_and_compare_prints_one_json_line() {
     let o = voxgi(&["compare", a.to_str().unwrap(), ao.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(error_line(&o).contains("ref_ao.png"), "{}", stderr(&o));
+}
+
+/// The library example that renders into its own device's texture writes, pixel for pixel,
+/// what `voxgi render` writes for the same scene, view and size.
+#[test]
+fn embed_example_pixels_equal_voxgi_render() {
+    let (w, h) = (64, 48);
+    let png = tmp("embed_cornell.png");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "64x48",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let cli = image::open(&png).expect("a PNG was written").to_rgba8();
+    let app = embed::render_cornell(w, h).expect("embed example");
+    assert_eq!(cli.as_raw().len(), app.len());
+    let differing = cli
+        .as_raw()
+        .iter()
+        .zip(&app)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differing, 0, "{differing} bytes differ");
+}
+
+#[test]
+fn render_checks_the_output_path_before_rendering() {
+    let missing_dir = tmp("no_such_dir").join("out.png");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        missing_dir.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let line = error_line(&o);
+    assert!(line.contains("does not exist"), "{line}");
+    // Refused before the scene was even loaded: no progress lines.
+    assert!(!stderr(&o).contains("uploading scene"), "{}", stderr(&o));
 }

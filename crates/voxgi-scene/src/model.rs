@@ -211,7 +211,7 @@ pub enum Projection {
     Orthographic { xmag: f32, ymag: f32 },
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     pub name: String,
     pub position: Vec3,

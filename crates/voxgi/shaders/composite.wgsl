@@ -36,13 +36,6 @@ override SHADOW_MAPS: bool = true;
 // compiled out (as SHADOW_MAPS, for CPU drivers).
 override SPECULAR: bool = true;
 
-const VIEW_FINAL: u32 = 0u;
-const VIEW_ALBEDO: u32 = 1u;
-const VIEW_NORMAL: u32 = 2u;
-const VIEW_DIRECT: u32 = 3u;
-const VIEW_AO: u32 = 4u;
-const VIEW_INDIRECT: u32 = 5u;
-
 fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
     let uv = (vec2<f32>(px) + 0.5) * frame.inv_size;
     let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);

@@ -72,8 +72,6 @@ fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
 // sixteenth of the ring's period, in Bayer order, and the upsample pass averages every 4x4
 // window, so each pixel gets the light of sixteen rotations of the bundle.
 
-const VIEW_AO: u32 = 4u;
-
 // False when no surface in the scene has a specular lobe: the glossy cone's code is then
 // compiled out (CPU drivers run an untaken branch's code; it cost 6 % of this pass).
 override GLOSSY: bool = true;

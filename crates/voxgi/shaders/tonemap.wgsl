@@ -1,10 +1,22 @@
-// tonemap: exposure, a filmic curve and the sRGB encoding, HDR target -> 8-bit image.
+// tonemap: exposure, a tone curve and the output encoding, from the HDR target into the
+// caller's target. A fullscreen triangle, so any renderable format works: sRGB formats encode
+// in the blending unit, 8-bit linear ones get the sRGB curve here (ENCODE_SRGB), float ones get
+// the tone-mapped linear values.
 
 //!include shared/scene.wgsl
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var hdr: texture_2d<f32>;
-@group(0) @binding(2) var ldr: texture_storage_2d<rgba8unorm, write>;
+
+// True for an 8-bit target without an sRGB view: the shader applies the sRGB curve itself.
+override ENCODE_SRGB: bool = false;
+
+@vertex
+fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    // One triangle covering the screen: (-1,-1), (3,-1), (-1,3).
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
 
 // Narkowicz's fit of the ACES reference rendering transform.
 fn aces(x: vec3<f32>) -> vec3<f32> {
@@ -35,23 +47,24 @@ fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, c <= vec3<f32>(0.0031308));
 }
 
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if f32(id.x) >= frame.size.x || f32(id.y) >= frame.size.y {
-        return;
-    }
-    let c = max(textureLoad(hdr, id.xy, 0).rgb * frame.exposure, vec3<f32>(0.0));
+@fragment
+fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let c = max(textureLoad(hdr, vec2<u32>(pos.xy), 0).rgb * frame.exposure, vec3<f32>(0.0));
     var t: vec3<f32>;
     switch frame.tonemap {
-        case 0u: {
+        case TONEMAP_ACES: {
             t = aces(c);
         }
-        case 1u: {
+        case TONEMAP_NEUTRAL: {
             t = pbr_neutral(c);
         }
         default: {
             t = c;
         }
     }
-    textureStore(ldr, id.xy, vec4<f32>(srgb_encode(clamp(t, vec3<f32>(0.0), vec3<f32>(1.0))), 1.0));
+    t = clamp(t, vec3<f32>(0.0), vec3<f32>(1.0));
+    if ENCODE_SRGB {
+        t = srgb_encode(t);
+    }
+    return vec4<f32>(t, 1.0);
 }

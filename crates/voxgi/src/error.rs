@@ -11,6 +11,10 @@ pub enum Error {
     NoAdapter { details: String },
     #[error("could not open the GPU device '{adapter}': {reason}")]
     Device { adapter: String, reason: String },
+    #[error(
+        "the GPU device lacks what voxgi needs: {0}. Open it with voxgi::required_limits(&adapter)"
+    )]
+    DeviceLimits(String),
     #[error("GPU error in {context}: {reason}")]
     Gpu { context: String, reason: String },
     #[error(transparent)]

@@ -3,7 +3,7 @@
 //! Every pass reads geometry from these buffers (vertex pulling), so the rasterizer, the
 //! voxelizer and the path tracer see exactly the same data.
 
-use crate::{Error, Result, Settings};
+use crate::{Error, RendererOptions, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene, pointcloud};
@@ -285,7 +285,7 @@ impl GpuScene {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         scene: &Scene,
-        settings: &Settings,
+        settings: &RendererOptions,
     ) -> Result<Self> {
         let mut vertices: Vec<GpuVertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
@@ -501,7 +501,7 @@ fn upload_textures(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     scene: &Scene,
-    settings: &Settings,
+    settings: &RendererOptions,
 ) -> Result<(wgpu::Texture, Vec<i32>)> {
     let used: Vec<usize> = {
         let mut u: Vec<usize> = scene

@@ -1,34 +1,70 @@
 //! voxgi: real-time global illumination by voxel cone tracing, on wgpu.
 //!
+//! The application owns the device; voxgi records into its encoder and writes into its
+//! texture:
+//!
 //! ```no_run
-//! let ctx = voxgi::GpuContext::from_env()?;
+//! # async fn run(adapter: wgpu::Adapter, view: wgpu::TextureView) -> Result<(), Box<dyn std::error::Error>> {
+//! use voxgi::wgpu;
+//! let (device, queue) = adapter
+//!     .request_device(&wgpu::DeviceDescriptor {
+//!         required_features: voxgi::required_features(&adapter),
+//!         required_limits: voxgi::required_limits(&adapter),
+//!         ..Default::default()
+//!     })
+//!     .await?;
 //! let scene = voxgi::scene::builtin::cornell_box();
-//! let mut renderer = voxgi::Renderer::new(&ctx, &scene, voxgi::Settings::default())?;
-//! let camera = renderer.default_camera().clone();
-//! renderer.render(&camera, 512, 512)?.save("cornell.png".as_ref())?;
-//! # Ok::<(), voxgi::Error>(())
+//! let mut renderer =
+//!     voxgi::Renderer::new(&device, &queue, &scene, &voxgi::RendererOptions::default())?;
+//! let params = voxgi::FrameParams::new(renderer.default_camera().clone());
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! let target = voxgi::Target::new(&view, wgpu::TextureFormat::Rgba8UnormSrgb, 512, 512);
+//! renderer.render(&mut encoder, &target, &params)?;
+//! queue.submit([encoder.finish()]);
+//! # Ok(())
+//! # }
 //! ```
+//!
+//! Cargo features: `headless` (a device from the environment and rendering to images in
+//! memory, for tools and tests), `image-io` (PNG and EXR writing), `compare` (FLIP and error
+//! metrics between images), `reference` (the ground-truth path tracer). The `voxgi` command
+//! turns them all on; an application embedding the renderer needs none.
 
 pub mod brdf;
+#[cfg(feature = "compare")]
 pub mod compare;
 mod error;
-mod frame;
 pub mod gpu;
 pub mod gpu_scene;
+#[cfg(feature = "headless")]
+pub mod headless;
+mod options;
 pub mod output;
 pub mod passes;
+#[cfg(feature = "reference")]
 pub mod reference;
+mod renderer;
 mod settings;
+mod targets;
+mod view;
 pub mod voxel;
 
 pub use error::{Error, Result};
-pub use frame::{FrameTargets, Renderer};
-pub use gpu::GpuContext;
-pub use output::RenderOutput;
-pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use settings::{
-    MAX_BOUNCES, MAX_IMAGE_SIZE, Settings, Tonemap, UNLIMITED_BOUNCES, ViewMode, validate_size,
+pub use gpu::requirements::{check_device, minimum_limits, required_features, required_limits};
+#[cfg(feature = "headless")]
+pub(crate) use gpu::{readback, requirements};
+pub use options::{
+    FrameParams, MAX_BOUNCES, MAX_IMAGE_SIZE, RendererOptions, Tonemap, UNLIMITED_BOUNCES,
+    ViewMode, validate_size,
 };
+pub use output::RenderOutput;
+#[cfg(feature = "reference")]
+pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
+pub use renderer::{Renderer, Target, VoxelCounts};
+pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
+pub use targets::FrameTargets;
 pub use voxel::ConeSet;
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;
+/// The wgpu voxgi is built on: use it to create the device and textures you hand to voxgi.
+pub use wgpu;

@@ -1,6 +1,10 @@
-//! Rendered images and writing them: PNG (sRGB, tone mapped) and EXR (linear HDR).
+//! Rendered images and (with the `image-io` feature) writing them: PNG (sRGB, tone mapped) and
+//! EXR (linear HDR).
 
-use crate::{Error, Result, Tonemap};
+use crate::Tonemap;
+#[cfg(feature = "image-io")]
+use crate::{Error, Result};
+#[cfg(feature = "image-io")]
 use std::path::Path;
 
 /// What one render produced.
@@ -34,6 +38,7 @@ impl RenderOutput {
     }
 
     /// Writes by extension: `.png` gets the tone-mapped image, `.exr` the linear radiance.
+    #[cfg(feature = "image-io")]
     pub fn save(&self, path: &Path) -> Result<()> {
         let ext = path
             .extension()
@@ -121,6 +126,7 @@ pub fn tonemap(hdr: &[f32], exposure_ev: f32, curve: Tonemap) -> Vec<u8> {
 }
 
 /// Reads an image as linear RGB f32: EXR as stored, PNG/JPEG sRGB-decoded.
+#[cfg(feature = "image-io")]
 pub fn load_linear(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
     let fail = |reason: String| Error::Output {
         path: path.to_path_buf(),

@@ -1,250 +1,231 @@
-//! Every knob of the renderer in one place, with documented defaults and range checks.
+//! A scene file's `[settings]` table: parsed here so that every front end (the CLI, a viewer,
+//! an application) shares one parser and one list of keys.
 
+use crate::options::{
+    FrameParams, MAX_BOUNCES, RendererOptions, Tonemap, UNLIMITED_BOUNCES, ViewMode,
+};
 use crate::voxel::ConeSet;
+use crate::voxel::dense::DIRECTIONS;
 use crate::{Error, Result};
+use serde::Deserialize;
 
-/// The curve that maps exposed linear radiance to display values.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Tonemap {
-    /// Narkowicz's fit of ACES: filmic toe and shoulder, desaturates very bright colours.
-    #[default]
-    Aces,
-    /// Khronos PBR Neutral: base colours stay exact up to 0.76, highlights roll off.
-    Neutral,
-    /// No curve: clamp to [0, 1]. For measurements.
-    Clamp,
-}
-
-/// What the output shows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ViewMode {
-    /// The lit image.
-    #[default]
-    Final,
-    /// Surface albedo (the G-buffer).
-    Albedo,
-    /// World-space normals mapped to colour.
-    Normal,
-    /// Direct light only, without emission.
-    Direct,
-    /// Ambient occlusion from the diffuse cones (white: open, black: occluded).
-    Ao,
-    /// Indirect light only.
-    Indirect,
-    /// The voxel volume ray-marched at `Settings::debug_level`: the finest albedo under the
-    /// first voxel with opacity > 0.5.
-    VoxelAlbedo,
-    /// The opacity of the first voxel with opacity > 0.5 at `debug_level`, as grey.
-    VoxelOpacity,
-    /// The radiance (un-premultiplied) of the first voxel with opacity > 0.5 at `debug_level`.
-    VoxelRadiance,
-}
-
-impl ViewMode {
-    /// The views the `debug` pass draws by ray-marching the voxel volume.
-    pub fn is_voxel(&self) -> bool {
-        matches!(
-            self,
-            ViewMode::VoxelAlbedo | ViewMode::VoxelOpacity | ViewMode::VoxelRadiance
-        )
-    }
-}
-
-/// `Settings::bounces` value for "until converged": voxel bounces are repeated until the
-/// energy left (the largest albedo to the power of the bounce count) is below 0.1 %.
-pub const UNLIMITED_BOUNCES: u32 = u32::MAX;
-/// Most bounces a finite setting may ask for.
-pub const MAX_BOUNCES: u32 = 8;
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Settings {
-    /// Width and height of each shadow map in texels (64..=8192). Default 1024.
-    pub shadow_map_size: u32,
-    /// Filter radius of point, spot and directional shadows in texels (0..=16). Area lights get
-    /// penumbrae from their size instead. Default 1.5.
-    pub shadow_softness: f32,
-    /// Exposure in stops: the image is scaled by 2^exposure before tone mapping (-20..=20).
-    pub exposure: f32,
-    pub tonemap: Tonemap,
-    /// Radiance of pixels that see no geometry.
-    pub background: [f32; 3],
-    pub view: ViewMode,
-    /// Largest material texture size; bigger textures are downsampled (1..=8192). Default 1024.
-    pub max_texture_size: u32,
-    /// Add a sun when the scene has no light and nothing emissive, instead of rendering black.
-    pub default_light: bool,
-
-    /// Voxels per side of the volume at the finest level: a power of two in 16..=512.
-    /// Default 128.
-    pub voxel_resolution: u32,
-    /// Six directional values per voxel above the finest level (true, default) or one.
-    pub anisotropic: bool,
-    /// Directional blocks each cone sample of the per-pixel gather reads in an anisotropic
-    /// volume: 3, every axis by its weight (the paper's filtering), or 2, the two axes of
-    /// largest weight renormalised: a fifth less gather time, with the Cornell box slightly
-    /// closer to the path tracer and the invariants slightly further (README). Default 3.
-    pub gather_axes: u32,
-    /// Diffuse cone set. Default: six cones of 60°.
-    pub cones: ConeSet,
-    /// Indirect bounces: 0 (direct light only) to 8, or `UNLIMITED_BOUNCES`. The last bounce is
-    /// the per-pixel gather; the others run in voxel space. Default 2.
-    pub bounces: u32,
-    /// Ambient occlusion radius in metres; `None`: a quarter of the volume's extent.
+/// The `[settings]` keys of a scene file. Every key is optional; a key that is present
+/// overrides the default (and is overridden in turn by a front end's own flags). Unknown keys
+/// are an error that names them.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSettings {
+    /// `RendererOptions::shadow_map_size`.
+    pub shadow_map_size: Option<u32>,
+    /// `RendererOptions::max_texture_size`.
+    pub max_texture_size: Option<u32>,
+    /// `RendererOptions::default_light`.
+    pub default_light: Option<bool>,
+    /// `RendererOptions::voxel_resolution`.
+    pub voxel_resolution: Option<u32>,
+    /// `RendererOptions::anisotropic`.
+    pub anisotropic: Option<bool>,
+    /// `RendererOptions::gather_axes`.
+    pub gather_axes: Option<u32>,
+    /// `RendererOptions::cones`: "6x60", "7x45" or "9x45".
+    pub cones: Option<String>,
+    /// `RendererOptions::bounces`: a number, "direct" (0) or "unlimited".
+    pub bounces: Option<BouncesValue>,
+    /// `RendererOptions::ao_radius`, metres.
     pub ao_radius: Option<f32>,
-    /// Ambient occlusion falloff lambda in 1/(1 + lambda r), per metre (>= 0). Default 0:
-    /// plain cosine-weighted visibility within the radius, what the AO reference computes.
-    pub ao_lambda: f32,
-    /// Cone sample step as a fraction of the cone's diameter (0.05..=2). Default 0.5.
-    pub step_factor: f32,
-    /// Cone origin offset along the normal, in finest voxels (0..=8): keeps a cone from seeing
-    /// its own surface's voxels. Default 1.5.
-    pub origin_offset: f32,
-    /// Longest cone in metres; `None`: the volume's diagonal.
+    /// `RendererOptions::ao_lambda`.
+    pub ao_lambda: Option<f32>,
+    /// `RendererOptions::step_factor`.
+    pub step_factor: Option<f32>,
+    /// `RendererOptions::origin_offset`, voxels.
+    pub origin_offset: Option<f32>,
+    /// `RendererOptions::max_distance`, metres.
     pub max_distance: Option<f32>,
-    /// Gather indirect light at half resolution and upsample it edge-aware. Default false.
-    pub half_resolution: bool,
-    /// Shadows of area lights by a cone traced through the voxels towards the light (aperture:
-    /// the light's size) instead of PCSS on the shadow map. Default false.
-    pub cone_shadows: bool,
-    /// Voxelize, inject, filter and bounce every frame, not only when the scene changed
-    /// (for benchmarks of fully dynamic scenes).
-    pub revoxelize_every_frame: bool,
-    /// Mip level the voxel views show, 0 = finest (< the volume's level count,
-    /// log2(voxel_resolution) + 1). Default 0.
-    pub debug_level: u32,
-    /// Directional chain the voxel views read above the finest level: 0..6 for +X, -X, +Y, -Y,
-    /// +Z, -Z (ignored with `anisotropic: false`). Default 0.
-    pub debug_direction: u32,
+    /// `RendererOptions::half_resolution`.
+    pub half_resolution: Option<bool>,
+    /// `RendererOptions::cone_shadows`.
+    pub cone_shadows: Option<bool>,
+    /// `FrameParams::exposure`, stops.
+    pub exposure: Option<f32>,
+    /// `FrameParams::tonemap`: "aces", "neutral" or "clamp".
+    pub tonemap: Option<String>,
+    /// `FrameParams::view`: "final", "albedo", "normal", "direct", "ao", "indirect",
+    /// "voxel-albedo", "voxel-opacity" or "voxel-radiance".
+    pub view: Option<String>,
+    /// `FrameParams::background`, linear radiance.
+    pub background: Option<[f32; 3]>,
+    /// `FrameParams::shadow_softness`, texels.
+    pub shadow_softness: Option<f32>,
+    /// `FrameParams::debug_level`.
+    pub voxel_level: Option<u32>,
+    /// `FrameParams::debug_direction`: "+x", "-x", "+y", "-y", "+z" or "-z".
+    pub voxel_dir: Option<String>,
 }
 
-impl Default for Settings {
-    fn default() -> Self {
-        Settings {
-            shadow_map_size: 1024,
-            shadow_softness: 1.5,
-            exposure: 0.0,
-            tonemap: Tonemap::Aces,
-            background: [0.0; 3],
-            view: ViewMode::Final,
-            max_texture_size: 1024,
-            default_light: true,
-            voxel_resolution: 128,
-            anisotropic: true,
-            gather_axes: 3,
-            cones: ConeSet::Six60,
-            bounces: 2,
-            ao_radius: None,
-            ao_lambda: 0.0,
-            step_factor: 0.5,
-            origin_offset: 1.5,
-            max_distance: None,
-            half_resolution: false,
-            cone_shadows: false,
-            revoxelize_every_frame: false,
-            debug_level: 0,
-            debug_direction: 0,
-        }
-    }
+/// A bounce count as a scene file writes it.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum BouncesValue {
+    /// 0..=8.
+    Count(u32),
+    /// "direct" or "unlimited".
+    Word(String),
 }
 
-impl Settings {
-    /// Checks every value against its documented range.
-    pub fn validate(&self) -> Result<()> {
-        let fail = |m: String| Err(Error::Setting(m));
-        if !(64..=8192).contains(&self.shadow_map_size) {
-            return fail(format!(
-                "shadow map size {} is outside 64..=8192",
-                self.shadow_map_size
-            ));
-        }
-        if !(0.0..=16.0).contains(&self.shadow_softness) {
-            return fail(format!(
-                "shadow softness {} is outside 0..=16 texels",
-                self.shadow_softness
-            ));
-        }
-        if !(-20.0..=20.0).contains(&self.exposure) {
-            return fail(format!("exposure {} EV is outside -20..=20", self.exposure));
-        }
-        if !self.background.iter().all(|c| c.is_finite() && *c >= 0.0) {
-            return fail("background must be finite and non-negative".into());
-        }
-        if !(1..=8192).contains(&self.max_texture_size) {
-            return fail(format!(
-                "max texture size {} is outside 1..=8192",
-                self.max_texture_size
-            ));
-        }
-        let r = self.voxel_resolution;
-        if !(16..=512).contains(&r) || !r.is_power_of_two() {
-            return fail(format!(
-                "voxel resolution {r} is not a power of two in 16..=512"
-            ));
-        }
-        if self.bounces > MAX_BOUNCES && self.bounces != UNLIMITED_BOUNCES {
-            return fail(format!(
-                "{} bounces: use 0..={MAX_BOUNCES} or unlimited",
-                self.bounces
-            ));
-        }
-        if let Some(a) = self.ao_radius
-            && !(a.is_finite() && a > 0.0)
-        {
-            return fail(format!("AO radius {a} must be a positive number of metres"));
-        }
-        if !(self.ao_lambda.is_finite() && self.ao_lambda >= 0.0) {
-            return fail(format!("AO lambda {} must be >= 0", self.ao_lambda));
-        }
-        if !(2..=3).contains(&self.gather_axes) {
-            return fail(format!("gather axes {} must be 2 or 3", self.gather_axes));
-        }
-        if !(0.05..=2.0).contains(&self.step_factor) {
-            return fail(format!(
-                "step factor {} is outside 0.05..=2",
-                self.step_factor
-            ));
-        }
-        if !(0.0..=8.0).contains(&self.origin_offset) {
-            return fail(format!(
-                "cone origin offset {} is outside 0..=8 voxels",
-                self.origin_offset
-            ));
-        }
-        if let Some(d) = self.max_distance
-            && !(d.is_finite() && d > 0.0)
-        {
-            return fail(format!(
-                "max cone distance {d} must be a positive number of metres"
-            ));
-        }
-        if self.voxel_resolution.is_power_of_two() {
-            let levels = self.voxel_resolution.ilog2() + 1;
-            if self.debug_level >= levels {
-                return fail(format!(
-                    "voxel debug level {} is outside 0..{levels} (voxel resolution {})",
-                    self.debug_level, self.voxel_resolution
-                ));
+impl SceneSettings {
+    /// Parses a `[settings]` table; errors name the key.
+    pub fn from_table(table: &toml::Table) -> Result<Self> {
+        let parse = |t: toml::Table| t.try_into::<SceneSettings>();
+        parse(table.clone()).map_err(|e| {
+            // serde names unknown keys but not the key of a wrongly typed value: find it.
+            let key = table.iter().find(|(k, v)| {
+                let mut one = toml::Table::new();
+                one.insert((*k).clone(), (*v).clone());
+                parse(one).is_err()
+            });
+            match key {
+                Some((k, _)) if !e.message().contains("unknown field") => {
+                    Error::Setting(format!("[settings] {k}: {}", e.message()))
+                }
+                _ => Error::Setting(format!("[settings]: {}", e.message())),
             }
+        })
+    }
+
+    /// Applies the keys that are present, checking each value's form (ranges are checked by
+    /// `RendererOptions::validate` and `FrameParams::validate`).
+    pub fn apply(&self, o: &mut RendererOptions, f: &mut FrameParams) -> Result<()> {
+        macro_rules! set {
+            ($dst:expr, $src:expr) => {
+                if let Some(v) = $src {
+                    $dst = v;
+                }
+            };
         }
-        if self.debug_direction >= 6 {
-            return fail(format!(
-                "voxel debug direction {} is outside 0..6 (+X, -X, +Y, -Y, +Z, -Z)",
-                self.debug_direction
-            ));
+        set!(o.shadow_map_size, self.shadow_map_size);
+        set!(o.max_texture_size, self.max_texture_size);
+        set!(o.default_light, self.default_light);
+        set!(o.voxel_resolution, self.voxel_resolution);
+        set!(o.anisotropic, self.anisotropic);
+        set!(o.gather_axes, self.gather_axes);
+        if let Some(c) = &self.cones {
+            o.cones = parse_cones(c)?;
+        }
+        if let Some(b) = &self.bounces {
+            o.bounces = match b {
+                BouncesValue::Count(n) => check_bounces(*n)?,
+                BouncesValue::Word(w) => parse_bounces(w)?,
+            };
+        }
+        if self.ao_radius.is_some() {
+            o.ao_radius = self.ao_radius;
+        }
+        set!(o.ao_lambda, self.ao_lambda);
+        set!(o.step_factor, self.step_factor);
+        set!(o.origin_offset, self.origin_offset);
+        if self.max_distance.is_some() {
+            o.max_distance = self.max_distance;
+        }
+        set!(o.half_resolution, self.half_resolution);
+        set!(o.cone_shadows, self.cone_shadows);
+        set!(f.exposure, self.exposure);
+        if let Some(t) = &self.tonemap {
+            f.tonemap = Tonemap::parse(t)?;
+        }
+        if let Some(v) = &self.view {
+            f.view = ViewMode::parse(v)?;
+        }
+        set!(f.background, self.background);
+        set!(f.shadow_softness, self.shadow_softness);
+        set!(f.debug_level, self.voxel_level);
+        if let Some(d) = &self.voxel_dir {
+            f.debug_direction = parse_direction(d)?;
         }
         Ok(())
     }
 }
 
-/// Largest image side voxgi renders (memory for the targets grows with its square).
-pub const MAX_IMAGE_SIZE: u32 = 8192;
+/// "6x60", "7x45" or "9x45".
+pub fn parse_cones(s: &str) -> Result<ConeSet> {
+    ConeSet::parse(s)
+        .ok_or_else(|| Error::Setting(format!("'{s}' is not a cone set (6x60, 7x45, 9x45)")))
+}
 
-/// Checks an output size.
-pub fn validate_size(width: u32, height: u32) -> Result<()> {
-    if width == 0 || height == 0 || width > MAX_IMAGE_SIZE || height > MAX_IMAGE_SIZE {
+/// A bounce count: "0".."8", "direct" or "unlimited" (also "inf").
+pub fn parse_bounces(s: &str) -> Result<u32> {
+    match s {
+        "unlimited" | "inf" => Ok(UNLIMITED_BOUNCES),
+        "direct" => Ok(0),
+        _ => check_bounces(s.parse().map_err(|_| {
+            Error::Setting(format!("'{s}' is not 0..={MAX_BOUNCES} or 'unlimited'"))
+        })?),
+    }
+}
+
+fn check_bounces(n: u32) -> Result<u32> {
+    if n > MAX_BOUNCES {
         return Err(Error::Setting(format!(
-            "image size {width}x{height} is outside 1x1..={MAX_IMAGE_SIZE}x{MAX_IMAGE_SIZE}"
+            "{n} bounces: use 0..={MAX_BOUNCES} or 'unlimited'"
         )));
     }
-    Ok(())
+    Ok(n)
+}
+
+/// "+x", "-x", "+y", "-y", "+z" or "-z" (any case) as a directional-chain index.
+pub fn parse_direction(s: &str) -> Result<u32> {
+    DIRECTIONS
+        .iter()
+        .position(|d| d.eq_ignore_ascii_case(s))
+        .map(|i| i as u32)
+        .ok_or_else(|| Error::Setting(format!("'{s}' is not a direction (+x, -x, +y, -y, +z, -z)")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use voxgi_scene::Camera;
+
+    fn parse(text: &str) -> Result<(RendererOptions, FrameParams)> {
+        let table: toml::Table = toml::from_str(text).expect("valid TOML");
+        let mut o = RendererOptions::default();
+        let mut f = FrameParams::new(Camera::look_at(glam::Vec3::Z, glam::Vec3::ZERO, 45.0));
+        SceneSettings::from_table(&table)?.apply(&mut o, &mut f)?;
+        Ok((o, f))
+    }
+
+    #[test]
+    fn keys_reach_options_and_frame_params() {
+        let (o, f) = parse(
+            "voxel_resolution = 64\nbounces = \"unlimited\"\ncones = \"9x45\"\n\
+             half_resolution = true\nexposure = -1.5\ntonemap = \"clamp\"\n\
+             view = \"voxel-opacity\"\nvoxel_dir = \"-Z\"\nao_radius = 2",
+        )
+        .unwrap();
+        assert_eq!(o.voxel_resolution, 64);
+        assert_eq!(o.bounces, UNLIMITED_BOUNCES);
+        assert_eq!(o.cones, ConeSet::Nine45);
+        assert!(o.half_resolution);
+        assert_eq!(o.ao_radius, Some(2.0));
+        assert_eq!(f.exposure, -1.5);
+        assert_eq!(f.tonemap, Tonemap::Clamp);
+        assert_eq!(f.view, ViewMode::VoxelOpacity);
+        assert_eq!(f.debug_direction, 5);
+        // Keys left out keep their defaults.
+        assert_eq!(
+            o.shadow_map_size,
+            RendererOptions::default().shadow_map_size
+        );
+    }
+
+    #[test]
+    fn unknown_keys_and_bad_values_are_named() {
+        let e = parse("voxel_resolutoin = 64").unwrap_err().to_string();
+        assert!(e.contains("voxel_resolutoin"), "{e}");
+        let e = parse("bounces = 9").unwrap_err().to_string();
+        assert!(e.contains("9 bounces"), "{e}");
+        let e = parse("tonemap = \"filmic\"").unwrap_err().to_string();
+        assert!(e.contains("filmic"), "{e}");
+        let e = parse("anisotropic = 3").unwrap_err().to_string();
+        assert!(e.contains("anisotropic"), "{e}");
+    }
 }

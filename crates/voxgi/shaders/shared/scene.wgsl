@@ -4,6 +4,22 @@
 const PI: f32 = 3.14159265358979;
 const NO_INDEX: u32 = 0xffffffffu;
 
+// Frame.view_mode: ViewMode::id() in src/options.rs (a test checks the two agree).
+const VIEW_FINAL: u32 = 0u;
+const VIEW_ALBEDO: u32 = 1u;
+const VIEW_NORMAL: u32 = 2u;
+const VIEW_DIRECT: u32 = 3u;
+const VIEW_AO: u32 = 4u;
+const VIEW_INDIRECT: u32 = 5u;
+const VIEW_VOXEL_ALBEDO: u32 = 6u;
+const VIEW_VOXEL_OPACITY: u32 = 7u;
+const VIEW_VOXEL_RADIANCE: u32 = 8u;
+
+// Frame.tonemap: Tonemap::id() in src/options.rs.
+const TONEMAP_ACES: u32 = 0u;
+const TONEMAP_NEUTRAL: u32 = 1u;
+const TONEMAP_CLAMP: u32 = 2u;
+
 // Per-frame camera and output parameters.
 struct Frame {
     view_proj: mat4x4<f32>,
@@ -14,11 +30,11 @@ struct Frame {
     inv_size: vec2<f32>,
     // 2^EV, applied before tone mapping.
     exposure: f32,
-    // 0 ACES filmic, 1 Khronos PBR Neutral, 2 clamp.
+    // TONEMAP_*.
     tonemap: u32,
     // Filter radius of punctual-light shadows, in shadow-map texels.
     shadow_softness: f32,
-    // Output selection for debugging (0 = final).
+    // VIEW_*: output selection for debugging.
     view_mode: u32,
     background: vec4<f32>,
     // 1: area lights' shadows by a cone traced through the voxels instead of the shadow map.

@@ -2,12 +2,12 @@
 //! indirect light and cone-traced visibility upsampled from the gather's resolution.
 
 use crate::brdf::BrdfTables;
-use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::specialized_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::passes::shadow::ShadowAtlas;
+use crate::targets::FrameTargets;
 
 const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };
 

@@ -1,13 +1,13 @@
 //! debug: the voxel views (`ViewMode::VoxelAlbedo`, `VoxelOpacity`, `VoxelRadiance`). Ray-marches
-//! the volume at `Settings::debug_level` and overwrites the HDR target; runs after composite and
+//! the volume at `FrameParams::debug_level` and overwrites the HDR target; runs after composite and
 //! before tonemap, only when such a view is selected.
 
-use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
+use crate::options::ViewMode;
 use crate::passes::composite::HDR_FORMAT;
-use crate::settings::ViewMode;
+use crate::targets::FrameTargets;
 use crate::voxel::dense::DenseVolume;
 use wgpu::util::DeviceExt;
 

@@ -2,12 +2,12 @@
 //! with `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
 
 use crate::brdf::BrdfTables;
-use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::specialized_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::settings::Settings;
+use crate::options::RendererOptions;
+use crate::targets::FrameTargets;
 use crate::voxel::dense::DenseVolume;
 use voxgi_scene::Scene;
 
@@ -35,7 +35,7 @@ pub struct GatherPass {
 
 impl GatherPass {
     /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
-    pub fn new(device: &wgpu::Device, settings: &Settings, glossy: bool) -> Self {
+    pub fn new(device: &wgpu::Device, settings: &RendererOptions, glossy: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![
             layout::uniform(0, c, false),
@@ -92,7 +92,7 @@ impl GatherPass {
         res.push(wgpu::BindingResource::Sampler(&vol.sampler));
         res.extend(t.gbuffer_resources());
         res.extend([
-            wgpu::BindingResource::TextureView(t.gather_target()),
+            wgpu::BindingResource::TextureView(&t.indirect_low),
             scene.lights.as_entire_binding(),
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),

@@ -1,10 +1,10 @@
 //! gbuffer: rasterizes all mesh instances into the G-buffer, then every point-cloud sample as a
 //! surfel (an oriented disc) into the same targets, depth-tested against the meshes.
 
-use crate::frame::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
+use crate::targets::FrameTargets;
 
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

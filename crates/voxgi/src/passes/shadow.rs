@@ -8,7 +8,7 @@ use crate::gpu_scene::{
     CONE_SHADOW_LIGHTS, GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT,
     LIGHT_SPOT,
 };
-use crate::settings::Settings;
+use crate::options::RendererOptions;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
@@ -199,7 +199,7 @@ pub fn behind_emitter(view: &GpuShadowView) -> bool {
 /// Shadow-map size: the setting, or, when every light's visibility on screen is cone-traced
 /// and the maps serve only the voxel injection, four texels per voxel of the volume (the
 /// injection reads them at voxel centres; finer maps only cost rendering time).
-pub fn atlas_resolution(settings: &Settings, lights: &[GpuLight]) -> u32 {
+pub fn atlas_resolution(settings: &RendererOptions, lights: &[GpuLight]) -> u32 {
     if composite_reads_shadow_maps(lights, settings.cone_shadows) {
         settings.shadow_map_size
     } else {
@@ -497,10 +497,10 @@ mod tests {
             &[rect; CONE_SHADOW_LIGHTS + 1],
             true
         ));
-        let settings = |cone_shadows| Settings {
+        let settings = |cone_shadows| RendererOptions {
             cone_shadows,
             voxel_resolution: 64,
-            ..Settings::default()
+            ..RendererOptions::default()
         };
         assert_eq!(atlas_resolution(&settings(true), &[rect]), 256);
         assert_eq!(atlas_resolution(&settings(false), &[rect]), 1024);

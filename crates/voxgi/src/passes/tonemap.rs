@@ -1,54 +1,121 @@
-//! tonemap: exposure, filmic curve and sRGB encoding into the 8-bit output.
+//! tonemap: exposure, the tone curve and the output encoding, from the HDR target into the
+//! caller's texture. It is the frame's last pass and the only one that touches the caller's
+//! target, so it is where the output format is adapted: one pipeline per target format, made
+//! the first time that format is seen.
 
-use crate::frame::FrameTargets;
 use crate::gpu::layout;
-use crate::gpu::shader::compute_pipeline;
+use crate::gpu::shader;
 use crate::gpu::timer::GpuTimer;
-
-pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+use crate::targets::FrameTargets;
 
 pub struct TonemapPass {
-    pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    module: wgpu::ShaderModule,
+    /// One pipeline per target format seen so far (a handful at most).
+    pipelines: Vec<(wgpu::TextureFormat, wgpu::RenderPipeline)>,
+}
+
+/// Whether the shader applies the sRGB curve itself: 8-bit targets without an sRGB view.
+/// sRGB formats encode in hardware; float and 10-bit formats take linear values.
+fn encodes_srgb(format: wgpu::TextureFormat) -> bool {
+    use wgpu::TextureFormat as F;
+    matches!(format, F::Rgba8Unorm | F::Bgra8Unorm)
 }
 
 impl TonemapPass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let c = wgpu::ShaderStages::COMPUTE;
+        let f = wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::texture_2d_load(1, c),
-                layout::storage_texture(2, LDR_FORMAT),
-            ],
+            entries: &[layout::uniform(0, f, false), layout::texture_2d_load(1, f)],
         });
-        let pipeline = compute_pipeline(device, "tonemap", "tonemap.wgsl", &layout);
-        TonemapPass { pipeline, layout }
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("tonemap"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        TonemapPass {
+            module: shader::module(device, "tonemap.wgsl"),
+            layout,
+            pipeline_layout,
+            pipelines: Vec::new(),
+        }
     }
 
+    /// Makes the pipeline for `format` if there is none yet.
+    pub fn prepare(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) {
+        if self.pipelines.iter().any(|(f, _)| *f == format) {
+            return;
+        }
+        let constants = [("ENCODE_SRGB", encodes_srgb(format) as u32 as f64)];
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("tonemap"),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &self.module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &self.module,
+                entry_point: Some("fs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        self.pipelines.push((format, pipeline));
+    }
+
+    /// Draws into `target`, whose format `prepare` has seen.
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
+        target: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
         timer: &mut GpuTimer,
     ) {
+        let Some((_, pipeline)) = self.pipelines.iter().find(|(f, _)| *f == format) else {
+            debug_assert!(false, "tonemap: no pipeline prepared for {format:?}");
+            return;
+        };
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tonemap"),
             layout: &self.layout,
             entries: &layout::entries(vec![
                 t.frame.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&t.hdr),
-                wgpu::BindingResource::TextureView(&t.ldr),
             ]),
         });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tonemap"),
-            timestamp_writes: timer.compute("tonemap"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: timer.render("tonemap"),
+            occlusion_query_set: None,
+            multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
+        pass.draw(0..3, 0..1);
     }
 }

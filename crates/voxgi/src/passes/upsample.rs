@@ -3,11 +3,11 @@
 //! composite finishes the upsample with an edge-aware 2x2 filter at full resolution (joint
 //! bilateral upsampling): the wide window runs on a quarter of the pixels at half resolution.
 
-use crate::frame::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::passes::gather::INDIRECT_FORMAT;
+use crate::targets::FrameTargets;
 
 pub struct UpsamplePass {
     pipeline: wgpu::ComputePipeline,

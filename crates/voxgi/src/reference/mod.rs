@@ -6,15 +6,15 @@
 //! (`shaders/reference.wgsl`) walks with a stack. Samples accumulate in an f32 buffer, a batch
 //! per submit, so long renders report progress and never hold the GPU for long.
 
-use crate::frame::{camera_view_proj, lit_scene};
-use crate::gpu::{layout, readback, shader};
+use crate::gpu::{checked, layout, readback, shader};
 use crate::gpu_scene::{GpuScene, NO_INDEX, scene_bounds};
+use crate::options::{FrameParams, RendererOptions, validate_size};
 use crate::output::{RenderOutput, tonemap};
-use crate::settings::validate_size;
-use crate::{Error, GpuContext, Result, Settings};
+use crate::view::{camera_view_proj, lit_scene};
+use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat3, Vec3};
-use voxgi_scene::{Camera, Scene};
+use voxgi_scene::Scene;
 use wgpu::util::DeviceExt;
 
 /// How many indirect bounces the reference simulates (as the cone tracer counts them).
@@ -128,7 +128,6 @@ const PATHS_PER_SUBMIT: u64 = 1 << 18;
 pub struct PathTracer {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    settings: Settings,
     scene: GpuScene,
     light_count: u32,
     center: Vec3,
@@ -239,17 +238,23 @@ pub const MAX_BVH_DEPTH: u32 = 64;
 
 impl PathTracer {
     /// Uploads `scene` (the same data the rasterizer gets, plus triangles and their BVH). Like
-    /// the rasterizer, an unlit scene gets a default sun when `settings.default_light`.
-    pub fn new(ctx: &GpuContext, scene: &Scene, settings: &Settings) -> Result<Self> {
+    /// the rasterizer, an unlit scene gets a default sun when `options.default_light`.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        options: &RendererOptions,
+    ) -> Result<Self> {
+        let settings = options;
         settings.validate()?;
         scene.validate()?;
         if scene.triangle_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let scene = lit_scene(scene, settings);
+        let scene = lit_scene(scene, settings.default_light);
         let scene = scene.as_ref();
-        let device = ctx.device.clone();
-        let queue = ctx.queue.clone();
+        let device = device.clone();
+        let queue = queue.clone();
         let (center, radius) = scene_bounds(scene);
         let flat = flatten(scene);
         let depth = bvh_depth(&flat.nodes);
@@ -264,7 +269,7 @@ impl PathTracer {
             flat.tris.len(),
             flat.nodes.len()
         );
-        let (gpu_scene, buffers) = ctx.checked("reference scene upload", || -> Result<_> {
+        let (gpu_scene, buffers) = checked(&device, "reference scene upload", || -> Result<_> {
             let gpu_scene = GpuScene::new(&device, &queue, scene, settings)?;
             let storage = |label: &str, bytes: &[u8]| {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -282,7 +287,7 @@ impl PathTracer {
                 ),
             ))
         })??;
-        let (layout, pipeline) = ctx.checked("reference pipeline creation", || {
+        let (layout, pipeline) = checked(&device, "reference pipeline creation", || {
             use wgpu::ShaderStages as S;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("reference"),
@@ -328,7 +333,6 @@ impl PathTracer {
         Ok(PathTracer {
             device,
             queue,
-            settings: settings.clone(),
             light_count: gpu_scene.light_count,
             scene: gpu_scene,
             center,
@@ -353,13 +357,14 @@ impl PathTracer {
     /// with the settings' exposure and curve, as the rasterizer's tonemap pass does.
     pub fn render(
         &mut self,
-        camera: &Camera,
+        frame: &FrameParams,
         width: u32,
         height: u32,
         opts: &ReferenceOptions,
         progress: &mut dyn FnMut(u32, u32),
     ) -> Result<RenderOutput> {
         validate_size(width, height)?;
+        let camera = &frame.camera;
         if !(camera.position.is_finite() && camera.forward.is_finite() && camera.up.is_finite()) {
             return Err(Error::Setting(
                 "camera position and direction must be finite".into(),
@@ -414,7 +419,7 @@ impl PathTracer {
             let count = batch.min(opts.spp - done);
             let params = GpuParams {
                 inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-                background: self.settings.background,
+                background: frame.background,
                 light_count: self.light_count,
                 width,
                 height,
@@ -471,7 +476,7 @@ impl PathTracer {
         let ldr = match opts.mode {
             // AO is a fraction in [0, 1]: shown as is.
             ReferenceMode::Ao { .. } => tonemap(&hdr, 0.0, crate::Tonemap::Clamp),
-            ReferenceMode::Radiance => tonemap(&hdr, self.settings.exposure, self.settings.tonemap),
+            ReferenceMode::Radiance => tonemap(&hdr, frame.exposure, frame.tonemap),
         };
         Ok(RenderOutput {
             width,

@@ -1,9 +1,10 @@
 //! Shared device and small helpers for building test scenes and probing images.
 
 use std::sync::OnceLock;
+use voxgi::headless::{self, GpuContext};
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Material, Mesh, Scene};
-use voxgi::{GpuContext, RenderOutput, Renderer, Settings};
+use voxgi::{FrameParams, RenderOutput, Renderer, RendererOptions, Tonemap, ViewMode};
 
 /// The one device all GPU tests share.
 pub fn ctx() -> &'static GpuContext {
@@ -39,21 +40,77 @@ pub fn plane_scene(albedo: f32) -> Scene {
     s
 }
 
-/// Settings for measuring direct light: no tone curve, no default light, no indirect light,
-/// a small volume (the voxel passes still run).
-pub fn measuring() -> Settings {
-    Settings {
-        tonemap: voxgi::Tonemap::Clamp,
+/// Options for measuring direct light: no default light, no indirect light, a small volume
+/// (the voxel passes still run).
+pub fn measuring() -> RendererOptions {
+    RendererOptions {
         default_light: false,
         bounces: 0,
         voxel_resolution: 32,
-        ..Settings::default()
+        ..RendererOptions::default()
     }
 }
 
-pub fn render(scene: &Scene, settings: Settings, camera: &Camera, w: u32, h: u32) -> RenderOutput {
-    let mut r = Renderer::new(ctx(), scene, settings).expect("renderer");
-    r.render(camera, w, h).expect("render")
+/// The frame parameters for measuring: the view from `camera`, no tone curve.
+pub fn clamped(camera: &Camera) -> FrameParams {
+    FrameParams {
+        tonemap: Tonemap::Clamp,
+        ..FrameParams::new(camera.clone())
+    }
+}
+
+/// A renderer on the shared device.
+pub fn renderer(scene: &Scene, options: &RendererOptions) -> Renderer {
+    ctx().renderer(scene, options).expect("renderer")
+}
+
+/// One frame of `r`, read back.
+pub fn frame(r: &mut Renderer, params: &FrameParams, w: u32, h: u32) -> RenderOutput {
+    headless::render(ctx(), r, params, w, h).expect("render")
+}
+
+/// What most tests vary: the renderer's options and the view mode. The rest of the frame's
+/// parameters keep their defaults, but for the tone curve: none (`clamped`).
+#[derive(Clone, Debug)]
+pub struct Setup {
+    pub options: RendererOptions,
+    pub view: ViewMode,
+}
+
+impl From<RendererOptions> for Setup {
+    fn from(options: RendererOptions) -> Self {
+        Setup {
+            options,
+            view: ViewMode::Final,
+        }
+    }
+}
+
+/// One frame from `camera` without a tone curve (the tests read linear radiance).
+pub fn render(
+    scene: &Scene,
+    setup: impl Into<Setup>,
+    camera: &Camera,
+    w: u32,
+    h: u32,
+) -> RenderOutput {
+    let setup = setup.into();
+    let params = FrameParams {
+        view: setup.view,
+        ..clamped(camera)
+    };
+    render_with(scene, &setup.options, &params, w, h)
+}
+
+/// One frame with these parameters.
+pub fn render_with(
+    scene: &Scene,
+    options: &RendererOptions,
+    params: &FrameParams,
+    w: u32,
+    h: u32,
+) -> RenderOutput {
+    frame(&mut renderer(scene, options), params, w, h)
 }
 
 /// The camera ray through the centre of pixel (x, y), as the renderer's projection makes it.

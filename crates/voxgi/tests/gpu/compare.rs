@@ -3,7 +3,7 @@
 use crate::common::*;
 use voxgi::compare::{Image, compare};
 use voxgi::output::tonemap;
-use voxgi::{Settings, Tonemap};
+use voxgi::{FrameParams, RendererOptions, Tonemap};
 
 fn constant_hdr(w: u32, h: u32, v: f32) -> Image {
     Image::from_hdr_rgba(w, h, &vec![v; (w * h * 4) as usize])
@@ -99,12 +99,12 @@ fn cpu_tonemap_matches_the_gpu_pass() {
     let scene = voxgi::scene::builtin::cornell_box();
     let cam = scene.cameras[0].clone();
     for curve in [Tonemap::Aces, Tonemap::Neutral, Tonemap::Clamp] {
-        let settings = Settings {
+        let params = FrameParams {
             tonemap: curve,
             exposure: 1.5,
-            ..Settings::default()
+            ..FrameParams::new(cam.clone())
         };
-        let out = render(&scene, settings, &cam, 48, 48);
+        let out = render_with(&scene, &RendererOptions::default(), &params, 48, 48);
         let cpu = tonemap(&out.hdr, 1.5, curve);
         let worst = cpu
             .iter()

@@ -3,11 +3,12 @@
 use crate::common::*;
 use voxgi::scene::glam::Vec3;
 use voxgi::scene::{Camera, Scene};
-use voxgi::{Error, Renderer, Settings};
+use voxgi::{Error, FrameParams, RendererOptions};
 
 #[test]
 fn empty_scene_is_an_error() {
-    let err = Renderer::new(ctx(), &Scene::default(), Settings::default())
+    let err = ctx()
+        .renderer(&Scene::default(), &RendererOptions::default())
         .err()
         .expect("must fail");
     assert!(matches!(err, Error::EmptyScene), "{err}");
@@ -16,124 +17,159 @@ fn empty_scene_is_an_error() {
 #[test]
 fn absurd_settings_are_errors() {
     let scene = voxgi::scene::builtin::cornell_box();
-    let cases: Vec<(&str, Settings)> = vec![
+    let cases: Vec<(&str, RendererOptions)> = vec![
         (
             "shadow map 5 texels",
-            Settings {
+            RendererOptions {
                 shadow_map_size: 5,
                 ..Default::default()
             },
         ),
         (
             "shadow map 100000",
-            Settings {
+            RendererOptions {
                 shadow_map_size: 100_000,
                 ..Default::default()
             },
         ),
         (
-            "exposure NaN",
-            Settings {
-                exposure: f32::NAN,
-                ..Default::default()
-            },
-        ),
-        (
-            "exposure 1000",
-            Settings {
-                exposure: 1000.0,
-                ..Default::default()
-            },
-        ),
-        (
-            "negative softness",
-            Settings {
-                shadow_softness: -1.0,
-                ..Default::default()
-            },
-        ),
-        (
-            "infinite background",
-            Settings {
-                background: [f32::INFINITY, 0.0, 0.0],
-                ..Default::default()
-            },
-        ),
-        (
             "texture size 0",
-            Settings {
+            RendererOptions {
                 max_texture_size: 0,
                 ..Default::default()
             },
         ),
         (
             "voxels 100",
-            Settings {
+            RendererOptions {
                 voxel_resolution: 100,
                 ..Default::default()
             },
         ),
         (
             "voxels 1024",
-            Settings {
+            RendererOptions {
                 voxel_resolution: 1024,
                 ..Default::default()
             },
         ),
         (
             "9 bounces",
-            Settings {
+            RendererOptions {
                 bounces: 9,
                 ..Default::default()
             },
         ),
         (
             "AO radius 0",
-            Settings {
+            RendererOptions {
                 ao_radius: Some(0.0),
                 ..Default::default()
             },
         ),
         (
             "4 gather axes",
-            Settings {
+            RendererOptions {
                 gather_axes: 4,
                 ..Default::default()
             },
         ),
         (
             "step 0",
-            Settings {
+            RendererOptions {
                 step_factor: 0.0,
                 ..Default::default()
             },
         ),
     ];
     for (what, s) in cases {
-        match Renderer::new(ctx(), &scene, s) {
+        match ctx().renderer(&scene, &s) {
             Err(Error::Setting(msg)) => assert!(!msg.is_empty(), "{what}"),
             Err(e) => panic!("{what}: wrong error {e}"),
             Ok(_) => panic!("{what}: accepted"),
         }
     }
+    // Per-frame parameters are checked by every frame, and a refused frame leaves the
+    // renderer working.
+    let mut r = renderer(&scene, &measuring());
+    let cam = scene.cameras[0].clone();
+    let frames: Vec<(&str, FrameParams)> = vec![
+        (
+            "exposure NaN",
+            FrameParams {
+                exposure: f32::NAN,
+                ..FrameParams::new(cam.clone())
+            },
+        ),
+        (
+            "exposure 1000",
+            FrameParams {
+                exposure: 1000.0,
+                ..FrameParams::new(cam.clone())
+            },
+        ),
+        (
+            "negative softness",
+            FrameParams {
+                shadow_softness: -1.0,
+                ..FrameParams::new(cam.clone())
+            },
+        ),
+        (
+            "infinite background",
+            FrameParams {
+                background: [f32::INFINITY, 0.0, 0.0],
+                ..FrameParams::new(cam.clone())
+            },
+        ),
+        (
+            "voxel level 6 of a 32³ volume",
+            FrameParams {
+                debug_level: 6,
+                ..FrameParams::new(cam.clone())
+            },
+        ),
+        (
+            "voxel direction 6",
+            FrameParams {
+                debug_direction: 6,
+                ..FrameParams::new(cam.clone())
+            },
+        ),
+    ];
+    for (what, p) in frames {
+        match voxgi::headless::render(ctx(), &mut r, &p, 8, 8) {
+            Err(Error::Setting(msg)) => assert!(!msg.is_empty(), "{what}"),
+            Err(e) => panic!("{what}: wrong error {e}"),
+            Ok(_) => panic!("{what}: accepted"),
+        }
+    }
+    let ok = frame(&mut r, &FrameParams::new(cam), 8, 8);
+    assert!(ok.mean_radiance()[0] > 0.0);
 }
 
 #[test]
 fn absurd_sizes_and_cameras_are_errors() {
     let scene = voxgi::scene::builtin::cornell_box();
-    let mut r = Renderer::new(ctx(), &scene, Settings::default()).expect("renderer");
-    let cam = scene.cameras[0].clone();
+    let mut r = renderer(&scene, &RendererOptions::default());
+    let cam = FrameParams::new(scene.cameras[0].clone());
     for (w, h) in [(0, 16), (16, 0), (100_000, 16)] {
         assert!(
-            matches!(r.render(&cam, w, h), Err(Error::Setting(_))),
+            matches!(
+                voxgi::headless::render(ctx(), &mut r, &cam, w, h),
+                Err(Error::Setting(_))
+            ),
             "{w}x{h} accepted"
         );
     }
     let mut bad = cam.clone();
-    bad.position = Vec3::new(f32::NAN, 0.0, 0.0);
-    assert!(matches!(r.render(&bad, 16, 16), Err(Error::Setting(_))));
+    bad.camera.position = Vec3::new(f32::NAN, 0.0, 0.0);
+    assert!(matches!(
+        voxgi::headless::render(ctx(), &mut r, &bad, 16, 16),
+        Err(Error::Setting(_))
+    ));
     // The renderer still works after refusing bad requests.
-    let ok = r.render(&cam, 16, 16).expect("render after errors");
+    let ok = frame(&mut r, &cam, 16, 16);
     assert!(ok.mean_radiance()[0] > 0.0);
 }
 
@@ -141,7 +177,7 @@ fn absurd_sizes_and_cameras_are_errors() {
 fn unlit_scene_gets_a_default_sun_instead_of_black() {
     let scene = plane_scene(0.5);
     let cam = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, 45.0);
-    let lit = render(&scene, Settings::default(), &cam, 32, 32);
+    let lit = render(&scene, RendererOptions::default(), &cam, 32, 32);
     assert!(
         lit.mean_radiance()[0] > 0.05,
         "mean {:?}",
@@ -156,7 +192,8 @@ fn unlit_scene_gets_a_default_sun_instead_of_black() {
 fn invalid_scene_data_is_an_error_not_a_panic() {
     let mut scene = plane_scene(0.5);
     scene.meshes[0].indices[1] = 999;
-    let err = Renderer::new(ctx(), &scene, Settings::default())
+    let err = ctx()
+        .renderer(&scene, &RendererOptions::default())
         .err()
         .expect("must fail");
     assert!(err.to_string().contains("out of range"), "{err}");

@@ -3,7 +3,7 @@
 
 use crate::common::*;
 use std::path::{Path, PathBuf};
-use voxgi::Settings;
+use voxgi::{FrameParams, RendererOptions};
 
 fn golden_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
@@ -78,12 +78,12 @@ fn assert_golden(name: &str, width: u32, height: u32, rgba: &[u8], threshold: f3
 fn cornell_box_direct_light() {
     let scene = voxgi::scene::builtin::cornell_box();
     let cam = scene.cameras[0].clone();
-    let settings = Settings {
+    let settings = RendererOptions {
         bounces: 0,
         voxel_resolution: 32,
-        ..Settings::default()
+        ..RendererOptions::default()
     };
-    let out = render(&scene, settings, &cam, 128, 128);
+    let out = render_with(&scene, &settings, &FrameParams::new(cam), 128, 128);
     // 0.02: the same driver reproduces the image bit for bit (see `rendering_is_deterministic`);
     // the margin absorbs other drivers' rounding in rasterization and transcendental functions
     // (a one-texel shift of a shadow edge costs about 0.005), while a changed light, shadow or
@@ -94,13 +94,16 @@ fn cornell_box_direct_light() {
 fn cornell_golden(name: &str, view: voxgi::ViewMode, bounces: u32) {
     let scene = voxgi::scene::builtin::cornell_box();
     let cam = scene.cameras[0].clone();
-    let settings = Settings {
-        view,
+    let settings = RendererOptions {
         bounces,
         voxel_resolution: 32,
-        ..Settings::default()
+        ..RendererOptions::default()
     };
-    let out = render(&scene, settings, &cam, 96, 96);
+    let params = FrameParams {
+        view,
+        ..FrameParams::new(cam)
+    };
+    let out = render_with(&scene, &settings, &params, 96, 96);
     // 0.03: as for the direct-light golden, plus the cone tracer's sums of many 3D texture
     // filtering steps, whose rounding differs between drivers more than rasterization does. A
     // changed cone weight, aperture or filter moves these images by 0.05 or more.

@@ -5,6 +5,7 @@
 mod analytic;
 mod common;
 mod compare;
+mod embed;
 mod errors;
 mod golden;
 mod points;

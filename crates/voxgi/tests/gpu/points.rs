@@ -1,10 +1,10 @@
 //! Point clouds render as surfels: a dense flat grid of discs shades like a Lambertian plane,
 //! with no holes, and clouds without normals or radii get estimated ones.
 
-use crate::common::ctx;
+use crate::common::{ctx, frame, renderer};
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Light, LightKind, PointCloud, Scene};
-use voxgi::{Renderer, Settings};
+use voxgi::{FrameParams, RendererOptions};
 
 const ALBEDO: f32 = 0.5;
 const IRRADIANCE: f32 = 1.0;
@@ -71,9 +71,9 @@ fn scene(pc: PointCloud) -> Scene {
 /// each other.
 fn check_lambertian_plane(pc: PointCloud) {
     let scene = scene(pc);
-    let mut r = Renderer::new(ctx(), &scene, Settings::default()).expect("renderer");
-    let cam = r.default_camera().clone();
-    let out = r.render(&cam, 64, 64).expect("render");
+    let mut r = renderer(&scene, &RendererOptions::default());
+    let cam = FrameParams::new(r.default_camera().clone());
+    let out = frame(&mut r, &cam, 64, 64);
     let expected = ALBEDO / std::f32::consts::PI * IRRADIANCE;
     let mut worst = (0.0f32, 0, 0);
     for y in 16..48 {
@@ -112,7 +112,7 @@ fn cloud_without_normals_or_radii_renders() {
 fn points_only_scene_is_not_empty() {
     let empty = Scene::default();
     assert!(matches!(
-        Renderer::new(ctx(), &empty, Settings::default()),
+        ctx().renderer(&empty, &RendererOptions::default()),
         Err(voxgi::Error::EmptyScene)
     ));
     // A cloud with no points next to a real one is skipped.
@@ -122,7 +122,7 @@ fn points_only_scene_is_not_empty() {
         transform: Mat4::IDENTITY,
         ..Default::default()
     });
-    let mut r = Renderer::new(ctx(), &s, Settings::default()).expect("renderer");
+    let mut r = renderer(&s, &RendererOptions::default());
     let points = r
         .memory()
         .into_iter()
@@ -130,6 +130,6 @@ fn points_only_scene_is_not_empty() {
         .expect("points in the memory report")
         .1;
     assert_eq!(points, (N * N * 32) as u64);
-    let cam = r.default_camera().clone();
-    r.render(&cam, 16, 16).expect("render");
+    let cam = FrameParams::new(r.default_camera().clone());
+    frame(&mut r, &cam, 16, 16);
 }

@@ -6,18 +6,33 @@ use std::f32::consts::PI;
 use voxgi::compare::{Image, compare};
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Light, LightKind, Material, Mesh, Scene, builtin};
-use voxgi::{Bounces, PathTracer, ReferenceMode, ReferenceOptions, RenderOutput, Settings};
+use voxgi::{
+    Bounces, FrameParams, PathTracer, ReferenceMode, ReferenceOptions, RenderOutput,
+    RendererOptions,
+};
 
+/// A path-traced image from `cam` without a tone curve.
 fn trace(
     scene: &Scene,
-    settings: &Settings,
+    options: &RendererOptions,
     cam: &Camera,
     w: u32,
     h: u32,
     opts: ReferenceOptions,
 ) -> RenderOutput {
-    let mut pt = PathTracer::new(ctx(), scene, settings).expect("path tracer");
-    pt.render(cam, w, h, &opts, &mut |_, _| {})
+    trace_with(scene, options, &clamped(cam), w, h, opts)
+}
+
+fn trace_with(
+    scene: &Scene,
+    options: &RendererOptions,
+    params: &FrameParams,
+    w: u32,
+    h: u32,
+    opts: ReferenceOptions,
+) -> RenderOutput {
+    let mut pt = PathTracer::new(&ctx().device, &ctx().queue, scene, options).expect("path tracer");
+    pt.render(params, w, h, &opts, &mut |_, _| {})
         .expect("reference render")
 }
 
@@ -114,13 +129,21 @@ fn reference_direct_light_matches_the_rasterizer_on_the_cornell_box() {
     let cam = scene.cameras[0].clone();
     let (w, h) = (64, 64);
     // Direct light only on the raster side too (no cone-traced bounces).
-    let settings = Settings {
+    let settings = RendererOptions {
         bounces: 0,
         voxel_resolution: 32,
-        ..Settings::default()
+        ..RendererOptions::default()
     };
-    let raster = render(&scene, settings.clone(), &cam, w, h);
-    let pt = trace(&scene, &settings, &cam, w, h, opts(64, Bounces::DirectOnly));
+    let aces = FrameParams::new(cam.clone());
+    let raster = render_with(&scene, &settings, &aces, w, h);
+    let pt = trace_with(
+        &scene,
+        &settings,
+        &aces,
+        w,
+        h,
+        opts(64, Bounces::DirectOnly),
+    );
     let c = compare(
         &Image::from_ldr_rgba8(w, h, &pt.ldr),
         &Image::from_ldr_rgba8(w, h, &raster.ldr),
@@ -258,11 +281,11 @@ fn reference_glossy_plane_under_a_white_sky_reflects_its_directional_albedo() {
     let theta = 60f32.to_radians();
     let pos = Vec3::new(0.0, theta.cos(), theta.sin());
     let cam = Camera::look_at(pos, Vec3::ZERO, 0.5);
-    let settings = Settings {
+    let white = FrameParams {
         background: [1.0; 3],
-        ..measuring()
+        ..clamped(&cam)
     };
-    let out = trace(&scene, &settings, &cam, 8, 8, opts(1024, Bounces::One));
+    let out = trace_with(&scene, &measuring(), &white, 8, 8, opts(1024, Bounces::One));
     let (mean, err) = mean_and_error(&out);
 
     // Quadrature over the hemisphere (midpoint rule in cos θ and φ).
@@ -373,12 +396,13 @@ fn cone_traced_cornell_box_agrees_with_the_path_tracer() {
     let cam = scene.cameras[0].clone();
     let (w, h) = (64, 64);
     // The default settings (128³, two bounces).
-    let settings = Settings::default();
-    let vct = render(&scene, settings.clone(), &cam, w, h);
-    let pt = trace(
+    let settings = RendererOptions::default();
+    let aces = FrameParams::new(cam.clone());
+    let vct = render_with(&scene, &settings, &aces, w, h);
+    let pt = trace_with(
         &scene,
         &settings,
-        &cam,
+        &aces,
         w,
         h,
         opts(128, Bounces::Exactly(2)),

@@ -61,3 +61,31 @@ fn wgsl_struct_sizes() {
         );
     }
 }
+
+/// The value of a `u32` constant of a parsed module.
+fn wgsl_u32(module: &naga::Module, name: &str) -> u32 {
+    let c = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("const {name} not found"))
+        .1;
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => v,
+        ref e => panic!("const {name} is not a u32 literal: {e:?}"),
+    }
+}
+
+/// View-mode and tone-map ids are defined once in Rust and once in WGSL: they must agree.
+#[test]
+fn view_and_tonemap_ids_agree_with_wgsl() {
+    let m = parse("composite.wgsl");
+    for v in voxgi::ViewMode::ALL {
+        let name = format!("VIEW_{}", v.name().replace('-', "_").to_uppercase());
+        assert_eq!(wgsl_u32(&m, &name), v.id(), "{name}");
+    }
+    for t in voxgi::Tonemap::ALL {
+        let name = format!("TONEMAP_{}", t.name().to_uppercase());
+        assert_eq!(wgsl_u32(&m, &name), t.id(), "{name}");
+    }
+}

@@ -5,16 +5,17 @@ use crate::common::*;
 use voxgi::scene::builtin;
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Material, Mesh, Scene};
-use voxgi::{Settings, ViewMode};
+use voxgi::{RendererOptions, ViewMode};
 
-fn vct(view: ViewMode, res: u32, bounces: u32) -> Settings {
-    Settings {
-        tonemap: voxgi::Tonemap::Clamp,
-        default_light: false,
+fn vct(view: ViewMode, res: u32, bounces: u32) -> Setup {
+    Setup {
+        options: RendererOptions {
+            default_light: false,
+            voxel_resolution: res,
+            bounces,
+            ..RendererOptions::default()
+        },
         view,
-        voxel_resolution: res,
-        bounces,
-        ..Settings::default()
     }
 }
 
@@ -51,7 +52,7 @@ fn ao_of_an_open_plane_is_one() {
     let scene = plane_scene(0.5);
     let cam = Camera::look_at(Vec3::new(0.0, 4.0, 0.01), Vec3::ZERO, 40.0);
     let mut s = vct(ViewMode::Ao, 64, 0);
-    s.ao_radius = Some(3.0);
+    s.options.ao_radius = Some(3.0);
     let out = render(&scene, s, &cam, 32, 32);
     let ao = mean(&out, 8, 8, 24, 24, 0);
     eprintln!("open plane AO {ao}");
@@ -74,9 +75,13 @@ fn ao_beside_a_wall_matches_the_closed_form() {
     let cam = Camera::look_at(Vec3::new(-1.0, 3.0, 0.01), Vec3::new(-0.4, 0.0, 0.0), 30.0);
     let mut s = vct(ViewMode::Ao, 64, 0);
     let radius = 4.0;
-    s.ao_radius = Some(radius);
-    let mut r = voxgi::Renderer::new(ctx(), &scene, s).expect("renderer");
-    let out = r.render(&cam, 64, 64).expect("render");
+    s.options.ao_radius = Some(radius);
+    let mut r = renderer(&scene, &s.options);
+    let params = voxgi::FrameParams {
+        view: s.view,
+        ..clamped(&cam)
+    };
+    let out = frame(&mut r, &params, 64, 64);
     let voxel = r.volume().grid.voxel_size;
     // A floor point at distance x from a wall far taller and wider than the AO radius R sees
     // the wall along every direction with a component towards it above x / R: with cosine
@@ -216,10 +221,10 @@ fn mean_indirect_is_consistent_between_64_and_256() {
 
 /// Mean indirect radiance of the Cornell box at 32³ and 32×32, one bounce, with `change`
 /// applied to the settings.
-fn cornell_mean_indirect(change: impl FnOnce(&mut Settings)) -> f32 {
+fn cornell_mean_indirect(change: impl FnOnce(&mut RendererOptions)) -> f32 {
     let scene = builtin::cornell_box();
     let mut s = vct(ViewMode::Indirect, 32, 1);
-    change(&mut s);
+    change(&mut s.options);
     let m = render(&scene, s, &scene.cameras[0], 32, 32).mean_radiance();
     (m[0] + m[1] + m[2]) / 3.0
 }
@@ -293,12 +298,9 @@ fn cone_shadows_agree_with_the_shadow_map() {
     let cam = scene.cameras[0].clone();
     let (w, h) = (64, 64);
     let direct = |cone_shadows: bool| {
-        let s = Settings {
-            cone_shadows,
-            half_resolution: true,
-            voxel_resolution: 64,
-            ..vct(ViewMode::Direct, 64, 1)
-        };
+        let mut s = vct(ViewMode::Direct, 64, 1);
+        s.options.cone_shadows = cone_shadows;
+        s.options.half_resolution = true;
         render(&scene, s, &cam, w, h)
     };
     let (pcss, cone) = (direct(false), direct(true));
@@ -362,10 +364,8 @@ fn half_resolution_gather_matches_full_and_keeps_edges() {
     let cam = scene.cameras[0].clone();
     let (w, h) = (64, 64);
     let indirect = |half_resolution: bool| {
-        let s = Settings {
-            half_resolution,
-            ..vct(ViewMode::Indirect, 64, 1)
-        };
+        let mut s = vct(ViewMode::Indirect, 64, 1);
+        s.options.half_resolution = half_resolution;
         render(&scene, s, &cam, w, h)
     };
     let (full, half) = (indirect(false), indirect(true));

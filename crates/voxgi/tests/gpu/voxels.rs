@@ -7,7 +7,7 @@ use voxgi::gpu::readback::{f16_to_f32, read_buffer_copy, read_texture_3d};
 use voxgi::scene::glam::{Mat4, Vec3, Vec4};
 use voxgi::scene::{Material, Mesh, Scene, builtin};
 use voxgi::voxel::{Grid, cpu};
-use voxgi::{Renderer, Settings, ViewMode};
+use voxgi::{FrameParams, Renderer, RendererOptions, ViewMode};
 
 /// One mesh holding `tris` (world space), each with its own vertices and face normal.
 fn triangle_scene(tris: &[[Vec3; 3]]) -> Scene {
@@ -35,7 +35,7 @@ fn triangle_scene(tris: &[[Vec3; 3]]) -> Scene {
 /// Voxel coordinates of the non-zero entries of the occupancy buffer (x fastest), and the
 /// values themselves.
 fn occupied(r: &Renderer) -> (BTreeSet<[u32; 3]>, Vec<u32>) {
-    let (device, queue) = r.device();
+    let (device, queue) = (&ctx().device, &ctx().queue);
     let vol = r.volume();
     let bytes = read_buffer_copy(device, queue, &vol.occupancy).expect("occupancy readback");
     let words: &[u32] = bytemuck::cast_slice(&bytes);
@@ -98,15 +98,15 @@ fn voxelize_matches_cpu_exactly() {
     );
     assert_eq!(grid.origin, Vec3::splat(-1.0 / 16.0));
 
-    let settings = Settings {
+    let settings = RendererOptions {
         voxel_resolution: RES,
         bounces: 0,
         ..measuring()
     };
-    let mut r = Renderer::new(ctx(), &scene, settings).expect("renderer");
+    let mut r = renderer(&scene, &settings);
     assert_eq!(r.volume().grid, grid);
-    let cam = r.default_camera().clone();
-    r.render(&cam, 16, 16).expect("render");
+    let cam = clamped(r.default_camera());
+    frame(&mut r, &cam, 16, 16);
 
     let (gpu, values) = occupied(&r);
     let expected = cpu::voxelize(&tris, &grid);
@@ -130,7 +130,10 @@ fn voxelize_matches_cpu_exactly() {
         extra
     );
 
-    let (fragments, count) = r.voxel_counts().expect("counts");
+    let voxgi::VoxelCounts {
+        fragments,
+        occupied: count,
+    } = r.voxel_counts().expect("counts");
     assert_eq!(
         count,
         gpu.len() as u64,
@@ -164,8 +167,8 @@ fn voxelize_matches_cpu_exactly() {
 #[test]
 fn walls_on_voxel_faces_leave_no_holes() {
     let mut r = cornell(256, true);
-    let cam = r.default_camera().clone();
-    r.render(&cam, 8, 8).expect("render");
+    let cam = clamped(r.default_camera());
+    frame(&mut r, &cam, 8, 8);
     let (gpu, _) = occupied(&r);
     let grid = r.volume().grid;
     let voxel = |m: f32, axis: usize| (m * 0.001 - grid.origin[axis]) / grid.voxel_size;
@@ -220,8 +223,8 @@ fn walls_on_voxel_faces_leave_no_holes() {
 }
 
 /// One mip level of a rgba16float 3D texture as f32 texels (x fastest), and its side.
-fn read_level(r: &Renderer, t: &wgpu::Texture, mip: u32) -> (Vec<Vec4>, u32) {
-    let (device, queue) = r.device();
+fn read_level(t: &wgpu::Texture, mip: u32) -> (Vec<Vec4>, u32) {
+    let (device, queue) = (&ctx().device, &ctx().queue);
     let bytes = read_texture_3d(device, queue, t, mip).expect("3D readback");
     let halves: &[u16] = bytemuck::cast_slice(&bytes);
     let texels = halves
@@ -301,21 +304,21 @@ fn check_filter_step(
 
 /// A measuring renderer of the Cornell box at `voxel_resolution`.
 fn cornell(voxel_resolution: u32, anisotropic: bool) -> Renderer {
-    let settings = Settings {
+    let settings = RendererOptions {
         voxel_resolution,
         anisotropic,
         ..measuring()
     };
-    Renderer::new(ctx(), &builtin::cornell_box(), settings).expect("renderer")
+    renderer(&builtin::cornell_box(), &settings)
 }
 
 fn check_filtering(anisotropic: bool) {
     let mut r = cornell(16, anisotropic);
-    let cam = r.default_camera().clone();
-    r.render(&cam, 16, 16).expect("render");
+    let cam = clamped(r.default_camera());
+    frame(&mut r, &cam, 16, 16);
     let vol = r.volume();
     let levels = vol.grid.levels();
-    let (finest, res) = read_level(&r, &vol.radiance, 0);
+    let (finest, res) = read_level(&vol.radiance, 0);
     assert_eq!(res, 16);
     // The test can only fail if the volume has structure: lit and unlit voxels, coloured ones.
     let lit = finest
@@ -339,7 +342,7 @@ fn check_filtering(anisotropic: bool) {
     };
     assert_eq!(vol.chain_blocks() as usize, dirs.len());
     let chains: Vec<Vec<Vec4>> = (0..levels - 1)
-        .map(|mip| read_level(&r, &vol.chains, mip).0)
+        .map(|mip| read_level(&vol.chains, mip).0)
         .collect();
     let mut partial = 0;
     for (block, dir) in dirs.into_iter().enumerate() {
@@ -371,15 +374,13 @@ fn voxel_filter_matches_cpu_isotropic() {
 const SIZE: u32 = 48;
 
 fn voxel_view(r: &mut Renderer, view: ViewMode, level: u32, dir: u32) -> voxgi::RenderOutput {
-    let s = Settings {
+    let p = FrameParams {
         view,
         debug_level: level,
         debug_direction: dir,
-        ..r.settings().clone()
+        ..clamped(r.default_camera())
     };
-    r.set_display_settings(&s).expect("display settings");
-    let cam = r.default_camera().clone();
-    r.render(&cam, SIZE, SIZE).expect("render")
+    frame(r, &p, SIZE, SIZE)
 }
 
 #[test]
@@ -431,14 +432,16 @@ fn voxel_debug_views_are_plausible() {
         );
     }
     // Out-of-range levels and directions are errors, not clamps.
-    let bad = Settings {
-        debug_level: 6,
-        ..r.settings().clone()
-    };
-    assert!(r.set_display_settings(&bad).is_err());
-    let bad = Settings {
-        debug_direction: 6,
-        ..r.settings().clone()
-    };
-    assert!(r.set_display_settings(&bad).is_err());
+    for bad in [
+        FrameParams {
+            debug_level: 6,
+            ..clamped(r.default_camera())
+        },
+        FrameParams {
+            debug_direction: 6,
+            ..clamped(r.default_camera())
+        },
+    ] {
+        assert!(voxgi::headless::render(ctx(), &mut r, &bad, 8, 8).is_err());
+    }
 }

@@ -1,16 +1,21 @@
-//! The device: chosen from the environment, Vulkan first.
+//! Headless rendering for tools and tests: a device opened from the environment (Vulkan
+//! first) and frames rendered to images in memory, built on the public API only
+//! (`Renderer::new`, `Renderer::render`). Applications that own a device do not need it.
 
-use crate::{Error, Result};
+use crate::options::FrameParams;
+use crate::output::RenderOutput;
+use crate::requirements::{required_features, required_limits};
+use crate::{Error, Renderer, Result, Target, readback};
 
-/// A wgpu device and queue plus what we learned about the adapter.
+/// A wgpu device and queue voxgi opened itself, plus what it learned about the adapter.
 pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     /// Timestamp queries inside passes are available (for `voxgi bench`).
     pub timestamps: bool,
-    /// GPU errors no error scope caught. wgpu's default is to panic; voxgi collects them here
-    /// and turns them into an `Error` at the end of the frame.
+    /// GPU errors no error scope caught. wgpu's default is to panic; on its own device voxgi
+    /// collects them here and turns them into an `Error` at the end of the frame.
     pub errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
 }
 
@@ -75,27 +80,9 @@ impl GpuContext {
             return Err(Error::NoAdapter { details });
         };
         let info = adapter.get_info();
-        let features = adapter.features();
-        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        let mut required_features = wgpu::Features::empty();
-        if timestamps {
-            required_features |= wgpu::Features::TIMESTAMP_QUERY;
-        }
-        // Ask for what the adapter offers (within the defaults' spirit): big scenes need large
-        // storage buffers, and lavapipe and real GPUs both allow far more than the defaults.
-        let al = adapter.limits();
-        let required_limits = wgpu::Limits {
-            max_storage_buffer_binding_size: al.max_storage_buffer_binding_size,
-            max_buffer_size: al.max_buffer_size,
-            max_texture_array_layers: al.max_texture_array_layers,
-            max_texture_dimension_2d: al.max_texture_dimension_2d,
-            max_texture_dimension_3d: al.max_texture_dimension_3d,
-            max_storage_textures_per_shader_stage: al.max_storage_textures_per_shader_stage.min(8),
-            max_compute_invocations_per_workgroup: al
-                .max_compute_invocations_per_workgroup
-                .min(1024),
-            ..wgpu::Limits::default()
-        };
+        let required_features = required_features(&adapter);
+        let timestamps = required_features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_limits = required_limits(&adapter);
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("voxgi"),
@@ -133,11 +120,9 @@ impl GpuContext {
         })
     }
 
-    /// Runs `f`, turning any validation or out-of-memory error it triggers into an `Error`
-    /// instead of wgpu's default panic.
     /// Takes the errors collected since the last call, as one `Error`.
-    pub fn take_error(errors: &std::sync::Mutex<Vec<String>>, context: &str) -> Result<()> {
-        let mut v = errors.lock().map_err(|_| Error::Gpu {
+    pub fn take_error(&self, context: &str) -> Result<()> {
+        let mut v = self.errors.lock().map_err(|_| Error::Gpu {
             context: context.into(),
             reason: "error log poisoned".into(),
         })?;
@@ -152,18 +137,92 @@ impl GpuContext {
         })
     }
 
-    pub fn checked<T>(&self, context: &str, f: impl FnOnce() -> T) -> Result<T> {
-        let scope_oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let scope_val = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let out = f();
-        let val = pollster::block_on(scope_val.pop());
-        let oom = pollster::block_on(scope_oom.pop());
-        if let Some(e) = val.or(oom) {
-            return Err(Error::Gpu {
-                context: context.into(),
+    /// A renderer on this device.
+    pub fn renderer(
+        &self,
+        scene: &voxgi_scene::Scene,
+        options: &crate::RendererOptions,
+    ) -> Result<Renderer> {
+        let r = Renderer::new(&self.device, &self.queue, scene, options);
+        self.take_error("renderer creation")?;
+        r
+    }
+}
+
+/// The format `render` writes the tone-mapped image in: 8-bit without an sRGB view, so the
+/// sRGB curve is voxgi's own (exact to the bit on every device) rather than the GPU's encoder,
+/// which may round differently by one step.
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// Most frames `render` records before giving up on the voxels settling: the first build; a
+/// second when it dropped fragments (its voxel count covers only those it kept); a third when
+/// the voxel pool then still overflowed; and one to spare.
+const MAX_FRAMES: u32 = 4;
+
+/// Renders one frame of `width` x `height` and reads it back: the tone-mapped image
+/// (`OUTPUT_FORMAT`) and the linear HDR radiance. Waits for the GPU, unlike
+/// `Renderer::render`. When the frame's voxel build overflowed a pool, the frame is rendered
+/// again once the pools have grown, so the image is always that of a renderer sized right.
+pub fn render(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    params: &FrameParams,
+    width: u32,
+    height: u32,
+) -> Result<RenderOutput> {
+    crate::validate_size(width, height)?;
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("headless output"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: OUTPUT_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    let target = Target::new(&view, OUTPUT_FORMAT, width, height);
+    for frame in 0..MAX_FRAMES {
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("headless frame"),
+            });
+        renderer.render(&mut encoder, &target, params)?;
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu {
+                context: "frame".into(),
                 reason: e.to_string(),
+            })?;
+        ctx.take_error("frame")?;
+        if !renderer.receive_feedback()? {
+            break;
+        }
+        if frame + 1 == MAX_FRAMES {
+            return Err(Error::Gpu {
+                context: "voxelize".into(),
+                reason: "the voxel pools still overflow after growing".into(),
             });
         }
-        Ok(out)
     }
+    let hdr = renderer.hdr_texture().ok_or_else(|| Error::Gpu {
+        context: "frame".into(),
+        reason: "no HDR target after rendering".into(),
+    })?;
+    let hdr_bytes = readback::read_texture(&ctx.device, &ctx.queue, hdr)?;
+    let ldr = readback::read_texture(&ctx.device, &ctx.queue, &texture)?;
+    ctx.take_error("readback")?;
+    Ok(RenderOutput {
+        width,
+        height,
+        hdr: bytemuck::cast_slice(&hdr_bytes).to_vec(),
+        ldr,
+    })
 }

@@ -1,0 +1,202 @@
+//! `voxgi bench`: GPU timestamps per pass over many frames, a table and JSON.
+
+use crate::args::{SceneArg, SettingsArgs, load_scene_and_settings, parse_size, scene_label};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use std::path::PathBuf;
+use voxgi::headless::{self, GpuContext};
+use voxgi::{Target, VoxelCounts, wgpu};
+
+#[derive(Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub scene: SceneArg,
+    /// Image size in pixels.
+    #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Frames timed (after the warm-up).
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub frames: u32,
+    /// Frames rendered before timing starts.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    pub warmup: u32,
+    /// Voxelize, inject, filter and bounce every frame (a fully dynamic scene).
+    #[arg(long)]
+    pub revoxelize: bool,
+    /// Write the results as JSON here.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let i = ((sorted.len() - 1) as f64 * p).round() as usize;
+    sorted[i]
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let label = scene_label(&args.scene);
+    let (scene, table) = load_scene_and_settings(&args.scene)?;
+    let camera = scene
+        .cameras
+        .first()
+        .cloned()
+        .unwrap_or_else(|| scene.default_camera());
+    let (settings, frame) = args
+        .settings
+        .resolve(table.as_ref(), camera)
+        .with_context(|| label.clone())?;
+    let ctx = GpuContext::from_env()?;
+    if !ctx.timestamps {
+        bail!(
+            "{} does not support GPU timestamp queries; voxgi bench needs them",
+            ctx.info.name
+        );
+    }
+    let mut renderer = ctx
+        .renderer(&scene, &settings)
+        .with_context(|| label.clone())?;
+    renderer.enable_timing(true);
+    let (w, h) = args.size;
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("bench output"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: headless::OUTPUT_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    let target = Target::new(&view, headless::OUTPUT_FORMAT, w, h);
+    eprintln!(
+        "bench: {label}, {w}x{h}, voxels {}³, {} frames after {} warm-up, on {} ({:?})",
+        settings.voxel_resolution, args.frames, args.warmup, ctx.info.name, ctx.info.backend
+    );
+    let mut per_pass: Vec<(&'static str, Vec<f64>)> = Vec::new();
+    let mut totals = Vec::new();
+    let mut walls = Vec::new();
+    let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
+    for i in 0..args.warmup + args.frames {
+        // Wall time from recording to the timestamps' readback: the whole frame, CPU included,
+        // whatever a driver's timestamps miss (lavapipe's read about 0 for some passes).
+        let start = std::time::Instant::now();
+        if args.revoxelize {
+            renderer.invalidate();
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.render(&mut encoder, &target, &frame)?;
+        ctx.queue.submit([encoder.finish()]);
+        let times = renderer.pass_times()?;
+        ctx.take_error("frame")?;
+        let wall = start.elapsed().as_secs_f64() * 1e3;
+        if i == 0 {
+            first_frame = times.clone();
+        }
+        if i < args.warmup {
+            continue;
+        }
+        totals.push(times.iter().map(|(_, ms)| ms).sum::<f64>());
+        walls.push(wall);
+        for (name, ms) in times {
+            match per_pass.iter_mut().find(|(n, _)| *n == name) {
+                Some(e) => e.1.push(ms),
+                None => per_pass.push((name, vec![ms])),
+            }
+        }
+        eprint!("\rframe {}/{}", i + 1 - args.warmup, args.frames);
+    }
+    eprintln!();
+    let VoxelCounts {
+        fragments,
+        occupied,
+    } = renderer.voxel_counts()?;
+    let mut rows = Vec::new();
+    println!(
+        "{:<14} {:>10} {:>10} {:>8}",
+        "pass", "median ms", "p95 ms", "frames"
+    );
+    for (name, v) in &mut per_pass {
+        v.sort_by(f64::total_cmp);
+        let (med, p95) = (percentile(v, 0.5), percentile(v, 0.95));
+        println!("{name:<14} {med:>10.3} {p95:>10.3} {:>8}", v.len());
+        rows.push(
+            serde_json::json!({"name": name, "median_ms": med, "p95_ms": p95, "frames": v.len()}),
+        );
+    }
+    totals.sort_by(f64::total_cmp);
+    let (fmed, fp95) = (percentile(&totals, 0.5), percentile(&totals, 0.95));
+    println!(
+        "{:<14} {fmed:>10.3} {fp95:>10.3} {:>8}",
+        "frame (GPU)",
+        totals.len()
+    );
+    walls.sort_by(f64::total_cmp);
+    let (wmed, wp95) = (percentile(&walls, 0.5), percentile(&walls, 0.95));
+    println!(
+        "{:<14} {wmed:>10.3} {wp95:>10.3} {:>8}",
+        "frame (wall)",
+        walls.len()
+    );
+    let update: Vec<(&'static str, f64)> = first_frame
+        .iter()
+        .filter(|(n, _)| !per_pass.iter().any(|(p, _)| p == n))
+        .copied()
+        .collect();
+    if !update.is_empty() {
+        let sum: f64 = update.iter().map(|(_, ms)| ms).sum();
+        println!("scene update, first frame only: {sum:.3} ms");
+        for (n, ms) in &update {
+            println!("  {n:<12} {ms:>10.3}");
+        }
+    }
+    let memory = renderer.memory();
+    let total_bytes: u64 = memory.iter().map(|(_, b)| b).sum();
+    println!("memory: {:.1} MiB total", total_bytes as f64 / 1048576.0);
+    for (name, bytes) in &memory {
+        println!("  {name:<36} {:>10.2} MiB", *bytes as f64 / 1048576.0);
+    }
+    println!("voxels: {fragments} fragments, {occupied} occupied voxels");
+    if let Some(path) = &args.json {
+        let json = serde_json::json!({
+            "adapter": ctx.info.name,
+            "backend": format!("{:?}", ctx.info.backend),
+            "device_type": format!("{:?}", ctx.info.device_type),
+            "driver": ctx.info.driver,
+            "scene": label,
+            "size": [w, h],
+            "frames": args.frames,
+            "settings": {
+                "voxel_resolution": settings.voxel_resolution,
+                "anisotropic": settings.anisotropic,
+                "cones": settings.cones.name(),
+                "bounces": settings.bounces,
+                "gather_axes": settings.gather_axes,
+                "half_resolution": settings.half_resolution,
+                "cone_shadows": settings.cone_shadows,
+                "revoxelize_every_frame": args.revoxelize,
+                "shadow_map_size": settings.shadow_map_size,
+                "step_factor": settings.step_factor,
+            },
+            "passes": rows,
+            "first_frame_ms": first_frame.iter().map(|(n, ms)| serde_json::json!({"name": n, "ms": ms})).collect::<Vec<_>>(),
+            "frame_ms": {"median": fmed, "p95": fp95},
+            "wall_ms": {"median": wmed, "p95": wp95},
+            "memory_bytes": memory.iter().map(|(n, b)| serde_json::json!({"name": n, "bytes": b})).collect::<Vec<_>>(),
+            "voxels": {"fragments": fragments, "occupied": occupied},
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&json)? + "\n")
+            .with_context(|| format!("{}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}

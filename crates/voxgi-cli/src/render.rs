@@ -1,0 +1,232 @@
+//! `voxgi render`: one image of a scene, by the real-time renderer or the path tracer.
+
+use crate::args::{
+    Progress, SceneArg, SettingsArgs, load_scene_and_settings, parse_size, parse_vec3, scene_label,
+};
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use voxgi::headless::{self, GpuContext};
+use voxgi::scene::glam::Vec3;
+use voxgi::scene::{Camera, Projection, Scene};
+use voxgi::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArg,
+    /// Output image; the extension picks the format (.png or .exr).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Image size in pixels.
+    #[arg(long, value_name = "WxH", default_value = "512x512", value_parser = parse_size)]
+    pub size: (u32, u32),
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Camera position, overriding the scene's camera (metres).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long, value_name = "DEGREES")]
+    pub fov: Option<f32>,
+    /// Which of the scene's cameras to use (by index, see `voxgi info`).
+    #[arg(long, value_name = "N")]
+    pub camera: Option<usize>,
+    /// Renderer: the real-time rasterizer, the reference path tracer, or the AO reference.
+    #[arg(long, value_enum, default_value_t = ModeArg::Raster)]
+    pub mode: ModeArg,
+    /// Reference modes: samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    pub spp: u32,
+    /// Reference modes: random seed (the same seed gives the same image).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub seed: u32,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    Raster,
+    Reference,
+    AoReference,
+}
+
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let p = Progress {
+        start: Instant::now(),
+    };
+    let ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext != "png" && ext != "exr" {
+        bail!(
+            "{}: unknown image type (use .png or .exr)",
+            args.output.display()
+        );
+    }
+    check_writable(&args.output)?;
+    let label = scene_label(&args.scene);
+    let (scene, table) = p.stage(&format!("loading {label}"), || {
+        load_scene_and_settings(&args.scene)
+    })?;
+    let default = scene
+        .cameras
+        .first()
+        .cloned()
+        .unwrap_or_else(|| scene.default_camera());
+    let camera = pick_camera(&scene, &default, args)?;
+    let (options, frame) = args
+        .settings
+        .resolve(table.as_ref(), camera)
+        .with_context(|| label.clone())?;
+    let ctx = p.stage("opening GPU", GpuContext::from_env)?;
+    eprintln!("GPU: {} ({:?})", ctx.info.name, ctx.info.backend);
+    let (w, h) = args.size;
+    let out = if args.mode == ModeArg::Raster {
+        let mut renderer = p
+            .stage("uploading scene", || ctx.renderer(&scene, &options))
+            .with_context(|| label.clone())?;
+        p.stage(&format!("rendering {w}x{h}"), || {
+            headless::render(&ctx, &mut renderer, &frame, w, h)
+        })?
+    } else {
+        let opts = ReferenceOptions {
+            spp: args.spp,
+            bounces: match options.bounces {
+                0 => Bounces::DirectOnly,
+                1 => Bounces::One,
+                voxgi::UNLIMITED_BOUNCES => Bounces::Unlimited,
+                n => Bounces::Exactly(n),
+            },
+            mode: if args.mode == ModeArg::AoReference {
+                ReferenceMode::Ao {
+                    // The cone tracer's AO radius, so the two are comparable.
+                    radius: options.ao_radius.unwrap_or_else(|| {
+                        let b = scene.bounds();
+                        voxgi::voxel::Grid::around(b.min, b.max, options.voxel_resolution).extent()
+                            * 0.25
+                    }),
+                }
+            } else {
+                ReferenceMode::Radiance
+            },
+            seed: args.seed,
+        };
+        let mut tracer = p
+            .stage("uploading scene and building the BVH", || {
+                PathTracer::new(&ctx.device, &ctx.queue, &scene, &options)
+            })
+            .with_context(|| label.clone())?;
+        eprintln!(
+            "path tracing {w}x{h}, {} spp, {} triangles",
+            opts.spp,
+            tracer.triangle_count()
+        );
+        let t = Instant::now();
+        let mut last = 0.0;
+        let out = tracer.render(&frame, w, h, &opts, &mut |done, total| {
+            let el = t.elapsed().as_secs_f64();
+            if el - last >= 1.0 || done == total {
+                last = el;
+                let eta = el / done as f64 * (total - done) as f64;
+                eprint!("\r  {done}/{total} spp  {el:.1} s elapsed  ETA {eta:.1} s   ");
+            }
+        })?;
+        eprintln!(
+            "\nrendered {} spp in {:.2} s",
+            opts.spp,
+            t.elapsed().as_secs_f64()
+        );
+        out
+    };
+    out.save(&args.output)?;
+    eprintln!(
+        "wrote {} ({w}x{h}) in {:.2} s",
+        args.output.display(),
+        p.start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn pick_camera(scene: &Scene, default: &Camera, args: &RenderArgs) -> Result<Camera> {
+    let mut cam = match args.camera {
+        Some(i) => scene.cameras.get(i).cloned().with_context(|| {
+            format!(
+                "camera {i} does not exist (the scene has {})",
+                scene.cameras.len()
+            )
+        })?,
+        None => default.clone(),
+    };
+    if args.eye.is_some() || args.target.is_some() {
+        let eye = args.eye.unwrap_or(cam.position);
+        let target = args.target.unwrap_or(cam.position + cam.forward);
+        if (target - eye).length() < 1e-6 {
+            bail!("--eye and --target are the same point");
+        }
+        let fov = match cam.projection {
+            Projection::Perspective { yfov } => yfov.to_degrees(),
+            _ => 45.0,
+        };
+        // The default camera's near plane sits just in front of the scene's bounds; a moved eye
+        // (perhaps inside the scene) needs one scaled to the scene instead.
+        let near = if args.eye.is_some() {
+            let b = scene.bounds();
+            let radius = if b.is_empty() {
+                1.0
+            } else {
+                b.size().length() * 0.5
+            };
+            cam.znear.min((radius * 1e-3).max(1e-4))
+        } else {
+            cam.znear
+        };
+        cam = Camera::look_at(eye, target, fov);
+        cam.znear = near;
+    }
+    if let Some(fov) = args.fov {
+        if !(fov > 0.5 && fov < 179.0) {
+            bail!("--fov {fov} is outside (0.5, 179) degrees");
+        }
+        cam.projection = Projection::Perspective {
+            yfov: fov.to_radians(),
+        };
+    }
+    Ok(cam)
+}
+
+/// Fails before any rendering when `path` cannot be written: its folder is missing or
+/// read-only, or it names a folder.
+fn check_writable(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        bail!("{}: is a directory, not an image file", path.display());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        bail!(
+            "{}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .with_context(|| format!("{}: cannot write here", path.display()))?;
+    if !existed {
+        // Leave no empty file behind if the render then fails.
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
+}

@@ -1,0 +1,104 @@
+//! Counters read back without waiting: the GPU's count is copied into a small mappable buffer
+//! in the same encoder as the work that wrote it, the buffer is mapped when that encoder is
+//! submitted, and the values are picked up by a later frame once the map has completed. No
+//! frame ever blocks on it.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+
+const IDLE: u8 = 0;
+const IN_FLIGHT: u8 = 1;
+const READY: u8 = 2;
+const FAILED: u8 = 3;
+
+/// More requests than this in flight means the caller is not submitting what voxgi records
+/// (or the GPU is many frames behind); further requests are dropped until some complete.
+const MAX_IN_FLIGHT: usize = 8;
+
+struct Slot {
+    buffer: wgpu::Buffer,
+    state: Arc<AtomicU8>,
+}
+
+/// A pool of readback buffers of `size` bytes for one kind of counter.
+pub struct CounterReadback {
+    label: &'static str,
+    size: u64,
+    slots: Vec<Slot>,
+}
+
+impl CounterReadback {
+    pub fn new(label: &'static str, size: u64) -> Self {
+        CounterReadback {
+            label,
+            size,
+            slots: Vec::new(),
+        }
+    }
+
+    /// Records a copy of `src[..size]` and its map on submission. Returns false when too many
+    /// reads are still in flight (nothing is recorded).
+    pub fn request(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        src: &wgpu::Buffer,
+    ) -> bool {
+        let i = match self
+            .slots
+            .iter()
+            .position(|s| s.state.load(Ordering::Acquire) == IDLE)
+        {
+            Some(i) => i,
+            None if self.slots.len() < MAX_IN_FLIGHT => {
+                self.slots.push(Slot {
+                    buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(self.label),
+                        size: self.size,
+                        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                        mapped_at_creation: false,
+                    }),
+                    state: Arc::new(AtomicU8::new(IDLE)),
+                });
+                self.slots.len() - 1
+            }
+            None => return false,
+        };
+        let slot = &self.slots[i];
+        slot.state.store(IN_FLIGHT, Ordering::Release);
+        encoder.copy_buffer_to_buffer(src, 0, &slot.buffer, 0, self.size);
+        let state = slot.state.clone();
+        encoder.map_buffer_on_submit(&slot.buffer, wgpu::MapMode::Read, .., move |r| {
+            state.store(if r.is_ok() { READY } else { FAILED }, Ordering::Release);
+        });
+        true
+    }
+
+    /// Every read completed since the last call, oldest first, as u32 words. Call after a
+    /// non-blocking `Device::poll` so that completed maps have run their callbacks.
+    pub fn take_ready(&mut self) -> Vec<Vec<u32>> {
+        let mut out = Vec::new();
+        for s in &self.slots {
+            match s.state.load(Ordering::Acquire) {
+                READY => {
+                    if let Ok(view) = s.buffer.slice(..).get_mapped_range() {
+                        out.push(bytemuck::cast_slice(&view).to_vec());
+                    }
+                    s.buffer.unmap();
+                    s.state.store(IDLE, Ordering::Release);
+                }
+                FAILED => s.state.store(IDLE, Ordering::Release),
+                _ => {}
+            }
+        }
+        out
+    }
+
+    /// Reads still waiting for their submission or for the GPU.
+    pub fn in_flight(&self) -> usize {
+        self.slots
+            .iter()
+            .filter(|s| s.state.load(Ordering::Acquire) == IN_FLIGHT)
+            .count()
+    }
+}

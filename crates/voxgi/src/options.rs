@@ -1,0 +1,362 @@
+//! The renderer's knobs with their documented defaults and range checks: creation-time
+//! options apart from per-frame parameters.
+
+use crate::voxel::ConeSet;
+use crate::{Error, Result};
+use voxgi_scene::Camera;
+
+/// The curve that maps exposed linear radiance to display values.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Tonemap {
+    /// Narkowicz's fit of ACES: filmic toe and shoulder, desaturates very bright colours.
+    #[default]
+    Aces,
+    /// Khronos PBR Neutral: base colours stay exact up to 0.76, highlights roll off.
+    Neutral,
+    /// No curve: clamp to [0, 1]. For measurements.
+    Clamp,
+}
+
+/// What the output shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ViewMode {
+    /// The lit image.
+    #[default]
+    Final,
+    /// Surface albedo (the G-buffer).
+    Albedo,
+    /// World-space normals mapped to colour.
+    Normal,
+    /// Direct light only, without emission.
+    Direct,
+    /// Ambient occlusion from the diffuse cones (white: open, black: occluded).
+    Ao,
+    /// Indirect light only.
+    Indirect,
+    /// The voxel volume ray-marched at `FrameParams::debug_level`: the finest albedo under the
+    /// first voxel with opacity > 0.5.
+    VoxelAlbedo,
+    /// The opacity of the first voxel with opacity > 0.5 at `debug_level`, as grey.
+    VoxelOpacity,
+    /// The radiance (un-premultiplied) of the first voxel with opacity > 0.5 at `debug_level`.
+    VoxelRadiance,
+}
+
+impl Tonemap {
+    /// Every curve, in the order of their ids.
+    pub const ALL: [Tonemap; 3] = [Tonemap::Aces, Tonemap::Neutral, Tonemap::Clamp];
+
+    /// The name scene files and the CLI use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::Aces => "aces",
+            Tonemap::Neutral => "neutral",
+            Tonemap::Clamp => "clamp",
+        }
+    }
+
+    /// The id the shaders switch on (`Frame.tonemap`; `TONEMAP_*` in shaders/shared/scene.wgsl).
+    pub fn id(self) -> u32 {
+        self as u32
+    }
+
+    /// A curve by name.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| Error::Setting(format!("tone map '{s}' is not aces, neutral or clamp")))
+    }
+}
+
+impl ViewMode {
+    /// Every view, in the order of their ids.
+    pub const ALL: [ViewMode; 9] = [
+        ViewMode::Final,
+        ViewMode::Albedo,
+        ViewMode::Normal,
+        ViewMode::Direct,
+        ViewMode::Ao,
+        ViewMode::Indirect,
+        ViewMode::VoxelAlbedo,
+        ViewMode::VoxelOpacity,
+        ViewMode::VoxelRadiance,
+    ];
+
+    /// The name scene files and the CLI use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ViewMode::Final => "final",
+            ViewMode::Albedo => "albedo",
+            ViewMode::Normal => "normal",
+            ViewMode::Direct => "direct",
+            ViewMode::Ao => "ao",
+            ViewMode::Indirect => "indirect",
+            ViewMode::VoxelAlbedo => "voxel-albedo",
+            ViewMode::VoxelOpacity => "voxel-opacity",
+            ViewMode::VoxelRadiance => "voxel-radiance",
+        }
+    }
+
+    /// The id the shaders switch on (`Frame.view_mode`; `VIEW_*` in shaders/shared/scene.wgsl).
+    pub fn id(self) -> u32 {
+        self as u32
+    }
+
+    /// A view by name.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|v| v.name()).collect();
+                Error::Setting(format!("view '{s}' is not one of {}", names.join(", ")))
+            })
+    }
+
+    /// The views the `debug` pass draws by ray-marching the voxel volume.
+    pub fn is_voxel(&self) -> bool {
+        matches!(
+            self,
+            ViewMode::VoxelAlbedo | ViewMode::VoxelOpacity | ViewMode::VoxelRadiance
+        )
+    }
+}
+
+/// `RendererOptions::bounces` value for "until converged": voxel bounces are repeated until the
+/// energy left (the largest albedo to the power of the bounce count) is below 0.1 %.
+pub const UNLIMITED_BOUNCES: u32 = u32::MAX;
+/// Most bounces a finite setting may ask for.
+pub const MAX_BOUNCES: u32 = 8;
+
+/// Creation-time options: what the renderer's pipelines, resources and voxel work depend on.
+/// `Renderer::new` takes them; `Renderer::set_options` rebuilds only what a change touches.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RendererOptions {
+    /// Width and height of each shadow map in texels (64..=8192). Default 1024.
+    pub shadow_map_size: u32,
+    /// Largest material texture size; bigger textures are downsampled (1..=8192). Default 1024.
+    pub max_texture_size: u32,
+    /// Add a sun when the scene has no light and nothing emissive, instead of rendering black.
+    /// Default true.
+    pub default_light: bool,
+    /// Voxels per side of the volume at the finest level: a power of two in 16..=512.
+    /// Default 128.
+    pub voxel_resolution: u32,
+    /// Six directional values per voxel above the finest level (true, default) or one.
+    pub anisotropic: bool,
+    /// Directional blocks each cone sample of the per-pixel gather reads in an anisotropic
+    /// volume: 3, every axis by its weight (the paper's filtering), or 2, the two axes of
+    /// largest weight renormalised (faster; docs/QUALITY.md has the cost in accuracy).
+    /// Default 3.
+    pub gather_axes: u32,
+    /// Diffuse cone set. Default: six cones of 60°.
+    pub cones: ConeSet,
+    /// Indirect bounces: 0 (direct light only) to 8, or `UNLIMITED_BOUNCES`. The last bounce is
+    /// the per-pixel gather; the others run in voxel space. Default 2.
+    pub bounces: u32,
+    /// Ambient occlusion radius in metres; `None`: a quarter of the volume's extent.
+    pub ao_radius: Option<f32>,
+    /// Ambient occlusion falloff lambda in 1/(1 + lambda r), per metre (>= 0). Default 0:
+    /// plain cosine-weighted visibility within the radius, what the AO reference computes.
+    pub ao_lambda: f32,
+    /// Cone sample step as a fraction of the cone's diameter (0.05..=2). Default 0.5.
+    pub step_factor: f32,
+    /// Cone origin offset along the normal, in finest voxels (0..=8): keeps a cone from seeing
+    /// its own surface's voxels. Default 1.5.
+    pub origin_offset: f32,
+    /// Longest cone in metres; `None`: the volume's diagonal.
+    pub max_distance: Option<f32>,
+    /// Gather indirect light at half resolution and upsample it edge-aware. Default false.
+    pub half_resolution: bool,
+    /// Shadows of area lights by a cone traced through the voxels towards the light (aperture:
+    /// the light's size) instead of PCSS on the shadow map. Default false.
+    pub cone_shadows: bool,
+    /// Voxel fragments the first build has room for (at least 1024); `None`: an upper bound
+    /// estimated from the scene. Too few is not an error: the build counts what did not fit
+    /// and the pool grows a frame later. Set it to avoid that frame in a known scene.
+    pub fragment_capacity: Option<u64>,
+    /// Occupied voxels the first build has room for (at least 1024); `None`: a quarter of the
+    /// fragment estimate. Grows like `fragment_capacity`.
+    pub voxel_capacity: Option<u64>,
+}
+
+impl Default for RendererOptions {
+    fn default() -> Self {
+        RendererOptions {
+            shadow_map_size: 1024,
+            max_texture_size: 1024,
+            default_light: true,
+            voxel_resolution: 128,
+            anisotropic: true,
+            gather_axes: 3,
+            cones: ConeSet::Six60,
+            bounces: 2,
+            ao_radius: None,
+            ao_lambda: 0.0,
+            step_factor: 0.5,
+            origin_offset: 1.5,
+            max_distance: None,
+            half_resolution: false,
+            cone_shadows: false,
+            fragment_capacity: None,
+            voxel_capacity: None,
+        }
+    }
+}
+
+impl RendererOptions {
+    /// Checks every value against its documented range.
+    pub fn validate(&self) -> Result<()> {
+        let fail = |m: String| Err(Error::Setting(m));
+        if !(64..=8192).contains(&self.shadow_map_size) {
+            return fail(format!(
+                "shadow map size {} is outside 64..=8192",
+                self.shadow_map_size
+            ));
+        }
+        if !(1..=8192).contains(&self.max_texture_size) {
+            return fail(format!(
+                "max texture size {} is outside 1..=8192",
+                self.max_texture_size
+            ));
+        }
+        let r = self.voxel_resolution;
+        if !(16..=512).contains(&r) || !r.is_power_of_two() {
+            return fail(format!(
+                "voxel resolution {r} is not a power of two in 16..=512"
+            ));
+        }
+        if self.bounces > MAX_BOUNCES && self.bounces != UNLIMITED_BOUNCES {
+            return fail(format!(
+                "{} bounces: use 0..={MAX_BOUNCES} or unlimited",
+                self.bounces
+            ));
+        }
+        if let Some(a) = self.ao_radius
+            && !(a.is_finite() && a > 0.0)
+        {
+            return fail(format!("AO radius {a} must be a positive number of metres"));
+        }
+        if !(self.ao_lambda.is_finite() && self.ao_lambda >= 0.0) {
+            return fail(format!("AO lambda {} must be >= 0", self.ao_lambda));
+        }
+        if !(2..=3).contains(&self.gather_axes) {
+            return fail(format!("gather axes {} must be 2 or 3", self.gather_axes));
+        }
+        if !(0.05..=2.0).contains(&self.step_factor) {
+            return fail(format!(
+                "step factor {} is outside 0.05..=2",
+                self.step_factor
+            ));
+        }
+        if !(0.0..=8.0).contains(&self.origin_offset) {
+            return fail(format!(
+                "cone origin offset {} is outside 0..=8 voxels",
+                self.origin_offset
+            ));
+        }
+        if let Some(d) = self.max_distance
+            && !(d.is_finite() && d > 0.0)
+        {
+            return fail(format!(
+                "max cone distance {d} must be a positive number of metres"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Mip levels of the volume, the finest included.
+    pub fn voxel_levels(&self) -> u32 {
+        self.voxel_resolution.max(1).ilog2() + 1
+    }
+}
+
+/// Per-frame parameters: the view and how it is displayed. Changing any of them never
+/// rebuilds a pipeline or redoes voxel work.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameParams {
+    /// The camera (the scene's own is `Renderer::default_camera`).
+    pub camera: Camera,
+    /// Exposure in stops: the image is scaled by 2^exposure before tone mapping (-20..=20).
+    /// Default 0.
+    pub exposure: f32,
+    /// Default ACES.
+    pub tonemap: Tonemap,
+    /// Radiance of pixels that see no geometry. Default black.
+    pub background: [f32; 3],
+    /// Default `ViewMode::Final`.
+    pub view: ViewMode,
+    /// Filter radius of point, spot and directional shadows in texels (0..=16). Area lights get
+    /// penumbrae from their size instead. Default 1.5.
+    pub shadow_softness: f32,
+    /// Mip level the voxel views show, 0 = finest (< `RendererOptions::voxel_levels`).
+    /// Default 0.
+    pub debug_level: u32,
+    /// Directional chain the voxel views read above the finest level: 0..6 for +X, -X, +Y, -Y,
+    /// +Z, -Z (ignored in an isotropic volume). Default 0.
+    pub debug_direction: u32,
+}
+
+impl FrameParams {
+    /// The defaults, seen from `camera`.
+    pub fn new(camera: Camera) -> Self {
+        FrameParams {
+            camera,
+            exposure: 0.0,
+            tonemap: Tonemap::Aces,
+            background: [0.0; 3],
+            view: ViewMode::Final,
+            shadow_softness: 1.5,
+            debug_level: 0,
+            debug_direction: 0,
+        }
+    }
+
+    /// Checks every value against its documented range; `levels` is the volume's mip count.
+    pub fn validate(&self, levels: u32) -> Result<()> {
+        let fail = |m: String| Err(Error::Setting(m));
+        let c = &self.camera;
+        if !(c.position.is_finite() && c.forward.is_finite() && c.up.is_finite()) {
+            return fail("camera position and direction must be finite".into());
+        }
+        if !(0.0..=16.0).contains(&self.shadow_softness) {
+            return fail(format!(
+                "shadow softness {} is outside 0..=16 texels",
+                self.shadow_softness
+            ));
+        }
+        if !(-20.0..=20.0).contains(&self.exposure) {
+            return fail(format!("exposure {} EV is outside -20..=20", self.exposure));
+        }
+        if !self.background.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return fail("background must be finite and non-negative".into());
+        }
+        if self.debug_level >= levels {
+            return fail(format!(
+                "voxel debug level {} is outside 0..{levels}",
+                self.debug_level
+            ));
+        }
+        if self.debug_direction >= 6 {
+            return fail(format!(
+                "voxel debug direction {} is outside 0..6 (+X, -X, +Y, -Y, +Z, -Z)",
+                self.debug_direction
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Largest image side voxgi renders (memory for the targets grows with its square).
+pub const MAX_IMAGE_SIZE: u32 = 8192;
+
+/// Checks an output size.
+pub fn validate_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 || width > MAX_IMAGE_SIZE || height > MAX_IMAGE_SIZE {
+        return Err(Error::Setting(format!(
+            "image size {width}x{height} is outside 1x1..={MAX_IMAGE_SIZE}x{MAX_IMAGE_SIZE}"
+        )));
+    }
+    Ok(())
+}

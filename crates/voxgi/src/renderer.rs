@@ -1,0 +1,642 @@
+//! The renderer: uploads a scene once, then records frames into the caller's encoder by calling
+//! the passes in one fixed order from `Renderer::render`:
+//!
+//! shadow → voxelize → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
+//!        → gbuffer → gather → upsample → composite → [debug] → tonemap
+//!
+//! `debug` runs only for the voxel views (`ViewMode::is_voxel`) and replaces the composite's
+//! output with the ray-marched volume. `tonemap` writes the caller's target.
+//!
+//! The voxel passes (and the shadow maps they read) run when the scene changed: on the first
+//! frame, after `invalidate`, and after a pool grew. Their overflow counters come back
+//! asynchronously (`gpu::feedback`): a build that overflowed is redone a frame later with room
+//! for everything, and no frame waits for the GPU.
+
+use crate::brdf::BrdfTables;
+use crate::gpu::feedback::CounterReadback;
+use crate::gpu::timer::GpuTimer;
+use crate::gpu::{checked, readback, requirements};
+use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
+use crate::options::{FrameParams, RendererOptions, UNLIMITED_BOUNCES, validate_size};
+use crate::passes::bounce::BouncePass;
+use crate::passes::composite::CompositePass;
+use crate::passes::debug::DebugPass;
+use crate::passes::filter::FilterPass;
+use crate::passes::gather::{self, GatherPass};
+use crate::passes::gbuffer::GbufferPass;
+use crate::passes::inject::InjectPass;
+use crate::passes::shadow::{self, ShadowAtlas, ShadowPass};
+use crate::passes::tonemap::TonemapPass;
+use crate::passes::upsample::UpsamplePass;
+use crate::passes::voxelize::VoxelizePass;
+use crate::targets::FrameTargets;
+use crate::view::{camera_view_proj, lit_scene};
+use crate::voxel::dense::{DenseVolume, estimate_fragments, triangle_table};
+use crate::voxel::{GpuCones, Grid};
+use crate::{Error, Result};
+use glam::Vec3;
+use voxgi_scene::{Aabb, Camera, Scene, pointcloud};
+use wgpu::util::DeviceExt;
+
+/// The caller's texture a frame is written to: a view of it, its format and size.
+///
+/// The texture needs `TextureUsages::RENDER_ATTACHMENT` and one of the renderable colour
+/// formats: `Bgra8UnormSrgb` and `Rgba8UnormSrgb` (swapchains; encoded to sRGB by the GPU),
+/// `Rgba8Unorm` and `Bgra8Unorm` (voxgi applies the sRGB curve itself), or a float format such
+/// as `Rgba16Float` (tone-mapped linear values).
+#[derive(Clone, Copy, Debug)]
+pub struct Target<'a> {
+    pub view: &'a wgpu::TextureView,
+    pub format: wgpu::TextureFormat,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl<'a> Target<'a> {
+    pub fn new(
+        view: &'a wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        Target {
+            view,
+            format,
+            width,
+            height,
+        }
+    }
+}
+
+/// Every pass, by name.
+struct Passes {
+    shadow: ShadowPass,
+    voxelize: VoxelizePass,
+    inject: InjectPass,
+    filter: FilterPass,
+    bounce: BouncePass,
+    gbuffer: GbufferPass,
+    gather: GatherPass,
+    upsample: UpsamplePass,
+    composite: CompositePass,
+    debug: DebugPass,
+    tonemap: TonemapPass,
+}
+
+/// Voxel statistics of a build, as the GPU counted them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VoxelCounts {
+    /// Fragments voxelization emitted (kept or not).
+    pub fragments: u64,
+    /// Voxels at least one fragment fell into.
+    pub occupied: u64,
+}
+
+/// Fills in normals (k = 16) and disc radii (k = 8) of point clouds that lack them. Normals face
+/// the cloud's local origin when that lies outside the cloud's bounds (scanners put the sensor
+/// there), else the default camera.
+fn estimate_point_attributes(scene: &mut Scene) {
+    let camera = scene
+        .cameras
+        .first()
+        .cloned()
+        .unwrap_or_else(|| scene.default_camera())
+        .position;
+    for pc in &mut scene.point_clouds {
+        if pc.positions.is_empty() || (!pc.normals.is_empty() && !pc.radii.is_empty()) {
+            continue;
+        }
+        let start = std::time::Instant::now();
+        let mut local = Aabb::EMPTY;
+        for &p in &pc.positions {
+            local.grow(p);
+        }
+        let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
+        // `estimate_normals` takes the viewpoint in world space.
+        let viewpoint = if origin_outside {
+            pc.transform.transform_point3(Vec3::ZERO)
+        } else {
+            camera
+        };
+        let what = match (pc.normals.is_empty(), pc.radii.is_empty()) {
+            (true, true) => "normals and radii",
+            (true, false) => "normals",
+            _ => "radii",
+        };
+        pointcloud::estimate_normals(pc, 16, viewpoint);
+        pointcloud::estimate_radii(pc, 8);
+        log::info!(
+            "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
+            pc.name,
+            pc.positions.len(),
+            start.elapsed().as_secs_f64(),
+            if origin_outside {
+                "the cloud's origin"
+            } else {
+                "the default camera"
+            }
+        );
+    }
+}
+
+/// A scene uploaded to the GPU, ready to render from any camera into the caller's targets.
+///
+/// The application owns the device: voxgi creates its resources on the `wgpu::Device` it is
+/// given, records into the caller's `CommandEncoder` and installs no handlers on the device.
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    options: RendererOptions,
+    scene: GpuScene,
+    atlas: ShadowAtlas,
+    passes: Passes,
+    brdf_tables: BrdfTables,
+    volume: DenseVolume,
+    triangles: (wgpu::Buffer, u32),
+    cones: wgpu::Buffer,
+    /// Voxel bounces per update (the per-pixel gather adds the last bounce).
+    voxel_bounces: u32,
+    /// The voxels (and shadow maps) must be rebuilt in the next frame.
+    dirty: bool,
+    counters: CounterReadback,
+    last_counts: Option<VoxelCounts>,
+    timer: GpuTimer,
+    targets: Option<FrameTargets>,
+    center: Vec3,
+    radius: f32,
+    default_camera: Camera,
+}
+
+impl Renderer {
+    /// Uploads `scene` to `device`. A scene with nothing to draw (no triangles, no points) is
+    /// an error; a scene with no light at all gets a default sun (when
+    /// `options.default_light`) so it does not render black. Point clouds without normals or
+    /// radii get estimated ones. The device must offer `required_limits`' minimum
+    /// (`Error::DeviceLimits` names what it lacks).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        options: &RendererOptions,
+    ) -> Result<Self> {
+        options.validate()?;
+        requirements::check_device(device)?;
+        scene.validate()?;
+        if scene.triangle_count() == 0 && scene.point_count() == 0 {
+            return Err(Error::EmptyScene);
+        }
+        let settings = options;
+        let mut scene = lit_scene(scene, settings.default_light);
+        if scene
+            .point_clouds
+            .iter()
+            .any(|pc| !pc.positions.is_empty() && (pc.normals.is_empty() || pc.radii.is_empty()))
+        {
+            estimate_point_attributes(scene.to_mut());
+        }
+        let scene = scene.as_ref();
+        let (center, radius) = scene_bounds(scene);
+        let (gpu_scene, atlas) = checked(device, "scene upload", || -> Result<_> {
+            let mut gpu_scene = GpuScene::new(device, queue, scene, settings)?;
+            let casts: Vec<bool> = scene.lights.iter().map(|l| l.cast_shadows).collect();
+            let res = shadow::atlas_resolution(settings, &gpu_scene.gpu_lights);
+            let (views, owners) =
+                shadow::plan_views(&mut gpu_scene.gpu_lights, &casts, center, radius, res);
+            queue.write_buffer(
+                &gpu_scene.lights,
+                0,
+                bytemuck::cast_slice(&gpu_scene.gpu_lights),
+            );
+            let atlas = ShadowAtlas::new(device, views, owners, res);
+            Ok((gpu_scene, atlas))
+        })??;
+        let glossy = gather::has_glossy(scene, gpu_scene.point_count);
+        let b = scene.bounds();
+        let grid = Grid::around(b.min, b.max, settings.voxel_resolution);
+        let estimate = estimate_fragments(scene, &grid);
+        let capacity = fragment_capacity(
+            device,
+            settings
+                .fragment_capacity
+                .unwrap_or(estimate)
+                .min(max_fragments(device)),
+        )?;
+        check_volume_fits(device, &grid)?;
+        // Slots: at most one per voxel, usually far fewer than fragments, and the fragment
+        // estimate is itself an upper bound. Start at a quarter; the first build's counters
+        // grow the buffers to the exact count if that is short.
+        let slots = slot_capacity(
+            device,
+            settings
+                .voxel_capacity
+                .unwrap_or(estimate / 4)
+                .min((grid.resolution as u64).pow(3))
+                .min(max_slots(device)),
+        )?;
+        let (passes, volume, triangles) = checked(device, "pipeline creation", || {
+            let passes = Passes {
+                shadow: ShadowPass::new(device),
+                voxelize: VoxelizePass::new(device),
+                inject: InjectPass::new(device, gpu_scene.light_count),
+                filter: FilterPass::new(device),
+                bounce: BouncePass::new(device, settings.anisotropic),
+                gbuffer: GbufferPass::new(device),
+                gather: GatherPass::new(device, settings, glossy),
+                upsample: UpsamplePass::new(device),
+                composite: CompositePass::new(
+                    device,
+                    shadow::composite_reads_shadow_maps(
+                        &gpu_scene.gpu_lights,
+                        settings.cone_shadows,
+                    ),
+                    glossy,
+                ),
+                debug: DebugPass::new(device),
+                tonemap: TonemapPass::new(device),
+            };
+            let volume = DenseVolume::new(device, grid, settings.anisotropic, capacity, slots);
+            (passes, volume, triangle_table(device, &gpu_scene))
+        })?;
+        let brdf_tables = BrdfTables::new(device, queue);
+        let voxel_bounces = voxel_bounce_count(scene, settings.bounces);
+        let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("cones"),
+            contents: bytemuck::bytes_of(&cone_uniforms(settings, &grid)),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let default_camera = scene
+            .cameras
+            .first()
+            .cloned()
+            .unwrap_or_else(|| scene.default_camera());
+        Ok(Renderer {
+            device: device.clone(),
+            queue: queue.clone(),
+            options: options.clone(),
+            scene: gpu_scene,
+            atlas,
+            passes,
+            brdf_tables,
+            volume,
+            triangles,
+            cones,
+            voxel_bounces,
+            dirty: true,
+            counters: CounterReadback::new("voxel counters readback", 16),
+            last_counts: None,
+            timer: GpuTimer::disabled(queue),
+            targets: None,
+            center,
+            radius,
+            default_camera,
+        })
+    }
+
+    /// The scene's own camera, or a view of its bounds.
+    pub fn default_camera(&self) -> &Camera {
+        &self.default_camera
+    }
+
+    /// The options this renderer was made with.
+    pub fn options(&self) -> &RendererOptions {
+        &self.options
+    }
+
+    /// Bytes of GPU memory per resource.
+    pub fn memory(&self) -> Vec<(&'static str, u64)> {
+        let mut m = self.scene.memory();
+        m.push(("shadow atlas", self.atlas.bytes()));
+        m.extend(self.volume.memory());
+        if let Some(t) = &self.targets {
+            m.push(("render targets", t.bytes()));
+        }
+        m
+    }
+
+    fn frame_uniforms(&self, p: &FrameParams, width: u32, height: u32) -> GpuFrame {
+        let view_proj = camera_view_proj(&p.camera, width, height, self.center, self.radius);
+        GpuFrame {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            camera_pos: p.camera.position.to_array(),
+            light_count: self.scene.light_count,
+            size: [width as f32, height as f32],
+            inv_size: [1.0 / width as f32, 1.0 / height as f32],
+            exposure: 2f32.powf(p.exposure),
+            tonemap: p.tonemap.id(),
+            shadow_softness: p.shadow_softness,
+            // The debug pass draws the voxel views; composite writes the lit image underneath.
+            view_mode: p.view.id(),
+            background: [p.background[0], p.background[1], p.background[2], 1.0],
+            cone_shadows: self.options.cone_shadows as u32,
+            _pad: [0; 3],
+        }
+    }
+
+    /// Records shadow maps, voxelization, injection, filtering and voxel bounces: everything
+    /// that depends on the scene and its lights but not on the camera.
+    fn record_voxels(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let timer = &mut self.timer;
+        let p = &self.passes;
+        p.shadow
+            .record(&self.device, encoder, &self.atlas, &self.scene, timer);
+        self.volume.record_begin(&self.device, encoder, timer);
+        let triangles = (&self.triangles.0, self.triangles.1);
+        p.voxelize.record(
+            &self.device,
+            encoder,
+            &self.scene,
+            triangles,
+            &self.volume,
+            timer,
+        );
+        self.volume.record_build(&self.device, encoder, timer);
+        // The kernels never write past their buffers, they only count: the counts come back
+        // a frame or more later and grow the pools then (`receive_feedback`).
+        if !self
+            .counters
+            .request(&self.device, encoder, &self.volume.counters)
+        {
+            log::warn!("voxel counters: too many readbacks in flight; is the encoder submitted?");
+        }
+        p.inject.record(
+            &self.device,
+            encoder,
+            &self.scene,
+            &self.atlas,
+            &self.volume,
+            timer,
+        );
+        p.filter.record(&self.device, encoder, &self.volume, timer);
+        for _ in 0..self.voxel_bounces {
+            p.bounce
+                .record(&self.device, encoder, &self.volume, &self.cones, timer);
+            p.filter.record(&self.device, encoder, &self.volume, timer);
+        }
+        self.dirty = false;
+    }
+
+    /// Acts on voxel counters that have come back since the last call: when a build had more
+    /// fragments or occupied voxels than room, the pools grow to fit and the voxels are rebuilt
+    /// in the next frame. Never waits; `render` calls it first. Returns whether the next frame
+    /// rebuilds the voxels.
+    pub fn receive_feedback(&mut self) -> Result<bool> {
+        // Non-blocking: runs the callbacks of maps that have completed.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        for words in self.counters.take_ready() {
+            let counts = VoxelCounts {
+                fragments: words[0] as u64,
+                occupied: words[1] as u64,
+            };
+            self.last_counts = Some(counts);
+            let v = &self.volume;
+            if counts.fragments <= v.fragment_capacity as u64
+                && counts.occupied <= v.slot_capacity as u64
+            {
+                continue;
+            }
+            let capacity = fragment_capacity(
+                &self.device,
+                counts.fragments.max(v.fragment_capacity as u64),
+            )?;
+            let slots = slot_capacity(&self.device, counts.occupied.max(v.slot_capacity as u64))?;
+            log::info!(
+                "voxels: {} fragments, {} occupied voxels: growing the pools to {capacity} \
+                 fragments and {slots} voxels and rebuilding",
+                counts.fragments,
+                counts.occupied
+            );
+            let (grid, aniso) = (v.grid, v.anisotropic);
+            self.volume = DenseVolume::new(&self.device, grid, aniso, capacity, slots);
+            self.dirty = true;
+        }
+        Ok(self.dirty)
+    }
+
+    /// Voxel statistics of the most recent build whose counters have come back.
+    pub fn last_voxel_counts(&self) -> Option<VoxelCounts> {
+        self.last_counts
+    }
+
+    /// Voxel statistics of the last build, read back now. This waits for the GPU: it is for
+    /// tools and tests, never called by a frame.
+    pub fn voxel_counts(&self) -> Result<VoxelCounts> {
+        let bytes = readback::read_buffer_copy(&self.device, &self.queue, &self.volume.counters)?;
+        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        Ok(VoxelCounts {
+            fragments: c[0] as u64,
+            occupied: c[1] as u64,
+        })
+    }
+
+    /// The dense volume, for tests and debugging.
+    pub fn volume(&self) -> &DenseVolume {
+        &self.volume
+    }
+
+    /// Turns per-pass GPU timing on or off (when the device has `TIMESTAMP_QUERY`).
+    pub fn enable_timing(&mut self, on: bool) {
+        self.timer = if on {
+            GpuTimer::new(&self.device, &self.queue, true)
+        } else {
+            GpuTimer::disabled(&self.queue)
+        };
+    }
+
+    /// Milliseconds per pass of everything recorded since the last call, once it has been
+    /// submitted. This waits for the GPU (for `voxgi bench`).
+    pub fn pass_times(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        self.timer.read(&self.device)
+    }
+
+    /// Marks lights or geometry as changed: the next frame rebuilds shadows and voxels.
+    pub fn invalidate(&mut self) {
+        self.dirty = true;
+    }
+
+    /// The linear HDR radiance of the last frame (before exposure and tone mapping),
+    /// `Rgba32Float` at the last target's size, with `COPY_SRC` and `TEXTURE_BINDING` usage.
+    pub fn hdr_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.hdr_texture)
+    }
+
+    /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
+    /// whole extent). Submit the encoder before the next call: the frame's uniforms are written
+    /// through the queue, so two frames in one submission would share the last one's.
+    ///
+    /// On the first frame (and after `invalidate`) this also records the voxel update. Nothing
+    /// here waits for the GPU.
+    pub fn render(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        params: &FrameParams,
+    ) -> Result<()> {
+        let (width, height) = (target.width, target.height);
+        validate_size(width, height)?;
+        params.validate(self.options.voxel_levels())?;
+        self.receive_feedback()?;
+        checked(&self.device, "tonemap pipeline", || {
+            self.passes.tonemap.prepare(&self.device, target.format)
+        })?;
+        let half = self.options.half_resolution;
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| t.width != width || t.height != height || t.half != half)
+        {
+            self.targets = Some(FrameTargets::new(&self.device, width, height, half));
+        }
+        if self.dirty {
+            self.record_voxels(encoder);
+        }
+        let frame = self.frame_uniforms(params, width, height);
+        let t = self.targets.as_ref().expect("targets were just created");
+        self.queue
+            .write_buffer(&t.frame, 0, bytemuck::bytes_of(&frame));
+        let timer = &mut self.timer;
+        let p = &self.passes;
+        p.gbuffer
+            .record(&self.device, encoder, t, &self.scene, timer);
+        p.gather.record(
+            &self.device,
+            encoder,
+            t,
+            &self.scene,
+            &self.volume,
+            &self.cones,
+            &self.brdf_tables,
+            timer,
+        );
+        p.upsample.record(&self.device, encoder, t, timer);
+        p.composite.record(
+            &self.device,
+            encoder,
+            t,
+            &self.scene,
+            &self.atlas,
+            &self.brdf_tables,
+            timer,
+        );
+        // Only for the voxel views: replaces the composite's output.
+        if params.view.is_voxel() {
+            p.debug.record(
+                &self.device,
+                encoder,
+                t,
+                &self.volume,
+                params.view,
+                params.debug_level,
+                params.debug_direction,
+                timer,
+            );
+        }
+        p.tonemap
+            .record(&self.device, encoder, t, target.view, target.format, timer);
+        timer.resolve(encoder);
+        Ok(())
+    }
+}
+
+/// The most fragments one storage binding can hold on this device.
+fn max_fragments(device: &wgpu::Device) -> u64 {
+    device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES
+}
+
+/// The most slots one storage binding can hold on this device.
+fn max_slots(device: &wgpu::Device) -> u64 {
+    device.limits().max_storage_buffer_binding_size / crate::voxel::dense::SLOT_BYTES
+}
+
+/// Checks a slot capacity against the device's storage-buffer limit.
+fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
+    let limit = device.limits().max_storage_buffer_binding_size / crate::voxel::dense::SLOT_BYTES;
+    let cap = wanted.max(1024);
+    if cap > limit.min(u32::MAX as u64) {
+        return Err(Error::Setting(format!(
+            "the scene occupies about {cap} voxels at this resolution, more than this GPU's \
+             storage-buffer limit allows ({limit}); lower the voxel resolution"
+        )));
+    }
+    Ok(cap as u32)
+}
+
+/// Checks that the volume's per-voxel buffers fit the device's limits.
+fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
+    let l = device.limits();
+    let occupancy = (grid.resolution as u64).pow(3) * 4;
+    if occupancy > l.max_storage_buffer_binding_size {
+        return Err(Error::Setting(format!(
+            "a {r}³ volume needs a {} MiB occupancy buffer, more than this GPU's {} MiB \
+             storage-buffer limit; use a voxel resolution of at most {}",
+            occupancy >> 20,
+            l.max_storage_buffer_binding_size >> 20,
+            ((l.max_storage_buffer_binding_size / 4) as f64)
+                .cbrt()
+                .log2()
+                .floor()
+                .exp2() as u32,
+            r = grid.resolution
+        )));
+    }
+    if grid.resolution > l.max_texture_dimension_3d {
+        return Err(Error::Setting(format!(
+            "a {}³ volume exceeds this GPU's 3D texture limit of {}",
+            grid.resolution, l.max_texture_dimension_3d
+        )));
+    }
+    Ok(())
+}
+
+/// Checks a fragment capacity against the device's storage-buffer limit.
+fn fragment_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
+    let limit =
+        device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES;
+    let cap = wanted.max(1024);
+    if cap > limit.min(u32::MAX as u64) {
+        return Err(Error::Setting(format!(
+            "the scene needs about {cap} voxel fragments at this resolution, more than this \
+             GPU's storage-buffer limit allows ({limit}); lower the voxel resolution"
+        )));
+    }
+    Ok(cap as u32)
+}
+
+/// Voxel-space bounces for a total of `bounces` indirect bounces (the gather adds one).
+fn voxel_bounce_count(scene: &Scene, bounces: u32) -> u32 {
+    if bounces != UNLIMITED_BOUNCES {
+        return bounces.saturating_sub(1);
+    }
+    // Until the energy left, max albedo^k, is below 0.1 %.
+    let rho = scene
+        .materials
+        .iter()
+        .map(|m| m.base_color[0].max(m.base_color[1]).max(m.base_color[2]))
+        .fold(0.0f32, f32::max)
+        .clamp(0.0, 0.99);
+    if rho <= 0.0 {
+        return 0;
+    }
+    ((1e-3f32.ln() / rho.ln()).ceil() as u32).clamp(1, 64)
+}
+
+/// The cone uniforms from the settings and the volume.
+pub fn cone_uniforms(settings: &RendererOptions, grid: &Grid) -> GpuCones {
+    let axes = settings.cones.axes();
+    let weights = settings.cones.weights();
+    let mut dirs = [[0f32; 4]; 16];
+    for (i, (a, w)) in axes.iter().zip(&weights).enumerate().take(16) {
+        dirs[i] = [a.x, a.y, a.z, *w];
+    }
+    GpuCones {
+        dirs,
+        count: axes.len().min(16) as u32,
+        diffuse_tan: (settings.cones.aperture() * 0.5).tan(),
+        step_factor: settings.step_factor,
+        max_distance: settings.max_distance.unwrap_or(grid.extent() * 3f32.sqrt()),
+        ao_lambda: settings.ao_lambda,
+        ao_radius: settings.ao_radius.unwrap_or(grid.extent() * 0.25),
+        origin_offset: settings.origin_offset,
+        indirect: (settings.bounces > 0) as u32,
+    }
+}

@@ -1,0 +1,137 @@
+//! Render targets of one output size, and their formats: the g-buffer, the gather's targets
+//! and the HDR image. Passes read and write them; only `tonemap` touches the caller's texture.
+
+use crate::gpu::layout;
+use crate::gpu_scene::GpuFrame;
+use crate::passes::composite::HDR_FORMAT;
+use crate::passes::gather::{GUIDE_FORMAT, INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::passes::gbuffer;
+
+/// Render targets of one output size.
+pub struct FrameTargets {
+    pub width: u32,
+    pub height: u32,
+    pub frame: wgpu::Buffer,
+    pub albedo: wgpu::TextureView,
+    pub normal: wgpu::TextureView,
+    pub emission: wgpu::TextureView,
+    pub depth: wgpu::TextureView,
+    /// Linear radiance (the composite's output, the debug views' too); `tonemap` reads it.
+    pub hdr: wgpu::TextureView,
+    /// Indirect light (rgb) and ambient occlusion (a) at the gather's resolution, every
+    /// pixel's interleaved samples filtered together (`upsample`); the composite upsamples it.
+    pub indirect: wgpu::TextureView,
+    /// The gather's target, at full or half resolution; `upsample` filters it into `indirect`.
+    pub indirect_low: wgpu::TextureView,
+    /// Cone-traced visibility of the first four area lights (one channel each), as the gather
+    /// traced it.
+    pub visibility_low: wgpu::TextureView,
+    /// Normal and camera distance of each gather pixel (the upsample's edge weights).
+    pub guide_low: wgpu::TextureView,
+    pub half: bool,
+    pub hdr_texture: wgpu::Texture,
+}
+
+impl FrameTargets {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, half: bool) -> Self {
+        let (lw, lh) = gather_size(width, height, half);
+        let sized = |label: &str,
+                     format: wgpu::TextureFormat,
+                     usage: wgpu::TextureUsages,
+                     (width, height): (u32, u32)| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let st = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let view = |t: wgpu::Texture| t.create_view(&Default::default());
+        let make = |label: &str, format, usage| sized(label, format, usage, (width, height));
+        let low = |label: &str, format| sized(label, format, st, (lw, lh));
+        let hdr_texture = make("hdr", HDR_FORMAT, st);
+        FrameTargets {
+            width,
+            height,
+            frame: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame"),
+                size: size_of::<GpuFrame>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            albedo: view(make("gbuffer albedo", gbuffer::ALBEDO_FORMAT, rt)),
+            normal: view(make("gbuffer normal", gbuffer::NORMAL_FORMAT, rt)),
+            emission: view(make("gbuffer emission", gbuffer::EMISSION_FORMAT, rt)),
+            depth: view(make("gbuffer depth", gbuffer::DEPTH_FORMAT, rt)),
+            indirect: view(low("indirect", INDIRECT_FORMAT)),
+            indirect_low: view(low("indirect gather", INDIRECT_FORMAT)),
+            visibility_low: view(low("visibility gather", VISIBILITY_FORMAT)),
+            guide_low: view(low("gather guide", GUIDE_FORMAT)),
+            half,
+            hdr: hdr_texture.create_view(&Default::default()),
+            hdr_texture,
+        }
+    }
+
+    /// Bytes per pixel of the full-resolution targets (g-buffer, HDR) and of those at the
+    /// gather's resolution (gathered and filtered indirect light, visibility, guide).
+    const FULL_BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16;
+    const LOW_BYTES_PER_PIXEL: u64 = 8 + 8 + 4 + 8;
+
+    pub fn bytes(&self) -> u64 {
+        let (lw, lh) = self.gather_size();
+        self.width as u64 * self.height as u64 * Self::FULL_BYTES_PER_PIXEL
+            + lw as u64 * lh as u64 * Self::LOW_BYTES_PER_PIXEL
+    }
+
+    /// Four consecutive bindings from `first` for the passes that shade from the g-buffer:
+    /// albedo, normal and emission (loaded) and depth.
+    pub fn gbuffer_layout(first: u32, c: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 4] {
+        [
+            layout::texture_2d_load(first, c),
+            layout::texture_2d_load(first + 1, c),
+            layout::texture_2d_load(first + 2, c),
+            layout::texture(
+                first + 3,
+                c,
+                wgpu::TextureSampleType::Depth,
+                wgpu::TextureViewDimension::D2,
+            ),
+        ]
+    }
+
+    /// The resources for `gbuffer_layout`, in its order.
+    pub fn gbuffer_resources(&self) -> [wgpu::BindingResource<'_>; 4] {
+        [
+            wgpu::BindingResource::TextureView(&self.albedo),
+            wgpu::BindingResource::TextureView(&self.normal),
+            wgpu::BindingResource::TextureView(&self.emission),
+            wgpu::BindingResource::TextureView(&self.depth),
+        ]
+    }
+
+    pub fn gather_size(&self) -> (u32, u32) {
+        gather_size(self.width, self.height, self.half)
+    }
+}
+
+/// The gather's resolution: full, or half rounded up.
+fn gather_size(width: u32, height: u32, half: bool) -> (u32, u32) {
+    if half {
+        (width.div_ceil(2), height.div_ceil(2))
+    } else {
+        (width, height)
+    }
+}

@@ -1,0 +1,189 @@
+//! voxgi inside an application: the embed example's pixels, every kind of target format, and
+//! voxel pools that grow a frame later while no frame waits for the GPU.
+
+#[path = "../../examples/embed.rs"]
+#[allow(dead_code)]
+mod example;
+
+use crate::common::*;
+use voxgi::gpu::readback::{f16_to_f32, read_texture};
+use voxgi::output::linear_to_srgb;
+use voxgi::scene::builtin;
+use voxgi::{FrameParams, Renderer, RendererOptions, Target, wgpu};
+
+/// The embed example opens its own device and texture; its pixels are those of the headless
+/// path (`voxgi render` writes the same bytes, checked by the CLI tests) to the bit.
+#[test]
+fn embed_example_renders_what_headless_renders() {
+    let (w, h) = (64, 48);
+    let app = example::render_cornell(w, h).expect("embed example");
+    let scene = builtin::cornell_box();
+    let mut r = renderer(&scene, &RendererOptions::default());
+    let params = FrameParams::new(r.default_camera().clone());
+    let out = frame(&mut r, &params, w, h);
+    assert_eq!(app.len(), out.ldr.len());
+    let differing = app.iter().zip(&out.ldr).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{differing} bytes differ");
+    // Not a blank image: the lit box has a mean 8-bit value of about 60.
+    let mean = app.iter().map(|&v| v as f64).sum::<f64>() / app.len() as f64;
+    assert!(mean > 20.0, "mean {mean}");
+}
+
+fn texture(format: wgpu::TextureFormat, w: u32, h: u32) -> wgpu::Texture {
+    ctx().device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test target"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// Records one frame into `t` and submits it; waits only so the test can look.
+fn draw(r: &mut Renderer, params: &FrameParams, t: &wgpu::Texture) {
+    let view = t.create_view(&Default::default());
+    let target = Target::new(&view, t.format(), t.width(), t.height());
+    let mut encoder = ctx().device.create_command_encoder(&Default::default());
+    r.render(&mut encoder, &target, params).expect("render");
+    ctx().queue.submit([encoder.finish()]);
+    ctx()
+        .device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+}
+
+/// RGBA of an 8-bit texture, channels in RGBA order.
+fn rgba8(t: &wgpu::Texture) -> Vec<u8> {
+    let mut px = read_texture(&ctx().device, &ctx().queue, t).expect("readback");
+    if matches!(
+        t.format(),
+        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+    ) {
+        for p in px.chunks_exact_mut(4) {
+            p.swap(0, 2);
+        }
+    }
+    px
+}
+
+/// The tone-mapped image in a swapchain's formats and an HDR one agrees with the 8-bit image
+/// voxgi encodes itself: BGRA is RGBA reordered; the GPU's sRGB encoder rounds within one
+/// step of voxgi's; a float target holds the tone-mapped linear values.
+#[test]
+fn every_target_format_gets_the_same_image() {
+    let (w, h) = (40, 32);
+    let scene = builtin::cornell_box();
+    let mut r = renderer(&scene, &measuring());
+    let params = FrameParams::new(r.default_camera().clone());
+    let reference = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
+    draw(&mut r, &params, &reference);
+    let want = rgba8(&reference);
+    let max_diff = |got: &[u8]| {
+        got.iter()
+            .zip(&want)
+            .map(|(a, b)| (*a as i32 - *b as i32).abs())
+            .max()
+            .unwrap_or(0)
+    };
+    for (format, tolerance) in [
+        (wgpu::TextureFormat::Bgra8Unorm, 0),
+        (wgpu::TextureFormat::Rgba8UnormSrgb, 1),
+        (wgpu::TextureFormat::Bgra8UnormSrgb, 1),
+    ] {
+        let t = texture(format, w, h);
+        draw(&mut r, &params, &t);
+        let d = max_diff(&rgba8(&t));
+        assert!(d <= tolerance, "{format:?}: differs by {d} steps");
+    }
+    let t = texture(wgpu::TextureFormat::Rgba16Float, w, h);
+    draw(&mut r, &params, &t);
+    let bytes = read_texture(&ctx().device, &ctx().queue, &t).expect("readback");
+    let halves: &[u16] = bytemuck::cast_slice(&bytes);
+    // Encoded here, the fp16 values (3 significant digits) land within one step of 255.
+    let encoded: Vec<u8> = halves
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let v = f16_to_f32(v);
+            if i % 4 == 3 {
+                (v * 255.0).round() as u8
+            } else {
+                (linear_to_srgb(v) * 255.0).round() as u8
+            }
+        })
+        .collect();
+    let d = max_diff(&encoded);
+    assert!(d <= 1, "Rgba16Float: differs by {d} steps");
+}
+
+/// A renderer whose pools are far too small for the scene still gets the right image: the
+/// first build counts what did not fit, the counters come back without any frame waiting, the
+/// pools grow and a later frame rebuilds. From then on every frame equals, to the bit, the
+/// frame of a renderer sized right from the start.
+#[test]
+fn overflowing_pools_grow_and_converge_to_the_right_image() {
+    let scene = builtin::cornell_box();
+    let (w, h) = (32, 32);
+    let small = RendererOptions {
+        voxel_resolution: 32,
+        fragment_capacity: Some(1),
+        voxel_capacity: Some(1),
+        ..RendererOptions::default()
+    };
+    let mut r = renderer(&scene, &small);
+    let (frags0, slots0) = (r.volume().fragment_capacity, r.volume().slot_capacity);
+    let params = FrameParams::new(r.default_camera().clone());
+    let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
+    let mut frames = Vec::new();
+    for _ in 0..4 {
+        draw(&mut r, &params, &t);
+        frames.push(rgba8(&t));
+    }
+    let counts = r.last_voxel_counts().expect("counters came back");
+    let (frags1, slots1) = (r.volume().fragment_capacity, r.volume().slot_capacity);
+    // The Cornell box at 32³ has several thousand fragments and occupied voxels: the
+    // 1024-entry minimum pools overflowed, and grew to the exact counts.
+    assert!(
+        counts.fragments > frags0 as u64 && counts.occupied > slots0 as u64,
+        "the test scene must overflow both pools: {counts:?} vs {frags0}/{slots0}"
+    );
+    assert_eq!(
+        (frags1 as u64, slots1 as u64),
+        (counts.fragments, counts.occupied)
+    );
+
+    let right = RendererOptions {
+        fragment_capacity: Some(counts.fragments),
+        voxel_capacity: Some(counts.occupied),
+        ..small
+    };
+    let mut sized = renderer(&scene, &right);
+    draw(&mut sized, &params, &t);
+    let want = rgba8(&t);
+    assert_eq!(
+        sized.volume().slot_capacity,
+        slots1,
+        "no growth when sized right"
+    );
+    // The overflowing first frame misses voxels. A build that dropped fragments counts the
+    // voxels of those it kept only, so the voxel pool may need a second round: by the third
+    // frame every voxel is there, and it stays so.
+    assert_ne!(frames[0], want, "the first frame should show the overflow");
+    let first = frames.iter().position(|f| *f == want);
+    eprintln!("overflow: first right frame {first:?} of {}", frames.len());
+    let first = first.expect("no frame converged to the right-sized renderer's image");
+    assert!(first <= 2, "converged only at frame {first}");
+    for (i, f) in frames.iter().enumerate().skip(first) {
+        assert!(
+            *f == want,
+            "frame {i} differs from the right-sized renderer's"
+        );
+    }
+}
