@@ -31,7 +31,7 @@ use crate::passes::upsample::UpsamplePass;
 use crate::passes::voxelize::VoxelizePass;
 use crate::targets::FrameTargets;
 use crate::view::{camera_view_proj, lit_scene};
-use crate::voxel::dense::{DenseVolume, estimate_fragments, triangle_table};
+use crate::voxel::dense::{DenseVolume, FragmentEstimate, triangle_table};
 use crate::voxel::{GpuCones, Grid};
 use crate::{Error, Result};
 use glam::Vec3;
@@ -165,6 +165,20 @@ pub struct Renderer {
     center: Vec3,
     radius: f32,
     default_camera: Camera,
+    /// What option changes need from the scene, kept instead of the scene itself.
+    facts: SceneFacts,
+}
+
+/// What `set_options` needs to know of the scene to rebuild what an option feeds.
+struct SceneFacts {
+    bounds: Aabb,
+    estimate: FragmentEstimate,
+    /// The largest albedo of any material (the unlimited-bounce count's convergence).
+    max_albedo: f32,
+    /// Which lights cast shadows, in the scene's order.
+    casts: Vec<bool>,
+    /// Whether any surface may have a specular lobe.
+    glossy: bool,
 }
 
 impl Renderer {
@@ -196,69 +210,51 @@ impl Renderer {
         }
         let scene = scene.as_ref();
         let (center, radius) = scene_bounds(scene);
-        let (gpu_scene, atlas) = checked(device, "scene upload", || -> Result<_> {
-            let mut gpu_scene = GpuScene::new(device, queue, scene, settings)?;
-            let casts: Vec<bool> = scene.lights.iter().map(|l| l.cast_shadows).collect();
-            let res = shadow::atlas_resolution(settings, &gpu_scene.gpu_lights);
-            let (views, owners) =
-                shadow::plan_views(&mut gpu_scene.gpu_lights, &casts, center, radius, res);
-            queue.write_buffer(
-                &gpu_scene.lights,
-                0,
-                bytemuck::cast_slice(&gpu_scene.gpu_lights),
-            );
-            let atlas = ShadowAtlas::new(device, views, owners, res);
-            Ok((gpu_scene, atlas))
+        let facts = SceneFacts {
+            bounds: scene.bounds(),
+            estimate: FragmentEstimate::of(scene),
+            max_albedo: scene
+                .materials
+                .iter()
+                .map(|m| m.base_color[0].max(m.base_color[1]).max(m.base_color[2]))
+                .fold(0.0f32, f32::max),
+            casts: scene.lights.iter().map(|l| l.cast_shadows).collect(),
+            glossy: false,
+        };
+        let mut gpu_scene = checked(device, "scene upload", || {
+            GpuScene::new(device, queue, scene, settings)
         })??;
-        let glossy = gather::has_glossy(scene, gpu_scene.point_count);
-        let b = scene.bounds();
-        let grid = Grid::around(b.min, b.max, settings.voxel_resolution);
-        let estimate = estimate_fragments(scene, &grid);
-        let capacity = fragment_capacity(
+        let facts = SceneFacts {
+            glossy: gather::has_glossy(scene, gpu_scene.point_count),
+            ..facts
+        };
+        let atlas = plan_atlas(
             device,
-            settings
-                .fragment_capacity
-                .unwrap_or(estimate)
-                .min(max_fragments(device)),
+            queue,
+            &mut gpu_scene,
+            &facts,
+            settings,
+            center,
+            radius,
         )?;
-        check_volume_fits(device, &grid)?;
-        // Slots: at most one per voxel, usually far fewer than fragments, and the fragment
-        // estimate is itself an upper bound. Start at a quarter; the first build's counters
-        // grow the buffers to the exact count if that is short.
-        let slots = slot_capacity(
-            device,
-            settings
-                .voxel_capacity
-                .unwrap_or(estimate / 4)
-                .min((grid.resolution as u64).pow(3))
-                .min(max_slots(device)),
-        )?;
-        let (passes, volume, triangles) = checked(device, "pipeline creation", || {
-            let passes = Passes {
-                shadow: ShadowPass::new(device),
-                voxelize: VoxelizePass::new(device),
-                inject: InjectPass::new(device, gpu_scene.light_count),
-                filter: FilterPass::new(device),
-                bounce: BouncePass::new(device, settings.anisotropic),
-                gbuffer: GbufferPass::new(device),
-                gather: GatherPass::new(device, settings, glossy),
-                upsample: UpsamplePass::new(device),
-                composite: CompositePass::new(
-                    device,
-                    shadow::composite_reads_shadow_maps(
-                        &gpu_scene.gpu_lights,
-                        settings.cone_shadows,
-                    ),
-                    glossy,
-                ),
-                debug: DebugPass::new(device),
-                tonemap: TonemapPass::new(device),
-            };
-            let volume = DenseVolume::new(device, grid, settings.anisotropic, capacity, slots);
-            (passes, volume, triangle_table(device, &gpu_scene))
+        let grid = grid(&facts, settings);
+        let volume = new_volume(device, &facts, settings, grid, None)?;
+        let passes = checked(device, "pipeline creation", || Passes {
+            shadow: ShadowPass::new(device),
+            voxelize: VoxelizePass::new(device),
+            inject: InjectPass::new(device, gpu_scene.light_count),
+            filter: FilterPass::new(device),
+            bounce: BouncePass::new(device, settings.anisotropic),
+            gbuffer: GbufferPass::new(device),
+            gather: GatherPass::new(device, settings, facts.glossy),
+            upsample: UpsamplePass::new(device),
+            composite: composite_pass(device, &gpu_scene, &facts, settings),
+            debug: DebugPass::new(device),
+            tonemap: TonemapPass::new(device),
         })?;
+        let triangles = triangle_table(device, &gpu_scene);
         let brdf_tables = BrdfTables::new(device, queue);
-        let voxel_bounces = voxel_bounce_count(scene, settings.bounces);
+        let voxel_bounces = voxel_bounce_count(facts.max_albedo, settings.bounces);
         let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("cones"),
             contents: bytemuck::bytes_of(&cone_uniforms(settings, &grid)),
@@ -289,7 +285,99 @@ impl Renderer {
             center,
             radius,
             default_camera,
+            facts,
         })
+    }
+
+    /// Changes the options, rebuilding only what depends on the ones that changed: the volume
+    /// for its resolution or anisotropy, the shadow atlas for its size or cone shadows, the
+    /// gather, bounce and composite pipelines for what they are specialised on; cone and AO
+    /// parameters and the bounce count are uniform writes. Voxel work is redone in the next
+    /// frame only if something it depends on changed. `max_texture_size` and `default_light`
+    /// shape the uploaded scene: changing them is an error (make a new renderer); the pool
+    /// capacities are only where the first build starts, so changing them does nothing.
+    pub fn set_options(&mut self, options: &RendererOptions) -> Result<()> {
+        options.validate()?;
+        let (old, new) = (&self.options, options);
+        if old.max_texture_size != new.max_texture_size || old.default_light != new.default_light {
+            return Err(Error::Setting(
+                "max_texture_size and default_light shape the uploaded scene: make a new \
+                 Renderer to change them"
+                    .into(),
+            ));
+        }
+        let device = &self.device;
+        let volume =
+            old.voxel_resolution != new.voxel_resolution || old.anisotropic != new.anisotropic;
+        let atlas = old.shadow_map_size != new.shadow_map_size
+            || old.cone_shadows != new.cone_shadows
+            || shadow::atlas_resolution(old, &self.scene.gpu_lights)
+                != shadow::atlas_resolution(new, &self.scene.gpu_lights);
+        let cones = volume
+            || old.cones != new.cones
+            || old.step_factor != new.step_factor
+            || old.max_distance != new.max_distance
+            || old.ao_radius != new.ao_radius
+            || old.ao_lambda != new.ao_lambda
+            || old.origin_offset != new.origin_offset
+            || old.bounces != new.bounces;
+        let grid = grid(&self.facts, new);
+        // Build everything first, so a failure leaves the renderer as it was.
+        let atlas_new = if atlas {
+            Some(plan_atlas(
+                device,
+                &self.queue,
+                &mut self.scene,
+                &self.facts,
+                new,
+                self.center,
+                self.radius,
+            )?)
+        } else {
+            None
+        };
+        let volume_new = if volume {
+            Some(new_volume(device, &self.facts, new, grid, None)?)
+        } else {
+            None
+        };
+        let gather = volume || old.gather_axes != new.gather_axes;
+        let (gather_new, bounce_new, composite_new) = checked(device, "pipeline creation", || {
+            (
+                gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
+                (old.anisotropic != new.anisotropic)
+                    .then(|| BouncePass::new(device, new.anisotropic)),
+                (old.cone_shadows != new.cone_shadows)
+                    .then(|| composite_pass(device, &self.scene, &self.facts, new)),
+            )
+        })?;
+        if let Some(a) = atlas_new {
+            self.atlas = a;
+        }
+        if let Some(v) = volume_new {
+            self.volume = v;
+        }
+        if let Some(p) = gather_new {
+            self.passes.gather = p;
+        }
+        if let Some(p) = bounce_new {
+            self.passes.bounce = p;
+        }
+        if let Some(p) = composite_new {
+            self.passes.composite = p;
+        }
+        if cones {
+            self.queue.write_buffer(
+                &self.cones,
+                0,
+                bytemuck::bytes_of(&cone_uniforms(new, &grid)),
+            );
+            self.voxel_bounces = voxel_bounce_count(self.facts.max_albedo, new.bounces);
+        }
+        // The gather's resolution needs no work here: the next frame makes targets to match.
+        self.dirty |= volume || atlas || cones;
+        self.options = options.clone();
+        Ok(())
     }
 
     /// The scene's own camera, or a view of its bounds.
@@ -406,8 +494,13 @@ impl Renderer {
                 counts.fragments,
                 counts.occupied
             );
-            let (grid, aniso) = (v.grid, v.anisotropic);
-            self.volume = DenseVolume::new(&self.device, grid, aniso, capacity, slots);
+            self.volume = new_volume(
+                &self.device,
+                &self.facts,
+                &self.options,
+                v.grid,
+                Some((capacity as u64, slots as u64)),
+            )?;
             self.dirty = true;
         }
         Ok(self.dirty)
@@ -538,6 +631,74 @@ impl Renderer {
     }
 }
 
+/// The volume's grid around the scene.
+fn grid(facts: &SceneFacts, options: &RendererOptions) -> Grid {
+    Grid::around(facts.bounds.min, facts.bounds.max, options.voxel_resolution)
+}
+
+/// A dense volume on `grid` with pools of `capacities` (fragments, occupied voxels), or sized
+/// from the options and the scene's estimate.
+fn new_volume(
+    device: &wgpu::Device,
+    facts: &SceneFacts,
+    options: &RendererOptions,
+    grid: Grid,
+    capacities: Option<(u64, u64)>,
+) -> Result<DenseVolume> {
+    check_volume_fits(device, &grid)?;
+    let estimate = facts.estimate.at(&grid);
+    // Slots: at most one per voxel, usually far fewer than fragments, and the fragment
+    // estimate is itself an upper bound. Start at a quarter; the first build's counters grow
+    // the pools to the exact count if that is short.
+    let (fragments, voxels) = capacities.unwrap_or((
+        options.fragment_capacity.unwrap_or(estimate),
+        options.voxel_capacity.unwrap_or(estimate / 4),
+    ));
+    let capacity = fragment_capacity(device, fragments.min(max_fragments(device)))?;
+    let slots = slot_capacity(
+        device,
+        voxels
+            .min((grid.resolution as u64).pow(3))
+            .min(max_slots(device)),
+    )?;
+    checked(device, "voxel volume", || {
+        DenseVolume::new(device, grid, options.anisotropic, capacity, slots)
+    })
+}
+
+/// Plans the shadow views for the options (writing each light's views into `scene`'s
+/// lights) and makes the atlas that holds them.
+fn plan_atlas(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &mut GpuScene,
+    facts: &SceneFacts,
+    options: &RendererOptions,
+    center: Vec3,
+    radius: f32,
+) -> Result<ShadowAtlas> {
+    checked(device, "shadow atlas", || {
+        let res = shadow::atlas_resolution(options, &scene.gpu_lights);
+        let (views, owners) =
+            shadow::plan_views(&mut scene.gpu_lights, &facts.casts, center, radius, res);
+        queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
+        ShadowAtlas::new(device, views, owners, res)
+    })
+}
+
+fn composite_pass(
+    device: &wgpu::Device,
+    scene: &GpuScene,
+    facts: &SceneFacts,
+    options: &RendererOptions,
+) -> CompositePass {
+    CompositePass::new(
+        device,
+        shadow::composite_reads_shadow_maps(&scene.gpu_lights, options.cone_shadows),
+        facts.glossy,
+    )
+}
+
 /// The most fragments one storage binding can hold on this device.
 fn max_fragments(device: &wgpu::Device) -> u64 {
     device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES
@@ -603,17 +764,12 @@ fn fragment_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
 }
 
 /// Voxel-space bounces for a total of `bounces` indirect bounces (the gather adds one).
-fn voxel_bounce_count(scene: &Scene, bounces: u32) -> u32 {
+fn voxel_bounce_count(max_albedo: f32, bounces: u32) -> u32 {
     if bounces != UNLIMITED_BOUNCES {
         return bounces.saturating_sub(1);
     }
     // Until the energy left, max albedo^k, is below 0.1 %.
-    let rho = scene
-        .materials
-        .iter()
-        .map(|m| m.base_color[0].max(m.base_color[1]).max(m.base_color[2]))
-        .fold(0.0f32, f32::max)
-        .clamp(0.0, 0.99);
+    let rho = max_albedo.clamp(0.0, 0.99);
     if rho <= 0.0 {
         return 0;
     }

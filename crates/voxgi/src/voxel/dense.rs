@@ -434,24 +434,42 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// An upper bound on the fragments `scene` makes on `grid`: per triangle, the columns its
-/// dominant-axis projection can touch times the three voxels a column can hold.
-pub fn estimate_fragments(scene: &voxgi_scene::Scene, grid: &Grid) -> u64 {
-    let inv = 1.0 / grid.voxel_size;
-    let mut total = 0u64;
-    // Area-light emitters count too: voxelize keeps them as occluders.
-    for inst in &scene.instances {
-        let m = &scene.meshes[inst.mesh];
-        for t in m.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]]
-                .map(|i| inst.transform.transform_point3(m.positions[i as usize]) * inv);
-            let n = (b - a).cross(c - a);
-            let projected = 0.5 * n.abs().max_element();
-            let perimeter = (b - a).length() + (c - b).length() + (a - c).length();
-            total += (3.0 * (projected + perimeter + 2.0)) as u64;
+/// An upper bound on the fragments a scene makes on a grid: per triangle, the columns its
+/// dominant-axis projection can touch times the three voxels a column can hold. Kept as sums
+/// over the triangles in metres, so it can be evaluated for any grid without the scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FragmentEstimate {
+    /// Sum of the triangles' dominant-axis projected areas, m².
+    area: f64,
+    /// Sum of their perimeters, m.
+    perimeter: f64,
+    triangles: u64,
+}
+
+impl FragmentEstimate {
+    pub fn of(scene: &voxgi_scene::Scene) -> Self {
+        let mut e = FragmentEstimate::default();
+        // Area-light emitters count too: voxelize keeps them as occluders.
+        for inst in &scene.instances {
+            let m = &scene.meshes[inst.mesh];
+            for t in m.indices.chunks_exact(3) {
+                let [a, b, c] = [t[0], t[1], t[2]]
+                    .map(|i| inst.transform.transform_point3(m.positions[i as usize]));
+                let n = (b - a).cross(c - a);
+                e.area += 0.5 * n.abs().max_element() as f64;
+                e.perimeter += ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
+                e.triangles += 1;
+            }
         }
+        e
     }
-    total
+
+    /// The bound on `grid`.
+    pub fn at(&self, grid: &Grid) -> u64 {
+        let inv = 1.0 / grid.voxel_size as f64;
+        (3.0 * (self.area * inv * inv + self.perimeter * inv + 2.0 * self.triangles as f64)).ceil()
+            as u64
+    }
 }
 
 /// Keeps the triangle table voxelize reads: per triangle, its draw, first index, base vertex.

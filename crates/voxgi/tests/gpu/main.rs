@@ -8,6 +8,7 @@ mod compare;
 mod embed;
 mod errors;
 mod golden;
+mod options;
 mod points;
 mod reference;
 mod shaders;

@@ -1,0 +1,161 @@
+//! Creation-time options against per-frame parameters: a renderer whose options were changed
+//! renders exactly what a renderer made with the new options renders, and per-frame
+//! parameters change the picture without any option.
+
+use crate::common::*;
+use voxgi::scene::builtin;
+use voxgi::{ConeSet, FrameParams, RendererOptions, Tonemap, ViewMode};
+
+const SIZE: u32 = 32;
+
+fn base() -> RendererOptions {
+    RendererOptions {
+        voxel_resolution: 16,
+        bounces: 1,
+        ..RendererOptions::default()
+    }
+}
+
+/// Each change, applied with `set_options` to a renderer that has already rendered, gives the
+/// image of a fresh renderer with those options, to the bit.
+#[test]
+fn changed_options_render_like_a_fresh_renderer() {
+    let scene = builtin::cornell_box();
+    let changes: Vec<(&str, RendererOptions)> = vec![
+        (
+            "voxel resolution",
+            RendererOptions {
+                voxel_resolution: 32,
+                ..base()
+            },
+        ),
+        (
+            "isotropic",
+            RendererOptions {
+                anisotropic: false,
+                ..base()
+            },
+        ),
+        (
+            "gather axes",
+            RendererOptions {
+                gather_axes: 2,
+                ..base()
+            },
+        ),
+        (
+            "cones",
+            RendererOptions {
+                cones: ConeSet::Nine45,
+                ..base()
+            },
+        ),
+        (
+            "bounces",
+            RendererOptions {
+                bounces: 3,
+                ..base()
+            },
+        ),
+        (
+            "cone step",
+            RendererOptions {
+                step_factor: 1.0,
+                ..base()
+            },
+        ),
+        (
+            "half resolution",
+            RendererOptions {
+                half_resolution: true,
+                ..base()
+            },
+        ),
+        (
+            "cone shadows",
+            RendererOptions {
+                cone_shadows: true,
+                ..base()
+            },
+        ),
+        (
+            "shadow map",
+            RendererOptions {
+                shadow_map_size: 256,
+                ..base()
+            },
+        ),
+    ];
+    let mut r = renderer(&scene, &base());
+    let params = FrameParams::new(r.default_camera().clone());
+    let first = frame(&mut r, &params, SIZE, SIZE);
+    for (what, options) in changes {
+        r.set_options(&base()).expect("back to the base options");
+        let again = frame(&mut r, &params, SIZE, SIZE);
+        assert!(again.hdr == first.hdr, "{what}: back to the base options");
+        r.set_options(&options).expect(what);
+        let changed = frame(&mut r, &params, SIZE, SIZE);
+        let fresh = render_with(&scene, &options, &params, SIZE, SIZE);
+        assert!(
+            changed.hdr == fresh.hdr,
+            "{what}: differs from a fresh renderer"
+        );
+        // Each change changes the picture, so the comparison could fail.
+        assert!(changed.hdr != first.hdr, "{what}: no visible effect");
+    }
+}
+
+#[test]
+fn options_that_shape_the_upload_are_refused() {
+    let scene = builtin::cornell_box();
+    let mut r = renderer(&scene, &base());
+    for o in [
+        RendererOptions {
+            max_texture_size: 64,
+            ..base()
+        },
+        RendererOptions {
+            default_light: false,
+            ..base()
+        },
+        RendererOptions {
+            voxel_resolution: 100,
+            ..base()
+        },
+    ] {
+        assert!(r.set_options(&o).is_err(), "{o:?} accepted");
+        assert_eq!(*r.options(), base(), "a refused change leaves the options");
+    }
+}
+
+/// Per-frame parameters need no option: exposure, curve and view change the image of one
+/// renderer, and going back gives the first image again.
+#[test]
+fn frame_params_change_the_picture_without_rebuilding() {
+    let scene = builtin::cornell_box();
+    let mut r = renderer(&scene, &base());
+    let params = FrameParams::new(r.default_camera().clone());
+    let first = frame(&mut r, &params, SIZE, SIZE);
+    for p in [
+        FrameParams {
+            exposure: 1.0,
+            ..params.clone()
+        },
+        FrameParams {
+            tonemap: Tonemap::Neutral,
+            ..params.clone()
+        },
+        FrameParams {
+            view: ViewMode::Indirect,
+            ..params.clone()
+        },
+        FrameParams {
+            background: [1.0, 0.0, 0.0],
+            ..params.clone()
+        },
+    ] {
+        let out = frame(&mut r, &p, SIZE, SIZE);
+        assert!(out.ldr != first.ldr, "{p:?}: no effect");
+    }
+    assert!(frame(&mut r, &params, SIZE, SIZE).ldr == first.ldr);
+}
