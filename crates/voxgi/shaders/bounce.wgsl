@@ -4,20 +4,17 @@
 
 //!include shared/scene.wgsl
 //!include shared/volume.wgsl
-//!include shared/dense_sample.wgsl
 //!include shared/cone.wgsl
 
-@group(0) @binding(0) var<uniform> vol: Volume;
-@group(0) @binding(1) var<uniform> cones: Cones;
-@group(0) @binding(2) var radiance0: texture_3d<f32>;
-@group(0) @binding(3) var chains: texture_3d<f32>;
-@group(0) @binding(4) var voxel_sampler: sampler;
-@group(0) @binding(5) var albedo_tex: texture_3d<f32>;
-@group(0) @binding(6) var normal_tex: texture_3d<f32>;
-@group(0) @binding(7) var<storage, read> slot_voxel: array<u32>;
-@group(0) @binding(8) var<storage, read> counters: array<u32>;
-@group(0) @binding(9) var<storage, read> slot_direct: array<vec4<f32>>;
-@group(0) @binding(10) var<storage, read_write> slot_next: array<vec4<f32>>;
+@group(0) @binding(0) var<uniform> cones: Cones;
+// Group 1: the voxel structure. The leaves below are the dense volume's occupied voxels (its
+// slots), placed by its `vol`: the one part of this pass that is not yet structure-neutral.
+@group(2) @binding(0) var albedo_tex: texture_3d<f32>;
+@group(2) @binding(1) var normal_tex: texture_3d<f32>;
+@group(2) @binding(2) var<storage, read> slot_voxel: array<u32>;
+@group(2) @binding(3) var<storage, read> counters: array<u32>;
+@group(2) @binding(4) var<storage, read> slot_direct: array<vec4<f32>>;
+@group(2) @binding(5) var<storage, read_write> slot_next: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {

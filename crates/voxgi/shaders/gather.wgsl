@@ -1,35 +1,33 @@
 // gather: per pixel (or per 2x2 block at half resolution), indirect light from the voxels:
-// diffuse cones (irradiance and ambient occlusion) and one glossy cone along the mirror
-// direction whose aperture follows the roughness; with cone shadows, the visibility of the
+// diffuse cones (irradiance and ambient occlusion) and one glossy cone along the specular
+// lobe's dominant direction whose aperture follows the roughness; with cone shadows, the visibility of the
 // first area lights by one cone each.
 
 //!include shared/scene.wgsl
 //!include shared/volume.wgsl
 //!include shared/brdf.wgsl
-//!include shared/dense_sample.wgsl
 //!include shared/cone.wgsl
 //!include shared/interleave.wgsl
 
+// Group 0, the frame's globals.
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> vol: Volume;
-@group(0) @binding(2) var<uniform> cones: Cones;
-@group(0) @binding(3) var radiance0: texture_3d<f32>;
-@group(0) @binding(4) var chains: texture_3d<f32>;
-@group(0) @binding(5) var voxel_sampler: sampler;
-@group(0) @binding(6) var gb_albedo: texture_2d<f32>;
-@group(0) @binding(7) var gb_normal: texture_2d<f32>;
-@group(0) @binding(8) var gb_emission: texture_2d<f32>;
-@group(0) @binding(9) var gb_depth: texture_depth_2d;
+@group(0) @binding(1) var<uniform> cones: Cones;
+@group(0) @binding(2) var<storage, read> lights: array<Light>;
+// The specular lobe's directional albedo: (a, b) over (n.v, roughness).
+@group(0) @binding(3) var specular_table: texture_2d<f32>;
+@group(0) @binding(4) var table_sampler: sampler;
+// Group 1: the voxel structure (voxels/<kind>/sample.wgsl). Group 2, the pass's own:
+@group(2) @binding(0) var gb_albedo: texture_2d<f32>;
+@group(2) @binding(1) var gb_normal: texture_2d<f32>;
+@group(2) @binding(2) var gb_emission: texture_2d<f32>;
+@group(2) @binding(3) var gb_depth: texture_depth_2d;
 // rgb: indirect radiance towards the camera, a: ambient occlusion.
-@group(0) @binding(10) var indirect_out: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(11) var<storage, read> lights: array<Light>;
+@group(2) @binding(4) var indirect_out: texture_storage_2d<rgba16float, write>;
 // Visibility of the first CONE_SHADOW_LIGHTS area lights, one per channel.
-@group(0) @binding(12) var visibility_out: texture_storage_2d<rgba8unorm, write>;
+@group(2) @binding(5) var visibility_out: texture_storage_2d<rgba8unorm, write>;
 // Normal and distance to the camera (0: background), for the upsample's edge weights: one
 // fetch there instead of the g-buffer's depth and normal and an unprojection per tap.
-@group(0) @binding(13) var guide_out: texture_storage_2d<rgba16float, write>;
-// The specular lobe's directional albedo: (a, b) over (n.v, roughness).
-@group(0) @binding(14) var specular_table: texture_2d<f32>;
+@group(2) @binding(6) var guide_out: texture_storage_2d<rgba16float, write>;
 
 // Visibility of an area light by one cone from p to its centre, as wide as the light looks
 // from p: 1 - the opacity the cone gathers before reaching the light.
@@ -38,13 +36,13 @@ fn cone_visibility(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let dist = length(to);
     let dir = to / dist;
     let tan_half = clamp(light.size / dist, 0.01, 1.0);
-    let origin = p + n * vol.voxel_size * cones.origin_offset;
+    let origin = p + n * voxels_voxel_size() * cones.origin_offset;
     // Stop before the samples' filters reach the emitter's plane: the light hangs on (or in)
     // other geometry, which must not count as its occluder. A sample of diameter d filters
     // trilinearly over the next coarser level too, so its support reaches 2d: stop where the
     // plane is 2d away, (dist - t) cos = 4 tan t.
     let cos_plane = max(abs(dot(dir, light.direction)), 0.1);
-    let stop = dist * cos_plane / (cos_plane + 4.0 * tan_half) - vol.voxel_size;
+    let stop = dist * cos_plane / (cos_plane + 4.0 * tan_half) - voxels_voxel_size();
     return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0)).a;
 }
 
@@ -116,12 +114,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let dir = normalize(mix(n, reflect(-v, n), lean));
         // Cone half-angle from the GGX lobe width, no narrower than a voxel allows anyway.
         let tan_half = clamp(a, 0.01, 1.0);
-        let origin = p + n * vol.voxel_size * cones.origin_offset;
+        let origin = p + n * voxels_voxel_size() * cones.origin_offset;
         let spec = trace_cone(origin, n, dir, tan_half, cones.max_distance).rgb;
         // Weighted by the lobe's directional albedo, a table of the very BRDF the path tracer
         // integrates (Karis's analytic fit, used before, is 10-18 % low at roughness 0.2-0.5).
         let uv = vec2<f32>(max(dot(n, v), 1e-4), s.roughness);
-        let ab = textureSampleLevel(specular_table, voxel_sampler, uv, 0.0).rg;
+        let ab = textureSampleLevel(specular_table, table_sampler, uv, 0.0).rg;
         indirect += spec * specular_albedo(f0, ab);
     }
     textureStore(indirect_out, gid.xy, vec4<f32>(indirect, g.ao));

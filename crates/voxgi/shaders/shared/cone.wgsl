@@ -1,9 +1,10 @@
 //!include shared/brdf.wgsl
 
-// Cone tracing, written once against the voxel structure's samplers: sample_depth(position,
-// diameter, direction), optical depth (L sigma, sigma) of the volume filtered to `diameter`,
-// and sample_depth_wide, the same for diameters of at least WIDE_SAMPLE voxels (a structure
-// whose wide samples cost no less may implement it as sample_depth).
+//!include voxels/sample.wgsl
+
+// Cone tracing, written once against the voxel contract (voxels/<kind>/sample.wgsl):
+// WIDE_SAMPLE, voxels_voxel_size, voxels_contains, sample_depth, sample_depth_wide and
+// sample_voxels, and nothing else of the structure. The including shader declares `cones`.
 
 // The filter size of a cone sample at distance t from a surface (normal n). A surface can
 // neither occlude nor light itself, so a sample must not read the voxels of its cone's own
@@ -16,18 +17,18 @@
 const SELF_CLEARANCE: f32 = 3.0;
 
 fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32) -> f32 {
-    let h = dot(p - origin, n) + vol.voxel_size * cones.origin_offset;
-    return clamp((h - vol.voxel_size) / SELF_CLEARANCE, vol.voxel_size, d);
+    let h = dot(p - origin, n) + voxels_voxel_size() * cones.origin_offset;
+    return clamp((h - voxels_voxel_size()) / SELF_CLEARANCE, voxels_voxel_size(), d);
 }
 
 fn outside_volume(p: vec3<f32>) -> bool {
-    return !inside_volume(volume_uvw(p));
+    return !voxels_contains(p);
 }
 
 // A narrowed sample covers less: step no further than its filter reaches, so thin walls are
 // not stepped over.
 fn cone_step(d: f32, ds: f32) -> f32 {
-    return max(min(d * cones.step_factor, ds), vol.voxel_size * 0.25);
+    return max(min(d * cones.step_factor, ds), voxels_voxel_size() * 0.25);
 }
 
 // Opacity a of a sample of size ds, corrected for a step of length `step`.
@@ -41,15 +42,15 @@ fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
 // optical depth is 1 - e^(-sigma d'/d).
 fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
-    var t = vol.voxel_size;
+    var t = voxels_voxel_size();
     // Two loops: samples widen monotonically along a cone that leaves its surface, and once
     // they are WIDE_SAMPLE voxels across they no longer read the finest level (a quarter of the
     // fetches per step; 8 % of the gather on lavapipe).
     for (var i = 0u; i < 512u; i++) {
         let p = origin + dir * t;
-        let d = max(vol.voxel_size, 2.0 * tan_half * t);
+        let d = max(voxels_voxel_size(), 2.0 * tan_half * t);
         let ds = cone_sample_size(origin, n, p, d);
-        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || ds >= WIDE_SAMPLE * vol.voxel_size {
+        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || ds >= WIDE_SAMPLE * voxels_voxel_size() {
             break;
         }
         let step = cone_step(d, ds);
@@ -62,7 +63,7 @@ fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, ma
         if t >= max_dist || acc.a >= 0.995 || outside_volume(p) {
             break;
         }
-        let d = max(vol.voxel_size, 2.0 * tan_half * t);
+        let d = max(voxels_voxel_size(), 2.0 * tan_half * t);
         let ds = cone_sample_size(origin, n, p, d);
         let step = cone_step(d, ds);
         acc = composite_sample(acc, sample_depth_wide(p, ds, dir), step / ds);
@@ -83,13 +84,13 @@ fn composite_sample(acc: vec4<f32>, s: vec4<f32>, k: f32) -> vec4<f32> {
 // Ambient occlusion along one cone: opacity weighted by 1/(1 + lambda r), up to ao_radius.
 fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f32 {
     var occ = 0.0;
-    var t = vol.voxel_size;
+    var t = voxels_voxel_size();
     for (var i = 0u; i < 256u; i++) {
         let p = origin + dir * t;
         if t >= cones.ao_radius || occ >= 0.995 || outside_volume(p) {
             break;
         }
-        let d = max(vol.voxel_size, 2.0 * tan_half * t);
+        let d = max(voxels_voxel_size(), 2.0 * tan_half * t);
         let ds = cone_sample_size(origin, n, p, d);
         let s = sample_voxels(p, ds, dir);
         let step = cone_step(d, ds);
@@ -122,7 +123,7 @@ const ALL_CONES: u32 = 2u;
 // the period, so the estimate is unbiased at about 60 % of the cost.
 fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool, half: u32) -> Gathered {
     let frame = tangent_frame(n);
-    let origin = p + n * vol.voxel_size * cones.origin_offset;
+    let origin = p + n * voxels_voxel_size() * cones.origin_offset;
     var e = vec3<f32>(0.0);
     var occ = 0.0;
     // Neighbouring pixels trace different cones but the same number of them, so SIMD lanes

@@ -1,6 +1,8 @@
 //! WGSL composition: a shader names the shared files it needs with `//!include shared/NAME.wgsl`
-//! lines, which are replaced by those files (each at most once). Tiny on purpose: WGSL has no
-//! modules yet, and this is all voxgi needs.
+//! lines, which are replaced by those files (each at most once). `//!include voxels/NAME.wgsl`
+//! picks the voxel structure's own file, `voxels/<kind>/NAME.wgsl`: that is how cone tracing,
+//! written once, meets a structure. Tiny on purpose: WGSL has no modules yet, and this is all
+//! voxgi needs.
 
 macro_rules! wgsl {
     ($($path:literal),* $(,)?) => {
@@ -16,7 +18,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/lights.wgsl",
     "shared/volume.wgsl",
     "shared/fragment.wgsl",
-    "shared/dense_sample.wgsl",
+    "voxels/dense/sample.wgsl",
     "shared/cone.wgsl",
     "shared/surfel.wgsl",
     "shared/interleave.wgsl",
@@ -66,22 +68,37 @@ fn raw(name: &str) -> std::borrow::Cow<'static, str> {
         .unwrap_or_else(|| panic!("unknown shader file {name}"))
 }
 
-/// The full WGSL of shader `name` with its includes expanded.
+/// The voxel structures whose WGSL lives under `shaders/voxels/<kind>/`.
+pub const STRUCTURES: &[&str] = &["dense"];
+
+/// The structure the renderer builds today.
+const STRUCTURE: &str = "dense";
+
+/// The full WGSL of shader `name` with its includes expanded, for the dense volume.
 pub fn compose(name: &str) -> String {
+    compose_for(name, STRUCTURE)
+}
+
+/// The full WGSL of shader `name` with `voxels/` includes taken from structure `kind`.
+pub fn compose_for(name: &str, kind: &str) -> String {
     let mut out = String::new();
     let mut seen = Vec::new();
-    expand(name, &mut out, &mut seen);
+    expand(name, kind, &mut out, &mut seen);
     out
 }
 
-fn expand(name: &str, out: &mut String, seen: &mut Vec<String>) {
+fn expand(name: &str, kind: &str, out: &mut String, seen: &mut Vec<String>) {
     if seen.iter().any(|s| s == name) {
         return;
     }
     seen.push(name.to_string());
     for line in raw(name).lines() {
         if let Some(inc) = line.trim().strip_prefix("//!include ") {
-            expand(inc.trim(), out, seen);
+            let inc = inc.trim();
+            match inc.strip_prefix("voxels/") {
+                Some(file) => expand(&format!("voxels/{kind}/{file}"), kind, out, seen),
+                None => expand(inc, kind, out, seen),
+            }
         } else {
             out.push_str(line);
             out.push('\n');
@@ -115,10 +132,23 @@ pub fn specialized_pipeline(
     layout: &wgpu::BindGroupLayout,
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
+    grouped_pipeline(device, label, file, &[layout], constants)
+}
+
+/// `specialized_pipeline` with one layout per bind group: 0 the frame's globals, 1 the voxel
+/// structure, 2 the pass's own (rerun's re_renderer keeps bind groups by owner the same way).
+pub fn grouped_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let module = module(device, file);
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().copied().map(Some).collect();
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
-        bind_group_layouts: &[Some(layout)],
+        bind_group_layouts: &layouts,
         immediate_size: 0,
     });
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -139,5 +169,5 @@ pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
     SOURCES
         .iter()
         .map(|(n, _)| *n)
-        .filter(|n| !n.starts_with("shared/"))
+        .filter(|n| !n.starts_with("shared/") && !n.starts_with("voxels/"))
 }

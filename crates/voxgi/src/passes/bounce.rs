@@ -3,12 +3,13 @@
 //! and written in one).
 
 use crate::gpu::layout;
-use crate::gpu::shader::{compute_pipeline, specialized_pipeline};
+use crate::gpu::shader::{compute_pipeline, grouped_pipeline};
 use crate::gpu::timer::GpuTimer;
 use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
 
 pub struct BouncePass {
     gather: wgpu::ComputePipeline,
+    globals: wgpu::BindGroupLayout,
     gather_layout: wgpu::BindGroupLayout,
     store: wgpu::ComputePipeline,
     store_layout: wgpu::BindGroupLayout,
@@ -17,19 +18,20 @@ pub struct BouncePass {
 impl BouncePass {
     pub fn new(device: &wgpu::Device, anisotropic: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
-        let mut entries = vec![layout::uniform(0, c, false), layout::uniform(1, c, false)];
-        entries.extend(DenseVolume::sampling_layout(2, c));
-        entries.extend([
-            layout::texture_3d_load(5, c),
-            layout::texture_3d_load(6, c),
-            layout::storage(7, c, true),
-            layout::storage(8, c, true),
-            layout::storage(9, c, true),
-            layout::storage(10, c, false),
-        ]);
+        let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bounce globals"),
+            entries: &[layout::uniform(0, c, false)],
+        });
         let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bounce"),
-            entries: &entries,
+            entries: &[
+                layout::texture_3d_load(0, c),
+                layout::texture_3d_load(1, c),
+                layout::storage(2, c, true),
+                layout::storage(3, c, true),
+                layout::storage(4, c, true),
+                layout::storage(5, c, false),
+            ],
         });
         let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bounce_store"),
@@ -41,15 +43,17 @@ impl BouncePass {
                 layout::storage_texture_3d(4, RADIANCE_FORMAT),
             ],
         });
+        let voxels = DenseVolume::sampling_layout(device);
         BouncePass {
-            gather: specialized_pipeline(
+            gather: grouped_pipeline(
                 device,
                 "bounce",
                 "bounce.wgsl",
-                &gather_layout,
+                &[&globals, &voxels, &gather_layout],
                 &DenseVolume::sampling_constants(anisotropic, 3),
             ),
             store: compute_pipeline(device, "bounce", "bounce_store.wgsl", &store_layout),
+            globals,
             gather_layout,
             store_layout,
         }
@@ -63,24 +67,24 @@ impl BouncePass {
         cones: &wgpu::Buffer,
         timer: &mut GpuTimer,
     ) {
-        let views = vol.sampling_views();
         let v = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (albedo, normal) = (v(&vol.albedo), v(&vol.normal));
-        let mut res = vec![vol.volume.as_entire_binding(), cones.as_entire_binding()];
-        res.extend(views.iter().map(wgpu::BindingResource::TextureView));
-        res.extend([
-            wgpu::BindingResource::Sampler(&vol.sampler),
-            wgpu::BindingResource::TextureView(&albedo),
-            wgpu::BindingResource::TextureView(&normal),
-            vol.slot_voxel.as_entire_binding(),
-            vol.counters.as_entire_binding(),
-            vol.slot_direct.as_entire_binding(),
-            vol.slot_next.as_entire_binding(),
-        ]);
+        let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("bounce globals"),
+            layout: &self.globals,
+            entries: &layout::entries(vec![cones.as_entire_binding()]),
+        });
         let gather_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bounce"),
             layout: &self.gather_layout,
-            entries: &layout::entries(res),
+            entries: &layout::entries(vec![
+                wgpu::BindingResource::TextureView(&albedo),
+                wgpu::BindingResource::TextureView(&normal),
+                vol.slot_voxel.as_entire_binding(),
+                vol.counters.as_entire_binding(),
+                vol.slot_direct.as_entire_binding(),
+                vol.slot_next.as_entire_binding(),
+            ]),
         });
         let radiance = v(&vol.radiance);
         let store_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -99,7 +103,9 @@ impl BouncePass {
             timestamp_writes: timer.compute("bounce"),
         });
         pass.set_pipeline(&self.gather);
-        pass.set_bind_group(0, &gather_bind, &[]);
+        pass.set_bind_group(0, &globals, &[]);
+        pass.set_bind_group(1, vol.sampling(), &[]);
+        pass.set_bind_group(2, &gather_bind, &[]);
         pass.dispatch_workgroups_indirect(&vol.args, 0);
         pass.set_pipeline(&self.store);
         pass.set_bind_group(0, &store_bind, &[]);

@@ -1,9 +1,10 @@
 //! gather: per-pixel indirect light from the voxels (diffuse cones with AO, glossy cone) and,
 //! with `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
+//! Bind groups: 0 the frame's globals, 1 the voxel structure's sampling group, 2 its own.
 
 use crate::brdf::BrdfTables;
 use crate::gpu::layout;
-use crate::gpu::shader::specialized_pipeline;
+use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::options::RendererOptions;
@@ -30,6 +31,7 @@ pub fn has_glossy(scene: &Scene, point_count: u32) -> bool {
 
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
+    globals: wgpu::BindGroupLayout,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -37,24 +39,26 @@ impl GatherPass {
     /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
     pub fn new(device: &wgpu::Device, settings: &RendererOptions, glossy: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
-        let mut entries = vec![
-            layout::uniform(0, c, false),
-            layout::uniform(1, c, false),
-            layout::uniform(2, c, false),
-        ];
-        entries.extend(DenseVolume::sampling_layout(3, c));
-        entries.extend(FrameTargets::gbuffer_layout(6, c));
+        let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gather globals"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::uniform(1, c, false),
+                layout::storage(2, c, true),
+                layout::texture(
+                    3,
+                    c,
+                    wgpu::TextureSampleType::Float { filterable: true },
+                    wgpu::TextureViewDimension::D2,
+                ),
+                layout::sampler(4, c),
+            ],
+        });
+        let mut entries = FrameTargets::gbuffer_layout(0, c).to_vec();
         entries.extend([
-            layout::storage_texture(10, INDIRECT_FORMAT),
-            layout::storage(11, c, true),
-            layout::storage_texture(12, VISIBILITY_FORMAT),
-            layout::storage_texture(13, GUIDE_FORMAT),
-            layout::texture(
-                14,
-                c,
-                wgpu::TextureSampleType::Float { filterable: true },
-                wgpu::TextureViewDimension::D2,
-            ),
+            layout::storage_texture(4, INDIRECT_FORMAT),
+            layout::storage_texture(5, VISIBILITY_FORMAT),
+            layout::storage_texture(6, GUIDE_FORMAT),
         ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather"),
@@ -63,8 +67,16 @@ impl GatherPass {
         let [iso, axes] =
             DenseVolume::sampling_constants(settings.anisotropic, settings.gather_axes);
         let constants = [iso, axes, ("GLOSSY", f64::from(u8::from(glossy)))];
+        let voxels = DenseVolume::sampling_layout(device);
         GatherPass {
-            pipeline: specialized_pipeline(device, "gather", "gather.wgsl", &layout, &constants),
+            pipeline: grouped_pipeline(
+                device,
+                "gather",
+                "gather.wgsl",
+                &[&globals, &voxels, &layout],
+                &constants,
+            ),
+            globals,
             layout,
         }
     }
@@ -82,23 +94,24 @@ impl GatherPass {
         tables: &BrdfTables,
         timer: &mut GpuTimer,
     ) {
-        let views = vol.sampling_views();
-        let mut res = vec![
-            t.frame.as_entire_binding(),
-            vol.volume.as_entire_binding(),
-            cones.as_entire_binding(),
-        ];
-        res.extend(views.iter().map(wgpu::BindingResource::TextureView));
-        res.push(wgpu::BindingResource::Sampler(&vol.sampler));
-        res.extend(t.gbuffer_resources());
+        let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gather globals"),
+            layout: &self.globals,
+            entries: &layout::entries(vec![
+                t.frame.as_entire_binding(),
+                cones.as_entire_binding(),
+                scene.lights.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&tables.specular_albedo),
+                wgpu::BindingResource::Sampler(&tables.sampler),
+            ]),
+        });
+        let mut res = t.gbuffer_resources().to_vec();
         res.extend([
             wgpu::BindingResource::TextureView(&t.indirect_low),
-            scene.lights.as_entire_binding(),
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),
-            wgpu::BindingResource::TextureView(&tables.specular_albedo),
         ]);
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let own = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather"),
             layout: &self.layout,
             entries: &layout::entries(res),
@@ -109,7 +122,9 @@ impl GatherPass {
             timestamp_writes: timer.compute("gather"),
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, &globals, &[]);
+        pass.set_bind_group(1, vol.sampling(), &[]);
+        pass.set_bind_group(2, &own, &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
 }

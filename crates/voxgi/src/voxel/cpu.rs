@@ -100,3 +100,104 @@ pub fn filter_parent(children: &[Vec4; 8], dir: Option<u32>) -> Vec4 {
     }
     sum * 0.25
 }
+
+/// A 3D texture's mip chain on the CPU: texels (x fastest) and size per level.
+pub struct Texture3d {
+    pub levels: Vec<(Vec<Vec4>, UVec3)>,
+}
+
+impl Texture3d {
+    fn texel(&self, level: usize, c: [i64; 3]) -> Vec4 {
+        let (texels, size) = &self.levels[level];
+        let [x, y, z] = [0, 1, 2].map(|a| c[a].clamp(0, size[a] as i64 - 1) as u32);
+        texels[(x + size.x * (y + size.y * z)) as usize]
+    }
+
+    /// `textureSampleLevel` with a trilinear, clamp-to-edge sampler at one level.
+    fn sample_at(&self, level: usize, uvw: Vec3) -> Vec4 {
+        let size = self.levels[level].1.as_vec3();
+        let t = uvw * size - 0.5;
+        let base = t.floor();
+        let f = t - base;
+        let b = [base.x as i64, base.y as i64, base.z as i64];
+        let mut out = Vec4::ZERO;
+        for i in 0..8 {
+            let o = [i & 1, (i >> 1) & 1, i >> 2];
+            let w = (0..3)
+                .map(|a| if o[a] == 1 { f[a] } else { 1.0 - f[a] })
+                .product::<f32>();
+            out += w * self.texel(level, [b[0] + o[0], b[1] + o[1], b[2] + o[2]]);
+        }
+        out
+    }
+
+    /// `textureSampleLevel` with linear filtering between levels.
+    pub fn sample(&self, uvw: Vec3, lod: f32) -> Vec4 {
+        let top = self.levels.len() - 1;
+        let lod = lod.clamp(0.0, top as f32);
+        let lo = lod.floor() as usize;
+        let hi = (lo + 1).min(top);
+        self.sample_at(lo, uvw)
+            .lerp(self.sample_at(hi, uvw), lod - lo as f32)
+    }
+}
+
+/// The dense volume as `voxels/dense/sample.wgsl` reads it: placement, the finest level and
+/// the directional chains (six blocks stacked along z, or one).
+pub struct DenseSampler<'a> {
+    pub grid: Grid,
+    pub anisotropic: bool,
+    pub radiance0: &'a Texture3d,
+    pub chains: &'a Texture3d,
+}
+
+impl DenseSampler<'_> {
+    fn uvw(&self, p: Vec3) -> Vec3 {
+        (p - self.grid.origin) / self.grid.extent()
+    }
+
+    fn inside(uvw: Vec3) -> bool {
+        uvw.cmpge(Vec3::ZERO).all() && uvw.cmple(Vec3::ONE).all()
+    }
+
+    /// `sample_chains`, with every axis read (`SAMPLE_AXES` = 3).
+    fn chains(&self, uvw: Vec3, cl: f32, dir: Vec3) -> Vec4 {
+        let levels = self.grid.levels() as f32;
+        let upper = (cl.floor() + 1.0).min(levels - 2.0);
+        let texels = ((self.grid.resolution / 2) as f32 * (-upper).exp2()).max(1.0);
+        let z = uvw.z.clamp(0.5 / texels, 1.0 - 0.5 / texels);
+        if !self.anisotropic {
+            return self.chains.sample(Vec3::new(uvw.x, uvw.y, z), cl);
+        }
+        let block = Vec3::new(
+            if dir.x >= 0.0 { 0.0 } else { 1.0 },
+            if dir.y >= 0.0 { 2.0 } else { 3.0 },
+            if dir.z >= 0.0 { 4.0 } else { 5.0 },
+        );
+        let w = dir * dir;
+        let at = |b: f32| {
+            self.chains
+                .sample(Vec3::new(uvw.x, uvw.y, (z + b) / 6.0), cl)
+        };
+        w.x * at(block.x) + w.y * at(block.y) + w.z * at(block.z)
+    }
+
+    /// `sample_depth`: optical depth per sample diameter, filtered to `diameter`.
+    pub fn sample_depth(&self, p: Vec3, diameter: f32, dir: Vec3) -> Vec4 {
+        let uvw = self.uvw(p);
+        if !Self::inside(uvw) {
+            return Vec4::ZERO;
+        }
+        let vs = self.grid.voxel_size;
+        let top = self.grid.levels() as f32 - 1.0;
+        let lod = (diameter / vs).max(1.0).log2().clamp(0.0, top);
+        let fine = self.radiance0.sample(uvw, 0.0);
+        let coarse = self.chains(uvw, (lod - 1.0).max(0.0), dir);
+        fine.lerp(coarse, lod.min(1.0))
+    }
+
+    /// `sample_voxels`: premultiplied radiance and opacity.
+    pub fn sample_voxels(&self, p: Vec3, diameter: f32, dir: Vec3) -> Vec4 {
+        from_depth(self.sample_depth(p, diameter, dir))
+    }
+}

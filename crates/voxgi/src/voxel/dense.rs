@@ -56,6 +56,7 @@ pub struct DenseVolume {
     /// chain.
     pub chains: wgpu::Texture,
     pub sampler: wgpu::Sampler,
+    sampling: wgpu::BindGroup,
     build_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
     build: BuildPipelines,
@@ -207,14 +208,36 @@ impl DenseVolume {
             resolve: pipe("resolve"),
         };
         let no = wgpu::BufferUsages::empty();
+        let volume = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("volume"),
+            contents: bytemuck::bytes_of(&volume),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let radiance = texture_3d(device, "voxel radiance", res, 1, RADIANCE_FORMAT);
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("voxels"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let sampling = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel sampling"),
+            layout: &Self::sampling_layout(device),
+            entries: &layout::entries(vec![
+                volume.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&radiance.create_view(&Default::default())),
+                wgpu::BindingResource::TextureView(&chains.create_view(&Default::default())),
+                wgpu::BindingResource::Sampler(&sampler),
+            ]),
+        });
         DenseVolume {
             grid,
             anisotropic,
-            volume: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("volume"),
-                contents: bytemuck::bytes_of(&volume),
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            }),
+            volume,
             fragment_capacity,
             slot_capacity: slots as u32,
             fragments: storage_buffer(
@@ -238,18 +261,10 @@ impl DenseVolume {
             albedo: texture_3d(device, "voxel albedo", res, 1, ALBEDO_FORMAT),
             normal: texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT),
             emission: texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT),
-            radiance: texture_3d(device, "voxel radiance", res, 1, RADIANCE_FORMAT),
+            radiance,
             chains,
-            sampler: device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("voxels"),
-                address_mode_u: wgpu::AddressMode::ClampToEdge,
-                address_mode_v: wgpu::AddressMode::ClampToEdge,
-                address_mode_w: wgpu::AddressMode::ClampToEdge,
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                mipmap_filter: wgpu::MipmapFilterMode::Linear,
-                ..Default::default()
-            }),
+            sampler,
+            sampling,
             build_layout,
             args_layout,
             build,
@@ -290,7 +305,7 @@ impl DenseVolume {
         ]
     }
 
-    /// Values for dense_sample.wgsl's `override` constants, for the pipelines that sample a
+    /// Values for voxels/dense/sample.wgsl's `override` constants, for the pipelines that sample a
     /// volume of this mode.
     pub fn sampling_constants(anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
         [
@@ -299,31 +314,34 @@ impl DenseVolume {
         ]
     }
 
-    /// Bindings cone tracing reads, from `first`: radiance0, the chains, and the sampler.
-    pub fn sampling_layout(
-        first: u32,
-        visibility: wgpu::ShaderStages,
-    ) -> Vec<wgpu::BindGroupLayoutEntry> {
-        let mut v: Vec<_> = (0..2)
-            .map(|i| {
-                layout::texture(
-                    first + i,
-                    visibility,
-                    wgpu::TextureSampleType::Float { filterable: true },
-                    wgpu::TextureViewDimension::D3,
-                )
-            })
-            .collect();
-        v.push(layout::sampler(first + 2, visibility));
-        v
+    /// The layout of @group(1) in every pipeline that samples voxels, the twin of
+    /// shaders/voxels/dense/sample.wgsl: the volume's placement, radiance0, the chains and the
+    /// sampler. Layouts with the same entries are one layout to wgpu, so each pass makes its
+    /// own and binds the volume's `sampling` group.
+    pub fn sampling_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let texture = |binding| {
+            layout::texture(
+                binding,
+                c,
+                wgpu::TextureSampleType::Float { filterable: true },
+                wgpu::TextureViewDimension::D3,
+            )
+        };
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel sampling"),
+            entries: &[
+                layout::uniform(0, c, false),
+                texture(1),
+                texture(2),
+                layout::sampler(3, c),
+            ],
+        })
     }
 
-    /// Views for `sampling_layout`, in the same order.
-    pub fn sampling_views(&self) -> Vec<wgpu::TextureView> {
-        vec![
-            self.radiance.create_view(&Default::default()),
-            self.chains.create_view(&Default::default()),
-        ]
+    /// The bind group for `sampling_layout`.
+    pub fn sampling(&self) -> &wgpu::BindGroup {
+        &self.sampling
     }
 
     /// Records the start of a build: forget the previous one and clear what it filled. Runs

@@ -5,6 +5,7 @@
 mod analytic;
 mod common;
 mod compare;
+mod contract;
 mod embed;
 mod errors;
 mod golden;

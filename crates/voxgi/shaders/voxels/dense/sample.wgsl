@@ -1,12 +1,38 @@
-// The samplers of the dense mip-mapped volume: the volume filtered to `diameter` around `pos`,
-// as seen travelling along `dir`, as optical depth (sample_depth, sample_depth_wide) or as
-// premultiplied radiance and opacity (sample_voxels). The including
-// shader declares `vol`, `radiance0` (finest level, isotropic), `chains` (the directional mip
-// chains, one level above the finest, as blocks stacked along z: +X, -X, +Y, -Y, +Z, -Z; in
-// isotropic mode one block) and `voxel_sampler` (trilinear, clamp to edge).
+// The dense mip-mapped volume's side of the voxel contract: the names cone tracing, the gather
+// and the bounce may use (docs/ARCHITECTURE.md, "The voxel contract"; the test
+// `every_structure_defines_the_voxel_contract` checks the signatures):
+//
+//   const WIDE_SAMPLE: f32                       samples at least this many voxels across may
+//                                                skip the finest level (sample_depth_wide)
+//   fn voxels_voxel_size() -> f32                finest voxel edge, metres
+//   fn voxels_contains(p) -> bool                p lies inside the structure's bounds
+//   fn sample_depth(p, d, dir) -> vec4<f32>      optical depth (L sigma, sigma) per sample
+//                                                diameter, filtered to diameter d, seen along dir
+//   fn sample_depth_wide(p, d, dir)              the same for d >= WIDE_SAMPLE voxels
+//   fn sample_voxels(p, d, dir) -> vec4<f32>     premultiplied radiance and opacity
+//
+// Everything here reads @group(1) only: the volume's placement `vol`, `radiance0` (finest
+// level, isotropic), `chains` (the directional mip chains, one level above the finest, as
+// blocks stacked along z: +X, -X, +Y, -Y, +Z, -Z; in isotropic mode one block) and
+// `voxel_sampler` (trilinear, clamp to edge). `DenseVolume::sampling_layout` is its twin.
 //
 // No branch: CPU drivers run every side of a branch that differs between SIMD lanes, and
 // even a branch no lane takes costs more on lavapipe than the fetch it would skip.
+
+//!include shared/volume.wgsl
+
+@group(1) @binding(0) var<uniform> vol: Volume;
+@group(1) @binding(1) var radiance0: texture_3d<f32>;
+@group(1) @binding(2) var chains: texture_3d<f32>;
+@group(1) @binding(3) var voxel_sampler: sampler;
+
+fn voxels_voxel_size() -> f32 {
+    return vol.voxel_size;
+}
+
+fn voxels_contains(p: vec3<f32>) -> bool {
+    return inside_volume(volume_uvw(p));
+}
 
 fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     return from_depth(sample_depth(pos, diameter, dir));

@@ -1,0 +1,309 @@
+//! The seam between cone tracing and the voxel structures: every structure defines the WGSL
+//! contract with the right signatures, cone tracing uses nothing else of a structure, and the
+//! dense volume's `sample_voxels` agrees with its CPU twin at random points of a tiny volume.
+
+use crate::common::*;
+use voxgi::gpu::readback::{f16_to_f32, read_texture_3d};
+use voxgi::gpu::shader;
+use voxgi::scene::builtin;
+use voxgi::scene::glam::{UVec3, Vec3, Vec4};
+use voxgi::voxel::cpu::{DenseSampler, Texture3d};
+use voxgi::voxel::dense::DenseVolume;
+use voxgi::{FrameParams, RendererOptions, wgpu};
+
+fn parse(src: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)))
+}
+
+fn validate(module: &naga::Module) {
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(module)
+    .unwrap_or_else(|e| panic!("{e:?}"));
+}
+
+/// A type's WGSL spelling, as far as the contract needs it.
+fn type_name(m: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
+    use naga::{ScalarKind as K, TypeInner as T, VectorSize as V};
+    let scalar = |s: naga::Scalar| match (s.kind, s.width) {
+        (K::Float, 4) => "f32",
+        (K::Bool, _) => "bool",
+        (K::Uint, 4) => "u32",
+        _ => "?",
+    };
+    match &m.types[ty].inner {
+        T::Scalar(s) => scalar(*s).into(),
+        T::Vector { size, scalar: s } => {
+            let n = match size {
+                V::Bi => 2,
+                V::Tri => 3,
+                V::Quad => 4,
+            };
+            format!("vec{n}<{}>", scalar(*s))
+        }
+        other => format!("{other:?}"),
+    }
+}
+
+/// The contract: each function's argument types and result type.
+const CONTRACT: &[(&str, &[&str], &str)] = &[
+    ("voxels_voxel_size", &[], "f32"),
+    ("voxels_contains", &["vec3<f32>"], "bool"),
+    (
+        "sample_depth",
+        &["vec3<f32>", "f32", "vec3<f32>"],
+        "vec4<f32>",
+    ),
+    (
+        "sample_depth_wide",
+        &["vec3<f32>", "f32", "vec3<f32>"],
+        "vec4<f32>",
+    ),
+    (
+        "sample_voxels",
+        &["vec3<f32>", "f32", "vec3<f32>"],
+        "vec4<f32>",
+    ),
+];
+
+#[test]
+fn every_structure_defines_the_voxel_contract() {
+    for kind in shader::STRUCTURES {
+        let src = shader::compose_for(&format!("voxels/{kind}/sample.wgsl"), kind);
+        let m = parse(&src);
+        validate(&m);
+        for (name, args, result) in CONTRACT {
+            let f = m
+                .functions
+                .iter()
+                .map(|(_, f)| f)
+                .find(|f| f.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("{kind}: no fn {name}"));
+            let got: Vec<String> = f.arguments.iter().map(|a| type_name(&m, a.ty)).collect();
+            assert_eq!(got, *args, "{kind}: {name}'s arguments");
+            let ret = f.result.as_ref().map(|r| type_name(&m, r.ty));
+            assert_eq!(ret.as_deref(), Some(*result), "{kind}: {name}'s result");
+        }
+        let wide = m
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some("WIDE_SAMPLE"))
+            .unwrap_or_else(|| panic!("{kind}: no const WIDE_SAMPLE"))
+            .1;
+        assert_eq!(type_name(&m, wide.ty), "f32", "{kind}: WIDE_SAMPLE");
+        // A structure's resources are @group(1): group 0 and 2 belong to the frame and the pass.
+        for (_, g) in m.global_variables.iter() {
+            if let Some(b) = &g.binding {
+                assert_eq!(b.group, 1, "{kind}: {:?} is not in group 1", g.name);
+            }
+        }
+    }
+}
+
+/// Cone tracing compiles against a stand-in structure that defines the contract and nothing
+/// else: it reaches into no structure's own names.
+#[test]
+fn cone_tracing_uses_only_the_contract() {
+    let cone = shader::compose_for("shared/cone.wgsl", "dense");
+    let dense = shader::compose_for("voxels/dense/sample.wgsl", "dense");
+    // What the including shader brings: the shared structs and constants.
+    let volume = shader::compose("shared/volume.wgsl");
+    let scene = shader::compose("shared/scene.wgsl");
+    assert!(
+        cone.contains(&dense),
+        "cone.wgsl no longer includes voxels/sample.wgsl"
+    );
+    let stub = format!(
+        "{volume}
+const WIDE_SAMPLE: f32 = 2.0;
+fn voxels_voxel_size() -> f32 {{ return 0.1; }}
+fn voxels_contains(p: vec3<f32>) -> bool {{ return true; }}
+fn sample_depth(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(0.0); }}
+fn sample_depth_wide(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(0.0); }}
+fn sample_voxels(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(0.0); }}
+"
+    );
+    let src = scene
+        + &cone.replace(&dense, &stub)
+        + "@group(0) @binding(0) var<uniform> cones: Cones;
+@compute @workgroup_size(1)
+fn main() {
+    let g = gather_diffuse(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), 0.0, true, ALL_CONES);
+}
+";
+    validate(&parse(&src));
+}
+
+/// A mip chain read back from an fp16 3D texture.
+fn read_chain(t: &wgpu::Texture) -> Texture3d {
+    let levels = (0..t.mip_level_count())
+        .map(|mip| {
+            let bytes = read_texture_3d(&ctx().device, &ctx().queue, t, mip).expect("readback");
+            let halves: &[u16] = bytemuck::cast_slice(&bytes);
+            let texels = halves
+                .chunks_exact(4)
+                .map(|h| Vec4::from_array([0, 1, 2, 3].map(|i| f16_to_f32(h[i]))))
+                .collect();
+            let size = UVec3::new(
+                t.width() >> mip,
+                t.height() >> mip,
+                t.depth_or_array_layers() >> mip,
+            )
+            .max(UVec3::ONE);
+            (texels, size)
+        })
+        .collect();
+    Texture3d { levels }
+}
+
+const PROBE: &str = "
+struct Probe { p: vec4<f32>, dir: vec4<f32> }
+@group(0) @binding(0) var<storage, read> probes: array<Probe>;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&probes) {
+        return;
+    }
+    let q = probes[id.x];
+    results[id.x] = sample_voxels(q.p.xyz, q.p.w, q.dir.xyz);
+}
+";
+
+/// `sample_voxels` of the dense volume, run by a probe shader at random points, diameters and
+/// directions of the lit Cornell box at 16³, against `cpu::DenseSampler`.
+fn probe_matches_cpu(anisotropic: bool) {
+    let options = RendererOptions {
+        voxel_resolution: 16,
+        anisotropic,
+        ..measuring()
+    };
+    let mut r = renderer(&builtin::cornell_box(), &options);
+    let params = FrameParams::new(r.default_camera().clone());
+    frame(&mut r, &params, 8, 8);
+    let vol = r.volume();
+    let grid = vol.grid;
+
+    // Points over the volume and a little outside it (where the answer is 0), diameters of
+    // one to 24 voxels (every level), directions over the sphere: a fixed LCG, so the test
+    // is the same every run.
+    let mut seed = 0x2545_f491_u32;
+    let mut rnd = move || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let n = 512;
+    let mut probes: Vec<[f32; 8]> = Vec::with_capacity(n);
+    for _ in 0..n {
+        let p = grid.origin + Vec3::new(rnd(), rnd(), rnd()) * 1.1 * grid.extent()
+            - 0.05 * grid.extent();
+        let d = grid.voxel_size * 24f32.powf(rnd());
+        let dir = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::Y);
+        probes.push([p.x, p.y, p.z, d, dir.x, dir.y, dir.z, 0.0]);
+    }
+    let device = &ctx().device;
+    let queue = &ctx().queue;
+    use wgpu::util::DeviceExt;
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("probes"),
+        contents: bytemuck::cast_slice(&probes),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let output = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe results"),
+        size: (n * 16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let src = shader::compose_for("voxels/dense/sample.wgsl", "dense") + PROBE;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("probe"),
+        source: wgpu::ShaderSource::Wgsl(src.into()),
+    });
+    let c = wgpu::ShaderStages::COMPUTE;
+    let own = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("probe"),
+        entries: &[
+            voxgi::gpu::layout::storage(0, c, true),
+            voxgi::gpu::layout::storage(1, c, false),
+        ],
+    });
+    let voxels = DenseVolume::sampling_layout(device);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("probe"),
+        bind_group_layouts: &[Some(&own), Some(&voxels)],
+        immediate_size: 0,
+    });
+    let constants = DenseVolume::sampling_constants(anisotropic, 3);
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("probe"),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            ..Default::default()
+        },
+        cache: None,
+    });
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("probe"),
+        layout: &own,
+        entries: &voxgi::gpu::layout::entries(vec![
+            input.as_entire_binding(),
+            output.as_entire_binding(),
+        ]),
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(1, vol.sampling(), &[]);
+        pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
+    }
+    queue.submit([encoder.finish()]);
+    let bytes = voxgi::gpu::readback::read_buffer_copy(device, queue, &output).expect("results");
+    let gpu: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+
+    let (radiance0, chains) = (read_chain(&vol.radiance), read_chain(&vol.chains));
+    let cpu = DenseSampler {
+        grid,
+        anisotropic,
+        radiance0: &radiance0,
+        chains: &chains,
+    };
+    let (mut worst, mut nonzero) = (0.0f32, 0);
+    for (q, g) in probes.iter().zip(gpu) {
+        let p = Vec3::new(q[0], q[1], q[2]);
+        let dir = Vec3::new(q[4], q[5], q[6]);
+        let want = cpu.sample_voxels(p, q[3], dir);
+        let got = Vec4::from_array(*g);
+        // Filtering hardware interpolates with 8-bit fractional weights (lavapipe, most
+        // GPUs): a weight off by 1/512 moves a value by that share of a texel difference, and
+        // opacity spans 0..1, so 5e-3 absolute; radiance is a tenth of that scale here.
+        let err = (got - want).abs().max_element();
+        worst = worst.max(err);
+        if want.w > 0.01 {
+            nonzero += 1;
+        }
+        assert!(
+            err <= 5e-3,
+            "sample_voxels({p}, {}, {dir}): GPU {got}, CPU {want}",
+            q[3]
+        );
+    }
+    eprintln!(
+        "probe (anisotropic {anisotropic}): worst difference {worst:.2e}, {nonzero} of {n} samples see voxels"
+    );
+    // The probe must look at something: most samples inside the box see its walls.
+    assert!(nonzero > n / 4, "only {nonzero} of {n} samples see voxels");
+}
+
+#[test]
+fn dense_sample_voxels_matches_its_cpu_twin() {
+    probe_matches_cpu(true);
+    probe_matches_cpu(false);
+}
