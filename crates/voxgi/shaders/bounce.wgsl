@@ -19,7 +19,7 @@
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = gid.x + gid.y * nwg.x * 64u;
-    if s >= min(counters[1], arrayLength(&slot_voxel)) {
+    if s >= min(counters[0], arrayLength(&slot_voxel)) {
         return;
     }
     let c = voxel_coord(slot_voxel[s], vol.resolution);

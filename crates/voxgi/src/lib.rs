@@ -34,6 +34,7 @@ pub mod brdf;
 #[cfg(feature = "compare")]
 pub mod compare;
 mod error;
+pub mod fragments;
 pub mod gpu;
 pub mod gpu_scene;
 #[cfg(feature = "headless")]

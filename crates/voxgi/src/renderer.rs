@@ -13,6 +13,8 @@
 //! for everything, and no frame waits for the GPU.
 
 use crate::brdf::BrdfTables;
+use crate::fragments::voxelize::VoxelizePass;
+use crate::fragments::{self, FragmentEstimate, Fragments, triangle_table};
 use crate::gpu::feedback::CounterReadback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
@@ -20,21 +22,19 @@ use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
 use crate::options::{FrameParams, RendererOptions, UNLIMITED_BOUNCES, validate_size};
 use crate::passes::bounce::BouncePass;
 use crate::passes::composite::CompositePass;
-use crate::passes::debug::DebugPass;
-use crate::passes::filter::FilterPass;
 use crate::passes::gather::{self, GatherPass};
 use crate::passes::gbuffer::GbufferPass;
 use crate::passes::inject::InjectPass;
 use crate::passes::shadow::{self, ShadowAtlas, ShadowPass};
 use crate::passes::tonemap::TonemapPass;
 use crate::passes::upsample::UpsamplePass;
-use crate::passes::voxelize::VoxelizePass;
 use crate::targets::FrameTargets;
 use crate::view::{camera_view_proj, lit_scene};
-use crate::voxel::dense::{DenseVolume, FragmentEstimate, triangle_table};
-use crate::voxel::{GpuCones, Grid};
+use crate::voxel::dense::{DensePipelines, DenseVolume};
+use crate::voxel::{DebugView, GpuCones, Grid, VoxelStructure};
 use crate::{Error, Result};
 use glam::Vec3;
+use std::sync::Arc;
 use voxgi_scene::{Aabb, Camera, Scene, pointcloud};
 use wgpu::util::DeviceExt;
 
@@ -73,13 +73,11 @@ struct Passes {
     shadow: ShadowPass,
     voxelize: VoxelizePass,
     inject: InjectPass,
-    filter: FilterPass,
     bounce: BouncePass,
     gbuffer: GbufferPass,
     gather: GatherPass,
     upsample: UpsamplePass,
     composite: CompositePass,
-    debug: DebugPass,
     tonemap: TonemapPass,
 }
 
@@ -151,7 +149,11 @@ pub struct Renderer {
     atlas: ShadowAtlas,
     passes: Passes,
     brdf_tables: BrdfTables,
+    fragments: Fragments,
+    /// The voxel structure. Inject and bounce still read its leaves (the dense volume's slots)
+    /// directly; everything else goes through `VoxelStructure`.
     volume: DenseVolume,
+    dense_pipelines: Arc<DensePipelines>,
     triangles: (wgpu::Buffer, u32),
     cones: wgpu::Buffer,
     /// Voxel bounces per update (the per-pixel gather adds the last bounce).
@@ -238,18 +240,18 @@ impl Renderer {
             radius,
         )?;
         let grid = grid(&facts, settings);
-        let volume = new_volume(device, &facts, settings, grid, None)?;
+        let fragments = new_fragments(device, &facts, settings, grid, None)?;
+        let dense_pipelines = checked(device, "pipeline creation", || DensePipelines::new(device))?;
+        let volume = new_volume(device, &dense_pipelines, &facts, settings, grid, None)?;
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             voxelize: VoxelizePass::new(device),
             inject: InjectPass::new(device, gpu_scene.light_count),
-            filter: FilterPass::new(device),
             bounce: BouncePass::new(device, settings.anisotropic),
             gbuffer: GbufferPass::new(device),
             gather: GatherPass::new(device, settings, facts.glossy),
             upsample: UpsamplePass::new(device),
             composite: composite_pass(device, &gpu_scene, &facts, settings),
-            debug: DebugPass::new(device),
             tonemap: TonemapPass::new(device),
         })?;
         let triangles = triangle_table(device, &gpu_scene);
@@ -273,12 +275,14 @@ impl Renderer {
             atlas,
             passes,
             brdf_tables,
+            fragments,
             volume,
+            dense_pipelines,
             triangles,
             cones,
             voxel_bounces,
             dirty: true,
-            counters: CounterReadback::new("voxel counters readback", 16),
+            counters: CounterReadback::new("voxel counters readback", 2),
             last_counts: None,
             timer: GpuTimer::disabled(queue),
             targets: None,
@@ -337,7 +341,9 @@ impl Renderer {
             None
         };
         let volume_new = if volume {
-            Some(new_volume(device, &self.facts, new, grid, None)?)
+            let f = new_fragments(device, &self.facts, new, grid, None)?;
+            let v = new_volume(device, &self.dense_pipelines, &self.facts, new, grid, None)?;
+            Some((f, v))
         } else {
             None
         };
@@ -354,7 +360,8 @@ impl Renderer {
         if let Some(a) = atlas_new {
             self.atlas = a;
         }
-        if let Some(v) = volume_new {
+        if let Some((f, v)) = volume_new {
+            self.fragments = f;
             self.volume = v;
         }
         if let Some(p) = gather_new {
@@ -394,6 +401,7 @@ impl Renderer {
     pub fn memory(&self) -> Vec<(&'static str, u64)> {
         let mut m = self.scene.memory();
         m.push(("shadow atlas", self.atlas.bytes()));
+        m.extend(self.fragments.memory());
         m.extend(self.volume.memory());
         if let Some(t) = &self.targets {
             m.push(("render targets", t.bytes()));
@@ -428,23 +436,25 @@ impl Renderer {
         let p = &self.passes;
         p.shadow
             .record(&self.device, encoder, &self.atlas, &self.scene, timer);
-        self.volume.record_begin(&self.device, encoder, timer);
+        self.fragments.record_clear(encoder);
         let triangles = (&self.triangles.0, self.triangles.1);
         p.voxelize.record(
             &self.device,
             encoder,
             &self.scene,
             triangles,
-            &self.volume,
+            &self.fragments,
             timer,
         );
-        self.volume.record_build(&self.device, encoder, timer);
+        self.volume
+            .record_build(&self.device, encoder, &self.fragments, timer);
         // The kernels never write past their buffers, they only count: the counts come back
         // a frame or more later and grow the pools then (`receive_feedback`).
-        if !self
-            .counters
-            .request(&self.device, encoder, &self.volume.counters)
-        {
+        if !self.counters.request(
+            &self.device,
+            encoder,
+            &[&self.fragments.count, self.volume.leaf_counter()],
+        ) {
             log::warn!("voxel counters: too many readbacks in flight; is the encoder submitted?");
         }
         p.inject.record(
@@ -455,11 +465,11 @@ impl Renderer {
             &self.volume,
             timer,
         );
-        p.filter.record(&self.device, encoder, &self.volume, timer);
+        self.volume.record_filter(&self.device, encoder, timer);
         for _ in 0..self.voxel_bounces {
             p.bounce
                 .record(&self.device, encoder, &self.volume, &self.cones, timer);
-            p.filter.record(&self.device, encoder, &self.volume, timer);
+            self.volume.record_filter(&self.device, encoder, timer);
         }
         self.dirty = false;
     }
@@ -477,30 +487,32 @@ impl Renderer {
                 occupied: words[1] as u64,
             };
             self.last_counts = Some(counts);
-            let v = &self.volume;
-            if counts.fragments <= v.fragment_capacity as u64
-                && counts.occupied <= v.slot_capacity as u64
-            {
+            let (frags, leaves) = (self.fragments.capacity as u64, self.volume.leaf_capacity());
+            if counts.fragments <= frags && counts.occupied <= leaves {
                 continue;
             }
-            let capacity = fragment_capacity(
-                &self.device,
-                counts.fragments.max(v.fragment_capacity as u64),
-            )?;
-            let slots = slot_capacity(&self.device, counts.occupied.max(v.slot_capacity as u64))?;
+            if counts.fragments > frags {
+                let grid = self.fragments.grid;
+                self.fragments = new_fragments(
+                    &self.device,
+                    &self.facts,
+                    &self.options,
+                    grid,
+                    Some(counts.fragments),
+                )?;
+            }
+            if counts.occupied > leaves {
+                let slots = slot_capacity(&self.device, counts.occupied)?;
+                self.volume.grow(&self.device, slots as u64);
+            }
             log::info!(
-                "voxels: {} fragments, {} occupied voxels: growing the pools to {capacity} \
-                 fragments and {slots} voxels and rebuilding",
+                "voxels: {} fragments, {} occupied voxels: growing the pools to {} fragments \
+                 and {} voxels and rebuilding",
                 counts.fragments,
-                counts.occupied
+                counts.occupied,
+                self.fragments.capacity,
+                self.volume.leaf_capacity()
             );
-            self.volume = new_volume(
-                &self.device,
-                &self.facts,
-                &self.options,
-                v.grid,
-                Some((capacity as u64, slots as u64)),
-            )?;
             self.dirty = true;
         }
         Ok(self.dirty)
@@ -514,12 +526,19 @@ impl Renderer {
     /// Voxel statistics of the last build, read back now. This waits for the GPU: it is for
     /// tools and tests, never called by a frame.
     pub fn voxel_counts(&self) -> Result<VoxelCounts> {
-        let bytes = readback::read_buffer_copy(&self.device, &self.queue, &self.volume.counters)?;
-        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        let read = |b: &wgpu::Buffer| -> Result<u64> {
+            let bytes = readback::read_buffer_copy(&self.device, &self.queue, b)?;
+            Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[0] as u64)
+        };
         Ok(VoxelCounts {
-            fragments: c[0] as u64,
-            occupied: c[1] as u64,
+            fragments: read(&self.fragments.count)?,
+            occupied: read(self.volume.leaf_counter())?,
         })
+    }
+
+    /// The fragments of the last build, for tests and debugging.
+    pub fn fragments(&self) -> &Fragments {
+        &self.fragments
     }
 
     /// The dense volume, for tests and debugging.
@@ -613,14 +632,15 @@ impl Renderer {
         );
         // Only for the voxel views: replaces the composite's output.
         if params.view.is_voxel() {
-            p.debug.record(
+            self.volume.record_debug(
                 &self.device,
                 encoder,
                 t,
-                &self.volume,
-                params.view,
-                params.debug_level,
-                params.debug_direction,
+                DebugView {
+                    mode: params.view,
+                    level: params.debug_level,
+                    direction: params.debug_direction,
+                },
                 timer,
             );
         }
@@ -636,33 +656,49 @@ fn grid(facts: &SceneFacts, options: &RendererOptions) -> Grid {
     Grid::around(facts.bounds.min, facts.bounds.max, options.voxel_resolution)
 }
 
-/// A dense volume on `grid` with pools of `capacities` (fragments, occupied voxels), or sized
-/// from the options and the scene's estimate.
-fn new_volume(
+/// The fragment buffer on `grid`, with room for `capacity` fragments, or for as many as the
+/// options or the scene's estimate say.
+fn new_fragments(
     device: &wgpu::Device,
     facts: &SceneFacts,
     options: &RendererOptions,
     grid: Grid,
-    capacities: Option<(u64, u64)>,
+    capacity: Option<u64>,
+) -> Result<Fragments> {
+    let wanted = capacity
+        .or(options.fragment_capacity)
+        .unwrap_or_else(|| facts.estimate.at(&grid));
+    let capacity = fragments::capacity(device, wanted.min(fragments::max_fragments(device)))?;
+    checked(device, "voxel fragments", || {
+        Fragments::new(device, grid, capacity)
+    })
+}
+
+/// A dense volume on `grid` with room for `leaves` occupied voxels, or for as many as the
+/// options or the scene's estimate say.
+fn new_volume(
+    device: &wgpu::Device,
+    pipelines: &Arc<DensePipelines>,
+    facts: &SceneFacts,
+    options: &RendererOptions,
+    grid: Grid,
+    leaves: Option<u64>,
 ) -> Result<DenseVolume> {
     check_volume_fits(device, &grid)?;
-    let estimate = facts.estimate.at(&grid);
     // Slots: at most one per voxel, usually far fewer than fragments, and the fragment
     // estimate is itself an upper bound. Start at a quarter; the first build's counters grow
     // the pools to the exact count if that is short.
-    let (fragments, voxels) = capacities.unwrap_or((
-        options.fragment_capacity.unwrap_or(estimate),
-        options.voxel_capacity.unwrap_or(estimate / 4),
-    ));
-    let capacity = fragment_capacity(device, fragments.min(max_fragments(device)))?;
+    let wanted = leaves
+        .or(options.voxel_capacity)
+        .unwrap_or_else(|| facts.estimate.at(&grid) / 4);
     let slots = slot_capacity(
         device,
-        voxels
+        wanted
             .min((grid.resolution as u64).pow(3))
             .min(max_slots(device)),
     )?;
     checked(device, "voxel volume", || {
-        DenseVolume::new(device, grid, options.anisotropic, capacity, slots)
+        DenseVolume::new(device, pipelines, grid, options.anisotropic, slots)
     })
 }
 
@@ -697,11 +733,6 @@ fn composite_pass(
         shadow::composite_reads_shadow_maps(&scene.gpu_lights, options.cone_shadows),
         facts.glossy,
     )
-}
-
-/// The most fragments one storage binding can hold on this device.
-fn max_fragments(device: &wgpu::Device) -> u64 {
-    device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES
 }
 
 /// The most slots one storage binding can hold on this device.
@@ -747,20 +778,6 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
         )));
     }
     Ok(())
-}
-
-/// Checks a fragment capacity against the device's storage-buffer limit.
-fn fragment_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
-    let limit =
-        device.limits().max_storage_buffer_binding_size / crate::voxel::dense::FRAGMENT_BYTES;
-    let cap = wanted.max(1024);
-    if cap > limit.min(u32::MAX as u64) {
-        return Err(Error::Setting(format!(
-            "the scene needs about {cap} voxel fragments at this resolution, more than this \
-             GPU's storage-buffer limit allows ({limit}); lower the voxel resolution"
-        )));
-    }
-    Ok(cap as u32)
 }
 
 /// Voxel-space bounces for a total of `bounces` indirect bounces (the gather adds one).

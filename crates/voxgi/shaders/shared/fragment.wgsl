@@ -1,5 +1,21 @@
 // Voxel fragments: the one interface between geometry (meshes, points) and voxel structures.
-// 16 bytes: voxel coordinates, albedo + opacity, normal, emission.
+// 16 bytes: voxel coordinates, albedo + opacity, normal, emission. A structure is built from
+// these and nothing else. The fragment buffer's length is its capacity: a pass that makes
+// fragments counts every one in `fragment_count[0]` and stores those that fit.
+
+// Where the finest voxels lie: the grid every structure shares. Twin: `GpuFragmentGrid` in
+// src/fragments/mod.rs.
+struct FragmentGrid {
+    // World position of the grid's minimum corner.
+    origin: vec3<f32>,
+    // Voxels per side.
+    resolution: u32,
+    // World size of a voxel.
+    voxel_size: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
 
 struct Fragment {
     // x | y << 10 | z << 20, finest-level voxel coordinates.

@@ -12,7 +12,7 @@ struct Volume {
     levels: u32,
     // 1: six directional values per voxel above the finest level, 0: one.
     anisotropic: u32,
-    fragment_capacity: u32,
+    _pad: u32,
 }
 
 const MAX_CONES: u32 = 16u;

@@ -20,30 +20,32 @@ struct Slot {
     state: Arc<AtomicU8>,
 }
 
-/// A pool of readback buffers of `size` bytes for one kind of counter.
+/// A pool of readback buffers for `count` counters, each the first `u32` of its own buffer.
 pub struct CounterReadback {
     label: &'static str,
-    size: u64,
+    count: usize,
     slots: Vec<Slot>,
 }
 
 impl CounterReadback {
-    pub fn new(label: &'static str, size: u64) -> Self {
+    pub fn new(label: &'static str, count: usize) -> Self {
         CounterReadback {
             label,
-            size,
+            count,
             slots: Vec::new(),
         }
     }
 
-    /// Records a copy of `src[..size]` and its map on submission. Returns false when too many
-    /// reads are still in flight (nothing is recorded).
+    /// Records a copy of the first `u32` of each of `sources` (`count` of them) and the map
+    /// on submission. Returns false when too many reads are still in flight (nothing is
+    /// recorded).
     pub fn request(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        src: &wgpu::Buffer,
+        sources: &[&wgpu::Buffer],
     ) -> bool {
+        debug_assert_eq!(sources.len(), self.count);
         let i = match self
             .slots
             .iter()
@@ -54,7 +56,7 @@ impl CounterReadback {
                 self.slots.push(Slot {
                     buffer: device.create_buffer(&wgpu::BufferDescriptor {
                         label: Some(self.label),
-                        size: self.size,
+                        size: 4 * self.count as u64,
                         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
                         mapped_at_creation: false,
                     }),
@@ -66,7 +68,9 @@ impl CounterReadback {
         };
         let slot = &self.slots[i];
         slot.state.store(IN_FLIGHT, Ordering::Release);
-        encoder.copy_buffer_to_buffer(src, 0, &slot.buffer, 0, self.size);
+        for (i, src) in sources.iter().enumerate() {
+            encoder.copy_buffer_to_buffer(src, 0, &slot.buffer, 4 * i as u64, 4);
+        }
         let state = slot.state.clone();
         encoder.map_buffer_on_submit(&slot.buffer, wgpu::MapMode::Read, .., move |r| {
             state.store(if r.is_ok() { READY } else { FAILED }, Ordering::Release);

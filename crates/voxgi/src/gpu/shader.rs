@@ -25,16 +25,16 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/upsample.wgsl",
     "shadow.wgsl",
     "gbuffer.wgsl",
-    "voxelize.wgsl",
-    "dense_build.wgsl",
+    "fragments/voxelize.wgsl",
+    "voxels/dense/dense_build.wgsl",
     "inject.wgsl",
-    "filter.wgsl",
+    "voxels/dense/filter.wgsl",
     "bounce.wgsl",
     "bounce_store.wgsl",
     "gather.wgsl",
     "upsample.wgsl",
     "composite.wgsl",
-    "debug.wgsl",
+    "voxels/dense/debug.wgsl",
     "tonemap.wgsl",
     "reference.wgsl",
 ];
@@ -169,5 +169,5 @@ pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
     SOURCES
         .iter()
         .map(|(n, _)| *n)
-        .filter(|n| !n.starts_with("shared/") && !n.starts_with("voxels/"))
+        .filter(|n| !n.starts_with("shared/") && !n.ends_with("/sample.wgsl"))
 }

@@ -5,6 +5,7 @@
 use crate::gpu::layout;
 use crate::gpu::shader::{compute_pipeline, grouped_pipeline};
 use crate::gpu::timer::GpuTimer;
+use crate::voxel::VoxelStructure;
 use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
 
 pub struct BouncePass {

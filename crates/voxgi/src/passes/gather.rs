@@ -9,6 +9,7 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::options::RendererOptions;
 use crate::targets::FrameTargets;
+use crate::voxel::VoxelStructure;
 use crate::voxel::dense::DenseVolume;
 use voxgi_scene::Scene;
 
@@ -89,7 +90,7 @@ impl GatherPass {
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
         scene: &GpuScene,
-        vol: &DenseVolume,
+        voxels: &dyn VoxelStructure,
         cones: &wgpu::Buffer,
         tables: &BrdfTables,
         timer: &mut GpuTimer,
@@ -123,7 +124,7 @@ impl GatherPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &globals, &[]);
-        pass.set_bind_group(1, vol.sampling(), &[]);
+        pass.set_bind_group(1, voxels.sampling(), &[]);
         pass.set_bind_group(2, &own, &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }

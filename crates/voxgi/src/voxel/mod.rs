@@ -1,15 +1,74 @@
-//! Voxels: where the volume sits, the fragments geometry turns into, the cone sets, and the voxel
-//! structures built from fragments.
+//! Voxels: where the volume sits, the cone sets, and the voxel structures built from fragments.
 //!
-//! Cone tracing is written once in WGSL (`shaders/shared/cone.wgsl`) against
-//! `sample_voxels(position, diameter, direction)`; a structure provides that function and the
-//! bindings it reads. The dense mip-mapped volume (`dense.rs`) is the first structure.
+//! A structure is anything cone tracing can sample (DESIGN.md, seam 2). In Rust it implements
+//! `VoxelStructure`; in WGSL it provides `shaders/voxels/<kind>/sample.wgsl`, the contract of
+//! names cone tracing uses (`shaders/shared/cone.wgsl`), reading only its own `@group(1)`.
+//! The dense mip-mapped volume (`dense/`) is the first structure.
 
 pub mod cpu;
 pub mod dense;
 
+use crate::fragments::Fragments;
+use crate::gpu::timer::GpuTimer;
+use crate::options::ViewMode;
+use crate::targets::FrameTargets;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+
+/// What a voxel debug view shows: one of the voxel `ViewMode`s, at mip `level` (0 = finest),
+/// along directional chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) where there are chains.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DebugView {
+    pub mode: ViewMode,
+    pub level: u32,
+    pub direction: u32,
+}
+
+/// A voxel structure: built from fragments and nothing else, holding the radiance of its
+/// leaves, filtered into coarser levels, sampled by cone tracing through `sampling()` at
+/// `@group(1)` of every pipeline that traces cones.
+pub trait VoxelStructure {
+    /// The structure's name, also its WGSL folder: `shaders/voxels/<kind>/`.
+    fn kind(&self) -> &'static str;
+    /// The grid of its finest voxels (the fragments' grid).
+    fn grid(&self) -> Grid;
+    /// Records a build from `fragments`, replacing the previous one: leaves get albedo,
+    /// normal, emission and opacity; their radiance is cleared.
+    fn record_build(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    );
+    /// Records the filtering of the leaves' radiance into every coarser level.
+    fn record_filter(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+    );
+    /// A buffer whose first `u32` is the number of leaves the last build needed, counted past
+    /// the capacity (read back asynchronously to grow the pools).
+    fn leaf_counter(&self) -> &wgpu::Buffer;
+    /// Leaves the pools hold.
+    fn leaf_capacity(&self) -> u64;
+    /// Makes room for `leaves` leaves; the contents are lost (the next build refills them).
+    fn grow(&mut self, device: &wgpu::Device, leaves: u64);
+    /// Bytes per GPU resource.
+    fn memory(&self) -> Vec<(&'static str, u64)>;
+    /// The bind group of the WGSL contract's resources, `@group(1)`.
+    fn sampling(&self) -> &wgpu::BindGroup;
+    /// Records a debug view into the HDR target, replacing the lit image.
+    fn record_debug(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        view: DebugView,
+        timer: &mut GpuTimer,
+    );
+}
 
 /// Mirrors `Volume` in shaders/shared/volume.wgsl.
 #[repr(C)]
@@ -20,7 +79,7 @@ pub struct GpuVolume {
     pub voxel_size: f32,
     pub levels: u32,
     pub anisotropic: u32,
-    pub fragment_capacity: u32,
+    pub _pad: u32,
 }
 
 /// Mirrors `Cones` in shaders/shared/volume.wgsl.

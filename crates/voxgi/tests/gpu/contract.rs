@@ -7,6 +7,7 @@ use voxgi::gpu::readback::{f16_to_f32, read_texture_3d};
 use voxgi::gpu::shader;
 use voxgi::scene::builtin;
 use voxgi::scene::glam::{UVec3, Vec3, Vec4};
+use voxgi::voxel::VoxelStructure;
 use voxgi::voxel::cpu::{DenseSampler, Texture3d};
 use voxgi::voxel::dense::DenseVolume;
 use voxgi::{FrameParams, RendererOptions, wgpu};

@@ -2,7 +2,7 @@
 // fragments of each voxel, so the result does not depend on thread order (deterministic).
 //
 // Entry points, in the order the host runs them:
-//   begin           remember the previous slot count, reset the counters
+//   begin           remember the previous slot count, reset the slot counter
 //   clear_previous  zero the voxels the previous build filled (cheaper than clearing N^3)
 //   prepare_fragments / prepare_slots  indirect dispatch sizes from the counters
 //   allocate        one slot per occupied voxel
@@ -13,20 +13,22 @@
 //!include shared/fragment.wgsl
 
 @group(0) @binding(0) var<uniform> vol: Volume;
+// The fragments, as voxelize (or any other source) left them: the only input.
 @group(0) @binding(1) var<storage, read> fragments: array<Fragment>;
-// [0] fragments, [1] slots, [2] slots of the previous build.
-@group(0) @binding(2) var<storage, read_write> counters: array<atomic<u32>>;
-// Per voxel: 0 empty, 1 occupied, 2 + slot once allocated, LOCKED while allocating.
-@group(0) @binding(3) var<storage, read_write> occupancy: array<atomic<u32>>;
+@group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
+// [0] slots (occupied voxels, counted past the capacity), [1] slots of the previous build.
+@group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>>;
+// Per voxel: 0 empty, 2 + slot once allocated, LOCKED while allocating (or past capacity).
+@group(0) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>>;
 // Per slot: the voxel's linear index.
-@group(0) @binding(4) var<storage, read_write> slot_voxel: array<u32>;
+@group(0) @binding(5) var<storage, read_write> slot_voxel: array<u32>;
 // Per slot, ACCUM_STRIDE u32 sums: count, albedo rgb (8-bit units), normal xyz (snorm16 units,
 // two's complement), emission rgb (1/4096 units).
-@group(0) @binding(5) var<storage, read_write> accum: array<atomic<u32>>;
-@group(0) @binding(6) var albedo_out: texture_storage_3d<rgba8unorm, write>;
-@group(0) @binding(7) var normal_out: texture_storage_3d<rgba8snorm, write>;
-@group(0) @binding(8) var emission_out: texture_storage_3d<rgba16float, write>;
-@group(0) @binding(9) var radiance_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(6) var<storage, read_write> accum: array<atomic<u32>>;
+@group(0) @binding(7) var albedo_out: texture_storage_3d<rgba8unorm, write>;
+@group(0) @binding(8) var normal_out: texture_storage_3d<rgba8snorm, write>;
+@group(0) @binding(9) var emission_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(10) var radiance_out: texture_storage_3d<rgba16float, write>;
 // Indirect dispatch arguments: [0..3] over slots, [3..6] over fragments. Only the prepare_*
 // entry points bind them (a buffer cannot be storage and indirect in one dispatch).
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
@@ -49,27 +51,31 @@ fn write_args(offset: u32, count: u32) {
     args[offset + 2u] = 1u;
 }
 
+// Fragments made and kept: the count runs past the buffer when it overflowed.
+fn stored_fragments() -> u32 {
+    return min(fragment_count[0], arrayLength(&fragments));
+}
+
 @compute @workgroup_size(1)
 fn begin() {
-    atomicStore(&counters[2], atomicLoad(&counters[1]));
+    atomicStore(&counters[1], atomicLoad(&counters[0]));
     atomicStore(&counters[0], 0u);
-    atomicStore(&counters[1], 0u);
 }
 
 @compute @workgroup_size(1)
 fn prepare_fragments() {
-    write_args(3u, min(atomicLoad(&counters[0]), vol.fragment_capacity));
+    write_args(3u, stored_fragments());
 }
 
 @compute @workgroup_size(1)
 fn prepare_slots() {
-    write_args(0u, min(atomicLoad(&counters[1]), arrayLength(&slot_voxel)));
+    write_args(0u, min(atomicLoad(&counters[0]), arrayLength(&slot_voxel)));
 }
 
 @compute @workgroup_size(64)
 fn clear_previous(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = flat(gid, nwg);
-    if s >= min(atomicLoad(&counters[2]), arrayLength(&slot_voxel)) {
+    if s >= min(atomicLoad(&counters[1]), arrayLength(&slot_voxel)) {
         return;
     }
     let c = voxel_coord(slot_voxel[s], vol.resolution);
@@ -82,25 +88,25 @@ fn clear_previous(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
 @compute @workgroup_size(64)
 fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat(gid, nwg);
-    if i >= min(atomicLoad(&counters[0]), vol.fragment_capacity) {
+    if i >= stored_fragments() {
         return;
     }
     let v = voxel_index(unpack_coord(fragments[i].coord), vol.resolution);
     // The first fragment of a voxel takes it; the weak exchange may fail spuriously, so retry
     // while the voxel is still unclaimed.
     for (var tries = 0u; tries < 64u; tries++) {
-        let r = atomicCompareExchangeWeak(&occupancy[v], 1u, LOCKED);
+        let r = atomicCompareExchangeWeak(&occupancy[v], 0u, LOCKED);
         if r.exchanged {
             // Counted even past the capacity, so the host can see how many slots it needs;
             // voxels beyond it stay unallocated (LOCKED) and are skipped.
-            let s = atomicAdd(&counters[1], 1u);
+            let s = atomicAdd(&counters[0], 1u);
             if s < arrayLength(&slot_voxel) {
                 slot_voxel[s] = v;
                 atomicStore(&occupancy[v], s + 2u);
             }
             return;
         }
-        if r.old_value != 1u {
+        if r.old_value != 0u {
             return;
         }
     }
@@ -109,7 +115,7 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
 @compute @workgroup_size(64)
 fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat(gid, nwg);
-    if i >= min(atomicLoad(&counters[0]), vol.fragment_capacity) {
+    if i >= stored_fragments() {
         return;
     }
     let f = fragments[i];
@@ -138,7 +144,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = flat(gid, nwg);
-    if s >= min(atomicLoad(&counters[1]), arrayLength(&slot_voxel)) {
+    if s >= min(atomicLoad(&counters[0]), arrayLength(&slot_voxel)) {
         return;
     }
     let base = s * ACCUM_STRIDE;

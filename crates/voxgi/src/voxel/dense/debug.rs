@@ -2,13 +2,13 @@
 //! the volume at `FrameParams::debug_level` and overwrites the HDR target; runs after composite and
 //! before tonemap, only when such a view is selected.
 
+use super::DenseVolume;
 use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::ViewMode;
 use crate::passes::composite::HDR_FORMAT;
 use crate::targets::FrameTargets;
-use crate::voxel::dense::DenseVolume;
 use wgpu::util::DeviceExt;
 
 pub struct DebugPass {
@@ -32,7 +32,7 @@ impl DebugPass {
             ],
         });
         DebugPass {
-            pipeline: compute_pipeline(device, "debug", "debug.wgsl", &layout),
+            pipeline: compute_pipeline(device, "debug", "voxels/dense/debug.wgsl", &layout),
             layout,
         }
     }

@@ -11,18 +11,24 @@
 //! injection and bounces run over occupied voxels only, and clearing touches only the voxels
 //! the previous build filled.
 
+pub mod debug;
+pub mod filter;
+
 use super::{GpuVolume, Grid, texture_bytes};
+use crate::fragments::Fragments;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
-use crate::gpu_scene::GpuScene;
+use crate::targets::FrameTargets;
+use crate::voxel::{DebugView, VoxelStructure};
+use debug::DebugPass;
+use filter::FilterPass;
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Snorm;
 pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Bytes per fragment (`Fragment` in shaders/shared/fragment.wgsl).
-pub const FRAGMENT_BYTES: u64 = 16;
 /// u32 sums per slot (`ACCUM_STRIDE` in dense_build.wgsl).
 const ACCUM_STRIDE: u64 = 10;
 /// Bytes of the largest per-slot buffer (the sums).
@@ -34,11 +40,9 @@ pub struct DenseVolume {
     pub grid: Grid,
     pub anisotropic: bool,
     pub volume: wgpu::Buffer,
-    pub fragment_capacity: u32,
     /// Occupied voxels the slot buffers hold.
     pub slot_capacity: u32,
-    pub fragments: wgpu::Buffer,
-    /// [0] fragments emitted, [1] occupied voxels (slots), [2] slots of the previous build.
+    /// [0] occupied voxels (slots, counted past the capacity), [1] slots of the previous build.
     pub counters: wgpu::Buffer,
     pub occupancy: wgpu::Buffer,
     pub slot_voxel: wgpu::Buffer,
@@ -57,9 +61,18 @@ pub struct DenseVolume {
     pub chains: wgpu::Texture,
     pub sampler: wgpu::Sampler,
     sampling: wgpu::BindGroup,
+    pipelines: Arc<DensePipelines>,
+}
+
+/// The dense volume's own pipelines (dense_build, filter, debug): made once per renderer and
+/// shared by every volume it makes, since a volume is remade whenever it grows or its
+/// resolution changes.
+pub struct DensePipelines {
     build_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
     build: BuildPipelines,
+    filter: FilterPass,
+    debug: DebugPass,
 }
 
 struct BuildPipelines {
@@ -140,39 +153,14 @@ pub fn mip_view(t: &wgpu::Texture, mip: u32) -> wgpu::TextureView {
     })
 }
 
-impl DenseVolume {
-    pub fn new(
-        device: &wgpu::Device,
-        grid: Grid,
-        anisotropic: bool,
-        fragment_capacity: u32,
-        slot_capacity: u32,
-    ) -> Self {
-        let res = grid.resolution;
-        let levels = grid.levels();
-        let slots = slot_capacity.max(1) as u64;
-        let volume = GpuVolume {
-            origin: grid.origin.to_array(),
-            resolution: res,
-            voxel_size: grid.voxel_size,
-            levels,
-            anisotropic: anisotropic as u32,
-            fragment_capacity,
-        };
-        let chains = texture_3d_blocks(
-            device,
-            "voxel radiance mips",
-            res / 2,
-            chain_blocks(anisotropic),
-            levels - 1,
-            RADIANCE_FORMAT,
-        );
+impl DensePipelines {
+    pub fn new(device: &wgpu::Device) -> Arc<Self> {
         let build_layout = build_layout(device);
         let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dense_build args"),
             entries: &[layout::storage(0, wgpu::ShaderStages::COMPUTE, false)],
         });
-        let module = shader::module(device, "dense_build.wgsl");
+        let module = shader::module(device, "voxels/dense/dense_build.wgsl");
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("dense_build"),
             bind_group_layouts: &[Some(&build_layout)],
@@ -207,6 +195,44 @@ impl DenseVolume {
             prepare_slots: pipe("prepare_slots"),
             resolve: pipe("resolve"),
         };
+        Arc::new(DensePipelines {
+            build_layout,
+            args_layout,
+            build,
+            filter: FilterPass::new(device),
+            debug: DebugPass::new(device),
+        })
+    }
+}
+
+impl DenseVolume {
+    /// A volume on `grid` with room for `slot_capacity` occupied voxels.
+    pub fn new(
+        device: &wgpu::Device,
+        pipelines: &Arc<DensePipelines>,
+        grid: Grid,
+        anisotropic: bool,
+        slot_capacity: u32,
+    ) -> Self {
+        let res = grid.resolution;
+        let levels = grid.levels();
+        let slots = slot_capacity.max(1) as u64;
+        let volume = GpuVolume {
+            origin: grid.origin.to_array(),
+            resolution: res,
+            voxel_size: grid.voxel_size,
+            levels,
+            anisotropic: anisotropic as u32,
+            _pad: 0,
+        };
+        let chains = texture_3d_blocks(
+            device,
+            "voxel radiance mips",
+            res / 2,
+            chain_blocks(anisotropic),
+            levels - 1,
+            RADIANCE_FORMAT,
+        );
         let no = wgpu::BufferUsages::empty();
         let volume = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("volume"),
@@ -238,14 +264,7 @@ impl DenseVolume {
             grid,
             anisotropic,
             volume,
-            fragment_capacity,
             slot_capacity: slots as u32,
-            fragments: storage_buffer(
-                device,
-                "voxel fragments",
-                fragment_capacity as u64 * FRAGMENT_BYTES,
-                no,
-            ),
             counters: storage_buffer(device, "voxel counters", 16, no),
             occupancy: storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no),
             slot_voxel: storage_buffer(device, "voxel slots", slots * 4, no),
@@ -265,9 +284,7 @@ impl DenseVolume {
             chains,
             sampler,
             sampling,
-            build_layout,
-            args_layout,
-            build,
+            pipelines: pipelines.clone(),
         }
     }
 
@@ -276,12 +293,10 @@ impl DenseVolume {
         chain_blocks(self.anisotropic)
     }
 
-    /// Bytes per GPU resource.
-    pub fn memory(&self) -> Vec<(&'static str, u64)> {
+    fn memory_report(&self) -> Vec<(&'static str, u64)> {
         let res = self.grid.resolution;
         let aniso_mips = self.grid.levels() - 1;
         vec![
-            ("voxel fragments", self.fragments.size()),
             ("voxel occupancy", self.occupancy.size()),
             (
                 "voxel slots",
@@ -339,55 +354,41 @@ impl DenseVolume {
         })
     }
 
-    /// The bind group for `sampling_layout`.
-    pub fn sampling(&self) -> &wgpu::BindGroup {
-        &self.sampling
-    }
-
-    /// Records the start of a build: forget the previous one and clear what it filled. Runs
-    /// before `voxelize`.
-    pub fn record_begin(
+    /// Records a build from `fragments`: forget the previous build and clear what it filled,
+    /// then allocate a slot per occupied voxel, sum its fragments and resolve the finest level.
+    fn build(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let bind = self.build_bind_group(device);
+        let bind = self.build_bind_group(device, fragments);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("dense_build"),
                 timestamp_writes: timer.compute("dense_build"),
             });
             pass.set_bind_group(0, &bind, &[]);
-            pass.set_pipeline(&self.build.begin);
+            pass.set_pipeline(&self.pipelines.build.begin);
             pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&self.build.clear_previous);
+            pass.set_pipeline(&self.pipelines.build.clear_previous);
             pass.dispatch_workgroups_indirect(&self.args, 0);
         }
         encoder.clear_buffer(&self.occupancy, 0, None);
         encoder.clear_buffer(&self.accum, 0, None);
-    }
-
-    /// Records the fragments -> finest level build. Runs after `voxelize`.
-    pub fn record_build(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-    ) {
-        let bind = self.build_bind_group(device);
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dense_build args"),
-            layout: &self.args_layout,
+            layout: &self.pipelines.args_layout,
             entries: &layout::entries(vec![self.args.as_entire_binding()]),
         });
         // Separate passes: the prepare kernels write the dispatch sizes the others read.
         let steps: [(&wgpu::ComputePipeline, Option<u64>); 5] = [
-            (&self.build.prepare_fragments, None),
-            (&self.build.allocate, Some(12)),
-            (&self.build.accumulate, Some(12)),
-            (&self.build.prepare_slots, None),
-            (&self.build.resolve, Some(0)),
+            (&self.pipelines.build.prepare_fragments, None),
+            (&self.pipelines.build.allocate, Some(12)),
+            (&self.pipelines.build.accumulate, Some(12)),
+            (&self.pipelines.build.prepare_slots, None),
+            (&self.pipelines.build.resolve, Some(0)),
         ];
         for (pipeline, indirect) in steps {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -406,7 +407,7 @@ impl DenseVolume {
         }
     }
 
-    fn build_bind_group(&self, device: &wgpu::Device) -> wgpu::BindGroup {
+    fn build_bind_group(&self, device: &wgpu::Device, fragments: &Fragments) -> wgpu::BindGroup {
         let v = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (a, n, e, r) = (
             v(&self.albedo),
@@ -416,10 +417,11 @@ impl DenseVolume {
         );
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dense_build"),
-            layout: &self.build_layout,
+            layout: &self.pipelines.build_layout,
             entries: &layout::entries(vec![
                 self.volume.as_entire_binding(),
-                self.fragments.as_entire_binding(),
+                fragments.buffer.as_entire_binding(),
+                fragments.count.as_entire_binding(),
                 self.counters.as_entire_binding(),
                 self.occupancy.as_entire_binding(),
                 self.slot_voxel.as_entire_binding(),
@@ -440,77 +442,90 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         entries: &[
             layout::uniform(0, c, false),
             layout::storage(1, c, true),
-            layout::storage(2, c, false),
+            layout::storage(2, c, true),
             layout::storage(3, c, false),
             layout::storage(4, c, false),
             layout::storage(5, c, false),
-            layout::storage_texture_3d(6, ALBEDO_FORMAT),
-            layout::storage_texture_3d(7, NORMAL_FORMAT),
-            layout::storage_texture_3d(8, EMISSION_FORMAT),
-            layout::storage_texture_3d(9, RADIANCE_FORMAT),
+            layout::storage(6, c, false),
+            layout::storage_texture_3d(7, ALBEDO_FORMAT),
+            layout::storage_texture_3d(8, NORMAL_FORMAT),
+            layout::storage_texture_3d(9, EMISSION_FORMAT),
+            layout::storage_texture_3d(10, RADIANCE_FORMAT),
         ],
     })
 }
 
-/// An upper bound on the fragments a scene makes on a grid: per triangle, the columns its
-/// dominant-axis projection can touch times the three voxels a column can hold. Kept as sums
-/// over the triangles in metres, so it can be evaluated for any grid without the scene.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct FragmentEstimate {
-    /// Sum of the triangles' dominant-axis projected areas, m².
-    area: f64,
-    /// Sum of their perimeters, m.
-    perimeter: f64,
-    triangles: u64,
-}
-
-impl FragmentEstimate {
-    pub fn of(scene: &voxgi_scene::Scene) -> Self {
-        let mut e = FragmentEstimate::default();
-        // Area-light emitters count too: voxelize keeps them as occluders.
-        for inst in &scene.instances {
-            let m = &scene.meshes[inst.mesh];
-            for t in m.indices.chunks_exact(3) {
-                let [a, b, c] = [t[0], t[1], t[2]]
-                    .map(|i| inst.transform.transform_point3(m.positions[i as usize]));
-                let n = (b - a).cross(c - a);
-                e.area += 0.5 * n.abs().max_element() as f64;
-                e.perimeter += ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
-                e.triangles += 1;
-            }
-        }
-        e
+impl VoxelStructure for DenseVolume {
+    fn kind(&self) -> &'static str {
+        "dense"
     }
 
-    /// The bound on `grid`.
-    pub fn at(&self, grid: &Grid) -> u64 {
-        let inv = 1.0 / grid.voxel_size as f64;
-        (3.0 * (self.area * inv * inv + self.perimeter * inv + 2.0 * self.triangles as f64)).ceil()
-            as u64
+    fn grid(&self) -> Grid {
+        self.grid
     }
-}
 
-/// Keeps the triangle table voxelize reads: per triangle, its draw, first index, base vertex.
-pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> (wgpu::Buffer, u32) {
-    let mut t: Vec<[u32; 4]> = Vec::new();
-    for call in &scene.calls {
-        // The visible surface of an area light is lit analytically; voxelizing it too would
-        // count its light twice.
-        if call.light.is_some() {
-            continue;
-        }
-        for first in call.indices.clone().step_by(3) {
-            t.push([call.draw, first, call.base_vertex as u32, 0]);
-        }
+    fn record_build(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        self.build(device, encoder, fragments, timer);
     }
-    let n = t.len() as u32;
-    if t.is_empty() {
-        t.push([0; 4]);
+
+    fn record_filter(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut GpuTimer,
+    ) {
+        self.pipelines.filter.record(device, encoder, self, timer);
     }
-    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("voxelize triangles"),
-        contents: bytemuck::cast_slice(&t),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    (buffer, n)
+
+    fn leaf_counter(&self) -> &wgpu::Buffer {
+        &self.counters
+    }
+
+    fn leaf_capacity(&self) -> u64 {
+        self.slot_capacity as u64
+    }
+
+    fn grow(&mut self, device: &wgpu::Device, leaves: u64) {
+        *self = DenseVolume::new(
+            device,
+            &self.pipelines,
+            self.grid,
+            self.anisotropic,
+            leaves.min(u32::MAX as u64) as u32,
+        );
+    }
+
+    fn memory(&self) -> Vec<(&'static str, u64)> {
+        self.memory_report()
+    }
+
+    fn sampling(&self) -> &wgpu::BindGroup {
+        &self.sampling
+    }
+
+    fn record_debug(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        view: DebugView,
+        timer: &mut GpuTimer,
+    ) {
+        self.pipelines.debug.record(
+            device,
+            encoder,
+            targets,
+            self,
+            view.mode,
+            view.level,
+            view.direction,
+            timer,
+        );
+    }
 }

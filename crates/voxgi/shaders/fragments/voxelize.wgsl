@@ -7,10 +7,9 @@
 // spans at most three voxels.
 
 //!include shared/scene.wgsl
-//!include shared/volume.wgsl
 //!include shared/fragment.wgsl
 
-@group(0) @binding(0) var<uniform> vol: Volume;
+@group(0) @binding(0) var<uniform> grid: FragmentGrid;
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(2) var<storage, read> indices: array<u32>;
 @group(0) @binding(3) var<storage, read> draws: array<Draw>;
@@ -21,9 +20,7 @@
 @group(0) @binding(7) var<storage, read> triangles: array<vec4<u32>>;
 @group(0) @binding(8) var<storage, read_write> fragments: array<Fragment>;
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
-@group(0) @binding(9) var<storage, read_write> counters: array<atomic<u32>>;
-// Per voxel: 0 empty, 1 has fragments (the dense build assigns slots later).
-@group(0) @binding(10) var<storage, read_write> occupancy: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read_write> fragment_count: array<atomic<u32>>;
 
 // Does the triangle (relative to the box centre) overlap the box of half-size h along axis a?
 fn separated(a: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, h: f32) -> bool {
@@ -82,10 +79,10 @@ fn main(
     let wb = (draw.model * vec4<f32>(vb.position, 1.0)).xyz;
     let wc = (draw.model * vec4<f32>(vc.position, 1.0)).xyz;
     // Voxel space: the finest voxel is the unit cube.
-    let inv = 1.0 / vol.voxel_size;
-    let a = (wa - vol.origin) * inv;
-    let b = (wb - vol.origin) * inv;
-    let c = (wc - vol.origin) * inv;
+    let inv = 1.0 / grid.voxel_size;
+    let a = (wa - grid.origin) * inv;
+    let b = (wb - grid.origin) * inv;
+    let c = (wc - grid.origin) * inv;
     let cr = cross(b - a, c - a);
     let area2 = length(cr);
     if area2 < 1e-12 {
@@ -115,7 +112,7 @@ fn main(
     }
     let u = (w + 1u) % 3u;
     let v = (w + 2u) % 3u;
-    let res = i32(vol.resolution);
+    let res = i32(grid.resolution);
     let lo = max(vec3<i32>(floor(min(a, min(b, c)))), vec3<i32>(0));
     let hi = min(vec3<i32>(floor(max(a, max(b, c)))), vec3<i32>(res - 1));
     if any(hi < lo) {
@@ -181,8 +178,8 @@ fn main(
                 emission = vec3<f32>(0.0);
             }
             let coord = vec3<u32>(cell);
-            let slot = atomicAdd(&counters[0], 1u);
-            if slot < vol.fragment_capacity {
+            let slot = atomicAdd(&fragment_count[0], 1u);
+            if slot < arrayLength(&fragments) {
                 fragments[slot] = Fragment(
                     pack_coord(coord),
                     // Voxels bounce light diffusely: metals' diffuse albedo is zero.
@@ -190,7 +187,6 @@ fn main(
                     pack2x16snorm(oct_encode(n)),
                     pack_rgb9e5(emission),
                 );
-                atomicStore(&occupancy[voxel_index(coord, vol.resolution)], 1u);
             }
         }
     }

@@ -1,9 +1,9 @@
 //! filter: the volume's mip levels above the finest, isotropic or six-directional.
 
+use super::{DenseVolume, RADIANCE_FORMAT, mip_view};
 use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT, mip_view};
 use wgpu::util::DeviceExt;
 
 const STRIDE: u64 = 256;
@@ -33,7 +33,7 @@ impl FilterPass {
             ],
         });
         FilterPass {
-            pipeline: compute_pipeline(device, "filter", "filter.wgsl", &layout),
+            pipeline: compute_pipeline(device, "filter", "voxels/dense/filter.wgsl", &layout),
             layout,
         }
     }

@@ -1,9 +1,10 @@
-//! voxelize: every mesh triangle into voxel fragments (conservative, exact overlap).
+//! voxelize: every mesh triangle into voxel fragments (conservative, exact overlap). It writes
+//! the fragments and their count, nothing else.
 
+use crate::fragments::Fragments;
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::voxel::dense::DenseVolume;
 
 pub struct VoxelizePass {
     pipeline: wgpu::ComputePipeline,
@@ -31,11 +32,14 @@ impl VoxelizePass {
                 layout::storage(7, c, true),
                 layout::storage(8, c, false),
                 layout::storage(9, c, false),
-                layout::storage(10, c, false),
             ],
         });
-        let pipeline =
-            crate::gpu::shader::compute_pipeline(device, "voxelize", "voxelize.wgsl", &layout);
+        let pipeline = crate::gpu::shader::compute_pipeline(
+            device,
+            "voxelize",
+            "fragments/voxelize.wgsl",
+            &layout,
+        );
         VoxelizePass { pipeline, layout }
     }
 
@@ -45,14 +49,14 @@ impl VoxelizePass {
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         triangles: (&wgpu::Buffer, u32),
-        vol: &DenseVolume,
+        fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxelize"),
             layout: &self.layout,
             entries: &layout::entries(vec![
-                vol.volume.as_entire_binding(),
+                fragments.grid_uniform.as_entire_binding(),
                 scene.vertices.as_entire_binding(),
                 scene.indices.as_entire_binding(),
                 scene.draws.as_entire_binding(),
@@ -60,9 +64,8 @@ impl VoxelizePass {
                 wgpu::BindingResource::TextureView(&scene.texture_view),
                 wgpu::BindingResource::Sampler(&scene.sampler),
                 triangles.0.as_entire_binding(),
-                vol.fragments.as_entire_binding(),
-                vol.counters.as_entire_binding(),
-                vol.occupancy.as_entire_binding(),
+                fragments.buffer.as_entire_binding(),
+                fragments.count.as_entire_binding(),
             ]),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -1,0 +1,164 @@
+//! Voxel fragments, the one interface between geometry and voxel structures (DESIGN.md, seam
+//! 1): a pass that turns geometry into fragments (`voxelize` for meshes) writes them here and
+//! nothing else, and a structure is built from them and nothing else. The buffer's length is
+//! its capacity; the count runs past it when a build overflowed, and the renderer grows the
+//! buffer a frame later.
+
+pub mod voxelize;
+
+use crate::gpu_scene::GpuScene;
+use crate::voxel::Grid;
+use crate::{Error, Result};
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// Bytes per fragment (`Fragment` in shaders/shared/fragment.wgsl).
+pub const FRAGMENT_BYTES: u64 = 16;
+
+/// Mirrors `FragmentGrid` in shaders/shared/fragment.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuFragmentGrid {
+    pub origin: [f32; 3],
+    pub resolution: u32,
+    pub voxel_size: f32,
+    pub _pad: [u32; 3],
+}
+
+/// The fragment buffer of one grid, and its count.
+pub struct Fragments {
+    pub grid: Grid,
+    /// Where the fragments lie (`FragmentGrid`).
+    pub grid_uniform: wgpu::Buffer,
+    /// The fragments; its length is the capacity.
+    pub buffer: wgpu::Buffer,
+    /// [0]: fragments made by the last build, counted past the capacity.
+    pub count: wgpu::Buffer,
+    pub capacity: u32,
+}
+
+impl Fragments {
+    /// Room for `capacity` fragments on `grid` (check it first with `capacity`).
+    pub fn new(device: &wgpu::Device, grid: Grid, capacity: u32) -> Self {
+        let uniform = GpuFragmentGrid {
+            origin: grid.origin.to_array(),
+            resolution: grid.resolution,
+            voxel_size: grid.voxel_size,
+            _pad: [0; 3],
+        };
+        let storage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC;
+        Fragments {
+            grid,
+            grid_uniform: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("fragment grid"),
+                contents: bytemuck::bytes_of(&uniform),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("voxel fragments"),
+                size: capacity.max(1) as u64 * FRAGMENT_BYTES,
+                usage: storage,
+                mapped_at_creation: false,
+            }),
+            count: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("fragment count"),
+                size: 16,
+                usage: storage,
+                mapped_at_creation: false,
+            }),
+            capacity,
+        }
+    }
+
+    /// Records the start of a build: no fragments yet.
+    pub fn record_clear(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.count, 0, None);
+    }
+
+    pub fn memory(&self) -> Vec<(&'static str, u64)> {
+        vec![("voxel fragments", self.buffer.size())]
+    }
+}
+
+/// The most fragments one storage binding can hold on this device.
+pub fn max_fragments(device: &wgpu::Device) -> u64 {
+    device.limits().max_storage_buffer_binding_size / FRAGMENT_BYTES
+}
+
+/// Checks a fragment capacity against the device's storage-buffer limit (at least 1024).
+pub fn capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
+    let limit = max_fragments(device);
+    let cap = wanted.max(1024);
+    if cap > limit.min(u32::MAX as u64) {
+        return Err(Error::Setting(format!(
+            "the scene needs about {cap} voxel fragments at this resolution, more than this \
+             GPU's storage-buffer limit allows ({limit}); lower the voxel resolution"
+        )));
+    }
+    Ok(cap as u32)
+}
+
+/// An upper bound on the fragments a scene makes on a grid: per triangle, the columns its
+/// dominant-axis projection can touch times the three voxels a column can hold. Kept as sums
+/// over the triangles in metres, so it can be evaluated for any grid without the scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FragmentEstimate {
+    /// Sum of the triangles' dominant-axis projected areas, m².
+    area: f64,
+    /// Sum of their perimeters, m.
+    perimeter: f64,
+    triangles: u64,
+}
+
+impl FragmentEstimate {
+    pub fn of(scene: &voxgi_scene::Scene) -> Self {
+        let mut e = FragmentEstimate::default();
+        // Area-light emitters count too: voxelize keeps them as occluders.
+        for inst in &scene.instances {
+            let m = &scene.meshes[inst.mesh];
+            for t in m.indices.chunks_exact(3) {
+                let [a, b, c] = [t[0], t[1], t[2]]
+                    .map(|i| inst.transform.transform_point3(m.positions[i as usize]));
+                let n = (b - a).cross(c - a);
+                e.area += 0.5 * n.abs().max_element() as f64;
+                e.perimeter += ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
+                e.triangles += 1;
+            }
+        }
+        e
+    }
+
+    /// The bound on `grid`.
+    pub fn at(&self, grid: &Grid) -> u64 {
+        let inv = 1.0 / grid.voxel_size as f64;
+        (3.0 * (self.area * inv * inv + self.perimeter * inv + 2.0 * self.triangles as f64)).ceil()
+            as u64
+    }
+}
+
+/// Keeps the triangle table voxelize reads: per triangle, its draw, first index, base vertex.
+pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> (wgpu::Buffer, u32) {
+    let mut t: Vec<[u32; 4]> = Vec::new();
+    for call in &scene.calls {
+        // The visible surface of an area light is lit analytically; voxelizing it too would
+        // count its light twice.
+        if call.light.is_some() {
+            continue;
+        }
+        for first in call.indices.clone().step_by(3) {
+            t.push([call.draw, first, call.base_vertex as u32, 0]);
+        }
+    }
+    let n = t.len() as u32;
+    if t.is_empty() {
+        t.push([0; 4]);
+    }
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("voxelize triangles"),
+        contents: bytemuck::cast_slice(&t),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    (buffer, n)
+}
