@@ -5,27 +5,21 @@
 //!include shared/scene.wgsl
 //!include shared/volume.wgsl
 //!include shared/cone.wgsl
+//!include voxels/leaves.wgsl
 
 @group(0) @binding(0) var<uniform> cones: Cones;
-// Group 1: the voxel structure. The leaves below are the dense volume's occupied voxels (its
-// slots), placed by its `vol`: the one part of this pass that is not yet structure-neutral.
-@group(2) @binding(0) var albedo_tex: texture_3d<f32>;
-@group(2) @binding(1) var normal_tex: texture_3d<f32>;
-@group(2) @binding(2) var<storage, read> slot_voxel: array<u32>;
-@group(2) @binding(3) var<storage, read> counters: array<u32>;
-@group(2) @binding(4) var<storage, read> slot_direct: array<vec4<f32>>;
-@group(2) @binding(5) var<storage, read_write> slot_next: array<vec4<f32>>;
+// Group 1: the voxel structure's sampling, group 2: its leaves.
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = gid.x + gid.y * nwg.x * 64u;
-    if s >= min(counters[0], arrayLength(&slot_voxel)) {
+    if s >= leaf_count() {
         return;
     }
-    let c = voxel_coord(slot_voxel[s], vol.resolution);
-    let albedo = textureLoad(albedo_tex, c, 0);
-    let nw = textureLoad(normal_tex, c, 0);
-    let center = voxel_center(c, vol);
+    let c = leaf_coord(s);
+    let albedo = leaf_albedo(s);
+    let nw = leaf_normal(s);
+    let center = leaf_center(s);
     var e = vec3<f32>(0.0);
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
@@ -40,6 +34,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let n = vec3<f32>(0.0, 1.0, 0.0);
         e = 0.5 * (gather_diffuse(center, n, 0.0, false, ALL_CONES).irradiance + gather_diffuse(center, -n, 0.0, false, ALL_CONES).irradiance);
     }
-    let direct = slot_direct[s];
-    slot_next[s] = vec4<f32>(direct.rgb + albedo.rgb / PI * e * direct.a, direct.a);
+    let direct = leaf_direct[s];
+    leaf_next[s] = vec4<f32>(direct.rgb + albedo.rgb / PI * e * direct.a, direct.a);
 }

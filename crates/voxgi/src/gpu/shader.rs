@@ -19,6 +19,8 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/volume.wgsl",
     "shared/fragment.wgsl",
     "voxels/dense/sample.wgsl",
+    "voxels/dense/leaves.wgsl",
+    "voxels/dense/leaf_store.wgsl",
     "shared/cone.wgsl",
     "shared/surfel.wgsl",
     "shared/interleave.wgsl",
@@ -132,23 +134,24 @@ pub fn specialized_pipeline(
     layout: &wgpu::BindGroupLayout,
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    grouped_pipeline(device, label, file, &[layout], constants)
+    grouped_pipeline(device, label, file, &[Some(layout)], constants)
 }
 
-/// `specialized_pipeline` with one layout per bind group: 0 the frame's globals, 1 the voxel
-/// structure, 2 the pass's own (rerun's re_renderer keeps bind groups by owner the same way).
+/// `specialized_pipeline` with one layout per bind group, by owner as rerun's re_renderer
+/// keeps them: 0 the frame's globals, 1 the voxel structure's sampling, 2 the structure's
+/// leaves or the pass's own resources, 3 the leaves' radiance for writing. `None`: a group
+/// the shader does not use.
 pub fn grouped_pipeline(
     device: &wgpu::Device,
     label: &str,
     file: &str,
-    layouts: &[&wgpu::BindGroupLayout],
+    layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
     let module = module(device, file);
-    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().copied().map(Some).collect();
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
-        bind_group_layouts: &layouts,
+        bind_group_layouts: layouts,
         immediate_size: 0,
     });
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -166,8 +169,10 @@ pub fn grouped_pipeline(
 
 /// The names of all pass shaders (for tests that validate every one).
 pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
-    SOURCES
-        .iter()
-        .map(|(n, _)| *n)
-        .filter(|n| !n.starts_with("shared/") && !n.ends_with("/sample.wgsl"))
+    SOURCES.iter().map(|(n, _)| *n).filter(|n| {
+        !n.starts_with("shared/")
+            && !["sample.wgsl", "leaves.wgsl", "leaf_store.wgsl"]
+                .iter()
+                .any(|f| n.ends_with(&format!("/{f}")))
+    })
 }

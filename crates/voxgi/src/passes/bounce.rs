@@ -3,17 +3,15 @@
 //! and written in one).
 
 use crate::gpu::layout;
-use crate::gpu::shader::{compute_pipeline, grouped_pipeline};
+use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::voxel::VoxelStructure;
-use crate::voxel::dense::{DenseVolume, RADIANCE_FORMAT};
+use crate::voxel::dense::DenseVolume;
 
 pub struct BouncePass {
     gather: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
-    gather_layout: wgpu::BindGroupLayout,
     store: wgpu::ComputePipeline,
-    store_layout: wgpu::BindGroupLayout,
 }
 
 impl BouncePass {
@@ -23,40 +21,25 @@ impl BouncePass {
             label: Some("bounce globals"),
             entries: &[layout::uniform(0, c, false)],
         });
-        let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("bounce"),
-            entries: &[
-                layout::texture_3d_load(0, c),
-                layout::texture_3d_load(1, c),
-                layout::storage(2, c, true),
-                layout::storage(3, c, true),
-                layout::storage(4, c, true),
-                layout::storage(5, c, false),
-            ],
-        });
-        let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("bounce_store"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::storage(1, c, true),
-                layout::storage(2, c, true),
-                layout::storage(3, c, true),
-                layout::storage_texture_3d(4, RADIANCE_FORMAT),
-            ],
-        });
         let voxels = DenseVolume::sampling_layout(device);
+        let leaves = DenseVolume::leaves_layout(device);
+        let store = DenseVolume::leaf_store_layout(device);
         BouncePass {
             gather: grouped_pipeline(
                 device,
                 "bounce",
                 "bounce.wgsl",
-                &[&globals, &voxels, &gather_layout],
+                &[Some(&globals), Some(&voxels), Some(&leaves)],
                 &DenseVolume::sampling_constants(anisotropic, 3),
             ),
-            store: compute_pipeline(device, "bounce", "bounce_store.wgsl", &store_layout),
+            store: grouped_pipeline(
+                device,
+                "bounce",
+                "bounce_store.wgsl",
+                &[None, None, Some(&leaves), Some(&store)],
+                &[],
+            ),
             globals,
-            gather_layout,
-            store_layout,
         }
     }
 
@@ -64,52 +47,27 @@ impl BouncePass {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        vol: &DenseVolume,
+        voxels: &dyn VoxelStructure,
         cones: &wgpu::Buffer,
         timer: &mut GpuTimer,
     ) {
-        let v = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (albedo, normal) = (v(&vol.albedo), v(&vol.normal));
         let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bounce globals"),
             layout: &self.globals,
             entries: &layout::entries(vec![cones.as_entire_binding()]),
         });
-        let gather_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("bounce"),
-            layout: &self.gather_layout,
-            entries: &layout::entries(vec![
-                wgpu::BindingResource::TextureView(&albedo),
-                wgpu::BindingResource::TextureView(&normal),
-                vol.slot_voxel.as_entire_binding(),
-                vol.counters.as_entire_binding(),
-                vol.slot_direct.as_entire_binding(),
-                vol.slot_next.as_entire_binding(),
-            ]),
-        });
-        let radiance = v(&vol.radiance);
-        let store_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("bounce_store"),
-            layout: &self.store_layout,
-            entries: &layout::entries(vec![
-                vol.volume.as_entire_binding(),
-                vol.slot_voxel.as_entire_binding(),
-                vol.counters.as_entire_binding(),
-                vol.slot_next.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&radiance),
-            ]),
-        });
+        let (args, offset) = voxels.leaf_dispatch();
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("bounce"),
             timestamp_writes: timer.compute("bounce"),
         });
         pass.set_pipeline(&self.gather);
         pass.set_bind_group(0, &globals, &[]);
-        pass.set_bind_group(1, vol.sampling(), &[]);
-        pass.set_bind_group(2, &gather_bind, &[]);
-        pass.dispatch_workgroups_indirect(&vol.args, 0);
+        pass.set_bind_group(1, voxels.sampling(), &[]);
+        pass.set_bind_group(2, voxels.leaves(), &[]);
+        pass.dispatch_workgroups_indirect(args, offset);
         pass.set_pipeline(&self.store);
-        pass.set_bind_group(0, &store_bind, &[]);
-        pass.dispatch_workgroups_indirect(&vol.args, 0);
+        pass.set_bind_group(3, voxels.leaf_store(), &[]);
+        pass.dispatch_workgroups_indirect(args, offset);
     }
 }

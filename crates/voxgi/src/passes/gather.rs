@@ -74,7 +74,7 @@ impl GatherPass {
                 device,
                 "gather",
                 "gather.wgsl",
-                &[&globals, &voxels, &layout],
+                &[Some(&globals), Some(&voxels), Some(&layout)],
                 &constants,
             ),
             globals,

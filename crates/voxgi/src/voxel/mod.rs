@@ -59,6 +59,14 @@ pub trait VoxelStructure {
     fn memory(&self) -> Vec<(&'static str, u64)>;
     /// The bind group of the WGSL contract's resources, `@group(1)`.
     fn sampling(&self) -> &wgpu::BindGroup;
+    /// The leaves' bind group (`voxels/<kind>/leaves.wgsl`), `@group(2)` of the lighting
+    /// passes: what each leaf is, and its direct and bounced light.
+    fn leaves(&self) -> &wgpu::BindGroup;
+    /// The leaves' radiance for writing (`voxels/<kind>/leaf_store.wgsl`), `@group(3)`.
+    fn leaf_store(&self) -> &wgpu::BindGroup;
+    /// An indirect dispatch of one 64-wide workgroup per 64 leaves (2D past 65535 groups:
+    /// threads index leaves as `gid.x + gid.y * num_workgroups.x * 64`).
+    fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64);
     /// Records a debug view into the HDR target, replacing the lit image.
     fn record_debug(
         &self,

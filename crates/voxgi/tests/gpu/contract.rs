@@ -103,6 +103,68 @@ fn every_structure_defines_the_voxel_contract() {
     }
 }
 
+/// The leaves' contract of the lighting passes: names, signatures, and the groups (2 for the
+/// leaves, 3 for their radiance store).
+const LEAVES: &[(&str, &[&str], &str)] = &[
+    ("leaf_count", &[], "u32"),
+    ("leaf_coord", &["u32"], "vec3<u32>"),
+    ("leaf_center", &["u32"], "vec3<f32>"),
+    ("leaf_size", &[], "f32"),
+    ("leaf_albedo", &["u32"], "vec4<f32>"),
+    ("leaf_normal", &["u32"], "vec4<f32>"),
+    ("leaf_emission", &["u32"], "vec3<f32>"),
+];
+
+#[test]
+fn every_structure_defines_the_leaf_contract() {
+    for kind in shader::STRUCTURES {
+        let src = shader::compose_for(&format!("voxels/{kind}/leaf_store.wgsl"), kind);
+        let m = parse(&src);
+        validate(&m);
+        let mut contract: Vec<(&str, &[&str], &str)> = LEAVES.to_vec();
+        contract.push(("store_leaf_radiance", &["u32", "vec4<f32>"], ""));
+        for (name, args, result) in contract {
+            let f = m
+                .functions
+                .iter()
+                .map(|(_, f)| f)
+                .find(|f| f.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("{kind}: no fn {name}"));
+            let got: Vec<String> = f.arguments.iter().map(|a| type_name(&m, a.ty)).collect();
+            assert_eq!(got, *args, "{kind}: {name}'s arguments");
+            let ret = f.result.as_ref().map(|r| type_name(&m, r.ty));
+            assert_eq!(ret.unwrap_or_default(), result, "{kind}: {name}'s result");
+        }
+        for var in ["leaf_direct", "leaf_next"] {
+            let g = m
+                .global_variables
+                .iter()
+                .find(|(_, g)| g.name.as_deref() == Some(var))
+                .unwrap_or_else(|| panic!("{kind}: no {var}"))
+                .1;
+            assert!(
+                matches!(
+                    g.space,
+                    naga::AddressSpace::Storage {
+                        access
+                    } if access.contains(naga::StorageAccess::STORE)
+                ),
+                "{kind}: {var} must be writable storage"
+            );
+        }
+        for (_, g) in m.global_variables.iter() {
+            if let Some(b) = &g.binding {
+                assert!(
+                    b.group == 2 || b.group == 3,
+                    "{kind}: {:?} is in group {}",
+                    g.name,
+                    b.group
+                );
+            }
+        }
+    }
+}
+
 /// Cone tracing compiles against a stand-in structure that defines the contract and nothing
 /// else: it reaches into no structure's own names.
 #[test]

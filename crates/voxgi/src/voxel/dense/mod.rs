@@ -61,6 +61,8 @@ pub struct DenseVolume {
     pub chains: wgpu::Texture,
     pub sampler: wgpu::Sampler,
     sampling: wgpu::BindGroup,
+    leaves: wgpu::BindGroup,
+    leaf_store: wgpu::BindGroup,
     pipelines: Arc<DensePipelines>,
 }
 
@@ -260,30 +262,59 @@ impl DenseVolume {
                 wgpu::BindingResource::Sampler(&sampler),
             ]),
         });
+        let albedo = texture_3d(device, "voxel albedo", res, 1, ALBEDO_FORMAT);
+        let normal = texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT);
+        let emission = texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT);
+        let slot_voxel = storage_buffer(device, "voxel slots", slots * 4, no);
+        let counters = storage_buffer(device, "voxel counters", 16, no);
+        let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
+        let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let leaves = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel leaves"),
+            layout: &Self::leaves_layout(device),
+            entries: &layout::entries(vec![
+                volume.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view(&albedo)),
+                wgpu::BindingResource::TextureView(&view(&normal)),
+                wgpu::BindingResource::TextureView(&view(&emission)),
+                slot_voxel.as_entire_binding(),
+                counters.as_entire_binding(),
+                slot_direct.as_entire_binding(),
+                slot_next.as_entire_binding(),
+            ]),
+        });
+        let leaf_store = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel leaf store"),
+            layout: &Self::leaf_store_layout(device),
+            entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&view(&radiance))]),
+        });
         DenseVolume {
             grid,
             anisotropic,
             volume,
             slot_capacity: slots as u32,
-            counters: storage_buffer(device, "voxel counters", 16, no),
+            counters,
             occupancy: storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no),
-            slot_voxel: storage_buffer(device, "voxel slots", slots * 4, no),
+            slot_voxel,
             accum: storage_buffer(device, "voxel sums", slots * ACCUM_STRIDE * 4, no),
-            slot_direct: storage_buffer(device, "voxel direct light", slots * 16, no),
-            slot_next: storage_buffer(device, "voxel bounce light", slots * 16, no),
+            slot_direct,
+            slot_next,
             args: storage_buffer(
                 device,
                 "voxel dispatch sizes",
                 6 * 4,
                 wgpu::BufferUsages::INDIRECT,
             ),
-            albedo: texture_3d(device, "voxel albedo", res, 1, ALBEDO_FORMAT),
-            normal: texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT),
-            emission: texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT),
+            albedo,
+            normal,
+            emission,
             radiance,
             chains,
             sampler,
             sampling,
+            leaves,
+            leaf_store,
             pipelines: pipelines.clone(),
         }
     }
@@ -351,6 +382,33 @@ impl DenseVolume {
                 texture(2),
                 layout::sampler(3, c),
             ],
+        })
+    }
+
+    /// The layout of @group(2) of the lighting passes, twin of voxels/dense/leaves.wgsl.
+    pub fn leaves_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let c = wgpu::ShaderStages::COMPUTE;
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel leaves"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::texture_3d_load(1, c),
+                layout::texture_3d_load(2, c),
+                layout::texture_3d_load(3, c),
+                layout::storage(4, c, true),
+                layout::storage(5, c, true),
+                layout::storage(6, c, false),
+                layout::storage(7, c, false),
+            ],
+        })
+    }
+
+    /// The layout of @group(3) of the passes that store leaf radiance, twin of
+    /// voxels/dense/leaf_store.wgsl.
+    pub fn leaf_store_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel leaf store"),
+            entries: &[layout::storage_texture_3d(0, RADIANCE_FORMAT)],
         })
     }
 
@@ -507,6 +565,19 @@ impl VoxelStructure for DenseVolume {
 
     fn sampling(&self) -> &wgpu::BindGroup {
         &self.sampling
+    }
+
+    fn leaves(&self) -> &wgpu::BindGroup {
+        &self.leaves
+    }
+
+    fn leaf_store(&self) -> &wgpu::BindGroup {
+        &self.leaf_store
+    }
+
+    fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64) {
+        // The build's prepare_slots writes one thread per slot at offset 0.
+        (&self.args, 0)
     }
 
     fn record_debug(

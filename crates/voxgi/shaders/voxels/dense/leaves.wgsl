@@ -1,0 +1,57 @@
+// The dense volume's leaves: the occupied finest voxels, one slot each. The lighting passes
+// (inject, bounce, bounce_store) reach a structure's leaves through these names only:
+//
+//   fn leaf_count() -> u32                        leaves of the last build
+//   fn leaf_coord(i) -> vec3<u32>                 the leaf's finest-grid voxel
+//   fn leaf_center(i) -> vec3<f32>                its centre, metres
+//   fn leaf_size() -> f32                         its edge, metres
+//   fn leaf_albedo(i) / leaf_normal(i) / leaf_emission(i)   what the build resolved
+//   leaf_direct[i], leaf_next[i]                  per-leaf light: direct (inject) and bounced
+//
+// and voxels/<kind>/leaf_store.wgsl's store_leaf_radiance(i, premultiplied). All at
+// @group(2) (the store at @group(3)); `DenseVolume::leaves_layout` is the twin.
+
+//!include shared/volume.wgsl
+
+@group(2) @binding(0) var<uniform> leaf_grid: Volume;
+@group(2) @binding(1) var leaf_albedo_tex: texture_3d<f32>;
+@group(2) @binding(2) var leaf_normal_tex: texture_3d<f32>;
+@group(2) @binding(3) var leaf_emission_tex: texture_3d<f32>;
+// Per slot: the voxel's linear index.
+@group(2) @binding(4) var<storage, read> slot_voxel: array<u32>;
+// [0]: slots of the last build (counted past the capacity).
+@group(2) @binding(5) var<storage, read> counters: array<u32>;
+// Per leaf: direct radiance (rgb) and opacity, kept for the bounces.
+@group(2) @binding(6) var<storage, read_write> leaf_direct: array<vec4<f32>>;
+// Per leaf: the last bounce's outgoing radiance and opacity.
+@group(2) @binding(7) var<storage, read_write> leaf_next: array<vec4<f32>>;
+
+fn leaf_count() -> u32 {
+    return min(counters[0], arrayLength(&slot_voxel));
+}
+
+fn leaf_coord(i: u32) -> vec3<u32> {
+    return voxel_coord(slot_voxel[i], leaf_grid.resolution);
+}
+
+fn leaf_center(i: u32) -> vec3<f32> {
+    return voxel_center(leaf_coord(i), leaf_grid);
+}
+
+fn leaf_size() -> f32 {
+    return leaf_grid.voxel_size;
+}
+
+// Albedo (rgb) and opacity.
+fn leaf_albedo(i: u32) -> vec4<f32> {
+    return textureLoad(leaf_albedo_tex, leaf_coord(i), 0);
+}
+
+// Mean normal (xyz) and how well the fragments' normals agree (w).
+fn leaf_normal(i: u32) -> vec4<f32> {
+    return textureLoad(leaf_normal_tex, leaf_coord(i), 0);
+}
+
+fn leaf_emission(i: u32) -> vec3<f32> {
+    return textureLoad(leaf_emission_tex, leaf_coord(i), 0).rgb;
+}
