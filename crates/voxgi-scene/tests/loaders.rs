@@ -294,6 +294,7 @@ dynamic = true
 [include.material]
 base_color = [0.1, 0.2, 0.3]
 roughness = 0.25
+specular = 0.0
 
 [[include]]
 file = "sub/box.toml"
@@ -366,6 +367,8 @@ debug = { cones = 6 }
     let mat = &s.materials[m.material];
     assert_eq!(mat.base_color, [0.1, 0.2, 0.3, 1.0]);
     assert_eq!(mat.roughness, 0.25);
+    // A pure Lambertian can be asked for (the default is glTF's 1).
+    assert_eq!(mat.specular, 0.0);
 
     // The nested built-in box keeps its lights; then come the file's five lights in order.
     let cb = builtin::cornell_box();
@@ -522,6 +525,8 @@ fn bad_inputs_fail_with_the_file_name() {
         ("toml negative intensity", "negint.toml", light("type = \"point\"\nintensity = -1.0\nposition = [0.0, 1.0, 0.0]").into_bytes(), "intensity -1"),
         ("toml area without size", "nosize.toml", light("type = \"area\"\nintensity = 1.0\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nshape = \"rect\"").into_bytes(), "size"),
         ("toml unknown builtin", "nobuiltin.toml", b"[[include]]\nbuiltin = \"moon-base\"\n".to_vec(), "moon-base"),
+        ("toml overflowing number", "overflow.toml", light("type = \"point\"\nintensity = 1e400\nposition = [0.0, 1.0, 0.0]").into_bytes(), "line 3"),
+        ("toml specular out of range", "spec.toml", b"[[include]]\nbuiltin = \"cornell-box\"\n[include.material]\nspecular = 2.0\n".to_vec(), "specular"),
         ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type"),
         ("gltf invalid json", "bad.gltf", b"{ not json".to_vec(), ""),
         ("glb empty", "empty.glb", vec![], ""),

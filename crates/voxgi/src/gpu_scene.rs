@@ -118,29 +118,7 @@ pub fn half_bits(v: f32) -> u16 {
     if v.is_nan() || v <= 0.0 {
         return 0;
     }
-    let v = v.min(65504.0);
-    let bits = v.to_bits();
-    let exp = ((bits >> 23) & 0xff) as i32 - 127 + 15;
-    let mant = bits & 0x7f_ffff;
-    if exp <= 0 {
-        // Subnormal half (or zero).
-        if exp < -10 {
-            return 0;
-        }
-        let m = mant | 0x80_0000;
-        let shift = (14 - exp) as u32;
-        let half = m >> shift;
-        let rem = m & ((1 << shift) - 1);
-        let mid = 1 << (shift - 1);
-        let round = rem > mid || (rem == mid && half & 1 == 1);
-        return (half + round as u32) as u16;
-    }
-    let half = ((exp as u32) << 10) | (mant >> 13);
-    let rem = mant & 0x1fff;
-    let round = rem > 0x1000 || (rem == 0x1000 && half & 1 == 1);
-    // A carry into the exponent is the correct rounding; 65504 is the largest input, so it
-    // never reaches infinity.
-    (half + round as u32) as u16
+    half::f16::from_f32(v.min(65504.0)).to_bits()
 }
 
 /// Mirrors `Material` in shaders/shared/scene.wgsl.

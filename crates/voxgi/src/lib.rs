@@ -46,6 +46,7 @@ pub mod passes;
 pub mod reference;
 mod renderer;
 mod settings;
+pub mod shadow_atlas;
 mod targets;
 mod view;
 pub mod voxel;

@@ -18,6 +18,7 @@
 //! emissive = [0.0, 0.0, 0.0]       # linear radiance; also drops the emissive texture
 //! roughness = 0.5
 //! metallic = 0.0
+//! specular = 1.0                   # dielectric F0 = 0.04 x specular; 0: pure Lambertian
 //!
 //! [[light]]
 //! type = "spot"                    # "directional" | "point" | "spot" | "area"
@@ -105,6 +106,7 @@ struct MaterialOverride {
     emissive: Option<[f32; 3]>,
     roughness: Option<f32>,
     metallic: Option<f32>,
+    specular: Option<f32>,
 }
 
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
@@ -316,7 +318,11 @@ fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Resul
     {
         return Err("material colours must be finite and >= 0".into());
     }
-    for (k, v) in [("roughness", o.roughness), ("metallic", o.metallic)] {
+    for (k, v) in [
+        ("roughness", o.roughness),
+        ("metallic", o.metallic),
+        ("specular", o.specular),
+    ] {
         if v.is_some_and(|v| !(0.0..=1.0).contains(&v)) {
             return Err(format!("material {k} must be in [0, 1]"));
         }
@@ -335,6 +341,9 @@ fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Resul
         }
         if let Some(x) = o.metallic {
             m.metallic = x;
+        }
+        if let Some(x) = o.specular {
+            m.specular = x;
         }
     }
     Ok(())

@@ -33,7 +33,7 @@ struct Cones {
     ao_radius: f32,
     // Offset of the cone origin along the normal, in finest voxels.
     origin_offset: f32,
-    // 0: the per-pixel gather adds indirect light, 1: it does not (bounces = 0).
+    // 1: the per-pixel gather adds indirect light, 0: it does not (bounces = 0).
     indirect: u32,
 }
 

@@ -137,15 +137,7 @@ pub fn read_buffer_copy(
 
 /// An IEEE binary16 value (as read back from an rgba16float texture) as f32.
 pub fn f16_to_f32(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0f32 } else { 1.0 };
-    let exp = ((h >> 10) & 0x1f) as i32;
-    let mant = (h & 0x3ff) as f32;
-    match exp {
-        0 => sign * mant * 2f32.powi(-24),
-        31 if mant == 0.0 => sign * f32::INFINITY,
-        31 => f32::NAN,
-        _ => sign * (1.0 + mant / 1024.0) * 2f32.powi(exp - 15),
-    }
+    half::f16::from_bits(h).to_f32()
 }
 
 /// Maps a MAP_READ buffer and copies its contents out, waiting for the GPU.

@@ -6,7 +6,7 @@ use crate::gpu::layout;
 use crate::gpu::shader::specialized_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::passes::shadow::ShadowAtlas;
+use crate::shadow_atlas::ShadowAtlas;
 use crate::targets::FrameTargets;
 
 const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };

@@ -48,6 +48,22 @@ fn type_name(m: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
     }
 }
 
+/// Checks that `m` defines each function with these argument and result types ("": none).
+fn check_functions(m: &naga::Module, kind: &str, contract: &[(&str, &[&str], &str)]) {
+    for (name, args, result) in contract {
+        let f = m
+            .functions
+            .iter()
+            .map(|(_, f)| f)
+            .find(|f| f.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{kind}: no fn {name}"));
+        let got: Vec<String> = f.arguments.iter().map(|a| type_name(m, a.ty)).collect();
+        assert_eq!(got, *args, "{kind}: {name}'s arguments");
+        let ret = f.result.as_ref().map(|r| type_name(m, r.ty));
+        assert_eq!(ret.unwrap_or_default(), *result, "{kind}: {name}'s result");
+    }
+}
+
 /// The contract: each function's argument types and result type.
 const CONTRACT: &[(&str, &[&str], &str)] = &[
     ("voxels_voxel_size", &[], "f32"),
@@ -75,18 +91,7 @@ fn every_structure_defines_the_voxel_contract() {
         let src = shader::compose_for(&format!("voxels/{kind}/sample.wgsl"), kind);
         let m = parse(&src);
         validate(&m);
-        for (name, args, result) in CONTRACT {
-            let f = m
-                .functions
-                .iter()
-                .map(|(_, f)| f)
-                .find(|f| f.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("{kind}: no fn {name}"));
-            let got: Vec<String> = f.arguments.iter().map(|a| type_name(&m, a.ty)).collect();
-            assert_eq!(got, *args, "{kind}: {name}'s arguments");
-            let ret = f.result.as_ref().map(|r| type_name(&m, r.ty));
-            assert_eq!(ret.as_deref(), Some(*result), "{kind}: {name}'s result");
-        }
+        check_functions(&m, kind, CONTRACT);
         let wide = m
             .constants
             .iter()
@@ -121,20 +126,12 @@ fn every_structure_defines_the_leaf_contract() {
         let src = shader::compose_for(&format!("voxels/{kind}/leaf_store.wgsl"), kind);
         let m = parse(&src);
         validate(&m);
-        let mut contract: Vec<(&str, &[&str], &str)> = LEAVES.to_vec();
-        contract.push(("store_leaf_radiance", &["u32", "vec4<f32>"], ""));
-        for (name, args, result) in contract {
-            let f = m
-                .functions
-                .iter()
-                .map(|(_, f)| f)
-                .find(|f| f.name.as_deref() == Some(name))
-                .unwrap_or_else(|| panic!("{kind}: no fn {name}"));
-            let got: Vec<String> = f.arguments.iter().map(|a| type_name(&m, a.ty)).collect();
-            assert_eq!(got, *args, "{kind}: {name}'s arguments");
-            let ret = f.result.as_ref().map(|r| type_name(&m, r.ty));
-            assert_eq!(ret.unwrap_or_default(), result, "{kind}: {name}'s result");
-        }
+        check_functions(&m, kind, LEAVES);
+        check_functions(
+            &m,
+            kind,
+            &[("store_leaf_radiance", &["u32", "vec4<f32>"], "")],
+        );
         for var in ["leaf_direct", "leaf_next"] {
             let g = m
                 .global_variables

@@ -3,7 +3,7 @@
 
 use voxgi::gpu::shader;
 use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
-use voxgi::passes::shadow::GpuShadowView;
+use voxgi::shadow_atlas::GpuShadowView;
 use voxgi::voxel::{GpuCones, GpuVolume};
 
 fn parse(name: &str) -> naga::Module {

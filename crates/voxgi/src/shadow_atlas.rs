@@ -1,0 +1,387 @@
+//! The shadow atlas: every shadow view's distance map in one texture array, and where each
+//! light's views are. A shared resource: `shadow` renders into it, `inject` and `composite`
+//! read it.
+
+use crate::gpu::layout;
+use crate::gpu_scene::{
+    CONE_SHADOW_LIGHTS, GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT,
+    LIGHT_SPOT,
+};
+use crate::options::RendererOptions;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+/// Mirrors `ShadowView` in shaders/shared/scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuShadowView {
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub origin: [f32; 3],
+    pub kind: u32,
+    pub dir: [f32; 3],
+    pub texel: f32,
+    pub near: f32,
+    pub far: f32,
+    pub resolution: f32,
+    pub layer: u32,
+    pub plane: [f32; 4],
+}
+
+pub(crate) const SHADOW_ORTHO: u32 = 0;
+pub(crate) const SHADOW_PERSPECTIVE: u32 = 1;
+/// Uniform dynamic offsets must be multiples of 256 bytes.
+pub(crate) const UNIFORM_STRIDE: u64 = 256;
+pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// The shadow views of a scene's lights and the textures they render into.
+pub struct ShadowAtlas {
+    pub views: Vec<GpuShadowView>,
+    /// Which light each view belongs to.
+    pub view_light: Vec<usize>,
+    pub texture: wgpu::Texture,
+    pub array_view: wgpu::TextureView,
+    /// One view per layer, for rendering into it.
+    pub(crate) layer_views: Vec<wgpu::TextureView>,
+    pub(crate) depth_view: wgpu::TextureView,
+    pub views_buffer: wgpu::Buffer,
+    /// Each view's `GpuShadowView` at a `UNIFORM_STRIDE` offset (the shadow pass's dynamic
+    /// uniform).
+    pub(crate) uniforms: wgpu::Buffer,
+}
+
+fn up_for(dir: Vec3) -> Vec3 {
+    if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y }
+}
+
+/// Lays out shadow views for every shadow-casting light and records in `lights` where each
+/// light's views are.
+pub fn plan_views(
+    lights: &mut [GpuLight],
+    casts: &[bool],
+    center: Vec3,
+    radius: f32,
+    res: u32,
+) -> (Vec<GpuShadowView>, Vec<usize>) {
+    let mut views = Vec::new();
+    let mut owner = Vec::new();
+    let near = (radius * 1e-4).max(1e-5);
+    let res_f = res as f32;
+    for (li, light) in lights.iter_mut().enumerate() {
+        if !casts[li] {
+            continue;
+        }
+        let first = views.len() as u32;
+        let pos = Vec3::from(light.position);
+        let dir = Vec3::from(light.direction).normalize();
+        let far_from = |o: Vec3| (o - center).length() + radius * 1.01;
+        let plane = if matches!(light.kind, LIGHT_RECT | LIGHT_DISC) {
+            [dir.x, dir.y, dir.z, -dir.dot(pos)]
+        } else {
+            [0.0; 4]
+        };
+        let mut push = |view: Mat4,
+                        proj: Mat4,
+                        origin: Vec3,
+                        kind: u32,
+                        vdir: Vec3,
+                        texel: f32,
+                        near: f32,
+                        far: f32| {
+            views.push(GpuShadowView {
+                view_proj: (proj * view).to_cols_array_2d(),
+                inv_view_proj: (proj * view).inverse().to_cols_array_2d(),
+                origin: origin.to_array(),
+                kind,
+                dir: vdir.to_array(),
+                texel,
+                near,
+                far,
+                resolution: res_f,
+                layer: 0,
+                plane,
+            });
+            owner.push(li);
+        };
+        match light.kind {
+            LIGHT_DIRECTIONAL => {
+                // Fit the scene's bounding sphere; the map starts just outside it.
+                let origin = center - dir * radius * 1.05;
+                let view = Mat4::look_at_rh(origin, origin + dir, up_for(dir));
+                let proj =
+                    Mat4::orthographic_rh(-radius, radius, -radius, radius, 0.0, radius * 2.1);
+                push(
+                    view,
+                    proj,
+                    origin,
+                    SHADOW_ORTHO,
+                    dir,
+                    2.0 * radius / res_f,
+                    0.0,
+                    radius * 2.1,
+                );
+            }
+            LIGHT_SPOT => {
+                let half = (light.cos_outer.clamp(-1.0, 1.0).acos() + 2f32.to_radians())
+                    .min(85f32.to_radians());
+                let view = Mat4::look_at_rh(pos, pos + dir, up_for(dir));
+                let far = far_from(pos);
+                let proj = Mat4::perspective_rh(2.0 * half, 1.0, near, far);
+                push(
+                    view,
+                    proj,
+                    pos,
+                    SHADOW_PERSPECTIVE,
+                    dir,
+                    2.0 * half.tan() / res_f,
+                    near,
+                    far,
+                );
+            }
+            LIGHT_POINT | LIGHT_RECT | LIGHT_DISC => {
+                // Area lights look out from just in front of their surface.
+                let origin = if light.kind == LIGHT_POINT {
+                    pos
+                } else {
+                    pos + dir * near * 2.0
+                };
+                // A guard band of a few texels lets filter taps near a face's edge stay inside it.
+                let tan_half = 1.0 + 4.0 / res_f;
+                let far = far_from(origin);
+                let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, far);
+                for axis in [
+                    Vec3::X,
+                    Vec3::NEG_X,
+                    Vec3::Y,
+                    Vec3::NEG_Y,
+                    Vec3::Z,
+                    Vec3::NEG_Z,
+                ] {
+                    let view = Mat4::look_at_rh(origin, origin + axis, up_for(axis));
+                    push(
+                        view,
+                        proj,
+                        origin,
+                        SHADOW_PERSPECTIVE,
+                        axis,
+                        2.0 * tan_half / res_f,
+                        near,
+                        far,
+                    );
+                }
+            }
+            _ => {}
+        }
+        light.shadow_first = first;
+        light.shadow_count = views.len() as u32 - first;
+    }
+    for (i, v) in views.iter_mut().enumerate() {
+        v.layer = i as u32;
+    }
+    (views, owner)
+}
+
+/// Whether a cube face of an area light sees only what lies behind the emitter's plane, which
+/// the light cannot reach and so nobody looks up (the face opposite a one-sided emitter's
+/// direction): such a face is not rendered.
+pub fn behind_emitter(view: &GpuShadowView) -> bool {
+    let n = Vec3::new(view.plane[0], view.plane[1], view.plane[2]);
+    if view.kind != SHADOW_PERSPECTIVE || n == Vec3::ZERO {
+        return false;
+    }
+    // The face's frustum spans its axis a plus up to tan_half times the two other (coordinate)
+    // axes; its highest point over the plane is a.n + tan_half (|n|_1 - |a.n|).
+    let a = Vec3::from(view.dir);
+    let tan_half = 0.5 * view.texel * view.resolution;
+    let reach = a.dot(n) + tan_half * (n.abs().element_sum() - a.dot(n).abs());
+    reach <= 0.0
+}
+
+/// Shadow-map size: the setting, or, when every light's visibility on screen is cone-traced
+/// and the maps serve only the voxel injection, four texels per voxel of the volume (the
+/// injection reads them at voxel centres; finer maps only cost rendering time).
+pub fn atlas_resolution(settings: &RendererOptions, lights: &[GpuLight]) -> u32 {
+    if composite_reads_shadow_maps(lights, settings.cone_shadows) {
+        settings.shadow_map_size
+    } else {
+        settings
+            .shadow_map_size
+            .min((4 * settings.voxel_resolution).max(256))
+    }
+}
+
+/// Whether the composite looks up shadow maps: not when every light is an area light whose
+/// visibility the gather cone-traces (the first `CONE_SHADOW_LIGHTS` area lights).
+pub fn composite_reads_shadow_maps(lights: &[GpuLight], cone_shadows: bool) -> bool {
+    let cone_traced =
+        cone_shadows && lights.len() <= CONE_SHADOW_LIGHTS && lights.iter().all(GpuLight::is_area);
+    !cone_traced
+}
+
+impl ShadowAtlas {
+    pub fn new(
+        device: &wgpu::Device,
+        views: Vec<GpuShadowView>,
+        view_light: Vec<usize>,
+        res: u32,
+    ) -> Self {
+        let layers = views.len().max(1) as u32;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow atlas"),
+            size: wgpu::Extent3d {
+                width: res,
+                height: res,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: ATLAS_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let layer_views = (0..layers)
+            .map(|l| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("shadow layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: l,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow depth"),
+            size: wgpu::Extent3d {
+                width: res,
+                height: res,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let mut uniform_bytes = vec![0u8; UNIFORM_STRIDE as usize * views.len().max(1)];
+        for (i, v) in views.iter().enumerate() {
+            let o = i * UNIFORM_STRIDE as usize;
+            uniform_bytes[o..o + size_of::<GpuShadowView>()].copy_from_slice(bytemuck::bytes_of(v));
+        }
+        let mut view_bytes = bytemuck::cast_slice::<_, u8>(&views).to_vec();
+        view_bytes.resize(view_bytes.len().max(size_of::<GpuShadowView>()), 0);
+        ShadowAtlas {
+            uniforms: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow view uniforms"),
+                contents: &uniform_bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            views_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow views"),
+                contents: &view_bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
+            views,
+            view_light,
+            texture,
+            array_view,
+            layer_views,
+            depth_view: depth.create_view(&Default::default()),
+        }
+    }
+
+    /// Bindings 1, 2 and 3 of every shader that includes `shared/lights.wgsl`: the lights, the
+    /// shadow views and this atlas's maps.
+    pub fn lighting_layout(c: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 3] {
+        [
+            layout::storage(1, c, true),
+            layout::storage(2, c, true),
+            layout::texture(
+                3,
+                c,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2Array,
+            ),
+        ]
+    }
+
+    /// The resources for `lighting_layout`, in its order.
+    pub fn lighting_resources<'a>(&'a self, scene: &'a GpuScene) -> [wgpu::BindingResource<'a>; 3] {
+        [
+            scene.lights.as_entire_binding(),
+            self.views_buffer.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.array_view),
+        ]
+    }
+
+    pub fn bytes(&self) -> u64 {
+        let t = &self.texture;
+        (t.width() * t.height() * t.depth_or_array_layers()) as u64 * 8
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn light(kind: u32, direction: [f32; 3]) -> GpuLight {
+        GpuLight {
+            kind,
+            position: [0.0, 1.0, 0.0],
+            direction,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn only_cone_shadowed_area_lights_skip_the_shadow_maps() {
+        let rect = light(LIGHT_RECT, [0.0, -1.0, 0.0]);
+        let disc = light(LIGHT_DISC, [0.0, -1.0, 0.0]);
+        let point = light(LIGHT_POINT, [0.0, -1.0, 0.0]);
+        assert!(!composite_reads_shadow_maps(&[rect, disc], true));
+        assert!(composite_reads_shadow_maps(&[rect, disc], false));
+        // A point light keeps its shadow map beside cone-shadowed area lights.
+        assert!(composite_reads_shadow_maps(&[rect, point], true));
+        // Only the first CONE_SHADOW_LIGHTS area lights get a cone.
+        assert!(composite_reads_shadow_maps(
+            &[rect; CONE_SHADOW_LIGHTS + 1],
+            true
+        ));
+        let settings = |cone_shadows| RendererOptions {
+            cone_shadows,
+            voxel_resolution: 64,
+            ..RendererOptions::default()
+        };
+        assert_eq!(atlas_resolution(&settings(true), &[rect]), 256);
+        assert_eq!(atlas_resolution(&settings(false), &[rect]), 1024);
+        assert_eq!(atlas_resolution(&settings(true), &[rect, point]), 1024);
+    }
+
+    #[test]
+    fn a_down_facing_emitter_skips_only_its_upward_cube_face() {
+        let mut lights = [light(LIGHT_RECT, [0.0, -1.0, 0.0])];
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        let skipped: Vec<[f32; 3]> = views
+            .iter()
+            .filter(|v| behind_emitter(v))
+            .map(|v| v.dir)
+            .collect();
+        assert_eq!(skipped, vec![[0.0, 1.0, 0.0]]);
+        // A point light sees all round: no face is skipped.
+        let mut lights = [light(LIGHT_POINT, [0.0, -1.0, 0.0])];
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        assert!(views.iter().all(|v| !behind_emitter(v)));
+        // A tilted emitter sees a little of every side face, so none is skipped but the back.
+        let d = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let mut lights = [light(LIGHT_RECT, d.to_array())];
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        assert_eq!(views.iter().filter(|v| behind_emitter(v)).count(), 1);
+    }
+}
