@@ -369,3 +369,42 @@ fn render_checks_the_output_path_before_rendering() {
     // Refused before the scene was even loaded: no progress lines.
     assert!(!stderr(&o).contains("uploading scene"), "{}", stderr(&o));
 }
+
+/// The defaults the help states are the library's (they are defined once, in
+/// `RendererOptions::default` and `FrameParams::new`).
+#[test]
+fn help_states_the_library_defaults() {
+    let o = voxgi(&["render", "--help"]);
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout).into_owned();
+    let opts = voxgi::RendererOptions::default();
+    let cam = voxgi::scene::Camera::look_at(
+        voxgi::scene::glam::Vec3::Z,
+        voxgi::scene::glam::Vec3::ZERO,
+        45.0,
+    );
+    let frame = voxgi::FrameParams::new(cam);
+    let bounces = opts.bounces.to_string();
+    let cases = [
+        ("--exposure", frame.exposure.to_string()),
+        ("--tonemap", frame.tonemap.name().to_string()),
+        ("--view", frame.view.name().to_string()),
+        ("--shadow-map-size", opts.shadow_map_size.to_string()),
+        ("--voxel-resolution", opts.voxel_resolution.to_string()),
+        ("--bounces", bounces),
+        ("--cones", opts.cones.name().to_string()),
+        ("--ao-lambda", opts.ao_lambda.to_string()),
+        ("--step-factor", opts.step_factor.to_string()),
+    ];
+    for (flag, value) in cases {
+        let line = help
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{flag} ")))
+            .unwrap_or_else(|| panic!("{flag} is not in the help"));
+        assert!(
+            line.contains(&format!("Default {value}")),
+            "{flag}: the help says `{}`, the library's default is {value}",
+            line.trim()
+        );
+    }
+}

@@ -92,10 +92,12 @@ pub struct BrdfTables {
     /// below fp16's precision, so the shader interpolates it itself (f32 textures need not be
     /// filterable).
     pub ltc: wgpu::TextureView,
+    /// Bilinear, clamp-to-edge sampler for `specular_albedo` (the LTC table is read with loads).
     pub sampler: wgpu::Sampler,
 }
 
 impl BrdfTables {
+    /// Computes the albedo table, uploads both tables and creates the sampler.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         let albedo: Vec<f32> = specular_albedo_table().into_iter().flatten().collect();
         let ltc: Vec<f32> = bytemuck::pod_collect_to_vec(LTC_TABLE);

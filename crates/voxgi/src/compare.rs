@@ -18,7 +18,9 @@ use std::path::Path;
 /// An image to compare: linear RGB, plus its 8-bit sRGB encoding for LDR images.
 #[derive(Clone, Debug)]
 pub struct Image {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Linear RGB, row-major from the top-left.
     pub linear: Vec<[f32; 3]>,
@@ -54,6 +56,7 @@ impl Image {
         }
     }
 
+    /// Whether this is an HDR image (no 8-bit sRGB values), compared with HDR-FLIP.
     pub fn is_hdr(&self) -> bool {
         self.srgb8.is_none()
     }
@@ -104,7 +107,9 @@ impl Image {
 pub struct Comparison {
     /// Mean FLIP error in [0, 1] (LDR-FLIP for LDR images, HDR-FLIP for HDR images).
     pub flip_mean: f32,
+    /// Root mean square error over all linear RGB values.
     pub rmse: f64,
+    /// Relative MSE: mean of (t - r)² / (r² + 0.01) over all linear RGB values.
     pub rel_mse: f64,
     /// Whether HDR-FLIP was used.
     pub hdr: bool,

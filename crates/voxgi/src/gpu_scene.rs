@@ -13,18 +13,32 @@ use wgpu::util::DeviceExt;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuFrame {
+    /// World to clip space, column-major.
     pub view_proj: [[f32; 4]; 4],
+    /// Clip to world space (the inverse of `view_proj`), for unprojecting depth.
     pub inv_view_proj: [[f32; 4]; 4],
+    /// Camera position in world space, metres.
     pub camera_pos: [f32; 3],
+    /// Number of lights in the lights buffer.
     pub light_count: u32,
+    /// Output size in pixels (width, height).
     pub size: [f32; 2],
+    /// Reciprocal of `size`, 1/pixels.
     pub inv_size: [f32; 2],
+    /// Exposure scale 2^EV, applied before tone mapping.
     pub exposure: f32,
+    /// Tone curve: `Tonemap::id` (`TONEMAP_*` in the WGSL).
     pub tonemap: u32,
+    /// Filter radius of punctual-light shadows, in shadow-map texels.
     pub shadow_softness: f32,
+    /// Output selection for debugging: `ViewMode::id` (`VIEW_*` in the WGSL).
     pub view_mode: u32,
+    /// Background radiance where nothing is hit: linear RGB, alpha 1.
     pub background: [f32; 4],
+    /// 1: area lights' shadows by a cone traced through the voxels instead of the shadow map; 0
+    /// otherwise.
     pub cone_shadows: u32,
+    /// Padding to a multiple of 16 bytes; zero.
     pub _pad: [u32; 3],
 }
 
@@ -32,9 +46,13 @@ pub struct GpuFrame {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVertex {
+    /// Object-space position, metres.
     pub position: [f32; 3],
+    /// Texture coordinate u.
     pub u: f32,
+    /// Object-space normal (transformed by the draw's `normal_matrix`).
     pub normal: [f32; 3],
+    /// Texture coordinate v.
     pub v: f32,
 }
 
@@ -42,10 +60,15 @@ pub struct GpuVertex {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuDraw {
+    /// Object to world transform, column-major.
     pub model: [[f32; 4]; 4],
+    /// Inverse transpose of `model`, for normals (identity when `model` is singular).
     pub normal_matrix: [[f32; 4]; 4],
+    /// Index into the materials buffer.
     pub material: u32,
+    /// Index of the area light this geometry shows, or `NO_INDEX`.
     pub light: u32,
+    /// Padding to a multiple of 16 bytes; zero.
     pub _pad: [u32; 2],
 }
 
@@ -54,6 +77,7 @@ pub struct GpuDraw {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuPoint {
+    /// World-space position of the disc's centre, metres.
     pub position: [f32; 3],
     /// Disc radius in metres.
     pub radius: f32,
@@ -75,6 +99,8 @@ const _: () = assert!(size_of::<GpuPoint>() == 32);
 pub const POINT_NO_NORMAL: u32 = 0x8000_8000;
 
 impl GpuPoint {
+    /// Packs one surfel: albedo and emission (linear, W/(m² sr)) as f16, the normal
+    /// octahedral-encoded (`POINT_NO_NORMAL` for a zero or non-finite normal).
     pub fn new(
         position: Vec3,
         radius: f32,
@@ -125,15 +151,26 @@ pub fn half_bits(v: f32) -> u16 {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
+    /// Linear RGBA base colour; multiplies the base texture, alpha is tested against
+    /// `alpha_cutoff`.
     pub base_color: [f32; 4],
+    /// Emitted radiance, W/(m² sr), linear RGB; multiplies the emissive texture.
     pub emissive: [f32; 3],
+    /// Perceptual roughness in [0, 1].
     pub roughness: f32,
+    /// Metalness in [0, 1].
     pub metallic: f32,
+    /// Scales the dielectric F0 of 0.04 (KHR_materials_specular); 0 makes a pure Lambertian (>= 0).
     pub specular: f32,
+    /// Layer of the base-colour texture in the texture array, -1 for none.
     pub base_texture: i32,
+    /// Layer of the emissive texture in the texture array, -1 for none.
     pub emissive_texture: i32,
+    /// Texels with alpha below this are cut out; 0 for opaque and blended materials.
     pub alpha_cutoff: f32,
+    /// 1 for a double-sided material, else 0 (every surface is drawn without culling regardless).
     pub double_sided: u32,
+    /// Padding to a multiple of 16 bytes; zero.
     pub _pad: [u32; 2],
 }
 
@@ -141,27 +178,48 @@ pub struct GpuMaterial {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuLight {
+    /// World-space position, metres (the centre for area lights; unused for directional lights).
     pub position: [f32; 3],
+    /// The light type: one of the `LIGHT_*` constants.
     pub kind: u32,
+    /// Unit direction photons travel; for area lights the emitting side's normal.
     pub direction: [f32; 3],
+    /// Range of influence of point and spot lights, metres; 0 for unlimited.
     pub range: f32,
+    /// Emitted radiometric quantity, linear RGB: W/m² (directional), W/sr (point, spot), W/(m² sr)
+    /// (area).
     pub radiance: [f32; 3],
+    /// Emitting area of an area light, m² (0 for other lights).
     pub area: f32,
+    /// Rect: half-edge vector along u, metres. Disc: a unit tangent scaled by the radius.
     pub axis_u: [f32; 3],
+    /// Cosine of a spot light's inner cone half-angle (full intensity inside).
     pub cos_inner: f32,
+    /// Rect: half-edge vector along v, metres. Disc: the second tangent scaled by the radius.
     pub axis_v: [f32; 3],
+    /// Cosine of a spot light's outer cone half-angle (no light outside).
     pub cos_outer: f32,
+    /// Index of the light's first shadow view in the shadow atlas.
     pub shadow_first: u32,
+    /// Number of shadow views: 0 (no shadows), 1, or 6 for a cube.
     pub shadow_count: u32,
+    /// Radius of a disc with the light's area, metres: sets the penumbra size.
     pub size: f32,
+    /// Padding to a multiple of 16 bytes; zero.
     pub _pad: f32,
 }
 
+/// `GpuLight::kind` of a directional light (a sun).
 pub const LIGHT_DIRECTIONAL: u32 = 0;
+/// `GpuLight::kind` of a point light.
 pub const LIGHT_POINT: u32 = 1;
+/// `GpuLight::kind` of a spot light.
 pub const LIGHT_SPOT: u32 = 2;
+/// `GpuLight::kind` of a rectangular area light.
 pub const LIGHT_RECT: u32 = 3;
+/// `GpuLight::kind` of a disc area light.
 pub const LIGHT_DISC: u32 = 4;
+/// "None" for indices into GPU buffers (`GpuDraw::light` of geometry that is no emitter).
 pub const NO_INDEX: u32 = u32::MAX;
 /// Area lights whose visibility the gather can cone-trace (one channel each). Twin of
 /// `CONE_SHADOW_LIGHTS` in shaders/shared/scene.wgsl.
@@ -177,7 +235,9 @@ impl GpuLight {
 /// One indexed draw: a mesh instance.
 #[derive(Clone, Debug)]
 pub struct DrawCall {
+    /// The mesh's range in the shared index buffer.
     pub indices: std::ops::Range<u32>,
+    /// Offset of the mesh's first vertex in the shared vertex buffer.
     pub base_vertex: i32,
     /// Index into the draws buffer (passed as the instance index).
     pub draw: u32,
@@ -185,11 +245,20 @@ pub struct DrawCall {
     pub light: Option<usize>,
 }
 
+/// The scene's GPU buffers and textures, shared read-only by every pass, and the draw calls
+/// that rasterize its instances.
 pub struct GpuScene {
+    /// All meshes' vertices (`GpuVertex`), in object space, meshes one after another.
     pub vertices: wgpu::Buffer,
+    /// All meshes' triangle indices (u32, relative to each mesh's first vertex); index and storage
+    /// buffer.
     pub indices: wgpu::Buffer,
+    /// One `GpuDraw` per drawn instance.
     pub draws: wgpu::Buffer,
+    /// One `GpuMaterial` per scene material.
     pub materials: wgpu::Buffer,
+    /// One `GpuLight` per scene light; its shadow fields are written when the shadow views are
+    /// planned.
     pub lights: wgpu::Buffer,
     /// All point clouds' surfels (`GpuPoint`), in world space.
     pub points: wgpu::Buffer,
@@ -197,13 +266,21 @@ pub struct GpuScene {
     /// tangent plane, in metres (`pointcloud::surface_spread`); shadow maps push the surfel
     /// that far away from the light so noisy scans do not shadow themselves.
     pub point_spread: wgpu::Buffer,
+    /// Number of points in `points`.
     pub point_count: u32,
+    /// Every material texture as one layer of a square RGBA8 sRGB 2D array with a full mip
+    /// chain (a single white layer when no material has a texture).
     pub textures: wgpu::Texture,
+    /// `textures` as a 2D-array view.
     pub texture_view: wgpu::TextureView,
+    /// Trilinear, repeating sampler for the material textures.
     pub sampler: wgpu::Sampler,
+    /// One indexed draw per instance with triangles.
     pub calls: Vec<DrawCall>,
-    /// CPU copy of the lights, without shadow assignments (the shadow pass fills those).
+    /// CPU copy of the lights; their shadow-view fields are written when the renderer plans
+    /// the shadow atlas (`shadow_atlas::plan_views`).
     pub gpu_lights: Vec<GpuLight>,
+    /// Number of lights (`gpu_lights.len()`).
     pub light_count: u32,
 }
 
@@ -259,6 +336,10 @@ pub fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
 }
 
 impl GpuScene {
+    /// Uploads `scene`: flattens the meshes, makes one draw per instance, converts materials and
+    /// lights, packs the point clouds, and builds the texture array (textures downsampled to
+    /// `settings.max_texture_size`). Fails when the vertices or points exceed the device's
+    /// storage-buffer binding size or a texture's data is malformed.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,

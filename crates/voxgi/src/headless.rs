@@ -9,8 +9,11 @@ use crate::{Error, Renderer, Result, Target, readback};
 
 /// A wgpu device and queue voxgi opened itself, plus what it learned about the adapter.
 pub struct GpuContext {
+    /// The device, opened with `required_features` and `required_limits`.
     pub device: wgpu::Device,
+    /// The device's queue.
     pub queue: wgpu::Queue,
+    /// The adapter's name, backend and type.
     pub info: wgpu::AdapterInfo,
     /// Timestamp queries inside passes are available (for `voxgi bench`).
     pub timestamps: bool,

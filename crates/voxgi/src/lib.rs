@@ -30,6 +30,8 @@
 //! metrics between images), `reference` (the ground-truth path tracer). The `voxgi` command
 //! turns them all on; an application embedding the renderer needs none.
 
+#![warn(missing_docs)]
+
 pub mod brdf;
 #[cfg(feature = "compare")]
 pub mod compare;

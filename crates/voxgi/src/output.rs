@@ -10,7 +10,9 @@ use std::path::Path;
 /// What one render produced.
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Linear radiance, RGBA f32, row-major from the top-left, before exposure.
     pub hdr: Vec<f32>,

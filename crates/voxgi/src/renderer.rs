@@ -47,13 +47,18 @@ use wgpu::util::DeviceExt;
 /// as `Rgba16Float` (tone-mapped linear values).
 #[derive(Clone, Copy, Debug)]
 pub struct Target<'a> {
+    /// A view of the caller's texture (one mip level, one layer).
     pub view: &'a wgpu::TextureView,
+    /// The texture's format; the tonemap pass makes a pipeline for each format it is given.
     pub format: wgpu::TextureFormat,
+    /// The texture's width in pixels.
     pub width: u32,
+    /// The texture's height in pixels.
     pub height: u32,
 }
 
 impl<'a> Target<'a> {
+    /// A target from a view of the texture and the texture's format and size in pixels.
     pub fn new(
         view: &'a wgpu::TextureView,
         format: wgpu::TextureFormat,

@@ -16,16 +16,29 @@ use wgpu::util::DeviceExt;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuShadowView {
+    /// World to clip space of the view, column-major.
     pub view_proj: [[f32; 4]; 4],
+    /// Clip to world space (the inverse of `view_proj`).
     pub inv_view_proj: [[f32; 4]; 4],
+    /// Where distances are measured from (the light, or the start of an orthographic view), metres.
     pub origin: [f32; 3],
+    /// `SHADOW_ORTHO` (directional lights) or `SHADOW_PERSPECTIVE` (spot, point and area lights).
     pub kind: u32,
+    /// Unit view direction: the light's direction, or a cube face's axis.
     pub dir: [f32; 3],
+    /// World size of a texel, metres (orthographic), or its size in tangent units at distance 1
+    /// (perspective).
     pub texel: f32,
+    /// Near clip distance, metres.
     pub near: f32,
+    /// Far clip distance, metres.
     pub far: f32,
+    /// The map's width and height in texels.
     pub resolution: f32,
+    /// The view's layer in the atlas.
     pub layer: u32,
+    /// Emitter plane (xyz normal, w offset): geometry with dot(plane.xyz, x) + plane.w < 0 casts no
+    /// shadow. Zero for lights other than area lights.
     pub plane: [f32; 4],
 }
 
@@ -33,18 +46,23 @@ pub(crate) const SHADOW_ORTHO: u32 = 0;
 pub(crate) const SHADOW_PERSPECTIVE: u32 = 1;
 /// Uniform dynamic offsets must be multiples of 256 bytes.
 pub(crate) const UNIFORM_STRIDE: u64 = 256;
+/// Format of the atlas's distance maps: the nearest occluder's distance per texel, metres.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// The shadow views of a scene's lights and the textures they render into.
 pub struct ShadowAtlas {
+    /// Every shadow view, in layer order (`GpuLight::shadow_first` indexes it).
     pub views: Vec<GpuShadowView>,
     /// Which light each view belongs to.
     pub view_light: Vec<usize>,
+    /// The atlas texture: one square `ATLAS_FORMAT` layer per view (at least one).
     pub texture: wgpu::Texture,
+    /// `texture` as a 2D-array view, for the lighting passes.
     pub array_view: wgpu::TextureView,
     /// One view per layer, for rendering into it.
     pub(crate) layer_views: Vec<wgpu::TextureView>,
     pub(crate) depth_view: wgpu::TextureView,
+    /// `views` as a storage buffer (binding 2 of `lighting_layout`).
     pub views_buffer: wgpu::Buffer,
     /// Each view's `GpuShadowView` at a `UNIFORM_STRIDE` offset (the shadow pass's dynamic
     /// uniform).
@@ -220,6 +238,8 @@ pub fn composite_reads_shadow_maps(lights: &[GpuLight], cone_shadows: bool) -> b
 }
 
 impl ShadowAtlas {
+    /// Makes the atlas for `views` (owned by the lights in `view_light`), each map `res` texels
+    /// square, with its depth buffer and view buffers.
     pub fn new(
         device: &wgpu::Device,
         views: Vec<GpuShadowView>,
@@ -321,6 +341,8 @@ impl ShadowAtlas {
         ]
     }
 
+    /// GPU memory of the atlas in bytes, counted as 8 bytes per texel of every layer (the R32F
+    /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound).
     pub fn bytes(&self) -> u64 {
         let t = &self.texture;
         (t.width() * t.height() * t.depth_or_array_layers()) as u64 * 8

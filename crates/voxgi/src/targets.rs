@@ -9,12 +9,19 @@ use crate::passes::gbuffer;
 
 /// Render targets of one output size.
 pub struct FrameTargets {
+    /// Output width in pixels.
     pub width: u32,
+    /// Output height in pixels.
     pub height: u32,
+    /// The frame's `GpuFrame` uniform, written before each frame.
     pub frame: wgpu::Buffer,
+    /// G-buffer albedo (`gbuffer::ALBEDO_FORMAT`: rgb base colour, a metallic).
     pub albedo: wgpu::TextureView,
+    /// G-buffer normal (`gbuffer::NORMAL_FORMAT`: rgb world normal, a roughness).
     pub normal: wgpu::TextureView,
+    /// G-buffer emission (`gbuffer::EMISSION_FORMAT`: rgb emitted radiance, a specular).
     pub emission: wgpu::TextureView,
+    /// G-buffer depth (`gbuffer::DEPTH_FORMAT`).
     pub depth: wgpu::TextureView,
     /// Linear radiance (the composite's output, the debug views' too); `tonemap` reads it.
     pub hdr: wgpu::TextureView,
@@ -28,11 +35,15 @@ pub struct FrameTargets {
     pub visibility_low: wgpu::TextureView,
     /// Normal and camera distance of each gather pixel (the upsample's edge weights).
     pub guide_low: wgpu::TextureView,
+    /// Whether the gather runs at half resolution (each dimension halved, rounded up).
     pub half: bool,
+    /// The texture behind `hdr`, for reading the frame back.
     pub hdr_texture: wgpu::Texture,
 }
 
 impl FrameTargets {
+    /// Targets for a `width` x `height` output; the gather's targets at half that (rounded up) when
+    /// `half`.
     pub fn new(device: &wgpu::Device, width: u32, height: u32, half: bool) -> Self {
         let (lw, lh) = gather_size(width, height, half);
         let sized = |label: &str,
@@ -90,6 +101,7 @@ impl FrameTargets {
     const FULL_BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16;
     const LOW_BYTES_PER_PIXEL: u64 = 8 + 8 + 4 + 8;
 
+    /// GPU memory of the targets in bytes.
     pub fn bytes(&self) -> u64 {
         let (lw, lh) = self.gather_size();
         self.width as u64 * self.height as u64 * Self::FULL_BYTES_PER_PIXEL
@@ -122,6 +134,7 @@ impl FrameTargets {
         ]
     }
 
+    /// The gather's resolution in pixels: the output size, or half of it rounded up.
     pub fn gather_size(&self) -> (u32, u32) {
         gather_size(self.width, self.height, self.half)
     }

@@ -19,21 +19,27 @@ pub const FRAGMENT_BYTES: u64 = 16;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuFragmentGrid {
+    /// World position of the grid's minimum corner, metres.
     pub origin: [f32; 3],
+    /// Voxels per side.
     pub resolution: u32,
+    /// Edge length of a voxel, metres.
     pub voxel_size: f32,
+    /// Padding to the WGSL struct's 32 bytes; zero.
     pub _pad: [u32; 3],
 }
 
 /// The fragment buffer of one grid, and its count.
 pub struct Fragments {
+    /// The grid the fragments lie on (finest voxel level).
     pub grid: Grid,
     /// Where the fragments lie (`FragmentGrid`).
     pub grid_uniform: wgpu::Buffer,
     /// The fragments; its length is the capacity.
     pub buffer: wgpu::Buffer,
-    /// [0]: fragments made by the last build, counted past the capacity.
+    /// `[0]`: fragments made by the last build, counted past the capacity.
     pub count: wgpu::Buffer,
+    /// Fragments `buffer` holds; a build that makes more counts them and drops the rest.
     pub capacity: u32,
 }
 
@@ -77,6 +83,8 @@ impl Fragments {
         encoder.clear_buffer(&self.count, 0, None);
     }
 
+    /// GPU memory held, by buffer name, in bytes (the fragment buffer; the small buffers are left
+    /// out).
     pub fn memory(&self) -> Vec<(&'static str, u64)> {
         vec![("voxel fragments", self.buffer.size())]
     }
@@ -113,6 +121,8 @@ pub struct FragmentEstimate {
 }
 
 impl FragmentEstimate {
+    /// Sums the projected areas, perimeters and count of every instance's triangles, in world
+    /// space.
     pub fn of(scene: &voxgi_scene::Scene) -> Self {
         let mut e = FragmentEstimate::default();
         // Area-light emitters count too: voxelize keeps them as occluders.

@@ -6,12 +6,14 @@ use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 
+/// The voxelize compute pass (shaders/fragments/voxelize.wgsl): its pipeline and bind group layout.
 pub struct VoxelizePass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 impl VoxelizePass {
+    /// Compiles the pipeline and creates its bind group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -43,6 +45,9 @@ impl VoxelizePass {
         VoxelizePass { pipeline, layout }
     }
 
+    /// Records the pass over `triangles` (a buffer of per-triangle draw index, first index and base
+    /// vertex, and the triangle count), one workgroup per triangle, appending to `fragments` and
+    /// its count; clear the count first (`Fragments::record_clear`). Timed as "voxelize".
     pub fn record(
         &self,
         device: &wgpu::Device,

@@ -28,6 +28,8 @@ pub struct CounterReadback {
 }
 
 impl CounterReadback {
+    /// An empty pool for `count` counters; buffers (labelled `label`) are made as requests need
+    /// them.
     pub fn new(label: &'static str, count: usize) -> Self {
         CounterReadback {
             label,

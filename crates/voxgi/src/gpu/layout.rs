@@ -2,6 +2,7 @@
 
 use wgpu::{BindGroupLayoutEntry as Entry, BindingType, ShaderStages};
 
+/// A uniform buffer at `binding`, with a dynamic offset if `dynamic`.
 pub fn uniform(binding: u32, visibility: ShaderStages, dynamic: bool) -> Entry {
     Entry {
         binding,
@@ -15,6 +16,7 @@ pub fn uniform(binding: u32, visibility: ShaderStages, dynamic: bool) -> Entry {
     }
 }
 
+/// A storage buffer at `binding`, read-only or read-write.
 pub fn storage(binding: u32, visibility: ShaderStages, read_only: bool) -> Entry {
     Entry {
         binding,
@@ -28,6 +30,7 @@ pub fn storage(binding: u32, visibility: ShaderStages, read_only: bool) -> Entry
     }
 }
 
+/// A single-sampled texture at `binding` of the given sample type and view dimension.
 pub fn texture(
     binding: u32,
     visibility: ShaderStages,
@@ -56,6 +59,7 @@ pub fn texture_2d_load(binding: u32, visibility: ShaderStages) -> Entry {
     )
 }
 
+/// A write-only 2D storage texture of `format` at `binding`, for compute shaders.
 pub fn storage_texture(binding: u32, format: wgpu::TextureFormat) -> Entry {
     Entry {
         binding,
@@ -69,6 +73,7 @@ pub fn storage_texture(binding: u32, format: wgpu::TextureFormat) -> Entry {
     }
 }
 
+/// A filtering sampler at `binding`.
 pub fn sampler(binding: u32, visibility: ShaderStages) -> Entry {
     Entry {
         binding,
@@ -90,6 +95,7 @@ pub fn entries<'a>(resources: Vec<wgpu::BindingResource<'a>>) -> Vec<wgpu::BindG
         .collect()
 }
 
+/// A write-only 3D storage texture of `format` at `binding`, for compute shaders.
 pub fn storage_texture_3d(binding: u32, format: wgpu::TextureFormat) -> Entry {
     Entry {
         binding,

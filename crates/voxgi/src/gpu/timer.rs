@@ -6,6 +6,8 @@ use crate::{Error, Result};
 
 const MAX_SCOPES: u32 = 512;
 
+/// Timestamp queries for up to 512 pass scopes a frame, resolved into a buffer and read back
+/// after submission. Inert (all `None`) when disabled or when the device lacks `TIMESTAMP_QUERY`.
 pub struct GpuTimer {
     query_set: Option<wgpu::QuerySet>,
     resolve: Option<wgpu::Buffer>,
@@ -69,6 +71,8 @@ impl GpuTimer {
         Some((qs, i * 2))
     }
 
+    /// Timestamp writes for a compute pass named `label`, or `None` when the timer is off or the
+    /// frame's scopes are used up.
     pub fn compute(&mut self, label: &'static str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.next(label)
             .map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
@@ -78,6 +82,8 @@ impl GpuTimer {
             })
     }
 
+    /// Timestamp writes for a render pass named `label`, or `None` when the timer is off or the
+    /// frame's scopes are used up.
     pub fn render(&mut self, label: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
         self.next(label)
             .map(|(query_set, i)| wgpu::RenderPassTimestampWrites {

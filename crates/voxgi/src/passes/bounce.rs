@@ -8,6 +8,8 @@ use crate::gpu::timer::GpuTimer;
 use crate::voxel::VoxelStructure;
 use crate::voxel::dense::DenseVolume;
 
+/// The bounce pass (shaders/bounce.wgsl and bounce_store.wgsl): the gather and store pipelines
+/// and the layout of their cone uniform.
 pub struct BouncePass {
     gather: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
@@ -15,6 +17,8 @@ pub struct BouncePass {
 }
 
 impl BouncePass {
+    /// Compiles both pipelines; `anisotropic` must match the volume's mode (the gather samples all
+    /// three axes of an anisotropic volume).
     pub fn new(device: &wgpu::Device, anisotropic: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -43,6 +47,9 @@ impl BouncePass {
         }
     }
 
+    /// Records one bounce over the leaves of `voxels` with the diffuse cones in `cones` (`Cones` in
+    /// shared/volume.wgsl), then the store into the finest level, both as indirect dispatches timed
+    /// as "bounce". The volume must be filtered again before it is sampled.
     pub fn record(
         &self,
         device: &wgpu::Device,

@@ -11,8 +11,11 @@ use crate::targets::FrameTargets;
 
 const FILTERABLE: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: true };
 
+/// Format of the HDR target the composite writes: linear radiance, RGBA f32 (read back by
+/// headless rendering and tone mapped to the output).
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
+/// The composite compute pass (shaders/composite.wgsl): its pipeline and bind group layout.
 pub struct CompositePass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -51,6 +54,9 @@ impl CompositePass {
     }
 
     // The pass reads everything the frame has made so far; a struct for it would only rename.
+    /// Records the composite over the whole frame (8x8-pixel workgroups) into `t.hdr`, reading the
+    /// G-buffer, the upsampled gather results, the shadow atlas and the BRDF tables. Timed as
+    /// "composite".
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,

@@ -13,6 +13,8 @@ use crate::voxel::VoxelStructure;
 use crate::voxel::dense::DenseVolume;
 use voxgi_scene::Scene;
 
+/// Format of the gather's indirect-light target: rgb the indirect radiance towards the camera,
+/// a the ambient occlusion.
 pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Cone-traced visibility of up to four area lights.
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -30,6 +32,8 @@ pub fn has_glossy(scene: &Scene, point_count: u32) -> bool {
             .any(|m| m.specular > 0.0 || m.metallic > 0.0)
 }
 
+/// The gather compute pass (shaders/gather.wgsl): its pipeline and the layouts of its globals
+/// (group 0) and its own targets (group 2).
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
@@ -83,6 +87,9 @@ impl GatherPass {
     }
 
     // The pass reads what the frame and the volume hold; a struct for it would only rename.
+    /// Records the gather at `t.gather_size()` (8x8-pixel workgroups) into the low-resolution
+    /// indirect, visibility and guide targets, sampling `voxels` with the diffuse cones in `cones`.
+    /// Timed as "gather".
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,

@@ -6,11 +6,17 @@ use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::targets::FrameTargets;
 
+/// G-buffer albedo target: rgb linear base colour, a metallic.
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer normal target: rgb world-space unit normal (facing the viewer), a perceptual roughness.
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer emission target: rgb emitted radiance, a specular reflectance.
 pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer depth target (cleared to 1, less-than test).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// The G-buffer render pass (shaders/gbuffer.wgsl): the mesh and surfel pipelines and their
+/// shared bind group layout.
 pub struct GbufferPass {
     pipeline: wgpu::RenderPipeline,
     /// Surfels: 6 vertices per point, no index buffer.
@@ -19,6 +25,7 @@ pub struct GbufferPass {
 }
 
 impl GbufferPass {
+    /// Compiles both pipelines (no culling) and creates their bind group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -88,6 +95,8 @@ impl GbufferPass {
         }
     }
 
+    /// Records the pass: clears the G-buffer targets of `t`, draws every mesh draw call of `scene`,
+    /// then its points as surfels. Timed as "gbuffer".
     pub fn record(
         &self,
         device: &wgpu::Device,

@@ -9,6 +9,8 @@ use crate::voxel::VoxelStructure;
 use crate::voxel::dense::DenseVolume;
 use wgpu::util::DeviceExt;
 
+/// The inject compute pass (shaders/inject.wgsl): its pipeline, the layout of its globals, and
+/// the uniform holding the scene's light count.
 pub struct InjectPass {
     pipeline: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
@@ -16,6 +18,7 @@ pub struct InjectPass {
 }
 
 impl InjectPass {
+    /// Compiles the pipeline for a scene of `light_count` lights (fixed until the pass is rebuilt).
     pub fn new(device: &wgpu::Device, light_count: u32) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
@@ -43,6 +46,8 @@ impl InjectPass {
         }
     }
 
+    /// Records the injection of direct light (shadowed by `atlas`) and emission into every leaf of
+    /// `voxels` as an indirect dispatch. Timed as "inject".
     pub fn record(
         &self,
         device: &wgpu::Device,

@@ -9,6 +9,8 @@ use crate::shadow_atlas::{
     ATLAS_FORMAT, GpuShadowView, ShadowAtlas, UNIFORM_STRIDE, behind_emitter,
 };
 
+/// The shadow render pass (shaders/shadow.wgsl): the mesh and surfel pipelines writing distance
+/// maps into the shadow atlas, and their bind group layout.
 pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
     /// Point-cloud surfels: 6 vertices per point, no index buffer.
@@ -17,6 +19,7 @@ pub struct ShadowPass {
 }
 
 impl ShadowPass {
+    /// Compiles both pipelines (no culling) and creates their bind group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let vs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -74,6 +77,9 @@ impl ShadowPass {
         }
     }
 
+    /// Records one render pass per shadow view of `atlas` into its layer (skipping views that only
+    /// see the back of their emitter), drawing every mesh except the light's own emitter, and the
+    /// points. Timed as "shadow" (summed over the views).
     pub fn record(
         &self,
         device: &wgpu::Device,

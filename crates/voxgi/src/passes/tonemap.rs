@@ -8,6 +8,8 @@ use crate::gpu::shader;
 use crate::gpu::timer::GpuTimer;
 use crate::targets::FrameTargets;
 
+/// The tonemap render pass (shaders/tonemap.wgsl): a full-screen draw from the HDR target into
+/// the caller's texture, with one pipeline per target format.
 pub struct TonemapPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
@@ -24,6 +26,7 @@ fn encodes_srgb(format: wgpu::TextureFormat) -> bool {
 }
 
 impl TonemapPass {
+    /// Compiles the shader and creates the layouts; pipelines are made per format by `prepare`.
     pub fn new(device: &wgpu::Device) -> Self {
         let f = wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -9,12 +9,15 @@ use crate::gpu::timer::GpuTimer;
 use crate::passes::gather::INDIRECT_FORMAT;
 use crate::targets::FrameTargets;
 
+/// The upsample compute pass, stage one (shaders/upsample.wgsl): its pipeline and bind group
+/// layout.
 pub struct UpsamplePass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 impl UpsamplePass {
+    /// Compiles the pipeline and creates its bind group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -32,6 +35,8 @@ impl UpsamplePass {
         }
     }
 
+    /// Records the edge-aware 4x4 filter of `t.indirect_low` (guided by `t.guide_low`) into
+    /// `t.indirect`, at the gather's resolution. Timed as "upsample".
     pub fn record(
         &self,
         device: &wgpu::Device,

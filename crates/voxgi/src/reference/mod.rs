@@ -45,14 +45,20 @@ pub enum ReferenceMode {
     /// Ambient occlusion: the fraction of cosine-weighted rays from the first hit that travel
     /// `radius` metres without hitting anything, as grey radiance in [0, 1] (pixels that see
     /// nothing are 1). Its LDR output is that value, without exposure or tone curve.
-    Ao { radius: f32 },
+    Ao {
+        /// How far the rays reach, metres (positive and finite).
+        radius: f32,
+    },
 }
 
+/// Options of one reference render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReferenceOptions {
     /// Samples per pixel.
     pub spp: u32,
+    /// How many indirect bounces paths take (radiance mode only).
     pub bounces: Bounces,
+    /// Radiance or ambient occlusion.
     pub mode: ReferenceMode,
     /// The same seed gives the same image.
     pub seed: u32,
@@ -92,9 +98,14 @@ struct GpuParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuNode {
+    /// World-space box minimum, metres.
     pub lo: [f32; 3],
+    /// Inner node (`count` 0): index of the first of its two adjacent children. Leaf: index of its
+    /// first triangle.
     pub first: u32,
+    /// World-space box maximum, metres.
     pub hi: [f32; 3],
+    /// Triangles in a leaf (`first .. first + count`); 0 for an inner node.
     pub count: u32,
 }
 
@@ -102,11 +113,17 @@ pub struct GpuNode {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuTri {
+    /// First vertex, world space, metres.
     pub p0: [f32; 3],
+    /// Index into the scene's materials.
     pub material: u32,
+    /// Second vertex, world space, metres.
     pub p1: [f32; 3],
+    /// The area light this triangle shows, or `NO_INDEX`.
     pub light: u32,
+    /// Third vertex, world space, metres.
     pub p2: [f32; 3],
+    /// Padding to a multiple of 16 bytes; zero.
     pub _pad: u32,
 }
 
@@ -114,9 +131,13 @@ pub struct GpuTri {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuTriShading {
+    /// World-space unit normal of the first vertex; w is its u.
     pub n0: [f32; 4],
+    /// World-space unit normal of the second vertex; w is the first vertex's v.
     pub n1: [f32; 4],
+    /// World-space unit normal of the third vertex; w is the second vertex's u.
     pub n2: [f32; 4],
+    /// The remaining texture coordinates: (v1, u2, v2, unused).
     pub uv: [f32; 4],
 }
 
@@ -143,8 +164,11 @@ pub struct PathTracer {
 
 /// World-space triangles in BVH order, and the flattened BVH over them.
 pub struct FlatScene {
+    /// The flattened BVH; node 0 is the root.
     pub nodes: Vec<GpuNode>,
+    /// The triangles, in the order the leaves index them.
     pub tris: Vec<GpuTri>,
+    /// Shading attributes of `tris`, in the same order.
     pub shading: Vec<GpuTriShading>,
 }
 

@@ -103,6 +103,7 @@ pub fn filter_parent(children: &[Vec4; 8], dir: Option<u32>) -> Vec4 {
 
 /// A 3D texture's mip chain on the CPU: texels (x fastest) and size per level.
 pub struct Texture3d {
+    /// Per mip level, finest first: the texels (x fastest, then y, then z) and the size in texels.
     pub levels: Vec<(Vec<Vec4>, UVec3)>,
 }
 
@@ -145,9 +146,13 @@ impl Texture3d {
 /// The dense volume as `voxels/dense/sample.wgsl` reads it: placement, the finest level and
 /// the directional chains (six blocks stacked along z, or one).
 pub struct DenseSampler<'a> {
+    /// The volume's placement (origin, voxel size, finest resolution).
     pub grid: Grid,
+    /// Whether `chains` holds six directional blocks (stacked along z) rather than one.
     pub anisotropic: bool,
+    /// The finest level: stored (L sigma, sigma) per voxel.
     pub radiance0: &'a Texture3d,
+    /// The levels above the finest, from half the resolution down: stored (L sigma, sigma).
     pub chains: &'a Texture3d,
 }
 

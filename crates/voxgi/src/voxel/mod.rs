@@ -19,8 +19,12 @@ use glam::Vec3;
 /// along directional chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) where there are chains.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DebugView {
+    /// Which voxel property to show (`ViewMode::is_voxel` holds).
     pub mode: ViewMode,
+    /// Mip level to show, 0 = finest.
     pub level: u32,
+    /// Directional chain to show, 0..6 for +X, -X, +Y, -Y, +Z, -Z (ignored where there are no
+    /// chains).
     pub direction: u32,
 }
 
@@ -82,11 +86,17 @@ pub trait VoxelStructure {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVolume {
+    /// World position of the volume's minimum corner, metres.
     pub origin: [f32; 3],
+    /// Voxels per side at the finest level.
     pub resolution: u32,
+    /// Edge length of a finest voxel, metres.
     pub voxel_size: f32,
+    /// Mip levels including the finest.
     pub levels: u32,
+    /// 1: six directional values per voxel above the finest level, 0: one.
     pub anisotropic: u32,
+    /// Padding to 32 bytes; zero.
     pub _pad: u32,
 }
 
@@ -94,22 +104,35 @@ pub struct GpuVolume {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuCones {
+    /// Per cone: tangent-space axis (xyz, z = normal) and weight (w; the cone's share of the
+    /// cosine-weighted hemisphere, summing to 1 over the cones). Entries past `count` are zero.
     pub dirs: [[f32; 4]; 16],
+    /// Number of cones used in `dirs` (at most 16).
     pub count: u32,
+    /// Tangent of the diffuse cones' half-angle.
     pub diffuse_tan: f32,
+    /// Sample step as a fraction of the cone diameter.
     pub step_factor: f32,
+    /// Cones stop after this distance, metres.
     pub max_distance: f32,
+    /// Ambient occlusion falloff lambda in 1/(1 + lambda r), per metre.
     pub ao_lambda: f32,
+    /// Ambient occlusion rays stop at this distance, metres.
     pub ao_radius: f32,
+    /// Offset of the cone origin along the normal, in finest voxels.
     pub origin_offset: f32,
+    /// 1: the per-pixel gather adds indirect light, 0: it does not (bounces = 0).
     pub indirect: u32,
 }
 
 /// A cubic grid over the scene: `resolution` voxels per side from `origin`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
+    /// World position of the grid's minimum corner, metres.
     pub origin: Vec3,
+    /// Edge length of a voxel, metres.
     pub voxel_size: f32,
+    /// Voxels per side (a power of two).
     pub resolution: u32,
 }
 
@@ -132,6 +155,7 @@ impl Grid {
         }
     }
 
+    /// Edge length of the whole grid, metres.
     pub fn extent(&self) -> f32 {
         self.voxel_size * self.resolution as f32
     }
@@ -155,6 +179,7 @@ pub enum ConeSet {
 }
 
 impl ConeSet {
+    /// The set's name as settings and the command line spell it: "6x60", "7x45" or "9x45".
     pub fn name(&self) -> &'static str {
         match self {
             ConeSet::Six60 => "6x60",
@@ -163,6 +188,7 @@ impl ConeSet {
         }
     }
 
+    /// The set named `s` (as `name` spells it), or `None`.
     pub fn parse(s: &str) -> Option<Self> {
         [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45]
             .into_iter()

@@ -11,12 +11,15 @@ use crate::passes::composite::HDR_FORMAT;
 use crate::targets::FrameTargets;
 use wgpu::util::DeviceExt;
 
+/// The voxel debug compute pass (shaders/voxels/dense/debug.wgsl): its pipeline and bind group
+/// layout.
 pub struct DebugPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 impl DebugPass {
+    /// Compiles the pipeline and creates its bind group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -8,6 +8,7 @@ use wgpu::util::DeviceExt;
 
 const STRIDE: u64 = 256;
 
+/// The filter compute pass (shaders/voxels/dense/filter.wgsl): its pipeline and bind group layout.
 pub struct FilterPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -22,6 +23,7 @@ struct Step {
 }
 
 impl FilterPass {
+    /// Compiles the pipeline and creates its bind group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -56,6 +58,9 @@ impl FilterPass {
             .collect()
     }
 
+    /// Records the filtering of every level above the finest, coarsest last: one dispatch per
+    /// level, each reading the level below it (the finest level's `radiance` for the first) and
+    /// writing every block of `chains`. Timed as "filter" (summed over the levels).
     pub fn record(
         &self,
         device: &wgpu::Device,

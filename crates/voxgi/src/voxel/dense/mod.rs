@@ -25,9 +25,14 @@ use filter::FilterPass;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
+/// Format of the radiance textures (finest level and chains): optical depth, rgb L·sigma and
+/// a sigma (see `to_depth` in shaders/shared/volume.wgsl).
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Format of the finest level's albedo: rgb linear albedo, a opacity.
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Format of the finest level's normals: xyz mean normal, w how well the fragments' normals agree.
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Snorm;
+/// Format of the finest level's emission: rgb emitted radiance, W/(m² sr).
 pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// u32 sums per slot (`ACCUM_STRIDE` in dense_build.wgsl).
 const ACCUM_STRIDE: u64 = 10;
@@ -36,29 +41,45 @@ pub const SLOT_BYTES: u64 = ACCUM_STRIDE * 4;
 /// Directions of the anisotropic chains, in the order of `filter.wgsl`.
 pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
 
+/// The dense volume: the finest level's textures, the compact slots of its occupied voxels, the
+/// radiance mip chains above it, and the bind groups the passes reach it through.
 pub struct DenseVolume {
+    /// Where the volume lies and its finest resolution.
     pub grid: Grid,
+    /// Six directional chains (true) or one isotropic chain.
     pub anisotropic: bool,
+    /// The volume's placement as a `GpuVolume` uniform.
     pub volume: wgpu::Buffer,
     /// Occupied voxels the slot buffers hold.
     pub slot_capacity: u32,
-    /// [0] occupied voxels (slots, counted past the capacity), [1] slots of the previous build.
+    /// `[0]` occupied voxels (slots, counted past the capacity), `[1]` slots of the previous build.
     pub counters: wgpu::Buffer,
+    /// Per finest voxel (x fastest): 0 empty, 2 + slot once allocated, or a lock value while
+    /// allocating or past the capacity.
     pub occupancy: wgpu::Buffer,
+    /// Per slot: the linear index of its voxel.
     pub slot_voxel: wgpu::Buffer,
     accum: wgpu::Buffer,
+    /// Per slot: direct radiance (rgb) and opacity from inject, kept for the bounces (vec4 f32).
     pub slot_direct: wgpu::Buffer,
+    /// Per slot: the last bounce's outgoing radiance and opacity (vec4 f32).
     pub slot_next: wgpu::Buffer,
     /// Indirect dispatch sizes: [0..3] over slots, [3..6] over fragments.
     pub args: wgpu::Buffer,
+    /// Finest level: albedo and opacity per voxel (`ALBEDO_FORMAT`).
     pub albedo: wgpu::Texture,
+    /// Finest level: mean normal and normal agreement per voxel (`NORMAL_FORMAT`).
     pub normal: wgpu::Texture,
+    /// Finest level: emitted radiance per voxel (`EMISSION_FORMAT`).
     pub emission: wgpu::Texture,
+    /// Finest level: radiance as optical depth (`RADIANCE_FORMAT`), written by inject and the
+    /// bounces.
     pub radiance: wgpu::Texture,
     /// The directional chains (+X, -X, +Y, -Y, +Z, -Z) as `chain_blocks()` blocks stacked along z,
     /// each block one level coarser than the finest. In isotropic mode one block, the isotropic
     /// chain.
     pub chains: wgpu::Texture,
+    /// Trilinear, clamp-to-edge sampler for `radiance` and `chains`.
     pub sampler: wgpu::Sampler,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
@@ -156,6 +177,7 @@ pub fn mip_view(t: &wgpu::Texture, mip: u32) -> wgpu::TextureView {
 }
 
 impl DensePipelines {
+    /// Compiles the build pipelines and the filter and debug passes.
     pub fn new(device: &wgpu::Device) -> Arc<Self> {
         let build_layout = build_layout(device);
         let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
