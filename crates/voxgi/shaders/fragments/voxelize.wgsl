@@ -170,13 +170,6 @@ fn main(
             if m.emissive_texture >= 0 {
                 emission *= textureSampleLevel(textures, texture_sampler, uv, m.emissive_texture, lod).rgb;
             }
-            // The visible surface of an area light: its light reaches surfaces as the light's
-            // direct term (shaded per pixel, injected per voxel), so in the voxels it would
-            // count twice, and as an isotropic voxel it would also shine sideways from an
-            // emitter that is one-sided and flat. It stays an occluder.
-            if draw.light != NO_INDEX {
-                emission = vec3<f32>(0.0);
-            }
             let coord = vec3<u32>(cell);
             let slot = atomicAdd(&fragment_count[0], 1u);
             if slot < arrayLength(&fragments) {

@@ -125,8 +125,8 @@ impl FragmentEstimate {
     /// space.
     pub fn of(scene: &voxgi_scene::Scene) -> Self {
         let mut e = FragmentEstimate::default();
-        // Area-light emitters count too: voxelize keeps them as occluders.
-        for inst in &scene.instances {
+        // Area-light emitters make no fragments (`triangle_table`).
+        for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
             let m = &scene.meshes[inst.mesh];
             for t in m.indices.chunks_exact(3) {
                 let [a, b, c] = [t[0], t[1], t[2]]
@@ -152,8 +152,11 @@ impl FragmentEstimate {
 pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> (wgpu::Buffer, u32) {
     let mut t: Vec<[u32; 4]> = Vec::new();
     for call in &scene.calls {
-        // The visible surface of an area light is lit analytically; voxelizing it too would
-        // count its light twice.
+        // The visible surface of an area light is not voxelized, neither as an emitter (its
+        // light reaches surfaces as the light's direct term, shaded per pixel and injected per
+        // voxel, so it would count twice, and an isotropic voxel would shine sideways from a
+        // one-sided flat emitter) nor as an occluder: a free-standing lamp voxelized as an
+        // opaque slab moved the image further from the path tracer (docs/QUALITY.md).
         if call.light.is_some() {
             continue;
         }
