@@ -167,6 +167,9 @@ pub struct Renderer {
     /// The voxels (and shadow maps) must be rebuilt in the next frame.
     dirty: bool,
     counters: CounterReadback,
+    /// Counts every replacement of the fragments or the volume, so that counters read back
+    /// from pools that are gone are not acted on.
+    pools: u64,
     last_counts: Option<VoxelCounts>,
     timer: GpuTimer,
     targets: Option<FrameTargets>,
@@ -289,6 +292,7 @@ impl Renderer {
             voxel_bounces,
             dirty: true,
             counters: CounterReadback::new("voxel counters readback", 2),
+            pools: 0,
             last_counts: None,
             timer: GpuTimer::disabled(queue),
             targets: None,
@@ -369,6 +373,7 @@ impl Renderer {
         if let Some((f, v)) = volume_new {
             self.fragments = f;
             self.volume = v;
+            self.pools += 1;
         }
         if let Some(p) = gather_new {
             self.passes.gather = p;
@@ -460,6 +465,7 @@ impl Renderer {
             &self.device,
             encoder,
             &[&self.fragments.count, self.volume.leaf_counter()],
+            self.pools,
         ) {
             log::warn!("voxel counters: too many readbacks in flight; is the encoder submitted?");
         }
@@ -487,7 +493,10 @@ impl Renderer {
     pub fn receive_feedback(&mut self) -> Result<bool> {
         // Non-blocking: runs the callbacks of maps that have completed.
         let _ = self.device.poll(wgpu::PollType::Poll);
-        for words in self.counters.take_ready() {
+        for (pools, words) in self.counters.take_ready() {
+            if pools != self.pools {
+                continue;
+            }
             let counts = VoxelCounts {
                 fragments: words[0] as u64,
                 occupied: words[1] as u64,
@@ -511,6 +520,7 @@ impl Renderer {
                 let slots = slot_capacity(&self.device, counts.occupied)?;
                 self.volume.grow(&self.device, slots as u64);
             }
+            self.pools += 1;
             log::info!(
                 "voxels: {} fragments, {} occupied voxels: growing the pools to {} fragments \
                  and {} voxels and rebuilding",

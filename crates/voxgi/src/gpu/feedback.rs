@@ -18,6 +18,8 @@ const MAX_IN_FLIGHT: usize = 8;
 struct Slot {
     buffer: wgpu::Buffer,
     state: Arc<AtomicU8>,
+    /// The caller's tag for what was read (which pools), returned with the values.
+    tag: u64,
 }
 
 /// A pool of readback buffers for `count` counters, each the first `u32` of its own buffer.
@@ -39,13 +41,14 @@ impl CounterReadback {
     }
 
     /// Records a copy of the first `u32` of each of `sources` (`count` of them) and the map
-    /// on submission. Returns false when too many reads are still in flight (nothing is
-    /// recorded).
+    /// on submission; `tag` comes back with the values. Returns false when too many reads are
+    /// still in flight (nothing is recorded).
     pub fn request(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         sources: &[&wgpu::Buffer],
+        tag: u64,
     ) -> bool {
         debug_assert_eq!(sources.len(), self.count);
         let i = match self
@@ -63,12 +66,14 @@ impl CounterReadback {
                         mapped_at_creation: false,
                     }),
                     state: Arc::new(AtomicU8::new(IDLE)),
+                    tag: 0,
                 });
                 self.slots.len() - 1
             }
             None => return false,
         };
-        let slot = &self.slots[i];
+        let slot = &mut self.slots[i];
+        slot.tag = tag;
         slot.state.store(IN_FLIGHT, Ordering::Release);
         for (i, src) in sources.iter().enumerate() {
             encoder.copy_buffer_to_buffer(src, 0, &slot.buffer, 4 * i as u64, 4);
@@ -80,15 +85,15 @@ impl CounterReadback {
         true
     }
 
-    /// Every read completed since the last call, oldest first, as u32 words. Call after a
+    /// Every read completed since the last call, as (tag, u32 words). Call after a
     /// non-blocking `Device::poll` so that completed maps have run their callbacks.
-    pub fn take_ready(&mut self) -> Vec<Vec<u32>> {
+    pub fn take_ready(&mut self) -> Vec<(u64, Vec<u32>)> {
         let mut out = Vec::new();
         for s in &self.slots {
             match s.state.load(Ordering::Acquire) {
                 READY => {
                     if let Ok(view) = s.buffer.slice(..).get_mapped_range() {
-                        out.push(bytemuck::cast_slice(&view).to_vec());
+                        out.push((s.tag, bytemuck::cast_slice(&view).to_vec()));
                     }
                     s.buffer.unmap();
                     s.state.store(IDLE, Ordering::Release);

@@ -198,3 +198,33 @@ fn invalid_scene_data_is_an_error_not_a_panic() {
         .expect("must fail");
     assert!(err.to_string().contains("out of range"), "{err}");
 }
+
+/// A device opened without voxgi's limits is refused with an error that names what it lacks,
+/// before anything is created on it.
+#[test]
+fn a_device_below_the_minimum_limits_is_refused_by_name() {
+    use voxgi::wgpu;
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter =
+        pollster::block_on(instance.request_adapter(&Default::default())).expect("an adapter");
+    // GLES 3.1-level limits: among others a 3D texture side of 256 where voxgi needs 2048.
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_limits: wgpu::Limits::downlevel_defaults(),
+        ..Default::default()
+    }))
+    .expect("a device with low limits");
+    let scene = voxgi::scene::builtin::cornell_box();
+    match voxgi::Renderer::new(&device, &queue, &scene, &RendererOptions::default()) {
+        Err(Error::DeviceLimits(msg)) => {
+            assert!(msg.contains("max_texture_dimension_3d"), "{msg}");
+            let e = Error::DeviceLimits(msg).to_string();
+            assert!(
+                e.contains("required_limits"),
+                "the error says how to fix it: {e}"
+            );
+        }
+        Err(e) => panic!("wrong error: {e}"),
+        Ok(_) => panic!("a device below the minimum was accepted"),
+    }
+}
