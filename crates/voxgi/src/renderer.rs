@@ -592,8 +592,14 @@ impl Renderer {
     /// whole extent). Submit the encoder before the next call: the frame's uniforms are written
     /// through the queue, so two frames in one submission would share the last one's.
     ///
-    /// On the first frame (and after `invalidate`) this also records the voxel update. Nothing
-    /// here waits for the GPU.
+    /// The target's texture needs `TextureUsages::RENDER_ATTACHMENT` (nothing else), in a
+    /// renderable colour format: `Bgra8UnormSrgb` or `Rgba8UnormSrgb` (a swapchain's; the GPU
+    /// encodes sRGB), `Rgba8Unorm` or `Bgra8Unorm` (voxgi applies the sRGB curve), or a float
+    /// format such as `Rgba16Float` (tone-mapped linear values). Its previous contents are
+    /// overwritten. The first frame in a new format creates that format's pipeline.
+    ///
+    /// On the first frame (and after `invalidate`, a pool's growth or a voxel option's change)
+    /// this also records the voxel update. Nothing here waits for the GPU.
     pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
