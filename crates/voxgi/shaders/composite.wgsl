@@ -1,31 +1,25 @@
 // composite: deferred shading. Direct light from every light (with shadows), emission and the
 // gathered indirect light, in linear radiance, written to the HDR target.
 
-//!include shared/scene.wgsl
+//!include shared/globals.wgsl
 //!include shared/lights.wgsl
 //!include shared/upsample.wgsl
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> lights: array<Light>;
-@group(0) @binding(2) var<storage, read> shadow_views: array<ShadowView>;
-@group(0) @binding(3) var shadow_maps: texture_2d_array<f32>;
-@group(0) @binding(4) var gb_albedo: texture_2d<f32>;
-@group(0) @binding(5) var gb_normal: texture_2d<f32>;
-@group(0) @binding(6) var gb_emission: texture_2d<f32>;
-@group(0) @binding(7) var gb_depth: texture_depth_2d;
-@group(0) @binding(8) var hdr: texture_storage_2d<rgba32float, write>;
+// Group 0: the frame's globals (shared/globals.wgsl): the lights, the shadow atlas, and over
+// (n.v, roughness) the inverse matrices of the linearly transformed cosines fitted to the GGX
+// lobe (m00, m02, m20, m22, with m11 = 1; tools/fit_ltc.py; f32, interpolated here) and the
+// lobe's directional albedo (a, b: f0 a + f90 b), both from voxgi::brdf. Group 2, the pass's:
+@group(2) @binding(0) var gb_albedo: texture_2d<f32>;
+@group(2) @binding(1) var gb_normal: texture_2d<f32>;
+@group(2) @binding(2) var gb_emission: texture_2d<f32>;
+@group(2) @binding(3) var gb_depth: texture_depth_2d;
+@group(2) @binding(4) var hdr: texture_storage_2d<rgba32float, write>;
 // At the gather's resolution: rgb indirect radiance, a ambient occlusion (upsample stage one).
-@group(0) @binding(9) var indirect: texture_2d<f32>;
+@group(2) @binding(5) var indirect: texture_2d<f32>;
 // Cone-traced visibility of the first CONE_SHADOW_LIGHTS area lights, as the gather traced it.
-@group(0) @binding(10) var visibility: texture_2d<f32>;
+@group(2) @binding(6) var visibility: texture_2d<f32>;
 // Each gather sample's normal and camera distance.
-@group(0) @binding(11) var guide: texture_2d<f32>;
-// Over (n.v, roughness): the inverse matrices of the linearly transformed cosines fitted to the
-// GGX lobe (m00, m02, m20, m22, with m11 = 1; tools/fit_ltc.py; f32, interpolated here), and
-// the lobe's directional albedo (a, b: f0 a + f90 b), both from voxgi::brdf.
-@group(0) @binding(12) var ltc_table: texture_2d<f32>;
-@group(0) @binding(13) var specular_table: texture_2d<f32>;
-@group(0) @binding(14) var table_sampler: sampler;
+@group(2) @binding(7) var guide: texture_2d<f32>;
 
 // False when every light's visibility is cone-traced: the shadow-map code is then compiled
 // out. CPU drivers run a branch's code even when no lane takes it, and the shadow-map lookup

@@ -3,19 +3,12 @@
 // lobe's dominant direction whose aperture follows the roughness; with cone shadows, the visibility of the
 // first area lights by one cone each.
 
-//!include shared/scene.wgsl
-//!include shared/volume.wgsl
+//!include shared/globals.wgsl
 //!include shared/brdf.wgsl
 //!include shared/cone.wgsl
 //!include shared/interleave.wgsl
 
-// Group 0, the frame's globals.
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> cones: Cones;
-@group(0) @binding(2) var<storage, read> lights: array<Light>;
-// The specular lobe's directional albedo: (a, b) over (n.v, roughness).
-@group(0) @binding(3) var specular_table: texture_2d<f32>;
-@group(0) @binding(4) var table_sampler: sampler;
+// Group 0: the frame's globals (shared/globals.wgsl).
 // Group 1: the voxel structure (voxels/<kind>/sample.wgsl). Group 2, the pass's own:
 @group(2) @binding(0) var gb_albedo: texture_2d<f32>;
 @group(2) @binding(1) var gb_normal: texture_2d<f32>;

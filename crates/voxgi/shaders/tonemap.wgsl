@@ -3,10 +3,9 @@
 // in the blending unit, 8-bit linear ones get the sRGB curve here (ENCODE_SRGB), float ones get
 // the tone-mapped linear values.
 
-//!include shared/scene.wgsl
+//!include shared/globals.wgsl
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var hdr: texture_2d<f32>;
+@group(2) @binding(0) var hdr: texture_2d<f32>;
 
 // True for an 8-bit target without an sRGB view: the shader applies the sRGB curve itself.
 override ENCODE_SRGB: bool = false;

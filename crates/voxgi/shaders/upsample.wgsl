@@ -3,15 +3,14 @@
 // similarity, so it holds all sixteen rotations while light does not bleed across silhouettes
 // and creases. The composite upsamples the result to full resolution (shared/upsample.wgsl).
 
-//!include shared/scene.wgsl
+//!include shared/globals.wgsl
 //!include shared/interleave.wgsl
 //!include shared/upsample.wgsl
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var low: texture_2d<f32>;
+@group(2) @binding(0) var low: texture_2d<f32>;
 // Each gather sample's normal (rgb) and distance to the camera (a, 0 for background).
-@group(0) @binding(2) var guide: texture_2d<f32>;
-@group(0) @binding(3) var filtered: texture_storage_2d<rgba16float, write>;
+@group(2) @binding(1) var guide: texture_2d<f32>;
+@group(2) @binding(2) var filtered: texture_storage_2d<rgba16float, write>;
 
 // No branch or indexed local array in the loop: CPU drivers run both sides of lane-divergent
 // branches and spill indexed arrays to memory.

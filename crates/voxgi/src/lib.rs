@@ -37,6 +37,7 @@ pub mod brdf;
 pub mod compare;
 mod error;
 pub mod fragments;
+mod globals;
 pub mod gpu;
 pub mod gpu_scene;
 #[cfg(feature = "headless")]
@@ -64,9 +65,9 @@ pub use options::{
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use renderer::{Renderer, Target, VoxelCounts};
+pub use renderer::{Renderer, VoxelCounts};
 pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
-pub use targets::FrameTargets;
+pub use targets::{FrameTargets, Target};
 pub use voxel::ConeSet;
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;

@@ -29,7 +29,7 @@ use crate::passes::shadow::ShadowPass;
 use crate::passes::tonemap::TonemapPass;
 use crate::passes::upsample::UpsamplePass;
 use crate::shadow_atlas::{self as shadow, ShadowAtlas};
-use crate::targets::FrameTargets;
+use crate::targets::{FrameTargets, Target};
 use crate::view::{camera_view_proj, lit_scene};
 use crate::voxel::dense::{DensePipelines, DenseVolume};
 use crate::voxel::{DebugView, GpuCones, Grid, VoxelStructure};
@@ -38,41 +38,6 @@ use glam::Vec3;
 use std::sync::Arc;
 use voxgi_scene::{Aabb, Camera, Scene, pointcloud};
 use wgpu::util::DeviceExt;
-
-/// The caller's texture a frame is written to: a view of it, its format and size.
-///
-/// The texture needs `TextureUsages::RENDER_ATTACHMENT` and one of the renderable colour
-/// formats: `Bgra8UnormSrgb` and `Rgba8UnormSrgb` (swapchains; encoded to sRGB by the GPU),
-/// `Rgba8Unorm` and `Bgra8Unorm` (voxgi applies the sRGB curve itself), or a float format such
-/// as `Rgba16Float` (tone-mapped linear values).
-#[derive(Clone, Copy, Debug)]
-pub struct Target<'a> {
-    /// A view of the caller's texture (one mip level, one layer).
-    pub view: &'a wgpu::TextureView,
-    /// The texture's format; the tonemap pass makes a pipeline for each format it is given.
-    pub format: wgpu::TextureFormat,
-    /// The texture's width in pixels.
-    pub width: u32,
-    /// The texture's height in pixels.
-    pub height: u32,
-}
-
-impl<'a> Target<'a> {
-    /// A target from a view of the texture and the texture's format and size in pixels.
-    pub fn new(
-        view: &'a wgpu::TextureView,
-        format: wgpu::TextureFormat,
-        width: u32,
-        height: u32,
-    ) -> Self {
-        Target {
-            view,
-            format,
-            width,
-            height,
-        }
-    }
-}
 
 /// Every pass, by name.
 struct Passes {
@@ -155,6 +120,8 @@ pub struct Renderer {
     atlas: ShadowAtlas,
     passes: Passes,
     brdf_tables: BrdfTables,
+    /// The layout of the screen passes' `@group(0)` (`globals`).
+    globals_layout: wgpu::BindGroupLayout,
     fragments: Fragments,
     /// The voxel structure. Inject and bounce still read its leaves (the dense volume's slots)
     /// directly; everything else goes through `VoxelStructure`.
@@ -284,6 +251,7 @@ impl Renderer {
             atlas,
             passes,
             brdf_tables,
+            globals_layout: crate::globals::layout(device),
             fragments,
             volume,
             dense_pipelines,
@@ -628,30 +596,26 @@ impl Renderer {
         let t = self.targets.as_ref().expect("targets were just created");
         self.queue
             .write_buffer(&t.frame, 0, bytemuck::bytes_of(&frame));
+        let globals = crate::globals::bind_group(
+            &self.device,
+            &self.globals_layout,
+            &crate::globals::GlobalsSources {
+                targets: t,
+                cones: &self.cones,
+                scene: &self.scene,
+                atlas: &self.atlas,
+                tables: &self.brdf_tables,
+            },
+        );
         let timer = &mut self.timer;
         let p = &self.passes;
         p.gbuffer
             .record(&self.device, encoder, t, &self.scene, timer);
-        p.gather.record(
-            &self.device,
-            encoder,
-            t,
-            &self.scene,
-            &self.volume,
-            &self.cones,
-            &self.brdf_tables,
-            timer,
-        );
-        p.upsample.record(&self.device, encoder, t, timer);
-        p.composite.record(
-            &self.device,
-            encoder,
-            t,
-            &self.scene,
-            &self.atlas,
-            &self.brdf_tables,
-            timer,
-        );
+        p.gather
+            .record(&self.device, encoder, t, &globals, &self.volume, timer);
+        p.upsample.record(&self.device, encoder, t, &globals, timer);
+        p.composite
+            .record(&self.device, encoder, t, &globals, timer);
         // Only for the voxel views: replaces the composite's output.
         if params.view.is_voxel() {
             self.volume.record_debug(
@@ -667,7 +631,7 @@ impl Renderer {
             );
         }
         p.tonemap
-            .record(&self.device, encoder, t, target.view, target.format, timer);
+            .record(&self.device, encoder, t, &globals, target, timer);
         timer.resolve(encoder);
         Ok(())
     }

@@ -148,3 +148,38 @@ fn gather_size(width: u32, height: u32, half: bool) -> (u32, u32) {
         (width, height)
     }
 }
+
+/// The caller's texture a frame is written to: a view of it, its format and size.
+///
+/// The texture needs `TextureUsages::RENDER_ATTACHMENT` and one of the renderable colour
+/// formats: `Bgra8UnormSrgb` and `Rgba8UnormSrgb` (swapchains; encoded to sRGB by the GPU),
+/// `Rgba8Unorm` and `Bgra8Unorm` (voxgi applies the sRGB curve itself), or a float format such
+/// as `Rgba16Float` (tone-mapped linear values).
+#[derive(Clone, Copy, Debug)]
+pub struct Target<'a> {
+    /// A view of the caller's texture (one mip level, one layer).
+    pub view: &'a wgpu::TextureView,
+    /// The texture's format; the tonemap pass makes a pipeline for each format it is given.
+    pub format: wgpu::TextureFormat,
+    /// The texture's width in pixels.
+    pub width: u32,
+    /// The texture's height in pixels.
+    pub height: u32,
+}
+
+impl<'a> Target<'a> {
+    /// A target from a view of the texture and the texture's format and size in pixels.
+    pub fn new(
+        view: &'a wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        Target {
+            view,
+            format,
+            width,
+            height,
+        }
+    }
+}

@@ -13,6 +13,7 @@ macro_rules! wgsl {
 /// Every WGSL file, by path relative to `crates/voxgi/shaders`.
 const SOURCES: &[(&str, &str)] = wgsl![
     "shared/scene.wgsl",
+    "shared/globals.wgsl",
     "shared/brdf.wgsl",
     "shared/light_model.wgsl",
     "shared/lights.wgsl",

@@ -2,11 +2,9 @@
 //! with `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
 //! Bind groups: 0 the frame's globals, 1 the voxel structure's sampling group, 2 its own.
 
-use crate::brdf::BrdfTables;
 use crate::gpu::layout;
 use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::gpu_scene::GpuScene;
 use crate::options::RendererOptions;
 use crate::targets::FrameTargets;
 use crate::voxel::VoxelStructure;
@@ -36,7 +34,6 @@ pub fn has_glossy(scene: &Scene, point_count: u32) -> bool {
 /// (group 0) and its own targets (group 2).
 pub struct GatherPass {
     pipeline: wgpu::ComputePipeline,
-    globals: wgpu::BindGroupLayout,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -44,21 +41,7 @@ impl GatherPass {
     /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
     pub fn new(device: &wgpu::Device, settings: &RendererOptions, glossy: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
-        let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather globals"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::uniform(1, c, false),
-                layout::storage(2, c, true),
-                layout::texture(
-                    3,
-                    c,
-                    wgpu::TextureSampleType::Float { filterable: true },
-                    wgpu::TextureViewDimension::D2,
-                ),
-                layout::sampler(4, c),
-            ],
-        });
+        let globals = crate::globals::layout(device);
         let mut entries = FrameTargets::gbuffer_layout(0, c).to_vec();
         entries.extend([
             layout::storage_texture(4, INDIRECT_FORMAT),
@@ -81,38 +64,22 @@ impl GatherPass {
                 &[Some(&globals), Some(&voxels), Some(&layout)],
                 &constants,
             ),
-            globals,
             layout,
         }
     }
 
-    // The pass reads what the frame and the volume hold; a struct for it would only rename.
     /// Records the gather at `t.gather_size()` (8x8-pixel workgroups) into the low-resolution
-    /// indirect, visibility and guide targets, sampling `voxels` with the diffuse cones in `cones`.
-    /// Timed as "gather".
-    #[allow(clippy::too_many_arguments)]
+    /// indirect, visibility and guide targets, sampling `voxels` with the cones of the frame's
+    /// `globals`. Timed as "gather".
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
-        scene: &GpuScene,
+        globals: &wgpu::BindGroup,
         voxels: &dyn VoxelStructure,
-        cones: &wgpu::Buffer,
-        tables: &BrdfTables,
         timer: &mut GpuTimer,
     ) {
-        let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather globals"),
-            layout: &self.globals,
-            entries: &layout::entries(vec![
-                t.frame.as_entire_binding(),
-                cones.as_entire_binding(),
-                scene.lights.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&tables.specular_albedo),
-                wgpu::BindingResource::Sampler(&tables.sampler),
-            ]),
-        });
         let mut res = t.gbuffer_resources().to_vec();
         res.extend([
             wgpu::BindingResource::TextureView(&t.indirect_low),
@@ -130,7 +97,7 @@ impl GatherPass {
             timestamp_writes: timer.compute("gather"),
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &globals, &[]);
+        pass.set_bind_group(0, globals, &[]);
         pass.set_bind_group(1, voxels.sampling(), &[]);
         pass.set_bind_group(2, &own, &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);

@@ -6,7 +6,7 @@
 use crate::gpu::layout;
 use crate::gpu::shader;
 use crate::gpu::timer::GpuTimer;
-use crate::targets::FrameTargets;
+use crate::targets::{FrameTargets, Target};
 
 /// The tonemap render pass (shaders/tonemap.wgsl): a full-screen draw from the HDR target into
 /// the caller's texture, with one pipeline per target format.
@@ -31,11 +31,12 @@ impl TonemapPass {
         let f = wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap"),
-            entries: &[layout::uniform(0, f, false), layout::texture_2d_load(1, f)],
+            entries: &[layout::texture_2d_load(0, f)],
         });
+        let globals = crate::globals::layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("tonemap"),
-            bind_group_layouts: &[Some(&layout)],
+            bind_group_layouts: &[Some(&globals), None, Some(&layout)],
             immediate_size: 0,
         });
         TonemapPass {
@@ -85,10 +86,11 @@ impl TonemapPass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
-        target: &wgpu::TextureView,
-        format: wgpu::TextureFormat,
+        globals: &wgpu::BindGroup,
+        target: &Target,
         timer: &mut GpuTimer,
     ) {
+        let format = target.format;
         let Some((_, pipeline)) = self.pipelines.iter().find(|(f, _)| *f == format) else {
             debug_assert!(false, "tonemap: no pipeline prepared for {format:?}");
             return;
@@ -96,15 +98,12 @@ impl TonemapPass {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tonemap"),
             layout: &self.layout,
-            entries: &layout::entries(vec![
-                t.frame.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&t.hdr),
-            ]),
+            entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&t.hdr)]),
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tonemap"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
+                view: target.view,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
@@ -118,7 +117,8 @@ impl TonemapPass {
             multiview_mask: None,
         });
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, globals, &[]);
+        pass.set_bind_group(2, &bind, &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -4,7 +4,7 @@
 //! bilateral upsampling): the wide window runs on a quarter of the pixels at half resolution.
 
 use crate::gpu::layout;
-use crate::gpu::shader::compute_pipeline;
+use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::passes::gather::INDIRECT_FORMAT;
 use crate::targets::FrameTargets;
@@ -23,14 +23,20 @@ impl UpsamplePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("upsample"),
             entries: &[
-                layout::uniform(0, c, false),
+                layout::texture_2d_load(0, c),
                 layout::texture_2d_load(1, c),
-                layout::texture_2d_load(2, c),
-                layout::storage_texture(3, INDIRECT_FORMAT),
+                layout::storage_texture(2, INDIRECT_FORMAT),
             ],
         });
+        let globals = crate::globals::layout(device);
         UpsamplePass {
-            pipeline: compute_pipeline(device, "upsample", "upsample.wgsl", &layout),
+            pipeline: grouped_pipeline(
+                device,
+                "upsample",
+                "upsample.wgsl",
+                &[Some(&globals), None, Some(&layout)],
+                &[],
+            ),
             layout,
         }
     }
@@ -42,13 +48,13 @@ impl UpsamplePass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
+        globals: &wgpu::BindGroup,
         timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("upsample"),
             layout: &self.layout,
             entries: &layout::entries(vec![
-                t.frame.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&t.indirect_low),
                 wgpu::BindingResource::TextureView(&t.guide_low),
                 wgpu::BindingResource::TextureView(&t.indirect),
@@ -59,7 +65,8 @@ impl UpsamplePass {
             timestamp_writes: timer.compute("upsample"),
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, globals, &[]);
+        pass.set_bind_group(2, &bind, &[]);
         let (w, h) = t.gather_size();
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
