@@ -425,24 +425,21 @@ impl GpuScene {
             })
         };
         let max_binding = device.limits().max_storage_buffer_binding_size as usize;
-        let vbytes = std::mem::size_of_val(vertices.as_slice());
-        if vbytes > max_binding {
-            return Err(Error::Setting(format!(
-                "the scene's {} vertices need {} MiB, more than this GPU's storage-buffer limit of {} MiB",
-                vertices.len(),
-                vbytes >> 20,
-                max_binding >> 20
-            )));
-        }
-        let pbytes = std::mem::size_of_val(points.as_slice());
-        if pbytes > max_binding {
-            return Err(Error::Setting(format!(
-                "the scene's {} points need {} MiB, more than this GPU's storage-buffer limit of {} MiB",
-                points.len(),
-                pbytes >> 20,
-                max_binding >> 20
-            )));
-        }
+        let fits = |what: &str, count: usize, bytes: usize| {
+            if bytes > max_binding {
+                return Err(Error::Setting(format!(
+                    "the scene's {count} {what} need {} MiB, more than this GPU's storage-buffer \
+                     limit of {} MiB",
+                    bytes >> 20,
+                    max_binding >> 20
+                )));
+            }
+            Ok(())
+        };
+        fits("vertices", vertices.len(), size_of_val(vertices.as_slice()))?;
+        fits("points", points.len(), size_of_val(points.as_slice()))?;
+        fits("instances", draws.len(), size_of_val(draws.as_slice()))?;
+        fits("indices", indices.len(), size_of_val(indices.as_slice()))?;
         Ok(GpuScene {
             vertices: storage("vertices", bytemuck::cast_slice(&vertices), 32),
             indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -123,8 +123,8 @@ pub struct Renderer {
     /// The layout of the screen passes' `@group(0)` (`globals`).
     globals_layout: wgpu::BindGroupLayout,
     fragments: Fragments,
-    /// The voxel structure. Inject and bounce still read its leaves (the dense volume's slots)
-    /// directly; everything else goes through `VoxelStructure`.
+    /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
+    /// (and `volume()`, for tests) names the dense volume.
     volume: DenseVolume,
     dense_pipelines: Arc<DensePipelines>,
     triangles: (wgpu::Buffer, u32),
@@ -230,7 +230,9 @@ impl Renderer {
             composite: composite_pass(device, &gpu_scene, &facts, settings),
             tonemap: TonemapPass::new(device),
         })?;
-        let triangles = triangle_table(device, &gpu_scene);
+        let triangles = checked(device, "voxelization table", || {
+            triangle_table(device, &gpu_scene)
+        })??;
         let brdf_tables = BrdfTables::new(device, queue);
         let voxel_bounces = voxel_bounce_count(facts.max_albedo, settings.bounces);
         let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -271,13 +273,14 @@ impl Renderer {
         })
     }
 
-    /// Changes the options, rebuilding only what depends on the ones that changed: the volume
-    /// for its resolution or anisotropy, the shadow atlas for its size or cone shadows, the
-    /// gather, bounce and composite pipelines for what they are specialised on; cone and AO
-    /// parameters and the bounce count are uniform writes. Voxel work is redone in the next
-    /// frame only if something it depends on changed. `max_texture_size` and `default_light`
-    /// shape the uploaded scene: changing them is an error (make a new renderer); the pool
-    /// capacities are only where the first build starts, so changing them does nothing.
+    /// Changes the options, rebuilding only what depends on the ones that changed: the fragments
+    /// for the resolution, the volume for its resolution or anisotropy, the shadow atlas for
+    /// its size or cone shadows, the gather, bounce and composite pipelines for what they are
+    /// specialised on; cone and AO parameters and the bounce count are uniform writes. Voxel
+    /// work is redone in the next frame only if something it depends on changed.
+    /// `max_texture_size` and `default_light` shape the uploaded scene: changing them is an
+    /// error (make a new renderer). `fragment_capacity` and `voxel_capacity` size a pool when
+    /// it is made anew (here, for a new resolution or anisotropy), not the pools in use.
     pub fn set_options(&mut self, options: &RendererOptions) -> Result<()> {
         options.validate()?;
         let (old, new) = (&self.options, options);
@@ -318,10 +321,21 @@ impl Renderer {
         } else {
             None
         };
+        // The fragments depend on the grid only: a change of anisotropy keeps their grown pool.
+        let fragments_new = if old.voxel_resolution != new.voxel_resolution {
+            Some(new_fragments(device, &self.facts, new, grid, None)?)
+        } else {
+            None
+        };
         let volume_new = if volume {
-            let f = new_fragments(device, &self.facts, new, grid, None)?;
-            let v = new_volume(device, &self.dense_pipelines, &self.facts, new, grid, None)?;
-            Some((f, v))
+            Some(new_volume(
+                device,
+                &self.dense_pipelines,
+                &self.facts,
+                new,
+                grid,
+                None,
+            )?)
         } else {
             None
         };
@@ -338,8 +352,10 @@ impl Renderer {
         if let Some(a) = atlas_new {
             self.atlas = a;
         }
-        if let Some((f, v)) = volume_new {
+        if let Some(f) = fragments_new {
             self.fragments = f;
+        }
+        if let Some(v) = volume_new {
             self.volume = v;
             self.pools += 1;
         }
@@ -474,19 +490,24 @@ impl Renderer {
             if counts.fragments <= frags && counts.occupied <= leaves {
                 continue;
             }
-            if counts.fragments > frags {
+            // Build what grows first and swap it in only when all of it succeeded. A count
+            // past this device's limits is an error here (once per overflowing build), not a
+            // pool grown to the limit and rebuilt forever.
+            let fragments = if counts.fragments > frags {
+                let capacity = fragments::capacity(&self.device, counts.fragments)?;
                 let grid = self.fragments.grid;
-                self.fragments = new_fragments(
-                    &self.device,
-                    &self.facts,
-                    &self.options,
-                    grid,
-                    Some(counts.fragments),
-                )?;
-            }
+                Some(checked(&self.device, "voxel fragments", || {
+                    Fragments::new(&self.device, grid, capacity)
+                })?)
+            } else {
+                None
+            };
             if counts.occupied > leaves {
                 let slots = slot_capacity(&self.device, counts.occupied)?;
-                self.volume.grow(&self.device, slots as u64);
+                self.volume.grow(&self.device, slots as u64)?;
+            }
+            if let Some(f) = fragments {
+                self.fragments = f;
             }
             self.pools += 1;
             log::info!(
@@ -558,7 +579,9 @@ impl Renderer {
 
     /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
     /// whole extent). Submit the encoder before the next call: the frame's uniforms are written
-    /// through the queue, so two frames in one submission would share the last one's.
+    /// through the queue, so two frames in one submission would share the last one's; and a
+    /// frame that records the voxel update counts on that encoder being submitted (dropped,
+    /// the update is lost until the next `invalidate`).
     ///
     /// The target's texture needs `TextureUsages::RENDER_ATTACHMENT` (nothing else), in a
     /// renderable colour format: `Bgra8UnormSrgb` or `Rgba8UnormSrgb` (a swapchain's; the GPU
@@ -578,16 +601,17 @@ impl Renderer {
         validate_size(width, height)?;
         params.validate(self.options.voxel_levels())?;
         self.receive_feedback()?;
-        checked(&self.device, "tonemap pipeline", || {
-            self.passes.tonemap.prepare(&self.device, target.format)
-        })?;
+        self.passes.tonemap.prepare(&self.device, target.format)?;
         let half = self.options.half_resolution;
         if self
             .targets
             .as_ref()
             .is_none_or(|t| t.width != width || t.height != height || t.half != half)
         {
-            self.targets = Some(FrameTargets::new(&self.device, width, height, half));
+            // Out of memory for large sizes is an error here, not the device's handler's.
+            self.targets = Some(checked(&self.device, "render targets", || {
+                FrameTargets::new(&self.device, width, height, half)
+            })?);
         }
         if self.dirty {
             self.record_voxels(encoder);

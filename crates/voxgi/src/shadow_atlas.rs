@@ -345,7 +345,7 @@ impl ShadowAtlas {
     /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound).
     pub fn bytes(&self) -> u64 {
         let t = &self.texture;
-        (t.width() * t.height() * t.depth_or_array_layers()) as u64 * 8
+        t.width() as u64 * t.height() as u64 * t.depth_or_array_layers() as u64 * 8
     }
 }
 

@@ -151,19 +151,21 @@ fn gather_size(width: u32, height: u32, half: bool) -> (u32, u32) {
 
 /// The caller's texture a frame is written to: a view of it, its format and size.
 ///
-/// The texture needs `TextureUsages::RENDER_ATTACHMENT` and one of the renderable colour
-/// formats: `Bgra8UnormSrgb` and `Rgba8UnormSrgb` (swapchains; encoded to sRGB by the GPU),
-/// `Rgba8Unorm` and `Bgra8Unorm` (voxgi applies the sRGB curve itself), or a float format such
-/// as `Rgba16Float` (tone-mapped linear values).
+/// The texture needs `TextureUsages::RENDER_ATTACHMENT` and a renderable colour format: an
+/// sRGB one such as `Bgra8UnormSrgb` or `Rgba8UnormSrgb` (swapchains; encoded to sRGB by the
+/// GPU), a fixed-point one without sRGB such as `Rgba8Unorm`, `Bgra8Unorm` or `Rgb10a2Unorm`
+/// (voxgi applies the sRGB curve itself), or a float one such as `Rgba16Float` (tone-mapped
+/// linear values). Other formats are an error naming the format.
 #[derive(Clone, Copy, Debug)]
 pub struct Target<'a> {
     /// A view of the caller's texture (one mip level, one layer).
     pub view: &'a wgpu::TextureView,
-    /// The texture's format; the tonemap pass makes a pipeline for each format it is given.
+    /// The view's format (which may be the sRGB form of the texture's, as a swapchain view
+    /// often is); the tonemap pass makes a pipeline for each format it is given.
     pub format: wgpu::TextureFormat,
-    /// The texture's width in pixels.
+    /// The view's width in pixels.
     pub width: u32,
-    /// The texture's height in pixels.
+    /// The view's height in pixels.
     pub height: u32,
 }
 

@@ -149,7 +149,8 @@ impl FragmentEstimate {
 }
 
 /// Keeps the triangle table voxelize reads: per triangle, its draw, first index, base vertex.
-pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> (wgpu::Buffer, u32) {
+/// An error when the table would not fit one storage binding of this device.
+pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> Result<(wgpu::Buffer, u32)> {
     let mut t: Vec<[u32; 4]> = Vec::new();
     for call in &scene.calls {
         // The visible surface of an area light is not voxelized, neither as an emitter (its
@@ -168,10 +169,20 @@ pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> (wgpu::Buffer,
     if t.is_empty() {
         t.push([0; 4]);
     }
+    let bytes = size_of_val(t.as_slice()) as u64;
+    let limit = device.limits().max_storage_buffer_binding_size;
+    if bytes > limit {
+        return Err(Error::Setting(format!(
+            "the scene's {n} drawn triangles need a {} MiB voxelization table, more than this \
+             GPU's storage-buffer limit of {} MiB",
+            bytes >> 20,
+            limit >> 20
+        )));
+    }
     let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("voxelize triangles"),
         contents: bytemuck::cast_slice(&t),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    (buffer, n)
+    Ok((buffer, n))
 }

@@ -4,9 +4,10 @@
 //! the first time that format is seen.
 
 use crate::gpu::layout;
-use crate::gpu::shader;
 use crate::gpu::timer::GpuTimer;
+use crate::gpu::{checked, shader};
 use crate::targets::{FrameTargets, Target};
+use crate::{Error, Result};
 
 /// The tonemap render pass (shaders/tonemap.wgsl): a full-screen draw from the HDR target into
 /// the caller's texture, with one pipeline per target format.
@@ -18,11 +19,22 @@ pub struct TonemapPass {
     pipelines: Vec<(wgpu::TextureFormat, wgpu::RenderPipeline)>,
 }
 
-/// Whether the shader applies the sRGB curve itself: 8-bit targets without an sRGB view.
-/// sRGB formats encode in hardware; float and 10-bit formats take linear values.
+/// Whether the shader applies the sRGB curve itself: fixed-point targets without an sRGB view
+/// (`Rgba8Unorm`, `Bgra8Unorm`, `Rgb10a2Unorm`…), which a display reads as sRGB-encoded. sRGB
+/// formats encode in hardware; float formats (HDR targets) take the tone-mapped linear values.
 fn encodes_srgb(format: wgpu::TextureFormat) -> bool {
     use wgpu::TextureFormat as F;
-    matches!(format, F::Rgba8Unorm | F::Bgra8Unorm)
+    let float = matches!(
+        format,
+        F::R16Float
+            | F::Rg16Float
+            | F::Rgba16Float
+            | F::R32Float
+            | F::Rg32Float
+            | F::Rgba32Float
+            | F::Rg11b10Ufloat
+    );
+    !format.is_srgb() && !float
 }
 
 impl TonemapPass {
@@ -47,37 +59,55 @@ impl TonemapPass {
         }
     }
 
-    /// Makes the pipeline for `format` if there is none yet.
-    pub fn prepare(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) {
+    /// Makes the pipeline for `format` if there is none yet; an error (and nothing kept) when
+    /// the format cannot be rendered to this way.
+    pub fn prepare(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<()> {
         if self.pipelines.iter().any(|(f, _)| *f == format) {
-            return;
+            return Ok(());
+        }
+        let blendable = format
+            .guaranteed_format_features(device.features())
+            .allowed_usages
+            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+            && format
+                .sample_type(None, None)
+                .is_some_and(|t| matches!(t, wgpu::TextureSampleType::Float { .. }))
+            && !format.is_depth_stencil_format();
+        if !blendable {
+            return Err(Error::Setting(format!(
+                "the target format {format:?} is not a colour format voxgi can render to (use \
+                 an 8-bit UNORM or sRGB format, Rgb10a2Unorm, or a float format)"
+            )));
         }
         let constants = [("ENCODE_SRGB", encodes_srgb(format) as u32 as f64)];
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("tonemap"),
-            layout: Some(&self.pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &self.module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &self.module,
-                entry_point: Some("fs_main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
+        let pipeline = checked(device, "tonemap pipeline", || {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("tonemap"),
+                layout: Some(&self.pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &self.module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
                 },
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &self.module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })?;
         self.pipelines.push((format, pipeline));
+        Ok(())
     }
 
     /// Draws into `target`, whose format `prepare` has seen.

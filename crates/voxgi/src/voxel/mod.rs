@@ -57,8 +57,9 @@ pub trait VoxelStructure {
     fn leaf_counter(&self) -> &wgpu::Buffer;
     /// Leaves the pools hold.
     fn leaf_capacity(&self) -> u64;
-    /// Makes room for `leaves` leaves; the contents are lost (the next build refills them).
-    fn grow(&mut self, device: &wgpu::Device, leaves: u64);
+    /// Makes room for `leaves` leaves; the contents are lost (the next build refills them). On
+    /// an error (out of memory, a device limit) the structure is left as it was.
+    fn grow(&mut self, device: &wgpu::Device, leaves: u64) -> crate::Result<()>;
     /// Bytes per GPU resource.
     fn memory(&self) -> Vec<(&'static str, u64)>;
     /// The bind group of the WGSL contract's resources, `@group(1)`.

@@ -102,6 +102,20 @@ fn every_target_format_gets_the_same_image() {
         let d = max_diff(&rgba8(&t));
         assert!(d <= tolerance, "{format:?}: differs by {d} steps");
     }
+    // A 10-bit swapchain format without sRGB gets voxgi's sRGB curve too: within one 8-bit
+    // step once its 1023 levels are scaled to 255.
+    let t = texture(wgpu::TextureFormat::Rgb10a2Unorm, w, h);
+    draw(&mut r, &params, &t);
+    let bytes = read_texture(&ctx().device, &ctx().queue, &t).expect("readback");
+    let ten: Vec<u8> = bytemuck::cast_slice::<u8, u32>(&bytes)
+        .iter()
+        .flat_map(|&p| {
+            let c = |shift: u32| ((((p >> shift) & 1023) as f32) * 255.0 / 1023.0).round() as u8;
+            [c(0), c(10), c(20), 255]
+        })
+        .collect();
+    let d = max_diff(&ten);
+    assert!(d <= 1, "Rgb10a2Unorm: differs by {d} steps");
     let t = texture(wgpu::TextureFormat::Rgba16Float, w, h);
     draw(&mut r, &params, &t);
     let bytes = read_texture(&ctx().device, &ctx().queue, &t).expect("readback");
@@ -186,4 +200,26 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
             "frame {i} differs from the right-sized renderer's"
         );
     }
+}
+
+/// A target format the tone mapping cannot write is an error naming it, every time it is
+/// asked for, and the renderer keeps working for good formats.
+#[test]
+fn an_unrenderable_target_format_is_an_error_every_time() {
+    let scene = builtin::cornell_box();
+    let mut r = renderer(&scene, &measuring());
+    let params = FrameParams::new(r.default_camera().clone());
+    let bad = texture(wgpu::TextureFormat::Rgba8Uint, 8, 8);
+    let view = bad.create_view(&Default::default());
+    for attempt in 0..2 {
+        let target = Target::new(&view, bad.format(), 8, 8);
+        let mut encoder = ctx().device.create_command_encoder(&Default::default());
+        match r.render(&mut encoder, &target, &params) {
+            Err(voxgi::Error::Setting(msg)) => assert!(msg.contains("Rgba8Uint"), "{msg}"),
+            other => panic!("attempt {attempt}: {other:?}"),
+        }
+    }
+    let good = texture(wgpu::TextureFormat::Rgba8Unorm, 8, 8);
+    draw(&mut r, &params, &good);
+    assert!(rgba8(&good).iter().any(|&v| v > 0));
 }

@@ -571,14 +571,18 @@ impl VoxelStructure for DenseVolume {
         self.slot_capacity as u64
     }
 
-    fn grow(&mut self, device: &wgpu::Device, leaves: u64) {
-        *self = DenseVolume::new(
-            device,
-            &self.pipelines,
-            self.grid,
-            self.anisotropic,
-            leaves.min(u32::MAX as u64) as u32,
-        );
+    fn grow(&mut self, device: &wgpu::Device, leaves: u64) -> crate::Result<()> {
+        let grown = crate::gpu::checked(device, "voxel pools", || {
+            DenseVolume::new(
+                device,
+                &self.pipelines,
+                self.grid,
+                self.anisotropic,
+                leaves.min(u32::MAX as u64) as u32,
+            )
+        })?;
+        *self = grown;
+        Ok(())
     }
 
     fn memory(&self) -> Vec<(&'static str, u64)> {
