@@ -6,7 +6,7 @@
 use crate::brdf::BrdfTables;
 use crate::gpu::layout;
 use crate::gpu_scene::GpuScene;
-use crate::shadow_atlas::ShadowAtlas;
+use crate::lighting::atlas::ShadowAtlas;
 use crate::targets::FrameTargets;
 
 /// The layout of the frame's globals.

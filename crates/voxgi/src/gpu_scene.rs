@@ -278,7 +278,7 @@ pub struct GpuScene {
     /// One indexed draw per instance with triangles.
     pub calls: Vec<DrawCall>,
     /// CPU copy of the lights; their shadow-view fields are written when the renderer plans
-    /// the shadow atlas (`shadow_atlas::plan_views`).
+    /// the shadow atlas (`lighting::atlas::plan_views`).
     pub gpu_lights: Vec<GpuLight>,
     /// Number of lights (`gpu_lights.len()`).
     pub light_count: u32,

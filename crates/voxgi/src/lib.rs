@@ -42,14 +42,14 @@ pub mod gpu;
 pub mod gpu_scene;
 #[cfg(feature = "headless")]
 pub mod headless;
+pub mod lighting;
 mod options;
 pub mod output;
-pub mod passes;
 #[cfg(feature = "reference")]
 pub mod reference;
 mod renderer;
+pub mod screen;
 mod settings;
-pub mod shadow_atlas;
 mod targets;
 mod view;
 pub mod voxel;

@@ -3,9 +3,9 @@
 
 use crate::gpu::layout;
 use crate::gpu_scene::GpuFrame;
-use crate::passes::composite::HDR_FORMAT;
-use crate::passes::gather::{GUIDE_FORMAT, INDIRECT_FORMAT, VISIBILITY_FORMAT};
-use crate::passes::gbuffer;
+use crate::screen::composite::HDR_FORMAT;
+use crate::screen::gather::{GUIDE_FORMAT, INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::screen::gbuffer;
 
 /// Render targets of one output size.
 pub struct FrameTargets {

@@ -3,7 +3,7 @@
 
 use voxgi::gpu::shader;
 use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
-use voxgi::shadow_atlas::GpuShadowView;
+use voxgi::lighting::atlas::GpuShadowView;
 use voxgi::voxel::{GpuCones, GpuVolume};
 
 fn parse(name: &str) -> naga::Module {
@@ -31,7 +31,7 @@ fn every_shader_validates() {
 #[test]
 fn wgsl_struct_sizes() {
     // Between them these include every shared file that defines structs.
-    let modules = [parse("composite.wgsl"), parse("gather.wgsl")];
+    let modules = [parse("screen/composite.wgsl"), parse("screen/gather.wgsl")];
     let size_of_wgsl = |name: &str| -> u32 {
         modules
             .iter()
@@ -79,7 +79,7 @@ fn wgsl_u32(module: &naga::Module, name: &str) -> u32 {
 /// View-mode and tone-map ids are defined once in Rust and once in WGSL: they must agree.
 #[test]
 fn view_and_tonemap_ids_agree_with_wgsl() {
-    let m = parse("composite.wgsl");
+    let m = parse("screen/composite.wgsl");
     for v in voxgi::ViewMode::ALL {
         let name = format!("VIEW_{}", v.name().replace('-', "_").to_uppercase());
         assert_eq!(wgsl_u32(&m, &name), v.id(), "{name}");

@@ -7,7 +7,7 @@ use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::ViewMode;
-use crate::passes::composite::HDR_FORMAT;
+use crate::screen::composite::HDR_FORMAT;
 use crate::targets::FrameTargets;
 use wgpu::util::DeviceExt;
 

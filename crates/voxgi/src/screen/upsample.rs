@@ -6,7 +6,7 @@
 use crate::gpu::layout;
 use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::passes::gather::INDIRECT_FORMAT;
+use crate::screen::gather::INDIRECT_FORMAT;
 use crate::targets::FrameTargets;
 
 /// The upsample compute pass, stage one (shaders/upsample.wgsl): its pipeline and bind group
@@ -33,7 +33,7 @@ impl UpsamplePass {
             pipeline: grouped_pipeline(
                 device,
                 "upsample",
-                "upsample.wgsl",
+                "screen/upsample.wgsl",
                 &[Some(&globals), None, Some(&layout)],
                 &[],
             ),

@@ -45,7 +45,7 @@ impl GbufferPass {
                 layout::storage(6, wgpu::ShaderStages::VERTEX, true),
             ],
         });
-        let module = shader::module(device, "gbuffer.wgsl");
+        let module = shader::module(device, "screen/gbuffer.wgsl");
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer"),
             bind_group_layouts: &[Some(&layout)],

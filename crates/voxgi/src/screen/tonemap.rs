@@ -52,7 +52,7 @@ impl TonemapPass {
             immediate_size: 0,
         });
         TonemapPass {
-            module: shader::module(device, "tonemap.wgsl"),
+            module: shader::module(device, "screen/tonemap.wgsl"),
             layout,
             pipeline_layout,
             pipelines: Vec::new(),

@@ -5,7 +5,7 @@
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
-use crate::shadow_atlas::{
+use crate::lighting::atlas::{
     ATLAS_FORMAT, GpuShadowView, ShadowAtlas, UNIFORM_STRIDE, behind_emitter,
 };
 
@@ -32,7 +32,7 @@ impl ShadowPass {
                 layout::storage(4, wgpu::ShaderStages::VERTEX, true),
             ],
         });
-        let module = shader::module(device, "shadow.wgsl");
+        let module = shader::module(device, "lighting/shadow.wgsl");
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow"),
             bind_group_layouts: &[Some(&layout)],

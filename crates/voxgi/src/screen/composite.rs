@@ -42,7 +42,7 @@ impl CompositePass {
         let pipeline = grouped_pipeline(
             device,
             "composite",
-            "composite.wgsl",
+            "screen/composite.wgsl",
             &[Some(&globals), None, Some(&layout)],
             &constants,
         );

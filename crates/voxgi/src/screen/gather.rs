@@ -60,7 +60,7 @@ impl GatherPass {
             pipeline: grouped_pipeline(
                 device,
                 "gather",
-                "gather.wgsl",
+                "screen/gather.wgsl",
                 &[Some(&globals), Some(&voxels), Some(&layout)],
                 &constants,
             ),

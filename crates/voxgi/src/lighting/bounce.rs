@@ -32,14 +32,14 @@ impl BouncePass {
             gather: grouped_pipeline(
                 device,
                 "bounce",
-                "bounce.wgsl",
+                "lighting/bounce.wgsl",
                 &[Some(&globals), Some(&voxels), Some(&leaves)],
                 &DenseVolume::sampling_constants(anisotropic, 3),
             ),
             store: grouped_pipeline(
                 device,
                 "bounce",
-                "bounce_store.wgsl",
+                "lighting/bounce_store.wgsl",
                 &[None, None, Some(&leaves), Some(&store)],
                 &[],
             ),

@@ -4,7 +4,7 @@ use crate::gpu::layout;
 use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::shadow_atlas::ShadowAtlas;
+use crate::lighting::atlas::ShadowAtlas;
 use crate::voxel::VoxelStructure;
 use crate::voxel::dense::DenseVolume;
 use wgpu::util::DeviceExt;
@@ -33,7 +33,7 @@ impl InjectPass {
             pipeline: grouped_pipeline(
                 device,
                 "inject",
-                "inject.wgsl",
+                "lighting/inject.wgsl",
                 &[Some(&globals), None, Some(&leaves), Some(&store)],
                 &[],
             ),

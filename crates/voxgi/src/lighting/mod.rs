@@ -1,0 +1,9 @@
+//! Light into the voxels: the shadow atlas and the shadow pass that fills it, `inject` (direct
+//! light and emission into the structure's leaves) and `bounce` (further bounces in voxel
+//! space). A pass's module, WGSL file (`shaders/lighting/`), pipeline label and timing scope
+//! share one name; `renderer.rs` calls them in order.
+
+pub mod atlas;
+pub mod bounce;
+pub mod inject;
+pub mod shadow;
