@@ -2,6 +2,7 @@
 
 use crate::args::{SceneArg, load_scene, scene_label};
 use anyhow::Result;
+use voxgi::scene::animation::AnimationTarget;
 use voxgi::scene::{LightKind, Projection, Scene};
 
 pub fn run(arg: &SceneArg) -> Result<()> {
@@ -101,6 +102,24 @@ fn describe(s: &Scene, label: &str) -> String {
             c.name,
             c.position.to_array(),
             c.forward.to_array()
+        );
+    }
+    let _ = writeln!(o, "animations  {}", s.animations.len());
+    for (i, a) in s.animations.iter().enumerate() {
+        let target = match &a.target {
+            AnimationTarget::Instances { instances, .. } => {
+                format!("{} instance(s)", instances.len())
+            }
+            AnimationTarget::Light { light, .. } => format!(
+                "light '{}'",
+                s.lights.get(*light).map_or("?", |l| l.name.as_str())
+            ),
+        };
+        let _ = writeln!(
+            o,
+            "  [{i}] {:<20} {target:<18} {:.3} s",
+            a.name,
+            a.duration()
         );
     }
     o

@@ -4,6 +4,7 @@
 //! read scenes without a device. Every loader returns a [`Scene`] that passed [`Scene::validate`],
 //! so the renderer can trust indices and counts.
 
+pub mod animation;
 pub mod builtin;
 mod error;
 pub mod io;
@@ -170,6 +171,7 @@ impl Scene {
             m.material += mat0;
             m
         }));
+        let other_instances = other.instances.len();
         self.instances
             .extend(other.instances.into_iter().map(|mut i| {
                 i.mesh += mesh0;
@@ -206,6 +208,29 @@ impl Scene {
             }
             l
         }));
+        let inst0 = self.instances.len() - other_instances;
+        self.animations
+            .extend(other.animations.into_iter().map(|mut a| {
+                match &mut a.target {
+                    crate::animation::AnimationTarget::Instances {
+                        instances, outer, ..
+                    } => {
+                        instances.iter_mut().for_each(|i| *i += inst0);
+                        *outer = transform * *outer;
+                    }
+                    crate::animation::AnimationTarget::Light {
+                        light, rest, outer, ..
+                    } => {
+                        *light += light0;
+                        // The light as appended: moved into this scene like the others.
+                        if let Some(l) = self.lights.get(*light) {
+                            *rest = l.clone();
+                        }
+                        *outer = transform * *outer;
+                    }
+                }
+                a
+            }));
         self.cameras.extend(other.cameras.into_iter().map(|mut c| {
             c.position = transform.transform_point3(c.position);
             c.forward = (linear * c.forward).normalize_or(c.forward);

@@ -18,6 +18,8 @@ pub struct Scene {
     pub point_clouds: Vec<PointCloud>,
     /// Cameras found in the file; the first one is the default view.
     pub cameras: Vec<Camera>,
+    /// What moves over time (`Scene::set_time` applies them).
+    pub animations: Vec<crate::animation::Animation>,
 }
 
 /// One triangle list with one material (a glTF primitive, an OBJ group).
@@ -149,7 +151,7 @@ pub enum LightKind {
     Area { shape: AreaShape },
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Light {
     pub name: String,
     pub kind: LightKind,

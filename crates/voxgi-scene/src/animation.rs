@@ -1,0 +1,648 @@
+//! Animation: keyframed tracks of rigid motion and of light parameters, and sampling a scene's
+//! state at a time.
+//!
+//! A motion moves instances from the pose the file gives them (identity is the rest pose), in
+//! the space the animation was written in: `transform(t) = outer * M(t) * inner`, where
+//! `inner` is an instance's transform in that space and `outer` places that space in the world
+//! (the identity for a scene file's own animations; an include's transform for an included
+//! file's). A light's animated parameters replace its rest values, positions and directions
+//! given in the animation's space.
+
+use crate::{Light, Scene};
+use glam::{Mat4, Quat, Vec3};
+
+/// How values between two keyframes are found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Interpolation {
+    /// The earlier keyframe's value until the next keyframe.
+    Step,
+    /// Straight lines (rotations: spherical linear interpolation).
+    #[default]
+    Linear,
+    /// Catmull-Rom splines through the keyframes (rotations: normalised Catmull-Rom on the
+    /// quaternions, kept in one hemisphere).
+    Cubic,
+}
+
+/// What happens past the last keyframe.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Repeat {
+    /// Hold the first and last values outside the keyframes.
+    #[default]
+    Clamp,
+    /// Start over: time is taken modulo the last keyframe's time.
+    Loop,
+}
+
+/// Values a track can interpolate.
+pub trait Keyable: Copy {
+    /// `a + (b - a) s`.
+    fn lerp(a: Self, b: Self, s: f32) -> Self;
+    /// The Catmull-Rom value between `p1` and `p2` at `s`, with neighbours `p0` and `p3`.
+    fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self;
+    /// Every component is finite.
+    fn finite(&self) -> bool;
+}
+
+fn catmull_rom_weights(s: f32) -> [f32; 4] {
+    let (s2, s3) = (s * s, s * s * s);
+    [
+        0.5 * (-s3 + 2.0 * s2 - s),
+        0.5 * (3.0 * s3 - 5.0 * s2 + 2.0),
+        0.5 * (-3.0 * s3 + 4.0 * s2 + s),
+        0.5 * (s3 - s2),
+    ]
+}
+
+impl Keyable for f32 {
+    fn lerp(a: Self, b: Self, s: f32) -> Self {
+        a + (b - a) * s
+    }
+    fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
+        let w = catmull_rom_weights(s);
+        w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
+    }
+    fn finite(&self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Keyable for Vec3 {
+    fn lerp(a: Self, b: Self, s: f32) -> Self {
+        a.lerp(b, s)
+    }
+    fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
+        let w = catmull_rom_weights(s);
+        w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
+    }
+    fn finite(&self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Keyable for Quat {
+    fn lerp(a: Self, b: Self, s: f32) -> Self {
+        a.slerp(b, s)
+    }
+    fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
+        // Neighbours into p1's hemisphere, so the spline does not take the long way round.
+        let near = |q: Quat| if q.dot(p1) < 0.0 { -q } else { q };
+        let (p0, p2, p3) = (near(p0), near(p2), near(p3));
+        let w = catmull_rom_weights(s);
+        let v = w[0] * glam::Vec4::from(p0)
+            + w[1] * glam::Vec4::from(p1)
+            + w[2] * glam::Vec4::from(p2)
+            + w[3] * glam::Vec4::from(p3);
+        Quat::from_vec4(v).normalize()
+    }
+    fn finite(&self) -> bool {
+        self.is_finite()
+    }
+}
+
+/// Keyframes of one value: times in seconds, strictly increasing, each with its value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Track<T> {
+    times: Vec<f32>,
+    values: Vec<T>,
+    /// How to fill between keyframes.
+    pub interpolation: Interpolation,
+    /// What to do past the last keyframe.
+    pub repeat: Repeat,
+}
+
+impl<T: Keyable> Track<T> {
+    /// A track, checked: at least one keyframe, as many values as times, finite, times
+    /// non-negative and strictly increasing. The error says what is wrong.
+    pub fn new(
+        times: Vec<f32>,
+        values: Vec<T>,
+        interpolation: Interpolation,
+        repeat: Repeat,
+    ) -> Result<Self, String> {
+        if times.is_empty() {
+            return Err("a track needs at least one keyframe".into());
+        }
+        if times.len() != values.len() {
+            return Err(format!(
+                "{} keyframe times but {} values",
+                times.len(),
+                values.len()
+            ));
+        }
+        if let Some(i) = times.iter().position(|t| !t.is_finite() || *t < 0.0) {
+            return Err(format!(
+                "keyframe {i}: time {} is not a finite number of seconds >= 0",
+                times[i]
+            ));
+        }
+        if let Some(i) = (1..times.len()).find(|&i| times[i] <= times[i - 1]) {
+            return Err(format!(
+                "keyframe {i}: time {} does not come after {} (keyframes must be sorted)",
+                times[i],
+                times[i - 1]
+            ));
+        }
+        if let Some(i) = values.iter().position(|v| !v.finite()) {
+            return Err(format!("keyframe {i}: the value is not finite"));
+        }
+        Ok(Track {
+            times,
+            values,
+            interpolation,
+            repeat,
+        })
+    }
+
+    /// The time of the last keyframe.
+    pub fn duration(&self) -> f32 {
+        *self.times.last().expect("tracks are never empty")
+    }
+
+    /// The value at time `t` (seconds).
+    pub fn sample(&self, t: f32) -> T {
+        let n = self.times.len();
+        let end = self.duration();
+        let t = match self.repeat {
+            Repeat::Loop if end > 0.0 => t.rem_euclid(end),
+            _ => t,
+        };
+        if n == 1 || t <= self.times[0] {
+            return self.values[0];
+        }
+        if t >= end {
+            return self.values[n - 1];
+        }
+        // The segment [times[i], times[i + 1]) holding t.
+        let i = self.times.partition_point(|&k| k <= t) - 1;
+        let s = (t - self.times[i]) / (self.times[i + 1] - self.times[i]);
+        let v = &self.values;
+        match self.interpolation {
+            Interpolation::Step => v[i],
+            Interpolation::Linear => T::lerp(v[i], v[i + 1], s),
+            Interpolation::Cubic => {
+                // End segments repeat their end keyframe as the missing neighbour.
+                let p0 = v[i.saturating_sub(1)];
+                let p3 = v[(i + 2).min(n - 1)];
+                T::catmull_rom(p0, v[i], v[i + 1], p3, s)
+            }
+        }
+    }
+}
+
+/// A rigid motion over time: keyframed translation, rotation and scale, or a generator.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// Keyframed tracks; a missing track is the identity.
+    Keyframes {
+        /// Translation, metres.
+        translation: Option<Track<Vec3>>,
+        /// Rotation.
+        rotation: Option<Track<Quat>>,
+        /// Scale per axis.
+        scale: Option<Track<Vec3>>,
+    },
+    /// A full turn about the line through `center` along `axis` every `period` seconds.
+    Orbit {
+        /// A point on the axis, metres.
+        center: Vec3,
+        /// The axis (unit length).
+        axis: Vec3,
+        /// Seconds per turn (> 0).
+        period: f32,
+    },
+    /// `amplitude` × sin(2π t / period) along `axis`.
+    Oscillate {
+        /// The direction of motion (unit length).
+        axis: Vec3,
+        /// Metres.
+        amplitude: f32,
+        /// Seconds per cycle (> 0).
+        period: f32,
+    },
+}
+
+impl Motion {
+    /// The motion at time `t`, to apply on the left of the rest transform.
+    pub fn at(&self, t: f32) -> Mat4 {
+        match self {
+            Motion::Keyframes {
+                translation,
+                rotation,
+                scale,
+            } => Mat4::from_scale_rotation_translation(
+                scale.as_ref().map_or(Vec3::ONE, |s| s.sample(t)),
+                rotation.as_ref().map_or(Quat::IDENTITY, |r| r.sample(t)),
+                translation.as_ref().map_or(Vec3::ZERO, |x| x.sample(t)),
+            ),
+            Motion::Orbit {
+                center,
+                axis,
+                period,
+            } => {
+                let angle = std::f32::consts::TAU * t / period;
+                Mat4::from_translation(*center)
+                    * Mat4::from_axis_angle(*axis, angle)
+                    * Mat4::from_translation(-*center)
+            }
+            Motion::Oscillate {
+                axis,
+                amplitude,
+                period,
+            } => Mat4::from_translation(
+                *axis * (amplitude * (std::f32::consts::TAU * t / period).sin()),
+            ),
+        }
+    }
+
+    /// How long one pass of the motion lasts (a generator's period).
+    pub fn duration(&self) -> f32 {
+        match self {
+            Motion::Keyframes {
+                translation,
+                rotation,
+                scale,
+            } => [
+                translation.as_ref().map(Track::duration),
+                rotation.as_ref().map(Track::duration),
+                scale.as_ref().map(Track::duration),
+            ]
+            .into_iter()
+            .flatten()
+            .fold(0.0, f32::max),
+            Motion::Orbit { period, .. } | Motion::Oscillate { period, .. } => *period,
+        }
+    }
+}
+
+/// Keyframed light parameters; a missing track keeps the light's rest value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LightTracks {
+    /// World position, metres.
+    pub position: Option<Track<Vec3>>,
+    /// Where the light points (normalised when sampled).
+    pub direction: Option<Track<Vec3>>,
+    /// Linear RGB.
+    pub color: Option<Track<Vec3>>,
+    /// As `Light::intensity`.
+    pub intensity: Option<Track<f32>>,
+}
+
+impl LightTracks {
+    /// The light at time `t`, from its rest state; `outer` places the tracks' positions and
+    /// directions in the world.
+    pub fn apply(&self, rest: &Light, outer: Mat4, t: f32) -> Light {
+        let mut l = rest.clone();
+        if let Some(p) = &self.position {
+            l.position = outer.transform_point3(p.sample(t));
+        }
+        if let Some(d) = &self.direction {
+            l.direction = outer
+                .transform_vector3(d.sample(t))
+                .normalize_or(rest.direction);
+        }
+        if let Some(c) = &self.color {
+            l.color = c.sample(t).max(Vec3::ZERO).to_array();
+        }
+        if let Some(i) = &self.intensity {
+            l.intensity = i.sample(t).max(0.0);
+        }
+        l
+    }
+
+    fn duration(&self) -> f32 {
+        [
+            self.position.as_ref().map(Track::duration),
+            self.direction.as_ref().map(Track::duration),
+            self.color.as_ref().map(Track::duration),
+            self.intensity.as_ref().map(Track::duration),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(0.0, f32::max)
+    }
+}
+
+/// What an animation moves.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnimationTarget {
+    /// These instances (`Scene::instances` indices) move together by `motion`.
+    Instances {
+        /// Indices into `Scene::instances`; all dynamic.
+        instances: Vec<usize>,
+        /// Places the animation's space in the world.
+        outer: Mat4,
+        /// Each instance's transform at rest in the animation's space, in `instances` order.
+        inner: Vec<Mat4>,
+        /// The motion.
+        motion: Motion,
+    },
+    /// A light (`Scene::lights` index) and its rest state.
+    Light {
+        /// Index into `Scene::lights`.
+        light: usize,
+        /// The light at rest, in the world.
+        rest: Light,
+        /// Places the tracks' positions and directions in the world.
+        outer: Mat4,
+        /// The animated parameters.
+        tracks: LightTracks,
+    },
+}
+
+/// One named animation of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Animation {
+    /// For messages and `voxgi info`.
+    pub name: String,
+    /// What it moves.
+    pub target: AnimationTarget,
+}
+
+impl Animation {
+    /// How long one pass lasts, seconds.
+    pub fn duration(&self) -> f32 {
+        match &self.target {
+            AnimationTarget::Instances { motion, .. } => motion.duration(),
+            AnimationTarget::Light { tracks, .. } => tracks.duration(),
+        }
+    }
+}
+
+impl Scene {
+    /// Sets every animated instance and light to its state at time `t` (seconds). Sampling
+    /// the same time twice gives the same scene; untouched parts keep their values.
+    pub fn set_time(&mut self, t: f32) {
+        for a in &self.animations {
+            match &a.target {
+                AnimationTarget::Instances {
+                    instances,
+                    outer,
+                    inner,
+                    motion,
+                } => {
+                    let m = *outer * motion.at(t);
+                    for (&i, r) in instances.iter().zip(inner) {
+                        if let Some(inst) = self.instances.get_mut(i) {
+                            inst.transform = m * *r;
+                        }
+                    }
+                }
+                AnimationTarget::Light {
+                    light,
+                    rest,
+                    outer,
+                    tracks,
+                } => {
+                    if let Some(l) = self.lights.get_mut(*light) {
+                        *l = tracks.apply(rest, *outer, t);
+                    }
+                }
+            }
+        }
+    }
+
+    /// A copy of the scene at time `t`.
+    pub fn at_time(&self, t: f32) -> Scene {
+        let mut s = self.clone();
+        s.set_time(t);
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vec3, b: Vec3) -> bool {
+        (a - b).abs().max_element() < 1e-5
+    }
+
+    #[test]
+    fn tracks_interpolate_as_hand_computed() {
+        let times = vec![0.0, 1.0, 3.0];
+        let values = vec![0.0f32, 2.0, 6.0];
+        let lin = Track::new(
+            times.clone(),
+            values.clone(),
+            Interpolation::Linear,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        assert_eq!(lin.sample(-1.0), 0.0);
+        assert_eq!(lin.sample(0.5), 1.0);
+        assert_eq!(lin.sample(2.0), 4.0);
+        assert_eq!(lin.sample(10.0), 6.0);
+        let step = Track::new(
+            times.clone(),
+            values.clone(),
+            Interpolation::Step,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        assert_eq!(step.sample(0.99), 0.0);
+        assert_eq!(step.sample(1.0), 2.0);
+        assert_eq!(step.sample(2.9), 2.0);
+        let looped = Track::new(
+            times.clone(),
+            values.clone(),
+            Interpolation::Linear,
+            Repeat::Loop,
+        )
+        .unwrap();
+        assert_eq!(looped.sample(3.5), 1.0);
+        assert_eq!(looped.sample(-0.5), lin.sample(2.5));
+        // Catmull-Rom passes through its keyframes and, on keys spaced along a line with equal
+        // steps, is that line: 0, 2, 4, 6 at t = 0, 1, 2, 3.
+        let cubic = Track::new(
+            vec![0.0, 1.0, 2.0, 3.0],
+            vec![0.0f32, 2.0, 4.0, 6.0],
+            Interpolation::Cubic,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        for (t, v) in [(1.0, 2.0), (1.25, 2.5), (1.5, 3.0), (2.0, 4.0)] {
+            assert!(
+                (cubic.sample(t) - v).abs() < 1e-5,
+                "{t}: {}",
+                cubic.sample(t)
+            );
+        }
+    }
+
+    #[test]
+    fn bad_tracks_say_what_is_wrong() {
+        let bad = |t: Vec<f32>, v: Vec<f32>| {
+            Track::new(t, v, Interpolation::Linear, Repeat::Clamp).unwrap_err()
+        };
+        assert!(bad(vec![], vec![]).contains("at least one"));
+        assert!(bad(vec![0.0, 1.0], vec![0.0]).contains("2 keyframe times but 1"));
+        assert!(bad(vec![0.0, 2.0, 1.0], vec![0.0; 3]).contains("sorted"));
+        assert!(bad(vec![0.0, 0.0], vec![0.0; 2]).contains("sorted"));
+        assert!(bad(vec![f32::NAN], vec![0.0]).contains("finite"));
+        assert!(bad(vec![-1.0], vec![0.0]).contains(">= 0"));
+        assert!(bad(vec![0.0], vec![f32::INFINITY]).contains("not finite"));
+    }
+
+    #[test]
+    fn rotations_take_the_short_way() {
+        let a = Quat::from_rotation_y(0.0);
+        let b = -Quat::from_rotation_y(1.0);
+        for interp in [Interpolation::Linear, Interpolation::Cubic] {
+            let t = Track::new(vec![0.0, 1.0], vec![a, b], interp, Repeat::Clamp).unwrap();
+            let half = t.sample(0.5);
+            let want = Quat::from_rotation_y(0.5);
+            assert!(half.dot(want).abs() > 1.0 - 1e-5, "{interp:?}: {half:?}");
+        }
+    }
+
+    #[test]
+    fn generators_move_as_described() {
+        let orbit = Motion::Orbit {
+            center: Vec3::new(1.0, 0.0, 0.0),
+            axis: Vec3::Y,
+            period: 4.0,
+        };
+        // A quarter turn about +Y through (1, 0, 0) takes (2, 0, 0) to (1, 0, -1).
+        let p = orbit.at(1.0).transform_point3(Vec3::new(2.0, 0.0, 0.0));
+        assert!(close(p, Vec3::new(1.0, 0.0, -1.0)), "{p}");
+        assert!(close(
+            orbit.at(4.0).transform_point3(Vec3::X * 2.0),
+            Vec3::X * 2.0
+        ));
+        let osc = Motion::Oscillate {
+            axis: Vec3::X,
+            amplitude: 0.5,
+            period: 2.0,
+        };
+        assert!(close(
+            osc.at(0.5).transform_point3(Vec3::ZERO),
+            Vec3::X * 0.5
+        ));
+        assert!(close(
+            osc.at(1.5).transform_point3(Vec3::ZERO),
+            Vec3::X * -0.5
+        ));
+        assert_eq!(osc.duration(), 2.0);
+    }
+
+    #[test]
+    fn set_time_moves_instances_from_their_rest_pose_and_lights_from_theirs() {
+        let mut scene = crate::builtin::cornell_box();
+        let block = 0;
+        scene.instances[block].dynamic = true;
+        let rest = scene.instances[block].transform;
+        let light_rest = scene.lights[0].clone();
+        scene.animations.push(Animation {
+            name: "slide".into(),
+            target: AnimationTarget::Instances {
+                instances: vec![block],
+                outer: Mat4::IDENTITY,
+                inner: vec![rest],
+                motion: Motion::Keyframes {
+                    translation: Some(
+                        Track::new(
+                            vec![0.0, 2.0],
+                            vec![Vec3::ZERO, Vec3::new(0.2, 0.0, 0.0)],
+                            Interpolation::Linear,
+                            Repeat::Clamp,
+                        )
+                        .unwrap(),
+                    ),
+                    rotation: None,
+                    scale: None,
+                },
+            },
+        });
+        scene.animations.push(Animation {
+            name: "dim".into(),
+            target: AnimationTarget::Light {
+                light: 0,
+                rest: light_rest.clone(),
+                outer: Mat4::IDENTITY,
+                tracks: LightTracks {
+                    intensity: Some(
+                        Track::new(
+                            vec![0.0, 2.0],
+                            vec![1.0, 0.0],
+                            Interpolation::Linear,
+                            Repeat::Clamp,
+                        )
+                        .unwrap(),
+                    ),
+                    ..Default::default()
+                },
+            },
+        });
+        let half = scene.at_time(1.0);
+        assert_eq!(
+            half.instances[block].transform,
+            Mat4::from_translation(Vec3::new(0.1, 0.0, 0.0)) * rest
+        );
+        assert_eq!(half.lights[0].intensity, 0.5);
+        assert_eq!(half.lights[0].position, light_rest.position);
+        // Going back to 0 restores the rest state exactly.
+        let back = half.at_time(0.0);
+        assert_eq!(back.instances[block].transform, rest);
+        assert_eq!(back.lights[0], light_rest);
+        assert_eq!(scene.animations[0].duration(), 2.0);
+    }
+
+    #[test]
+    fn appending_a_scene_keeps_its_animations_in_its_own_space() {
+        let mut inner = crate::builtin::cornell_box();
+        let rest = inner.instances[0].transform;
+        let light_rest = inner.lights[0].clone();
+        let slide = Track::new(
+            vec![0.0, 1.0],
+            vec![Vec3::ZERO, Vec3::X],
+            Interpolation::Linear,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        inner.animations.push(Animation {
+            name: "slide".into(),
+            target: AnimationTarget::Instances {
+                instances: vec![0],
+                outer: Mat4::IDENTITY,
+                inner: vec![rest],
+                motion: Motion::Keyframes {
+                    translation: Some(slide.clone()),
+                    rotation: None,
+                    scale: None,
+                },
+            },
+        });
+        inner.animations.push(Animation {
+            name: "lamp".into(),
+            target: AnimationTarget::Light {
+                light: 0,
+                rest: light_rest.clone(),
+                outer: Mat4::IDENTITY,
+                tracks: LightTracks {
+                    position: Some(slide),
+                    ..Default::default()
+                },
+            },
+        });
+        let mut outer = crate::builtin::open_plane(0.5);
+        let (n_inst, n_lights) = (outer.instances.len(), outer.lights.len());
+        // Turned a quarter about +Y and moved: the slide along the file's +X becomes one along
+        // the world's -Z.
+        let t = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0))
+            * Mat4::from_rotation_y(std::f32::consts::FRAC_PI_2);
+        outer.append(inner, t, true);
+        outer.set_time(1.0);
+        let got = outer.instances[n_inst].transform;
+        let want = t * Mat4::from_translation(Vec3::X) * rest;
+        assert!(got.abs_diff_eq(want, 1e-5), "{got} vs {want}");
+        let l = &outer.lights[n_lights];
+        assert!(
+            close(l.position, t.transform_point3(Vec3::X)),
+            "{}",
+            l.position
+        );
+        // The light's other parameters are the appended (moved) rest light's.
+        assert_eq!(l.intensity, light_rest.intensity);
+    }
+}
