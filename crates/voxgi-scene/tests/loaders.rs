@@ -772,3 +772,126 @@ fn conformance_with_real_files() {
         assert!(s.triangle_count() >= 2, "{m}");
     }
 }
+
+#[test]
+fn scene_file_animations_sample_as_hand_computed() {
+    let dir = tmp("anim");
+    let path = write(
+        &dir,
+        "moving.toml",
+        r#"
+[[include]]
+name = "box"
+builtin = "cornell-box"
+translate = [1.0, 0.0, 0.0]
+dynamic = true
+
+[[light]]
+name = "key"
+type = "point"
+intensity = 4.0
+position = [0.0, 2.0, 0.0]
+
+[[animation]]
+target = "box"
+name = "slide"
+times = [0.0, 2.0]
+translate = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.5]]
+repeat = "loop"
+
+[[animation]]
+target = "key"
+times = [0.0, 1.0]
+intensity = [4.0, 0.0]
+position = [[0.0, 2.0, 0.0], [0.0, 3.0, 0.0]]
+"#,
+    );
+    let s = voxgi_scene::io::load(&path).expect("loads");
+    assert_eq!(s.animations.len(), 2);
+    assert_eq!(s.animations[0].name, "slide");
+    assert_eq!(s.animations[0].duration(), 2.0);
+    let rest: Vec<_> = s.instances.iter().map(|i| i.transform).collect();
+    // Half way through the slide: 0.25 m along +z on top of the include's placement.
+    let half = s.at_time(1.0);
+    for (i, r) in half.instances.iter().zip(&rest) {
+        let want = glam::Mat4::from_translation(Vec3::new(0.0, 0.0, 0.25)) * *r;
+        assert!(i.transform.abs_diff_eq(want, 1e-6), "{}", i.name);
+    }
+    let key = half.lights.iter().find(|l| l.name == "key").unwrap();
+    assert_eq!(key.intensity, 0.0);
+    assert!(close(key.position, Vec3::new(0.0, 3.0, 0.0)));
+    // Looping: t = 2.5 is t = 0.5.
+    let a = s.at_time(2.5);
+    let b = s.at_time(0.5);
+    assert_eq!(a.instances[0].transform, b.instances[0].transform);
+}
+
+#[test]
+fn bad_animations_are_errors_naming_the_file_and_the_animation() {
+    let dir = tmp("badanim");
+    let head = "[[include]]\nname = \"box\"\nbuiltin = \"cornell-box\"\ndynamic = true\n\
+                [[include]]\nname = \"fixed\"\nbuiltin = \"open-plane\"\n";
+    let cases = [
+        (
+            "unknown target",
+            "[[animation]]\ntarget = \"boxx\"\ntimes = [0.0]\ntranslate = [[0.0, 0.0, 0.0]]\n",
+            "no include",
+        ),
+        (
+            "static include",
+            "[[animation]]\ntarget = \"fixed\"\ntimes = [0.0]\ntranslate = [[0.0, 0.0, 0.0]]\n",
+            "dynamic = true",
+        ),
+        (
+            "unsorted",
+            "[[animation]]\ntarget = \"box\"\ntimes = [1.0, 0.5]\ntranslate = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]\n",
+            "sorted",
+        ),
+        (
+            "count",
+            "[[animation]]\ntarget = \"box\"\ntimes = [0.0, 1.0]\ntranslate = [[0.0, 0.0, 0.0]]\n",
+            "2 keyframe times but 1",
+        ),
+        (
+            "empty",
+            "[[animation]]\ntarget = \"box\"\ntimes = []\ntranslate = []\n",
+            "at least one",
+        ),
+        (
+            "non-finite",
+            "[[animation]]\ntarget = \"box\"\ntimes = [0.0, nan]\ntranslate = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]\n",
+            "finite",
+        ),
+        (
+            "nothing",
+            "[[animation]]\ntarget = \"box\"\n",
+            "nothing moves",
+        ),
+        (
+            "no times",
+            "[[animation]]\ntarget = \"box\"\ntranslate = [[0.0, 0.0, 0.0]]\n",
+            "needs keyframe `times`",
+        ),
+        (
+            "bad period",
+            "[[animation]]\ntarget = \"box\"\norbit = { center = [0.0, 0.0, 0.0], axis = [0.0, 1.0, 0.0], period = 0.0 }\n",
+            "period",
+        ),
+        (
+            "bad interpolation",
+            "[[animation]]\ntarget = \"box\"\ninterpolation = \"smooth\"\ntimes = [0.0]\ntranslate = [[0.0, 0.0, 0.0]]\n",
+            "smooth",
+        ),
+    ];
+    for (what, body, fragment) in cases {
+        let path = write(&dir, "a.toml", format!("{head}{body}"));
+        let e = voxgi_scene::io::load(&path)
+            .err()
+            .unwrap_or_else(|| panic!("{what}: accepted"))
+            .to_string();
+        assert!(
+            e.contains("a.toml") && e.contains("animation 1") && e.contains(fragment),
+            "{what}: {e}"
+        );
+    }
+}

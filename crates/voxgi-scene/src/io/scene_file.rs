@@ -7,6 +7,7 @@
 //! name = "sponza at noon"          # optional; default: the file stem
 //!
 //! [[include]]                      # any number, applied in order
+//! name = "sponza"                  # optional; what an [[animation]] targets
 //! file = "../scenes/sponza.obj"    # relative to this file; any format voxgi reads, also .toml
 //! # builtin = "cornell-box"        # instead of `file`: a built-in scene (exactly one of the two)
 //! translate = [0.0, 0.0, 0.0]      # metres (default 0)
@@ -54,11 +55,31 @@
 //!
 //! [settings]                       # anything; handed to the renderer untouched
 //! voxel_resolution = 256
+//!
+//! [[animation]]                    # any number; moves a dynamic include or changes a light
+//! target = "block"                 # an include's `name` (which must be dynamic) or a light's
+//! name = "slide"                   # optional; default: the target
+//! interpolation = "linear"         # "step" | "linear" | "cubic" (Catmull-Rom); default linear
+//! repeat = "loop"                  # "clamp" (hold the ends, default) | "loop"
+//! times = [0.0, 1.0, 2.0]          # keyframe times in seconds, increasing
+//! translate = [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.0, 0.0]]  # per keyframe, metres
+//! # rotate = [[0, 0, 0], …]        # degrees about X, then Y, then Z, per keyframe
+//! # scale = [1.0, …]               # number or [x, y, z] per keyframe
+//! # orbit = { center = [0, 0, 0], axis = [0, 1, 0], period = 4.0 }  # instead of keyframes
+//! # oscillate = { axis = [1, 0, 0], amplitude = 0.1, period = 2.0 } # instead of keyframes
+//! # for a light: position, direction, color ([r, g, b]) and intensity (numbers) per keyframe
 //! ```
+//!
+//! An include's motion is applied in world space on top of its placement (keyframe values are
+//! offsets from the rest pose); a light's keyframes replace its position, direction, colour or
+//! intensity. `Scene::set_time` applies them.
 //!
 //! Included scenes keep their own lights and cameras; without a `[camera]` the first included
 //! camera is the default view. Include cycles are reported as errors.
 
+use crate::animation::{
+    Animation, AnimationTarget, Interpolation, LightTracks, Motion, Repeat, Track,
+};
 use crate::{AreaShape, Camera, Light, LightKind, Result, Scene, SceneError};
 use glam::{Mat4, Vec3};
 use serde::Deserialize;
@@ -75,11 +96,51 @@ struct SceneFile {
     light: Vec<LightDef>,
     camera: Option<CameraDef>,
     settings: Option<toml::Table>,
+    #[serde(default)]
+    animation: Vec<AnimationDef>,
+}
+
+/// `[[animation]]`: keyframes (`times` with per-key values) or one generator, for an include
+/// or a light named `target`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct AnimationDef {
+    name: Option<String>,
+    target: String,
+    interpolation: Option<String>,
+    repeat: Option<String>,
+    times: Option<Vec<f32>>,
+    translate: Option<Vec<[f32; 3]>>,
+    rotate: Option<Vec<[f32; 3]>>,
+    scale: Option<Vec<Scale>>,
+    position: Option<Vec<[f32; 3]>>,
+    direction: Option<Vec<[f32; 3]>>,
+    color: Option<Vec<[f32; 3]>>,
+    intensity: Option<Vec<f32>>,
+    orbit: Option<OrbitDef>,
+    oscillate: Option<OscillateDef>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct OrbitDef {
+    center: [f32; 3],
+    axis: [f32; 3],
+    period: f32,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct OscillateDef {
+    axis: [f32; 3],
+    amplitude: f32,
+    period: f32,
 }
 
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 struct Include {
+    name: Option<String>,
     file: Option<String>,
     builtin: Option<String>,
     #[serde(default)]
@@ -226,6 +287,8 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         ..Default::default()
     };
 
+    // Each include's instances, for the animations that name it.
+    let mut include_instances: Vec<(Option<&str>, std::ops::Range<usize>, bool)> = Vec::new();
     for (i, inc) in file.include.iter().enumerate() {
         let what = format!("include {}", i + 1);
         let mut sub = match (&inc.file, &inc.builtin) {
@@ -261,7 +324,13 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
             * Mat4::from_rotation_y(r.y.to_radians())
             * Mat4::from_rotation_x(r.x.to_radians())
             * Mat4::from_scale(scale);
+        let first = scene.instances.len();
         scene.append(sub, transform, inc.dynamic);
+        include_instances.push((
+            inc.name.as_deref(),
+            first..scene.instances.len(),
+            inc.dynamic,
+        ));
     }
 
     for (i, l) in file.light.iter().enumerate() {
@@ -277,6 +346,12 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         } else {
             scene.lights.push(light);
         }
+    }
+
+    for (i, a) in file.animation.iter().enumerate() {
+        let anim = make_animation(a, &scene, &include_instances)
+            .map_err(|r| err(format!("animation {} ('{}'): {r}", i + 1, a.target)))?;
+        scene.animations.push(anim);
     }
 
     if let Some(c) = &file.camera {
@@ -475,4 +550,229 @@ fn make_light(l: &LightDef, index: usize) -> std::result::Result<Light, String> 
         range: l.range,
         cast_shadows: l.cast_shadows,
     })
+}
+
+fn parse_interpolation(s: Option<&str>) -> std::result::Result<Interpolation, String> {
+    match s.unwrap_or("linear") {
+        "step" => Ok(Interpolation::Step),
+        "linear" => Ok(Interpolation::Linear),
+        "cubic" => Ok(Interpolation::Cubic),
+        other => Err(format!(
+            "interpolation '{other}' is not step, linear or cubic"
+        )),
+    }
+}
+
+fn parse_repeat(s: Option<&str>) -> std::result::Result<Repeat, String> {
+    match s.unwrap_or("clamp") {
+        "clamp" => Ok(Repeat::Clamp),
+        "loop" => Ok(Repeat::Loop),
+        other => Err(format!("repeat '{other}' is not clamp or loop")),
+    }
+}
+
+/// One `[[animation]]` table as an `Animation` of `scene`, whose includes are
+/// `includes` (name, instance range, dynamic).
+fn make_animation(
+    a: &AnimationDef,
+    scene: &Scene,
+    includes: &[(Option<&str>, std::ops::Range<usize>, bool)],
+) -> std::result::Result<Animation, String> {
+    let interpolation = parse_interpolation(a.interpolation.as_deref())?;
+    let repeat = parse_repeat(a.repeat.as_deref())?;
+    let track = |what: &str, values: Option<Vec<Vec3>>| -> std::result::Result<_, String> {
+        let Some(values) = values else {
+            return Ok(None);
+        };
+        let times = a
+            .times
+            .clone()
+            .ok_or_else(|| format!("`{what}` needs keyframe `times`"))?;
+        Track::new(times, values, interpolation, repeat)
+            .map(Some)
+            .map_err(|e| format!("`{what}`: {e}"))
+    };
+    let v3 = |v: &Option<Vec<[f32; 3]>>| {
+        v.as_ref()
+            .map(|v| v.iter().map(|&x| Vec3::from(x)).collect())
+    };
+    let include = includes
+        .iter()
+        .filter(|(name, ..)| *name == Some(a.target.as_str()))
+        .collect::<Vec<_>>();
+    let light = scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.name == a.target)
+        .map(|(i, _)| i)
+        .collect::<Vec<_>>();
+    let name = a.name.clone().unwrap_or_else(|| a.target.clone());
+    match (include.as_slice(), light.as_slice()) {
+        ([(_, range, dynamic)], []) => {
+            if !dynamic {
+                return Err(
+                    "the include is static: set `dynamic = true` on it to let it move".into(),
+                );
+            }
+            if a.position.is_some()
+                || a.direction.is_some()
+                || a.color.is_some()
+                || a.intensity.is_some()
+            {
+                return Err(
+                    "an include takes translate, rotate, scale, orbit or oscillate, not light keys"
+                        .into(),
+                );
+            }
+            let keyed = a.translate.is_some() || a.rotate.is_some() || a.scale.is_some();
+            let motion = match (keyed, &a.orbit, &a.oscillate) {
+                (true, None, None) => Motion::Keyframes {
+                    translation: track("translate", v3(&a.translate))?,
+                    rotation: match &a.rotate {
+                        None => None,
+                        Some(r) => {
+                            let q = r
+                                .iter()
+                                .map(|d| {
+                                    let d = Vec3::from(*d);
+                                    glam::Quat::from_rotation_z(d.z.to_radians())
+                                        * glam::Quat::from_rotation_y(d.y.to_radians())
+                                        * glam::Quat::from_rotation_x(d.x.to_radians())
+                                })
+                                .collect();
+                            let times = a.times.clone().ok_or("`rotate` needs keyframe `times`")?;
+                            Some(
+                                Track::new(times, q, interpolation, repeat)
+                                    .map_err(|e| format!("`rotate`: {e}"))?,
+                            )
+                        }
+                    },
+                    scale: track(
+                        "scale",
+                        a.scale.as_ref().map(|s| {
+                            s.iter()
+                                .map(|s| match s {
+                                    Scale::Uniform(u) => Vec3::splat(*u),
+                                    Scale::Axes(v) => Vec3::from(*v),
+                                })
+                                .collect()
+                        }),
+                    )?,
+                },
+                (false, Some(o), None) => {
+                    let axis = Vec3::from(o.axis);
+                    if !(Vec3::from(o.center).is_finite()
+                        && axis.is_finite()
+                        && axis.length() > 0.0)
+                    {
+                        return Err(
+                            "orbit: center and axis must be finite, the axis non-zero".into()
+                        );
+                    }
+                    if !(o.period.is_finite() && o.period > 0.0) {
+                        return Err(format!("orbit: period {} must be > 0 seconds", o.period));
+                    }
+                    Motion::Orbit {
+                        center: Vec3::from(o.center),
+                        axis: axis.normalize(),
+                        period: o.period,
+                    }
+                }
+                (false, None, Some(o)) => {
+                    let axis = Vec3::from(o.axis);
+                    if !(axis.is_finite() && axis.length() > 0.0 && o.amplitude.is_finite()) {
+                        return Err(
+                            "oscillate: axis and amplitude must be finite, the axis non-zero"
+                                .into(),
+                        );
+                    }
+                    if !(o.period.is_finite() && o.period > 0.0) {
+                        return Err(format!(
+                            "oscillate: period {} must be > 0 seconds",
+                            o.period
+                        ));
+                    }
+                    Motion::Oscillate {
+                        axis: axis.normalize(),
+                        amplitude: o.amplitude,
+                        period: o.period,
+                    }
+                }
+                (false, None, None) => {
+                    return Err(
+                        "nothing moves: give translate/rotate/scale keyframes, orbit or oscillate"
+                            .into(),
+                    );
+                }
+                _ => return Err("give keyframes, orbit or oscillate, only one of them".into()),
+            };
+            let instances: Vec<usize> = range.clone().collect();
+            Ok(Animation {
+                name,
+                target: AnimationTarget::Instances {
+                    inner: instances
+                        .iter()
+                        .map(|&i| scene.instances[i].transform)
+                        .collect(),
+                    instances,
+                    outer: Mat4::IDENTITY,
+                    motion,
+                },
+            })
+        }
+        ([], [l]) => {
+            if a.translate.is_some()
+                || a.rotate.is_some()
+                || a.scale.is_some()
+                || a.orbit.is_some()
+                || a.oscillate.is_some()
+            {
+                return Err(
+                    "a light takes position, direction, color or intensity keyframes".into(),
+                );
+            }
+            let tracks = LightTracks {
+                position: track("position", v3(&a.position))?,
+                direction: track("direction", v3(&a.direction))?,
+                color: track("color", v3(&a.color))?,
+                intensity: match &a.intensity {
+                    None => None,
+                    Some(v) => {
+                        let times = a
+                            .times
+                            .clone()
+                            .ok_or("`intensity` needs keyframe `times`")?;
+                        Some(
+                            Track::new(times, v.clone(), interpolation, repeat)
+                                .map_err(|e| format!("`intensity`: {e}"))?,
+                        )
+                    }
+                },
+            };
+            if tracks == LightTracks::default() {
+                return Err(
+                    "nothing changes: give position, direction, color or intensity keyframes"
+                        .into(),
+                );
+            }
+            Ok(Animation {
+                name,
+                target: AnimationTarget::Light {
+                    light: *l,
+                    rest: scene.lights[*l].clone(),
+                    outer: Mat4::IDENTITY,
+                    tracks,
+                },
+            })
+        }
+        ([], []) => Err(format!(
+            "no include (by `name`) or light is called '{}'",
+            a.target
+        )),
+        _ => Err(format!(
+            "more than one include or light is called '{}'",
+            a.target
+        )),
+    }
 }
