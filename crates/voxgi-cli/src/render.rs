@@ -45,6 +45,9 @@ pub struct RenderArgs {
     /// Reference modes: random seed (the same seed gives the same image).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub seed: u32,
+    /// The scene's animations at this time, in seconds (default 0: the rest pose).
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
+    pub time: f32,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -75,6 +78,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let (scene, table) = p.stage(&format!("loading {label}"), || {
         load_scene_and_settings(&args.scene)
     })?;
+    if !args.time.is_finite() {
+        bail!("--time {} is not a finite number of seconds", args.time);
+    }
+    let mut scene = scene;
+    scene.set_time(args.time);
     let default = scene
         .cameras
         .first()

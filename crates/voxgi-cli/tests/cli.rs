@@ -408,3 +408,55 @@ fn help_states_the_library_defaults() {
         );
     }
 }
+
+/// `--time` renders the scene's animations at that instant: a lamp raised by its animation
+/// changes the picture, and a time that is not a number is refused.
+#[test]
+fn render_time_samples_the_scene_file_animations() {
+    let dir = tmp("anim");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("lamp.obj"),
+        "mtllib lamp.mtl\nv 0.13 0.30 0.18\nv 0.43 0.30 0.18\nv 0.43 0.30 0.42\nv 0.13 0.30 0.42\n\
+         vn 0 -1 0\nusemtl lamp\nf 1//1 2//1 3//1 4//1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("lamp.mtl"),
+        "newmtl lamp\nKd 0.7 0.7 0.7\nKe 4 4 4\n",
+    )
+    .unwrap();
+    let scene = dir.join("moving.toml");
+    std::fs::write(
+        &scene,
+        "[[include]]\nbuiltin = \"cornell-box\"\n[[include]]\nname = \"lamp\"\n\
+         file = \"lamp.obj\"\ndynamic = true\n[[animation]]\ntarget = \"lamp\"\n\
+         times = [0.0, 1.0]\ntranslate = [[0.0, 0.0, 0.0], [0.0, 0.2, 0.0]]\n",
+    )
+    .unwrap();
+    let render = |t: &str, out: &str| {
+        let png = dir.join(out);
+        let o = voxgi(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--time",
+            t,
+            "--size",
+            "32x32",
+            "--voxel-resolution",
+            "32",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        (o, png)
+    };
+    let (o0, p0) = render("0", "t0.png");
+    assert!(o0.status.success(), "{}", stderr(&o0));
+    let (o1, p1) = render("1", "t1.png");
+    assert!(o1.status.success(), "{}", stderr(&o1));
+    let (a, b) = (image::open(p0).unwrap(), image::open(p1).unwrap());
+    assert_ne!(a.as_bytes(), b.as_bytes(), "the animation had no effect");
+    let (bad, _) = render("nan", "tn.png");
+    assert!(!bad.status.success());
+    assert!(error_line(&bad).contains("--time"), "{}", error_line(&bad));
+}

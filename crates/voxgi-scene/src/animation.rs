@@ -334,6 +334,9 @@ pub enum AnimationTarget {
         outer: Mat4,
         /// Each instance's transform at rest in the animation's space, in `instances` order.
         inner: Vec<Mat4>,
+        /// The area lights whose visible surfaces these instances are (`Instance::light`),
+        /// with their rest state in the world: they move with their surface.
+        lights: Vec<(usize, Light)>,
         /// The motion.
         motion: Motion,
     },
@@ -359,6 +362,29 @@ pub struct Animation {
     pub target: AnimationTarget,
 }
 
+impl AnimationTarget {
+    /// `instances` of `scene`, at rest where they are now, moved together by `motion` in
+    /// world space.
+    pub fn instances(scene: &Scene, instances: Vec<usize>, motion: Motion) -> Self {
+        let inner = instances
+            .iter()
+            .map(|&i| scene.instances[i].transform)
+            .collect();
+        let lights = instances
+            .iter()
+            .filter_map(|&i| scene.instances[i].light)
+            .filter_map(|l| scene.lights.get(l).map(|rest| (l, rest.clone())))
+            .collect();
+        AnimationTarget::Instances {
+            instances,
+            outer: Mat4::IDENTITY,
+            inner,
+            lights,
+            motion,
+        }
+    }
+}
+
 impl Animation {
     /// How long one pass lasts, seconds.
     pub fn duration(&self) -> f32 {
@@ -379,12 +405,21 @@ impl Scene {
                     instances,
                     outer,
                     inner,
+                    lights,
                     motion,
                 } => {
-                    let m = *outer * motion.at(t);
+                    let motion = motion.at(t);
+                    let m = *outer * motion;
                     for (&i, r) in instances.iter().zip(inner) {
                         if let Some(inst) = self.instances.get_mut(i) {
                             inst.transform = m * *r;
+                        }
+                    }
+                    // The rest light is in the world: move it by the motion seen from there.
+                    let world = *outer * motion * outer.inverse();
+                    for (l, rest) in lights {
+                        if let Some(light) = self.lights.get_mut(*l) {
+                            *light = rest.transformed(world);
                         }
                     }
                 }
@@ -539,6 +574,7 @@ mod tests {
                 instances: vec![block],
                 outer: Mat4::IDENTITY,
                 inner: vec![rest],
+                lights: Vec::new(),
                 motion: Motion::Keyframes {
                     translation: Some(
                         Track::new(
@@ -606,6 +642,7 @@ mod tests {
                 instances: vec![0],
                 outer: Mat4::IDENTITY,
                 inner: vec![rest],
+                lights: Vec::new(),
                 motion: Motion::Keyframes {
                     translation: Some(slide.clone()),
                     rotation: None,
@@ -644,5 +681,37 @@ mod tests {
         );
         // The light's other parameters are the appended (moved) rest light's.
         assert_eq!(l.intensity, light_rest.intensity);
+    }
+
+    #[test]
+    fn an_area_light_moves_with_its_surface() {
+        let mut scene = crate::builtin::cornell_box();
+        let lamp = scene
+            .instances
+            .iter()
+            .position(|i| i.light.is_some())
+            .expect("the Cornell box's lamp is an area light's surface");
+        let light = scene.instances[lamp].light.unwrap();
+        let rest = scene.lights[light].clone();
+        let motion = Motion::Oscillate {
+            axis: Vec3::X,
+            amplitude: 0.1,
+            period: 4.0,
+        };
+        let target = AnimationTarget::instances(&scene, vec![lamp], motion);
+        scene.animations.push(Animation {
+            name: "sway".into(),
+            target,
+        });
+        let moved = scene.at_time(1.0);
+        let l = &moved.lights[light];
+        assert!(
+            close(l.position, rest.position + Vec3::X * 0.1),
+            "{}",
+            l.position
+        );
+        assert!(close(l.direction, rest.direction));
+        assert_eq!(l.kind, rest.kind, "a translation keeps the shape");
+        assert_eq!(moved.at_time(0.0).lights[light], rest);
     }
 }

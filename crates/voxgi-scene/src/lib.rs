@@ -159,7 +159,6 @@ impl Scene {
             self.lights.len(),
         );
         let linear = glam::Mat3::from_mat4(transform);
-        let normal_m = linear.inverse().transpose();
         self.textures.extend(other.textures);
         self.materials
             .extend(other.materials.into_iter().map(|mut m| {
@@ -186,37 +185,24 @@ impl Scene {
                 p.dynamic |= dynamic;
                 p
             }));
-        self.lights.extend(other.lights.into_iter().map(|mut l| {
-            l.position = transform.transform_point3(l.position);
-            let old_dir = l.direction;
-            l.direction = match l.kind {
-                LightKind::Area { .. } => (normal_m * l.direction).normalize_or(l.direction),
-                _ => (linear * l.direction).normalize_or(l.direction),
-            };
-            if let LightKind::Area { shape } = &mut l.kind {
-                match shape {
-                    AreaShape::Rect { u, v } => {
-                        *u = linear * *u;
-                        *v = linear * *v;
-                    }
-                    AreaShape::Disc { radius } => {
-                        let (t, b) = old_dir.any_orthonormal_pair();
-                        let scale = (linear * t).cross(linear * b).length().sqrt();
-                        *radius *= scale;
-                    }
-                }
-            }
-            l
-        }));
+        self.lights
+            .extend(other.lights.into_iter().map(|l| l.transformed(transform)));
         let inst0 = self.instances.len() - other_instances;
         self.animations
             .extend(other.animations.into_iter().map(|mut a| {
                 match &mut a.target {
                     crate::animation::AnimationTarget::Instances {
-                        instances, outer, ..
+                        instances,
+                        outer,
+                        lights,
+                        ..
                     } => {
                         instances.iter_mut().for_each(|i| *i += inst0);
                         *outer = transform * *outer;
+                        for (l, rest) in lights.iter_mut() {
+                            *l += light0;
+                            *rest = rest.transformed(transform);
+                        }
                     }
                     crate::animation::AnimationTarget::Light {
                         light, rest, outer, ..

@@ -169,6 +169,34 @@ pub struct Light {
 }
 
 impl Light {
+    /// The light moved by `m` (an affine transform): its position, its direction (an area
+    /// light's as a normal) and an area light's extent.
+    pub fn transformed(&self, m: Mat4) -> Light {
+        let mut l = self.clone();
+        let linear = glam::Mat3::from_mat4(m);
+        let normal_m = linear.inverse().transpose();
+        l.position = m.transform_point3(l.position);
+        let old_dir = l.direction;
+        l.direction = match l.kind {
+            LightKind::Area { .. } => (normal_m * l.direction).normalize_or(l.direction),
+            _ => (linear * l.direction).normalize_or(l.direction),
+        };
+        if let LightKind::Area { shape } = &mut l.kind {
+            match shape {
+                AreaShape::Rect { u, v } => {
+                    *u = linear * *u;
+                    *v = linear * *v;
+                }
+                AreaShape::Disc { radius } => {
+                    let (t, b) = old_dir.any_orthonormal_pair();
+                    let scale = (linear * t).cross(linear * b).length().sqrt();
+                    *radius *= scale;
+                }
+            }
+        }
+        l
+    }
+
     /// `color * intensity`.
     pub fn radiometric(&self) -> Vec3 {
         Vec3::from(self.color) * self.intensity

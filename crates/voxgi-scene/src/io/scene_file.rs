@@ -707,18 +707,9 @@ fn make_animation(
                 }
                 _ => return Err("give keyframes, orbit or oscillate, only one of them".into()),
             };
-            let instances: Vec<usize> = range.clone().collect();
             Ok(Animation {
                 name,
-                target: AnimationTarget::Instances {
-                    inner: instances
-                        .iter()
-                        .map(|&i| scene.instances[i].transform)
-                        .collect(),
-                    instances,
-                    outer: Mat4::IDENTITY,
-                    motion,
-                },
+                target: AnimationTarget::instances(scene, range.clone().collect(), motion),
             })
         }
         ([], [l]) => {
