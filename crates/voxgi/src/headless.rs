@@ -2,10 +2,11 @@
 //! first) and frames rendered to images in memory, built on the public API only
 //! (`Renderer::new`, `Renderer::render`). Applications that own a device do not need it.
 
+use crate::gpu::readback;
+use crate::gpu::requirements::{required_features, required_limits};
 use crate::options::FrameParams;
 use crate::output::RenderOutput;
-use crate::requirements::{required_features, required_limits};
-use crate::{Error, Renderer, Result, Target, readback};
+use crate::{Error, Renderer, Result, Target};
 
 /// A wgpu device and queue voxgi opened itself, plus what it learned about the adapter.
 pub struct GpuContext {

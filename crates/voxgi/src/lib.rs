@@ -56,8 +56,6 @@ pub mod voxel;
 
 pub use error::{Error, Result};
 pub use gpu::requirements::{check_device, minimum_limits, required_features, required_limits};
-#[cfg(feature = "headless")]
-pub(crate) use gpu::{readback, requirements};
 pub use options::{
     FrameParams, MAX_BOUNCES, MAX_IMAGE_SIZE, RendererOptions, Tonemap, UNLIMITED_BOUNCES,
     ViewMode, validate_size,

@@ -31,7 +31,7 @@ use crate::screen::tonemap::TonemapPass;
 use crate::screen::upsample::UpsamplePass;
 use crate::targets::{FrameTargets, Target};
 use crate::view::{camera_view_proj, lit_scene};
-use crate::voxel::dense::{DensePipelines, DenseVolume};
+use crate::voxel::dense::{DensePipelines, DenseVolume, SLOT_BYTES};
 use crate::voxel::{DebugView, GpuCones, Grid, VoxelStructure};
 use crate::{Error, Result};
 use glam::Vec3;
@@ -177,8 +177,7 @@ impl Renderer {
         if scene.triangle_count() == 0 && scene.point_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let settings = options;
-        let mut scene = lit_scene(scene, settings.default_light);
+        let mut scene = lit_scene(scene, options.default_light);
         if scene
             .point_clouds
             .iter()
@@ -188,6 +187,9 @@ impl Renderer {
         }
         let scene = scene.as_ref();
         let (center, radius) = scene_bounds(scene);
+        let mut gpu_scene = checked(device, "scene upload", || {
+            GpuScene::new(device, queue, scene, options)
+        })??;
         let facts = SceneFacts {
             bounds: scene.bounds(),
             estimate: FragmentEstimate::of(scene),
@@ -197,47 +199,40 @@ impl Renderer {
                 .map(|m| m.base_color[0].max(m.base_color[1]).max(m.base_color[2]))
                 .fold(0.0f32, f32::max),
             casts: scene.lights.iter().map(|l| l.cast_shadows).collect(),
-            glossy: false,
-        };
-        let mut gpu_scene = checked(device, "scene upload", || {
-            GpuScene::new(device, queue, scene, settings)
-        })??;
-        let facts = SceneFacts {
             glossy: gather::has_glossy(scene, gpu_scene.point_count),
-            ..facts
         };
         let atlas = plan_atlas(
             device,
             queue,
             &mut gpu_scene,
             &facts,
-            settings,
+            options,
             center,
             radius,
         )?;
-        let grid = grid(&facts, settings);
-        let fragments = new_fragments(device, &facts, settings, grid, None)?;
+        let grid = grid(&facts, options);
+        let fragments = new_fragments(device, &facts, options, grid, None)?;
         let dense_pipelines = checked(device, "pipeline creation", || DensePipelines::new(device))?;
-        let volume = new_volume(device, &dense_pipelines, &facts, settings, grid, None)?;
+        let volume = new_volume(device, &dense_pipelines, &facts, options, grid, None)?;
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             voxelize: VoxelizePass::new(device),
             inject: InjectPass::new(device, gpu_scene.light_count),
-            bounce: BouncePass::new(device, settings.anisotropic),
+            bounce: BouncePass::new(device, options.anisotropic),
             gbuffer: GbufferPass::new(device),
-            gather: GatherPass::new(device, settings, facts.glossy),
+            gather: GatherPass::new(device, options, facts.glossy),
             upsample: UpsamplePass::new(device),
-            composite: composite_pass(device, &gpu_scene, &facts, settings),
+            composite: composite_pass(device, &gpu_scene, &facts, options),
             tonemap: TonemapPass::new(device),
         })?;
         let triangles = checked(device, "voxelization table", || {
             triangle_table(device, &gpu_scene)
         })??;
         let brdf_tables = BrdfTables::new(device, queue);
-        let voxel_bounces = voxel_bounce_count(facts.max_albedo, settings.bounces);
+        let voxel_bounces = voxel_bounce_count(facts.max_albedo, options.bounces);
         let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("cones"),
-            contents: bytemuck::bytes_of(&cone_uniforms(settings, &grid)),
+            contents: bytemuck::bytes_of(&cone_uniforms(options, &grid)),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let default_camera = scene
@@ -678,7 +673,10 @@ fn new_fragments(
     let wanted = capacity
         .or(options.fragment_capacity)
         .unwrap_or_else(|| facts.estimate.at(&grid));
-    let capacity = fragments::capacity(device, wanted.min(fragments::max_fragments(device)))?;
+    let capacity = fragments::capacity(
+        device,
+        wanted.min(crate::gpu::max_entries(device, fragments::FRAGMENT_BYTES)),
+    )?;
     checked(device, "voxel fragments", || {
         Fragments::new(device, grid, capacity)
     })
@@ -705,7 +703,7 @@ fn new_volume(
         device,
         wanted
             .min((grid.resolution as u64).pow(3))
-            .min(max_slots(device)),
+            .min(crate::gpu::max_entries(device, SLOT_BYTES)),
     )?;
     checked(device, "voxel volume", || {
         DenseVolume::new(device, pipelines, grid, options.anisotropic, slots)
@@ -745,22 +743,9 @@ fn composite_pass(
     )
 }
 
-/// The most slots one storage binding can hold on this device.
-fn max_slots(device: &wgpu::Device) -> u64 {
-    device.limits().max_storage_buffer_binding_size / crate::voxel::dense::SLOT_BYTES
-}
-
-/// Checks a slot capacity against the device's storage-buffer limit.
+/// Checks a slot capacity (occupied voxels) against the device's storage-buffer limit.
 fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
-    let limit = device.limits().max_storage_buffer_binding_size / crate::voxel::dense::SLOT_BYTES;
-    let cap = wanted.max(1024);
-    if cap > limit.min(u32::MAX as u64) {
-        return Err(Error::Setting(format!(
-            "the scene occupies about {cap} voxels at this resolution, more than this GPU's \
-             storage-buffer limit allows ({limit}); lower the voxel resolution"
-        )));
-    }
-    Ok(cap as u32)
+    crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")
 }
 
 /// Checks that the volume's per-voxel buffers fit the device's limits.
@@ -803,10 +788,10 @@ fn voxel_bounce_count(max_albedo: f32, bounces: u32) -> u32 {
     ((1e-3f32.ln() / rho.ln()).ceil() as u32).clamp(1, 64)
 }
 
-/// The cone uniforms from the settings and the volume.
-pub fn cone_uniforms(settings: &RendererOptions, grid: &Grid) -> GpuCones {
-    let axes = settings.cones.axes();
-    let weights = settings.cones.weights();
+/// The cone uniforms from the options and the volume.
+pub fn cone_uniforms(options: &RendererOptions, grid: &Grid) -> GpuCones {
+    let axes = options.cones.axes();
+    let weights = options.cones.weights();
     let mut dirs = [[0f32; 4]; 16];
     for (i, (a, w)) in axes.iter().zip(&weights).enumerate().take(16) {
         dirs[i] = [a.x, a.y, a.z, *w];
@@ -814,12 +799,12 @@ pub fn cone_uniforms(settings: &RendererOptions, grid: &Grid) -> GpuCones {
     GpuCones {
         dirs,
         count: axes.len().min(16) as u32,
-        diffuse_tan: (settings.cones.aperture() * 0.5).tan(),
-        step_factor: settings.step_factor,
-        max_distance: settings.max_distance.unwrap_or(grid.extent() * 3f32.sqrt()),
-        ao_lambda: settings.ao_lambda,
-        ao_radius: settings.ao_radius.unwrap_or(grid.extent() * 0.25),
-        origin_offset: settings.origin_offset,
-        indirect: (settings.bounces > 0) as u32,
+        diffuse_tan: (options.cones.aperture() * 0.5).tan(),
+        step_factor: options.step_factor,
+        max_distance: options.max_distance.unwrap_or(grid.extent() * 3f32.sqrt()),
+        ao_lambda: options.ao_lambda,
+        ao_radius: options.ao_radius.unwrap_or(grid.extent() * 0.25),
+        origin_offset: options.origin_offset,
+        indirect: (options.bounces > 0) as u32,
     }
 }

@@ -78,7 +78,7 @@
 //! camera is the default view. Include cycles are reported as errors.
 
 use crate::animation::{
-    Animation, AnimationTarget, Interpolation, LightTracks, Motion, Repeat, Track,
+    Animation, AnimationTarget, Interpolation, Keyable, LightTracks, Motion, Repeat, Track,
 };
 use crate::{AreaShape, Camera, Light, LightKind, Result, Scene, SceneError};
 use glam::{Mat4, Vec3};
@@ -580,7 +580,14 @@ fn make_animation(
 ) -> std::result::Result<Animation, String> {
     let interpolation = parse_interpolation(a.interpolation.as_deref())?;
     let repeat = parse_repeat(a.repeat.as_deref())?;
-    let track = |what: &str, values: Option<Vec<Vec3>>| -> std::result::Result<_, String> {
+    // One key's values as a track over `times`, when the key is present.
+    fn key_track<T: Keyable>(
+        a: &AnimationDef,
+        what: &str,
+        values: Option<Vec<T>>,
+        interpolation: Interpolation,
+        repeat: Repeat,
+    ) -> std::result::Result<Option<Track<T>>, String> {
         let Some(values) = values else {
             return Ok(None);
         };
@@ -591,7 +598,9 @@ fn make_animation(
         Track::new(times, values, interpolation, repeat)
             .map(Some)
             .map_err(|e| format!("`{what}`: {e}"))
-    };
+    }
+    let track =
+        |what: &str, values: Option<Vec<Vec3>>| key_track(a, what, values, interpolation, repeat);
     let v3 = |v: &Option<Vec<[f32; 3]>>| {
         v.as_ref()
             .map(|v| v.iter().map(|&x| Vec3::from(x)).collect())
@@ -629,25 +638,22 @@ fn make_animation(
             let motion = match (keyed, &a.orbit, &a.oscillate) {
                 (true, None, None) => Motion::Keyframes {
                     translation: track("translate", v3(&a.translate))?,
-                    rotation: match &a.rotate {
-                        None => None,
-                        Some(r) => {
-                            let q = r
-                                .iter()
+                    rotation: key_track(
+                        a,
+                        "rotate",
+                        a.rotate.as_ref().map(|r| {
+                            r.iter()
                                 .map(|d| {
                                     let d = Vec3::from(*d);
                                     glam::Quat::from_rotation_z(d.z.to_radians())
                                         * glam::Quat::from_rotation_y(d.y.to_radians())
                                         * glam::Quat::from_rotation_x(d.x.to_radians())
                                 })
-                                .collect();
-                            let times = a.times.clone().ok_or("`rotate` needs keyframe `times`")?;
-                            Some(
-                                Track::new(times, q, interpolation, repeat)
-                                    .map_err(|e| format!("`rotate`: {e}"))?,
-                            )
-                        }
-                    },
+                                .collect()
+                        }),
+                        interpolation,
+                        repeat,
+                    )?,
                     scale: track(
                         "scale",
                         a.scale.as_ref().map(|s| {
@@ -727,19 +733,7 @@ fn make_animation(
                 position: track("position", v3(&a.position))?,
                 direction: track("direction", v3(&a.direction))?,
                 color: track("color", v3(&a.color))?,
-                intensity: match &a.intensity {
-                    None => None,
-                    Some(v) => {
-                        let times = a
-                            .times
-                            .clone()
-                            .ok_or("`intensity` needs keyframe `times`")?;
-                        Some(
-                            Track::new(times, v.clone(), interpolation, repeat)
-                                .map_err(|e| format!("`intensity`: {e}"))?,
-                        )
-                    }
-                },
+                intensity: key_track(a, "intensity", a.intensity.clone(), interpolation, repeat)?,
             };
             if tracks == LightTracks::default() {
                 return Err(

@@ -90,22 +90,9 @@ impl Fragments {
     }
 }
 
-/// The most fragments one storage binding can hold on this device.
-pub fn max_fragments(device: &wgpu::Device) -> u64 {
-    device.limits().max_storage_buffer_binding_size / FRAGMENT_BYTES
-}
-
 /// Checks a fragment capacity against the device's storage-buffer limit (at least 1024).
 pub fn capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
-    let limit = max_fragments(device);
-    let cap = wanted.max(1024);
-    if cap > limit.min(u32::MAX as u64) {
-        return Err(Error::Setting(format!(
-            "the scene needs about {cap} voxel fragments at this resolution, more than this \
-             GPU's storage-buffer limit allows ({limit}); lower the voxel resolution"
-        )));
-    }
-    Ok(cap as u32)
+    crate::gpu::pool_capacity(device, wanted, FRAGMENT_BYTES, "voxel fragments")
 }
 
 /// An upper bound on the fragments a scene makes on a grid: per triangle, the columns its

@@ -104,12 +104,4 @@ impl CounterReadback {
         }
         out
     }
-
-    /// Reads still waiting for their submission or for the GPU.
-    pub fn in_flight(&self) -> usize {
-        self.slots
-            .iter()
-            .filter(|s| s.state.load(Ordering::Acquire) == IN_FLIGHT)
-            .count()
-    }
 }

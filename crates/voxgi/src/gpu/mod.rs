@@ -9,6 +9,30 @@ pub mod timer;
 
 use crate::{Error, Result};
 
+/// The most entries of `entry_bytes` one storage binding can hold on this device.
+pub fn max_entries(device: &wgpu::Device, entry_bytes: u64) -> u64 {
+    device.limits().max_storage_buffer_binding_size / entry_bytes
+}
+
+/// A pool capacity of at least 1024 `what` (entries of `entry_bytes`, as in "voxel
+/// fragments"), checked against the device's storage-binding limit.
+pub fn pool_capacity(
+    device: &wgpu::Device,
+    wanted: u64,
+    entry_bytes: u64,
+    what: &str,
+) -> Result<u32> {
+    let limit = max_entries(device, entry_bytes);
+    let cap = wanted.max(1024);
+    if cap > limit.min(u32::MAX as u64) {
+        return Err(Error::Setting(format!(
+            "the scene needs about {cap} {what} at this resolution, more than this GPU's \
+             storage-buffer limit allows ({limit}); lower the voxel resolution"
+        )));
+    }
+    Ok(cap as u32)
+}
+
 /// Runs `f` inside validation and out-of-memory error scopes of its own, turning what it
 /// triggers into an `Error` naming `context` instead of reaching the device's handler. Popping
 /// a scope does not wait for the GPU: wgpu validates on the CPU as commands are made.

@@ -269,13 +269,12 @@ impl PathTracer {
         scene: &Scene,
         options: &RendererOptions,
     ) -> Result<Self> {
-        let settings = options;
-        settings.validate()?;
+        options.validate()?;
         scene.validate()?;
         if scene.triangle_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let scene = lit_scene(scene, settings.default_light);
+        let scene = lit_scene(scene, options.default_light);
         let scene = scene.as_ref();
         let device = device.clone();
         let queue = queue.clone();
@@ -294,7 +293,7 @@ impl PathTracer {
             flat.nodes.len()
         );
         let (gpu_scene, buffers) = checked(&device, "reference scene upload", || -> Result<_> {
-            let gpu_scene = GpuScene::new(&device, &queue, scene, settings)?;
+            let gpu_scene = GpuScene::new(&device, &queue, scene, options)?;
             let storage = |label: &str, bytes: &[u8]| {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(label),
@@ -378,7 +377,7 @@ impl PathTracer {
 
     /// Renders `opts.spp` samples per pixel, calling `progress(done, total)` after each batch.
     /// The HDR output is the mean radiance (or AO); the LDR output is tone mapped on the CPU
-    /// with the settings' exposure and curve, as the rasterizer's tonemap pass does.
+    /// with the frame parameters' exposure and curve, as the rasterizer's tonemap pass does.
     pub fn render(
         &mut self,
         frame: &FrameParams,

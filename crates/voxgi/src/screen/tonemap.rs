@@ -65,7 +65,7 @@ impl TonemapPass {
         if self.pipelines.iter().any(|(f, _)| *f == format) {
             return Ok(());
         }
-        let blendable = format
+        let renderable = format
             .guaranteed_format_features(device.features())
             .allowed_usages
             .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
@@ -73,7 +73,7 @@ impl TonemapPass {
                 .sample_type(None, None)
                 .is_some_and(|t| matches!(t, wgpu::TextureSampleType::Float { .. }))
             && !format.is_depth_stencil_format();
-        if !blendable {
+        if !renderable {
             return Err(Error::Setting(format!(
                 "the target format {format:?} is not a colour format voxgi can render to (use \
                  an 8-bit UNORM or sRGB format, Rgb10a2Unorm, or a float format)"

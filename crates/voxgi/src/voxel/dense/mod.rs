@@ -79,8 +79,6 @@ pub struct DenseVolume {
     /// each block one level coarser than the finest. In isotropic mode one block, the isotropic
     /// chain.
     pub chains: wgpu::Texture,
-    /// Trilinear, clamp-to-edge sampler for `radiance` and `chains`.
-    pub sampler: wgpu::Sampler,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
     leaf_store: wgpu::BindGroup,
@@ -333,7 +331,6 @@ impl DenseVolume {
             emission,
             radiance,
             chains,
-            sampler,
             sampling,
             leaves,
             leaf_store,
