@@ -1,15 +1,18 @@
 //! Animation: keyframed tracks of rigid motion and of light parameters, and sampling a scene's
 //! state at a time.
 //!
-//! A motion moves instances from the pose the file gives them (identity is the rest pose), in
-//! the space the animation was written in: `transform(t) = outer * M(t) * inner`, where
-//! `inner` is an instance's transform in that space and `outer` places that space in the world
-//! (the identity for a scene file's own animations; an include's transform for an included
-//! file's). A light's animated parameters replace its rest values, positions and directions
-//! given in the animation's space.
+//! A motion moves instances in the space the animation was written in:
+//! `transform(t) = outer * M(t) * inner`, where `outer` places that space in the world (the
+//! identity for a scene file's own animations; an include's transform for an included file's)
+//! and `inner` is where an instance sits when the motion is the identity. Most motions start
+//! from the pose the file gives (identity is the rest pose, `inner` the rest transform); a
+//! [`Motion::Nodes`] hierarchy (glTF's) gives a node's whole transform instead, and `inner` is
+//! then an instance's placement below that node. A light's animated parameters replace its rest
+//! values, positions and directions given in the animation's space.
 
 use crate::{Light, Scene};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3, Vec4};
+use std::sync::Arc;
 
 /// How values between two keyframes are found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -22,6 +25,11 @@ pub enum Interpolation {
     /// Catmull-Rom splines through the keyframes (rotations: normalised Catmull-Rom on the
     /// quaternions, kept in one hemisphere).
     Cubic,
+    /// Cubic Hermite splines with an in- and an out-tangent per keyframe (glTF's CUBICSPLINE),
+    /// tangents in value units per second; build such tracks with [`Track::hermite`].
+    /// Rotations: Hermite on the quaternions' components, normalised; unlike `Cubic` no
+    /// hemisphere is chosen, because the tangents are given for the components as stored.
+    Hermite,
 }
 
 /// What happens past the last keyframe.
@@ -40,8 +48,23 @@ pub trait Keyable: Copy {
     fn lerp(a: Self, b: Self, s: f32) -> Self;
     /// The Catmull-Rom value between `p1` and `p2` at `s`, with neighbours `p0` and `p3`.
     fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self;
+    /// The cubic Hermite value between `p0` and `p1` at `s` in 0..=1 over a segment `dt`
+    /// seconds long, leaving `p0` with tangent `b0` and reaching `p1` with tangent `a1`
+    /// (tangents per second, so they are scaled by `dt`; glTF 2.0, Appendix C).
+    fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self;
     /// Every component is finite.
     fn finite(&self) -> bool;
+}
+
+/// Weights of `p0`, `b0`, `p1` and `a1` in [`Keyable::hermite`].
+fn hermite_weights(dt: f32, s: f32) -> [f32; 4] {
+    let (s2, s3) = (s * s, s * s * s);
+    [
+        2.0 * s3 - 3.0 * s2 + 1.0,
+        dt * (s3 - 2.0 * s2 + s),
+        -2.0 * s3 + 3.0 * s2,
+        dt * (s3 - s2),
+    ]
 }
 
 fn catmull_rom_weights(s: f32) -> [f32; 4] {
@@ -62,6 +85,10 @@ impl Keyable for f32 {
         let w = catmull_rom_weights(s);
         w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
     }
+    fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self {
+        let w = hermite_weights(dt, s);
+        w[0] * p0 + w[1] * b0 + w[2] * p1 + w[3] * a1
+    }
     fn finite(&self) -> bool {
         self.is_finite()
     }
@@ -74,6 +101,10 @@ impl Keyable for Vec3 {
     fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
         let w = catmull_rom_weights(s);
         w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
+    }
+    fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self {
+        let w = hermite_weights(dt, s);
+        w[0] * p0 + w[1] * b0 + w[2] * p1 + w[3] * a1
     }
     fn finite(&self) -> bool {
         self.is_finite()
@@ -89,22 +120,40 @@ impl Keyable for Quat {
         let near = |q: Quat| if q.dot(p1) < 0.0 { -q } else { q };
         let (p0, p2, p3) = (near(p0), near(p2), near(p3));
         let w = catmull_rom_weights(s);
-        let v = w[0] * glam::Vec4::from(p0)
-            + w[1] * glam::Vec4::from(p1)
-            + w[2] * glam::Vec4::from(p2)
-            + w[3] * glam::Vec4::from(p3);
+        let v = w[0] * Vec4::from(p0)
+            + w[1] * Vec4::from(p1)
+            + w[2] * Vec4::from(p2)
+            + w[3] * Vec4::from(p3);
         Quat::from_vec4(v).normalize()
+    }
+    fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self {
+        let w = hermite_weights(dt, s);
+        let v = w[0] * Vec4::from(p0)
+            + w[1] * Vec4::from(b0)
+            + w[2] * Vec4::from(p1)
+            + w[3] * Vec4::from(a1);
+        // Tangents can cancel the values out; a zero quaternion has no direction to keep.
+        let q = Quat::from_vec4(v);
+        if q.length_squared() > 0.0 {
+            q.normalize()
+        } else {
+            p0
+        }
     }
     fn finite(&self) -> bool {
         self.is_finite()
     }
 }
 
-/// Keyframes of one value: times in seconds, strictly increasing, each with its value.
+/// Keyframes of one value: times in seconds, strictly increasing, each with its value (and,
+/// for Hermite tracks, its in- and out-tangents).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track<T> {
-    times: Vec<f32>,
-    values: Vec<T>,
+    // Boxed slices, not Vecs: tracks never grow, and three of them sit inline in `Motion`.
+    times: Box<[f32]>,
+    values: Box<[T]>,
+    /// (in, out) tangent per keyframe for `Interpolation::Hermite`; empty otherwise.
+    tangents: Box<[[T; 2]]>,
     /// How to fill between keyframes.
     pub interpolation: Interpolation,
     /// What to do past the last keyframe.
@@ -113,10 +162,54 @@ pub struct Track<T> {
 
 impl<T: Keyable> Track<T> {
     /// A track, checked: at least one keyframe, as many values as times, finite, times
-    /// non-negative and strictly increasing. The error says what is wrong.
+    /// non-negative and strictly increasing. The error says what is wrong. Hermite tracks need
+    /// tangents and come from [`Track::hermite`] instead.
     pub fn new(
         times: Vec<f32>,
         values: Vec<T>,
+        interpolation: Interpolation,
+        repeat: Repeat,
+    ) -> Result<Self, String> {
+        if interpolation == Interpolation::Hermite {
+            return Err("a Hermite track needs tangents (use Track::hermite)".into());
+        }
+        Self::checked(times, values, Vec::new(), interpolation, repeat)
+    }
+
+    /// A cubic Hermite track (glTF's CUBICSPLINE): per keyframe a value, the tangent arriving
+    /// at it (`in_tangents`) and the one leaving it (`out_tangents`), in value units per second.
+    /// Checked as [`Track::new`], and the tangents must be as many as the times, and finite.
+    pub fn hermite(
+        times: Vec<f32>,
+        values: Vec<T>,
+        in_tangents: Vec<T>,
+        out_tangents: Vec<T>,
+        repeat: Repeat,
+    ) -> Result<Self, String> {
+        for (what, t) in [("in", &in_tangents), ("out", &out_tangents)] {
+            if t.len() != times.len() {
+                return Err(format!(
+                    "{} keyframe times but {} {what}-tangents",
+                    times.len(),
+                    t.len()
+                ));
+            }
+            if let Some(i) = t.iter().position(|v| !v.finite()) {
+                return Err(format!("keyframe {i}: the {what}-tangent is not finite"));
+            }
+        }
+        let tangents = in_tangents
+            .into_iter()
+            .zip(out_tangents)
+            .map(|(a, b)| [a, b])
+            .collect();
+        Self::checked(times, values, tangents, Interpolation::Hermite, repeat)
+    }
+
+    fn checked(
+        times: Vec<f32>,
+        values: Vec<T>,
+        tangents: Vec<[T; 2]>,
         interpolation: Interpolation,
         repeat: Repeat,
     ) -> Result<Self, String> {
@@ -147,11 +240,22 @@ impl<T: Keyable> Track<T> {
             return Err(format!("keyframe {i}: the value is not finite"));
         }
         Ok(Track {
-            times,
-            values,
+            times: times.into(),
+            values: values.into(),
+            tangents: tangents.into(),
             interpolation,
             repeat,
         })
+    }
+
+    /// The keyframe times, seconds.
+    pub fn times(&self) -> &[f32] {
+        &self.times
+    }
+
+    /// The keyframe values, one per time.
+    pub fn values(&self) -> &[T] {
+        &self.values
     }
 
     /// The time of the last keyframe.
@@ -186,7 +290,67 @@ impl<T: Keyable> Track<T> {
                 let p3 = v[(i + 2).min(n - 1)];
                 T::catmull_rom(p0, v[i], v[i + 1], p3, s)
             }
+            // A track switched to Hermite after `Track::new` has no tangents: straight lines.
+            Interpolation::Hermite => match (self.tangents.get(i), self.tangents.get(i + 1)) {
+                (Some([_, out0]), Some([in1, _])) => {
+                    let dt = self.times[i + 1] - self.times[i];
+                    T::hermite(v[i], *out0, v[i + 1], *in1, dt, s)
+                }
+                _ => T::lerp(v[i], v[i + 1], s),
+            },
         }
+    }
+}
+
+/// One animated node of a [`Motion::Nodes`] hierarchy: its local transform is
+/// `offset * T(t) * R(t) * S(t)`, each part from its track or, without one, its rest value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotionNode {
+    /// The nearest animated ancestor: an earlier index in the same list. `None` for a node
+    /// whose ancestors do not move (a later or equal index is treated as `None` too).
+    pub parent: Option<usize>,
+    /// The fixed transform from the parent's frame (the animation's space when there is no
+    /// parent) to this node's parent frame: the product of the unanimated nodes in between.
+    pub offset: Mat4,
+    /// Translation where `translation` has no track.
+    pub rest_translation: Vec3,
+    /// Rotation (unit) where `rotation` has no track.
+    pub rest_rotation: Quat,
+    /// Scale where `scale` has no track.
+    pub rest_scale: Vec3,
+    /// Animated translation.
+    pub translation: Option<Track<Vec3>>,
+    /// Animated rotation.
+    pub rotation: Option<Track<Quat>>,
+    /// Animated scale.
+    pub scale: Option<Track<Vec3>>,
+}
+
+impl MotionNode {
+    /// `offset * T(t) * R(t) * S(t)`: the node in its parent's frame at time `t`.
+    pub fn local(&self, t: f32) -> Mat4 {
+        self.offset
+            * Mat4::from_scale_rotation_translation(
+                self.scale.as_ref().map_or(self.rest_scale, |s| s.sample(t)),
+                self.rotation
+                    .as_ref()
+                    .map_or(self.rest_rotation, |r| r.sample(t)),
+                self.translation
+                    .as_ref()
+                    .map_or(self.rest_translation, |x| x.sample(t)),
+            )
+    }
+
+    /// The last keyframe time of its tracks, 0 without any.
+    pub fn duration(&self) -> f32 {
+        [
+            self.translation.as_ref().map(Track::duration),
+            self.rotation.as_ref().map(Track::duration),
+            self.scale.as_ref().map(Track::duration),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(0.0, f32::max)
     }
 }
 
@@ -220,10 +384,22 @@ pub enum Motion {
         /// Seconds per cycle (> 0).
         period: f32,
     },
+    /// The transform of `nodes[node]` in the animation's space: the product of the local
+    /// transforms from its topmost animated ancestor down to it. Not relative to the rest
+    /// pose: a target's `inner` places each instance below this node (glTF's node hierarchy,
+    /// where parents and children may each be animated). The list is shared by the targets of
+    /// one file; an out-of-range `node` gives the identity.
+    Nodes {
+        /// Every animated node of the hierarchy, parents before children.
+        nodes: Arc<[MotionNode]>,
+        /// The node whose transform this is.
+        node: usize,
+    },
 }
 
 impl Motion {
-    /// The motion at time `t`, to apply on the left of the rest transform.
+    /// The motion at time `t`, to apply on the left of a target's `inner` transforms (for all
+    /// motions but [`Motion::Nodes`], the rest transforms).
     pub fn at(&self, t: f32) -> Mat4 {
         match self {
             Motion::Keyframes {
@@ -252,10 +428,21 @@ impl Motion {
             } => Mat4::from_translation(
                 *axis * (amplitude * (std::f32::consts::TAU * t / period).sin()),
             ),
+            Motion::Nodes { nodes, node } => {
+                let mut m = Mat4::IDENTITY;
+                let mut cur = Some(*node);
+                while let Some(n) = cur.and_then(|i| nodes.get(i).map(|n| (i, n))) {
+                    m = n.1.local(t) * m;
+                    // Only earlier parents, so a hand-made cycle cannot loop forever.
+                    cur = n.1.parent.filter(|&p| p < n.0);
+                }
+                m
+            }
         }
     }
 
-    /// How long one pass of the motion lasts (a generator's period).
+    /// How long one pass of the motion lasts (a generator's period; for [`Motion::Nodes`],
+    /// the last keyframe of any node in the list, so all targets of one file agree).
     pub fn duration(&self) -> f32 {
         match self {
             Motion::Keyframes {
@@ -271,6 +458,9 @@ impl Motion {
             .flatten()
             .fold(0.0, f32::max),
             Motion::Orbit { period, .. } | Motion::Oscillate { period, .. } => *period,
+            Motion::Nodes { nodes, .. } => {
+                nodes.iter().map(MotionNode::duration).fold(0.0, f32::max)
+            }
         }
     }
 }
@@ -332,10 +522,14 @@ pub enum AnimationTarget {
         instances: Vec<usize>,
         /// Places the animation's space in the world.
         outer: Mat4,
-        /// Each instance's transform at rest in the animation's space, in `instances` order.
+        /// Each instance's transform in the animation's space when the motion is the identity,
+        /// in `instances` order: its rest transform, or for [`Motion::Nodes`] its placement
+        /// below the moving node.
         inner: Vec<Mat4>,
-        /// The area lights whose visible surfaces these instances are (`Instance::light`),
-        /// with their rest state in the world: they move with their surface.
+        /// The lights that move with these instances (`Scene::lights` indices): the area
+        /// lights whose visible surfaces they are (`Instance::light`), and lights on the same
+        /// moving glTF node. Each with its state in the world when the motion is the identity
+        /// (for motions from rest, its rest state).
         lights: Vec<(usize, Light)>,
         /// The motion.
         motion: Motion,
@@ -517,6 +711,195 @@ mod tests {
         assert!(bad(vec![f32::NAN], vec![0.0]).contains("finite"));
         assert!(bad(vec![-1.0], vec![0.0]).contains(">= 0"));
         assert!(bad(vec![0.0], vec![f32::INFINITY]).contains("not finite"));
+    }
+
+    #[test]
+    fn hermite_tracks_follow_the_gltf_formula() {
+        // Keys at t = 1 and 3 (dt = 2): values 0 and 1, out-tangent 1 leaving the first, in-tangent
+        // 3 arriving at the second. The first key's in- and the last key's out-tangent are never
+        // used: 100 proves it. At t = 1.5, s = 0.25:
+        //   (2s³-3s²+1)·0 + dt(s³-2s²+s)·1 + (-2s³+3s²)·1 + dt(s³-s²)·3
+        //   = 0 + 2·0.140625 + 0.15625 + 2·(-0.046875)·3 = 0.15625.
+        let h = Track::hermite(
+            vec![1.0, 3.0],
+            vec![0.0f32, 1.0],
+            vec![100.0, 3.0],
+            vec![1.0, 100.0],
+            Repeat::Clamp,
+        )
+        .unwrap();
+        assert_eq!(h.interpolation, Interpolation::Hermite);
+        assert!((h.sample(1.5) - 0.15625).abs() < 1e-6, "{}", h.sample(1.5));
+        assert_eq!(h.sample(1.0), 0.0);
+        assert_eq!(h.sample(3.0), 1.0);
+        assert_eq!(h.sample(0.0), 0.0, "clamped before the first key");
+        assert_eq!(h.sample(9.0), 1.0, "clamped after the last key");
+        // Near the start the curve leaves along its out-tangent (1 per second).
+        let slope = (h.sample(1.001) - h.sample(1.0)) / 0.001;
+        assert!((slope - 1.0).abs() < 0.01, "{slope}");
+        // Three keys: the middle one's tangents serve both segments.
+        let three = Track::hermite(
+            vec![0.0, 1.0, 2.0],
+            vec![Vec3::ZERO, Vec3::X, Vec3::ZERO],
+            vec![Vec3::ZERO, Vec3::Y, Vec3::ZERO],
+            vec![Vec3::ZERO, Vec3::Z, Vec3::ZERO],
+            Repeat::Clamp,
+        )
+        .unwrap();
+        // s = 0.5, dt = 1: weights 0.5, 0.125, 0.5, -0.125 on p0, b0, p1, a1.
+        assert!(close(three.sample(0.5), Vec3::new(0.5, -0.125, 0.0)));
+        assert!(close(three.sample(1.5), Vec3::new(0.5, 0.0, 0.125)));
+        // Rotations come out unit length: halfway between two turns about Y with zero tangents
+        // is their normalised mean, the half turn.
+        let (a, b) = (Quat::IDENTITY, Quat::from_rotation_y(1.0));
+        let q = Track::hermite(
+            vec![0.0, 1.0],
+            vec![a, b],
+            vec![Quat::from_xyzw(0.0, 0.0, 0.0, 0.0); 2],
+            vec![Quat::from_xyzw(0.0, 0.0, 0.0, 0.0); 2],
+            Repeat::Clamp,
+        )
+        .unwrap()
+        .sample(0.5);
+        assert!((q.length() - 1.0).abs() < 1e-6);
+        assert!(q.dot(Quat::from_rotation_y(0.5)) > 1.0 - 1e-6, "{q:?}");
+    }
+
+    #[test]
+    fn bad_hermite_tracks_say_what_is_wrong() {
+        let err = Track::new(
+            vec![0.0],
+            vec![0.0f32],
+            Interpolation::Hermite,
+            Repeat::Clamp,
+        )
+        .unwrap_err();
+        assert!(err.contains("tangents"), "{err}");
+        let h = |a: Vec<f32>, b: Vec<f32>| {
+            Track::hermite(vec![0.0, 1.0], vec![0.0, 1.0], a, b, Repeat::Clamp).unwrap_err()
+        };
+        assert!(h(vec![0.0], vec![0.0; 2]).contains("2 keyframe times but 1 in-tangents"));
+        assert!(h(vec![0.0; 2], vec![0.0; 3]).contains("3 out-tangents"));
+        assert!(h(vec![0.0, f32::NAN], vec![0.0; 2]).contains("keyframe 1: the in-tangent"));
+        let unsorted = Track::hermite(
+            vec![1.0, 0.0],
+            vec![0.0f32; 2],
+            vec![0.0; 2],
+            vec![0.0; 2],
+            Repeat::Clamp,
+        )
+        .unwrap_err();
+        assert!(unsorted.contains("sorted"), "{unsorted}");
+        // Switched to Hermite without tangents: straight lines, no panic.
+        let mut lin = Track::new(
+            vec![0.0, 1.0],
+            vec![0.0f32, 2.0],
+            Interpolation::Linear,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        lin.interpolation = Interpolation::Hermite;
+        assert_eq!(lin.sample(0.5), 1.0);
+    }
+
+    #[test]
+    fn node_hierarchies_compose_parent_and_child_motion() {
+        let slide = Track::new(
+            vec![0.0, 2.0],
+            vec![Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0)],
+            Interpolation::Linear,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        let turn = Track::new(
+            vec![0.0, 4.0],
+            vec![
+                Quat::IDENTITY,
+                Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
+            ],
+            Interpolation::Linear,
+            Repeat::Clamp,
+        )
+        .unwrap();
+        let rest = MotionNode {
+            parent: None,
+            offset: Mat4::IDENTITY,
+            rest_translation: Vec3::ZERO,
+            rest_rotation: Quat::IDENTITY,
+            rest_scale: Vec3::ONE,
+            translation: None,
+            rotation: None,
+            scale: None,
+        };
+        let nodes: Arc<[MotionNode]> = vec![
+            // Parent: slides along X, scaled 2 at rest.
+            MotionNode {
+                rest_scale: Vec3::splat(2.0),
+                translation: Some(slide),
+                ..rest.clone()
+            },
+            // Child: one unit up from the parent (an unanimated node in between), turns about Z.
+            MotionNode {
+                parent: Some(0),
+                offset: Mat4::from_translation(Vec3::Y),
+                rest_translation: Vec3::new(0.0, 0.0, 3.0),
+                rotation: Some(turn),
+                ..rest.clone()
+            },
+            // Its parent link points forwards: treated as a root, never a loop.
+            MotionNode {
+                parent: Some(2),
+                rest_translation: Vec3::X,
+                ..rest
+            },
+        ]
+        .into();
+        let child = Motion::Nodes {
+            nodes: nodes.clone(),
+            node: 1,
+        };
+        // t = 1: parent T(1,0,0) S(2); child T(0,1,0) T(0,0,3) Rz(22.5°).
+        let want = Mat4::from_translation(Vec3::X)
+            * Mat4::from_scale(Vec3::splat(2.0))
+            * Mat4::from_translation(Vec3::new(0.0, 1.0, 3.0))
+            * Mat4::from_rotation_z(std::f32::consts::FRAC_PI_8);
+        assert!(child.at(1.0).abs_diff_eq(want, 1e-5), "{}", child.at(1.0));
+        assert_eq!(child.duration(), 4.0, "the longest track of the hierarchy");
+        let odd = Motion::Nodes {
+            nodes: nodes.clone(),
+            node: 2,
+        };
+        assert_eq!(odd.at(0.0), Mat4::from_translation(Vec3::X));
+        let missing = Motion::Nodes { nodes, node: 7 };
+        assert_eq!(missing.at(0.0), Mat4::IDENTITY);
+
+        // As a target: instances keep their placement below the node, and an included file's
+        // transform goes on the outside.
+        let mut scene = crate::builtin::cornell_box();
+        let mut inner = scene.clone();
+        let below = Mat4::from_translation(Vec3::new(0.5, 0.0, 0.0));
+        inner.instances[0].dynamic = true;
+        inner.animations.push(Animation {
+            name: "nodes".into(),
+            target: AnimationTarget::Instances {
+                instances: vec![0],
+                outer: Mat4::IDENTITY,
+                inner: vec![below],
+                lights: Vec::new(),
+                motion: child.clone(),
+            },
+        });
+        assert!(
+            inner.at_time(1.0).instances[0]
+                .transform
+                .abs_diff_eq(want * below, 1e-5)
+        );
+        let n0 = scene.instances.len();
+        let place = Mat4::from_translation(Vec3::new(0.0, 0.0, -4.0))
+            * Mat4::from_rotation_y(std::f32::consts::FRAC_PI_2);
+        scene.append(inner, place, false);
+        let got = scene.at_time(1.0).instances[n0].transform;
+        assert!(got.abs_diff_eq(place * want * below, 1e-5), "{got}");
     }
 
     #[test]

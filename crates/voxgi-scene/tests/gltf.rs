@@ -74,6 +74,18 @@ impl Bin {
         let view = self.view(&bytes);
         self.accessor(view, 5123, v.len(), "SCALAR")
     }
+
+    fn f32s(&mut self, v: &[f32]) -> usize {
+        let bytes: Vec<u8> = v.iter().flat_map(|f| f.to_le_bytes()).collect();
+        let view = self.view(&bytes);
+        self.accessor(view, 5126, v.len(), "SCALAR")
+    }
+
+    fn vec4(&mut self, v: &[[f32; 4]]) -> usize {
+        let bytes: Vec<u8> = v.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let view = self.view(&bytes);
+        self.accessor(view, 5126, v.len(), "VEC4")
+    }
 }
 
 fn tmp_dir() -> PathBuf {
@@ -876,4 +888,761 @@ fn mutated_samples_never_reach_the_panic_guard() {
     assert!(guarded.is_empty(), "{}", guarded.join("\n"));
     // Sanity: the mutations do hit validation (400 mutations; most change an index or count).
     assert!(errors > 100, "only {errors} mutations were rejected");
+}
+
+// ------------------------------------------------------------------------------------------
+// Animations
+
+/// The triangle every node of the animation documents shows: (0,0,0), (1,0,0), (0,1,0).
+const TRI: [[f32; 3]; 3] = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]];
+
+/// A `Bin` whose accessor 0 is the triangle's positions.
+fn tri_bin() -> Bin {
+    let mut b = Bin::default();
+    b.vec3(&TRI);
+    b
+}
+
+/// A glTF document with `nodes` (mesh 0 is the triangle), the scene's root `roots` and
+/// `animations`, on the data of `b`; `extra` is merged into the top level.
+fn anim_doc(b: &Bin, nodes: Value, roots: Value, animations: Value, extra: Value) -> Value {
+    let mut data = b.data.clone();
+    while !data.len().is_multiple_of(4) {
+        data.push(0);
+    }
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": roots}],
+        "nodes": nodes,
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}}]}],
+        "animations": animations,
+        "buffers": [{"byteLength": data.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&data))}],
+        "bufferViews": b.views,
+        "accessors": b.accessors,
+    });
+    if let (Some(d), Some(e)) = (doc.as_object_mut(), extra.as_object()) {
+        for (k, v) in e {
+            d.insert(k.clone(), v.clone());
+        }
+    }
+    doc
+}
+
+fn write_doc(name: &str, doc: &Value) -> PathBuf {
+    write(name, &serde_json::to_vec(doc).unwrap())
+}
+
+/// One sampler and one channel on `node`'s `path`.
+fn one_channel(node: usize, path: &str, input: usize, output: usize, interp: &str) -> Value {
+    json!([{
+        "name": "move",
+        "samplers": [{"input": input, "output": output, "interpolation": interp}],
+        "channels": [{"sampler": 0, "target": {"node": node, "path": path}}]
+    }])
+}
+
+/// Where instance `inst` puts the point `p` at time `t`.
+fn point_at(scene: &Scene, inst: usize, t: f32, p: Vec3) -> Vec3 {
+    scene.at_time(t).instances[inst]
+        .transform
+        .transform_point3(p)
+}
+
+#[test]
+fn linear_translation_keeps_the_rest_rotation_and_scale() {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 2.0]);
+    let values = b.vec3(&[[0.0, 0.0, 0.0], [4.0, 2.0, 0.0]]);
+    // Rest pose: 90 degrees about Z, scale 2, translation (0, 0, 5), which the channel replaces.
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let nodes = json!([{"name": "mover", "mesh": 0, "translation": [0.0, 0.0, 5.0],
+                        "rotation": [0.0, 0.0, s, s], "scale": [2.0, 2.0, 2.0]}]);
+    let doc = anim_doc(
+        &b,
+        nodes,
+        json!([0]),
+        one_channel(0, "translation", times, values, "LINEAR"),
+        json!({}),
+    );
+    let scene = io::load(&write_doc("anim_linear.gltf", &doc)).unwrap();
+    assert_eq!(scene.animations.len(), 1);
+    let a = &scene.animations[0];
+    assert_eq!(a.name, "move");
+    assert_eq!(a.duration(), 2.0);
+    assert!(scene.instances[0].dynamic, "animated instances are dynamic");
+    // The rest pose as loaded is the node's own TRS.
+    let rest = scene.instances[0].transform.transform_point3(Vec3::X);
+    assert!(close3(rest, Vec3::new(0.0, 2.0, 5.0), 1e-6), "{rest}");
+    // t = 0.5 is a quarter of the way: translation (1, 0.5, 0). The vertex (1, 0, 0) scales to
+    // (2, 0, 0), turns to (0, 2, 0) and moves to (1, 2.5, 0).
+    let p = point_at(&scene, 0, 0.5, Vec3::X);
+    assert!(close3(p, Vec3::new(1.0, 2.5, 0.0), 1e-6), "{p}");
+    // Clamped outside the keyframes (glTF has no repeat).
+    assert!(close3(
+        point_at(&scene, 0, -1.0, Vec3::X),
+        Vec3::new(0.0, 2.0, 0.0),
+        1e-6
+    ));
+    assert!(close3(
+        point_at(&scene, 0, 9.0, Vec3::X),
+        Vec3::new(4.0, 4.0, 0.0),
+        1e-6
+    ));
+}
+
+#[test]
+fn step_holds_each_keyframe_until_the_next() {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 1.0, 2.0]);
+    let values = b.vec3(&[[1.0; 3], [2.0; 3], [3.0; 3]]);
+    let doc = anim_doc(
+        &b,
+        json!([{"mesh": 0}]),
+        json!([0]),
+        one_channel(0, "scale", times, values, "STEP"),
+        json!({}),
+    );
+    let scene = io::load(&write_doc("anim_step.gltf", &doc)).unwrap();
+    for (t, x) in [
+        (0.0, 1.0),
+        (0.99, 1.0),
+        (1.0, 2.0),
+        (1.5, 2.0),
+        (1.999, 2.0),
+        (2.0, 3.0),
+        (5.0, 3.0),
+    ] {
+        assert_eq!(
+            point_at(&scene, 0, t, Vec3::X),
+            Vec3::new(x, 0.0, 0.0),
+            "t = {t}"
+        );
+    }
+}
+
+#[test]
+fn cubic_spline_is_the_hermite_curve_with_scaled_tangents() {
+    let mut b = tri_bin();
+    let (t0, t1) = (1.0f32, 3.0f32);
+    let times = b.f32s(&[t0, t1]);
+    // Per keyframe: in-tangent, value, out-tangent. The first in- and the last out-tangent are
+    // outside the curve (9s prove it).
+    let (v0, b0) = (Vec3::ZERO, Vec3::new(1.0, 0.0, -1.0));
+    let (a1, v1) = (Vec3::new(0.0, 2.0, 0.0), Vec3::splat(2.0));
+    let out: Vec<[f32; 3]> = [Vec3::splat(9.0), v0, b0, a1, v1, Vec3::splat(9.0)]
+        .iter()
+        .map(|v| v.to_array())
+        .collect();
+    let values = b.vec3(&out);
+    let doc = anim_doc(
+        &b,
+        json!([{"mesh": 0}]),
+        json!([0]),
+        one_channel(0, "translation", times, values, "CUBICSPLINE"),
+        json!({}),
+    );
+    let scene = io::load(&write_doc("anim_cubic.gltf", &doc)).unwrap();
+    assert_eq!(scene.animations[0].duration(), 3.0);
+    // glTF 2.0 Appendix C, at t = 1.5: s = 0.25, dt = 2.
+    let t = 1.5;
+    let dt = t1 - t0;
+    let s = (t - t0) / dt;
+    let want = (2.0 * s.powi(3) - 3.0 * s * s + 1.0) * v0
+        + (s.powi(3) - 2.0 * s * s + s) * dt * b0
+        + (-2.0 * s.powi(3) + 3.0 * s * s) * v1
+        + (s.powi(3) - s * s) * dt * a1;
+    // By hand: 0.84375·0 + 0.28125·(1,0,-1) + 0.15625·(2,2,2) - 0.09375·(0,2,0).
+    assert!(
+        close3(want, Vec3::new(0.59375, 0.125, 0.03125), 1e-6),
+        "{want}"
+    );
+    let got = point_at(&scene, 0, t, Vec3::ZERO);
+    assert!(close3(got, want, 1e-6), "{got} vs {want}");
+    // Through its keyframes, and clamped beyond them.
+    assert!(close3(point_at(&scene, 0, 1.0, Vec3::ZERO), v0, 1e-6));
+    assert!(close3(point_at(&scene, 0, 3.0, Vec3::ZERO), v1, 1e-6));
+    assert!(close3(point_at(&scene, 0, 0.0, Vec3::ZERO), v0, 1e-6));
+}
+
+#[test]
+fn linear_rotation_is_slerp_the_short_way() {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 1.0]);
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    // Identity to 90 degrees about Z, the second stored negated (the same rotation): slerp
+    // takes the short way, so halfway is 45 degrees, the quaternion (0, 0, sin 22.5°, cos 22.5°).
+    let values = b.vec4(&[[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, -s, -s]]);
+    let doc = anim_doc(
+        &b,
+        json!([{"mesh": 0}]),
+        json!([0]),
+        one_channel(0, "rotation", times, values, "LINEAR"),
+        json!({}),
+    );
+    let scene = io::load(&write_doc("anim_rotation.gltf", &doc)).unwrap();
+    let m = scene.at_time(0.5).instances[0].transform;
+    let (_, q, _) = m.to_scale_rotation_translation();
+    let want = voxgi_scene::glam::Quat::from_xyzw(0.0, 0.0, 0.382_683_43, 0.923_879_5);
+    assert!(q.dot(want).abs() > 1.0 - 1e-6, "{q:?}");
+    let p = m.transform_point3(Vec3::X);
+    assert!(close3(p, Vec3::new(s, s, 0.0), 1e-6), "{p}");
+}
+
+/// A parent that slides along X (animation "slide") with a child that turns about Z (animation
+/// "spin"), one unit above it, and a static grandchild one unit along the child's X; each shows
+/// the triangle; a point light sits on the grandchild.
+fn nested_doc() -> Value {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 1.0]);
+    let slide = b.vec3(&[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]);
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let spin = b.vec4(&[[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, s, s]]);
+    let nodes = json!([
+        {"name": "parent", "mesh": 0, "children": [1]},
+        {"name": "child", "mesh": 0, "translation": [0.0, 1.0, 0.0], "children": [2]},
+        {"name": "grandchild", "mesh": 0, "translation": [1.0, 0.0, 0.0],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        {"name": "static", "mesh": 0}
+    ]);
+    let animations = json!([
+        {"name": "slide", "samplers": [{"input": times, "output": slide}],
+         "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]},
+        {"name": "spin", "samplers": [{"input": times, "output": spin}],
+         "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]}
+    ]);
+    anim_doc(
+        &b,
+        nodes,
+        json!([3, 0]),
+        animations,
+        json!({
+            "extensionsUsed": ["KHR_lights_punctual"],
+            "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 2.0}]}}
+        }),
+    )
+}
+
+/// The nested document's world transforms at `t`, by hand: parent, child, grandchild.
+fn nested_want(t: f32) -> [Mat4; 3] {
+    let parent = Mat4::from_translation(Vec3::new(2.0 * t, 0.0, 0.0));
+    let child = parent
+        * Mat4::from_translation(Vec3::Y)
+        * Mat4::from_rotation_z(t * std::f32::consts::FRAC_PI_2);
+    [parent, child, child * Mat4::from_translation(Vec3::X)]
+}
+
+#[test]
+fn a_child_moves_with_its_animated_parent() {
+    let scene = io::load(&write_doc("anim_nested.gltf", &nested_doc())).unwrap();
+    // Instances in walk order: static, parent, child, grandchild.
+    assert_eq!(scene.instances.len(), 4);
+    assert!(
+        !scene.instances[0].dynamic,
+        "the unanimated root stays static"
+    );
+    assert!(scene.instances[1..].iter().all(|i| i.dynamic));
+    // One target per animated node: the parent's moves by "slide"; the child's (with the
+    // grandchild and its light) by both, named after both.
+    let names: Vec<&str> = scene.animations.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["slide", "slide, spin"]);
+    assert!(scene.animations.iter().all(|a| a.duration() == 1.0));
+    let at = scene.at_time(0.5);
+    let want = nested_want(0.5);
+    for (k, w) in want.iter().enumerate() {
+        let got = at.instances[k + 1].transform;
+        assert!(
+            got.abs_diff_eq(*w, 1e-6),
+            "instance {}: {got} vs {w}",
+            k + 1
+        );
+    }
+    assert_eq!(at.instances[0].transform, Mat4::IDENTITY);
+    // By hand at t = 0.5: parent at (1,0,0); the child one up at (1,1,0) turned 45°; the
+    // grandchild one unit along the child's X: (1 + √½, 1 + √½, 0). The light is there.
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let g = at.instances[3].transform.transform_point3(Vec3::ZERO);
+    assert!(close3(g, Vec3::new(1.0 + s, 1.0 + s, 0.0), 1e-6), "{g}");
+    assert!(
+        close3(at.lights[0].position, g, 1e-6),
+        "{}",
+        at.lights[0].position
+    );
+    // Sampling is repeatable and t = 0 is the rest pose.
+    assert_eq!(
+        at.at_time(0.0).instances[3].transform,
+        scene.at_time(0.0).instances[3].transform
+    );
+    assert!(
+        scene.at_time(0.0).instances[3]
+            .transform
+            .abs_diff_eq(scene.instances[3].transform, 1e-6)
+    );
+}
+
+#[test]
+fn an_included_animated_gltf_moves_in_the_include_space() {
+    write_doc("anim_included.gltf", &nested_doc());
+    let toml = r#"
+[[include]]
+file = "anim_included.gltf"
+translate = [0.0, 0.0, 5.0]
+rotate = [0.0, 90.0, 0.0]
+scale = 2.0
+"#;
+    let scene = io::load(&write("anim_include.toml", toml.as_bytes())).unwrap();
+    let place = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0))
+        * Mat4::from_rotation_y(std::f32::consts::FRAC_PI_2)
+        * Mat4::from_scale(Vec3::splat(2.0));
+    assert_eq!(scene.animations.len(), 2);
+    for t in [0.0, 0.25, 0.5, 1.0] {
+        let at = scene.at_time(t);
+        for (k, w) in nested_want(t).iter().enumerate() {
+            let got = at.instances[k + 1].transform;
+            assert!(
+                got.abs_diff_eq(place * *w, 1e-5),
+                "t {t} instance {}: {got}",
+                k + 1
+            );
+        }
+        let light = place.transform_point3(nested_want(t)[2].transform_point3(Vec3::ZERO));
+        assert!(
+            close3(at.lights[0].position, light, 1e-5),
+            "t {t}: {}",
+            at.lights[0].position
+        );
+    }
+}
+
+// A logger that keeps warnings, so tests can check what the loader said about their file.
+struct Capture;
+static WARNINGS: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+impl log::Log for Capture {
+    fn enabled(&self, m: &log::Metadata) -> bool {
+        m.level() <= log::Level::Warn
+    }
+    fn log(&self, r: &log::Record) {
+        if self.enabled(r.metadata()) {
+            WARNINGS.lock().unwrap().push(r.args().to_string());
+        }
+    }
+    fn flush(&self) {}
+}
+
+/// Loads `path` and returns the scene with the warnings that name its file.
+fn load_warned(path: &Path) -> (voxgi_scene::Result<Scene>, Vec<String>) {
+    static CAPTURE: Capture = Capture;
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // Tests run in parallel in one process: one logger for all, filtered by file name.
+        let _ = log::set_logger(&CAPTURE);
+        log::set_max_level(log::LevelFilter::Warn);
+    });
+    let scene = io::load(path);
+    let name = path.display().to_string();
+    let w = WARNINGS
+        .lock()
+        .unwrap()
+        .iter()
+        .filter(|w| w.contains(&name))
+        .cloned()
+        .collect();
+    (scene, w)
+}
+
+#[test]
+fn skins_morph_targets_and_weights_load_with_warnings() {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 1.0]);
+    let weights = b.f32s(&[0.0, 1.0]);
+    let target = b.vec3(&[[0.0, 0.0, 1.0]; 3]);
+    let joint_moves = b.vec3(&[[0.0; 3], [1.0, 0.0, 0.0]]);
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [{"name": "skinned", "mesh": 0, "skin": 0}, {"name": "joint"}, {"name": "morphing", "mesh": 1}],
+        "skins": [{"joints": [1]}],
+        "meshes": [
+            {"name": "body", "primitives": [{"attributes": {"POSITION": 0}}]},
+            {"name": "face", "primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": target}]}],
+             "weights": [0.0]}
+        ],
+        "animations": [
+            {"name": "smile", "samplers": [{"input": times, "output": weights}],
+             "channels": [{"sampler": 0, "target": {"node": 2, "path": "weights"}}]},
+            {"name": "wave", "samplers": [{"input": times, "output": joint_moves}],
+             "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}
+        ],
+        "buffers": [{"byteLength": b.data.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&b.data))}],
+        "bufferViews": b.views,
+        "accessors": b.accessors,
+    });
+    let (scene, warnings) = load_warned(&write_doc("anim_skin_morph.gltf", &doc));
+    let scene = scene.unwrap();
+    assert_eq!(scene.instances.len(), 2, "both meshes are drawn");
+    assert!(
+        scene.animations.is_empty(),
+        "weights are not played; the joint moves nothing drawn"
+    );
+    let has = |s: &str| warnings.iter().any(|w| w.contains(s));
+    assert!(
+        has("skinned mesh 0 'body'") && has("skinning is not supported"),
+        "{warnings:?}"
+    );
+    assert!(has("mesh 1 'face' has morph targets"), "{warnings:?}");
+    assert!(
+        has("animation 0 'smile'") && has("morph-target weights are not supported"),
+        "{warnings:?}"
+    );
+    assert!(
+        has("animation 1 'wave' moves no mesh or light"),
+        "{warnings:?}"
+    );
+}
+
+#[test]
+fn two_animations_on_one_property_warn_and_the_later_wins() {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 1.0]);
+    let first = b.vec3(&[[0.0; 3], [1.0, 0.0, 0.0]]);
+    let second = b.vec3(&[[0.0; 3], [0.0, 1.0, 0.0]]);
+    let animations = json!([
+        {"name": "right", "samplers": [{"input": times, "output": first}],
+         "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]},
+        {"name": "up", "samplers": [{"input": times, "output": second}],
+         "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}
+    ]);
+    let doc = anim_doc(&b, json!([{"mesh": 0}]), json!([0]), animations, json!({}));
+    let (scene, warnings) = load_warned(&write_doc("anim_overlap.gltf", &doc));
+    let scene = scene.unwrap();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("animated by both 'right' and 'up'")),
+        "{warnings:?}"
+    );
+    assert_eq!(scene.animations.len(), 1);
+    assert_eq!(scene.animations[0].name, "up");
+    assert_eq!(point_at(&scene, 0, 1.0, Vec3::ZERO), Vec3::Y);
+}
+
+#[test]
+fn bad_animation_data_fails_with_the_file_and_animation() {
+    let mut b = tri_bin();
+    let unsorted = b.f32s(&[0.0, 2.0, 1.0]);
+    let three = b.vec3(&[[0.0; 3]; 3]);
+    let two_times = b.f32s(&[0.0, 1.0]);
+    let five = b.vec3(&[[0.0; 3]; 5]);
+    let nan = b.vec3(&[[0.0; 3], [f32::NAN, 0.0, 0.0]]);
+    let negative = b.f32s(&[-1.0, 1.0]);
+    let two = b.vec3(&[[0.0; 3]; 2]);
+    let zero_quat = b.vec4(&[[0.0; 4], [0.0, 0.0, 0.0, 1.0]]);
+    let int_times = b.u16s(&[0, 1]);
+    let cases: Vec<(&str, Value, &str)> = vec![
+        (
+            "anim_unsorted.gltf",
+            one_channel(0, "translation", unsorted, three, "LINEAR"),
+            "sorted",
+        ),
+        (
+            "anim_cubic_count.gltf",
+            one_channel(0, "translation", two_times, five, "CUBICSPLINE"),
+            "CUBICSPLINE output has 5 values for 2 keyframe times; it needs 3 per keyframe",
+        ),
+        (
+            "anim_linear_count.gltf",
+            one_channel(0, "scale", two_times, five, "LINEAR"),
+            "2 keyframe times but 5 output values",
+        ),
+        (
+            "anim_nan.gltf",
+            one_channel(0, "translation", two_times, nan, "STEP"),
+            "keyframe 1: the value is not finite",
+        ),
+        (
+            "anim_negative.gltf",
+            one_channel(0, "translation", negative, two, "LINEAR"),
+            ">= 0",
+        ),
+        (
+            "anim_zero_quat.gltf",
+            one_channel(0, "rotation", two_times, zero_quat, "LINEAR"),
+            "zero quaternion",
+        ),
+        (
+            "anim_vec3_rotation.gltf",
+            one_channel(0, "rotation", two_times, two, "LINEAR"),
+            "not allowed",
+        ),
+        (
+            "anim_int_times.gltf",
+            one_channel(0, "translation", int_times, two, "LINEAR"),
+            "not allowed",
+        ),
+        (
+            "anim_no_node.gltf",
+            one_channel(7, "translation", two_times, two, "LINEAR"),
+            "node 7 does not exist",
+        ),
+        (
+            "anim_bad_interp.gltf",
+            one_channel(0, "translation", two_times, two, "SMOOTH"),
+            "interpolation",
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, animations, fragment) in cases {
+        let doc = anim_doc(&b, json!([{"mesh": 0}]), json!([0]), animations, json!({}));
+        let path = write_doc(name, &doc);
+        match std::panic::catch_unwind(|| io::load(&path)) {
+            Err(_) => failures.push(format!("{name}: panicked")),
+            Ok(Ok(_)) => failures.push(format!("{name}: loaded without error")),
+            Ok(Err(e)) => {
+                let msg = e.to_string();
+                println!("{name}: {msg}");
+                // The JSON validation names the animation by its path, the loader by index and name.
+                let anim = msg.contains("animation 0 'move'") || msg.contains("animations[0]");
+                if !msg.contains(name) || !anim || !msg.contains(fragment) {
+                    failures.push(format!(
+                        "{name}: '{msg}' lacks the file, the animation or '{fragment}'"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+// ------------------------------------------------------------------------------------------
+// Khronos animated samples, when present
+
+/// A Khronos sample `name` (`.gltf` or `.glb`) from `../shared/scenes` (or the folder in
+/// `VOXGI_GLTF_SAMPLES`), if it is there.
+fn animated_sample(name: &str) -> Option<PathBuf> {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    let mut dirs: Vec<PathBuf> = std::env::var_os("VOXGI_GLTF_SAMPLES")
+        .map(PathBuf::from)
+        .into_iter()
+        .collect();
+    dirs.extend([
+        shared.join("gltf_samples"),
+        shared.join(name),
+        shared.join("gltf_samples").join(name),
+    ]);
+    let found = dirs
+        .iter()
+        .flat_map(|d| ["gltf", "glb"].map(|x| d.join(format!("{name}.{x}"))))
+        .find(|p| p.exists());
+    if found.is_none() {
+        eprintln!("skipped: Khronos sample {name} is not in ../shared/scenes");
+    }
+    found
+}
+
+/// Minimal base64 decoding for reading data URIs in the tests themselves.
+fn unbase64(s: &str) -> Vec<u8> {
+    let val = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        _ => 63,
+    };
+    let (mut out, mut acc, mut bits) = (Vec::new(), 0u32, 0);
+    for c in s.bytes().filter(|c| !c.is_ascii_whitespace() && *c != b'=') {
+        acc = (acc << 6) | u32::from(val(c));
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+        }
+    }
+    out
+}
+
+/// The float components of accessor `ai` of an embedded glTF, read straight from its JSON and
+/// data URIs (tightly packed or strided, no sparse): one Vec per element.
+fn accessor_floats(doc: &Value, ai: usize) -> Vec<Vec<f32>> {
+    let acc = &doc["accessors"][ai];
+    assert_eq!(acc["componentType"], 5126, "float accessor");
+    let n = match acc["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC3" => 3,
+        "VEC4" => 4,
+        t => panic!("type {t}"),
+    };
+    let view = &doc["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let buffer = &doc["buffers"][view["buffer"].as_u64().unwrap() as usize];
+    let uri = buffer["uri"].as_str().unwrap();
+    let data = unbase64(&uri[uri.find(",").unwrap() + 1..]);
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let stride = view["byteStride"].as_u64().map_or(4 * n, |s| s as usize);
+    (0..acc["count"].as_u64().unwrap() as usize)
+        .map(|k| {
+            (0..n)
+                .map(|c| {
+                    let o = start + k * stride + 4 * c;
+                    f32::from_le_bytes(data[o..o + 4].try_into().unwrap())
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// glTF LINEAR sampling of keyframes `times`/`values` at `t`, written out for the test.
+fn lerp_keys(times: &[Vec<f32>], values: &[Vec<f32>], t: f32) -> (usize, f32) {
+    // Before the first key: the first segment at s = 0 (glTF clamps).
+    let k = times.iter().rposition(|x| x[0] <= t).unwrap_or(0);
+    let k = k.min(times.len() - 2);
+    let s = ((t - times[k][0]) / (times[k + 1][0] - times[k][0])).clamp(0.0, 1.0);
+    assert_eq!(values.len(), times.len());
+    (k, s)
+}
+
+#[test]
+fn khronos_box_animated_matches_its_own_accessors() {
+    use voxgi_scene::glam::Quat;
+    let Some(path) = animated_sample("BoxAnimated") else {
+        return;
+    };
+    let doc: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let scene = io::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    // Two animations: node 2 (inner box) rotates; its grandparent node 0 translates. The inner
+    // box is moved by both, so they play as one target; the outer box stays static.
+    let anims = doc["animations"].as_array().unwrap();
+    assert_eq!(anims.len(), 2);
+    let channel = |a: usize| {
+        let ch = &anims[a]["channels"][0];
+        let sm = &anims[a]["samplers"][ch["sampler"].as_u64().unwrap() as usize];
+        let (i, o) = (
+            sm["input"].as_u64().unwrap() as usize,
+            sm["output"].as_u64().unwrap() as usize,
+        );
+        (
+            ch["target"]["node"].as_u64().unwrap(),
+            ch["target"]["path"].as_str().unwrap().to_string(),
+            accessor_floats(&doc, i),
+            accessor_floats(&doc, o),
+        )
+    };
+    let (rot_node, rot_path, rot_t, rot_v) = channel(0);
+    let (tr_node, tr_path, tr_t, tr_v) = channel(1);
+    assert_eq!(
+        (rot_node, rot_path.as_str(), tr_node, tr_path.as_str()),
+        (2, "rotation", 0, "translation")
+    );
+    let end = rot_t.last().unwrap()[0].max(tr_t.last().unwrap()[0]);
+    assert_eq!(
+        scene.animations.len(),
+        1,
+        "{:?}",
+        scene.animations.iter().map(|a| &a.name).collect::<Vec<_>>()
+    );
+    assert_eq!(scene.animations[0].name, "animation 0, animation 1");
+    assert!((scene.animations[0].duration() - end).abs() < 1e-6);
+    let inner = scene
+        .instances
+        .iter()
+        .position(|i| i.name == "node 2")
+        .unwrap();
+    let outer = scene
+        .instances
+        .iter()
+        .position(|i| i.name == "node 3")
+        .unwrap();
+    assert!(scene.instances[inner].dynamic && !scene.instances[outer].dynamic);
+    // The inner box's world transform at t, from the file: node 0 = T(t) R0, node 1 = I,
+    // node 2 = R(t) (rest TRS of node 0 and 2 from the JSON).
+    let quat = |v: &[f32]| Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize();
+    let rest_rot = |n: usize| {
+        quat(
+            &doc["nodes"][n]["rotation"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap() as f32)
+                .collect::<Vec<_>>(),
+        )
+    };
+    for t in [0.3, 1.0, 1.6, 2.2, 3.0] {
+        let (k, s) = lerp_keys(&tr_t, &tr_v, t);
+        let tr = Vec3::from_slice(&tr_v[k]).lerp(Vec3::from_slice(&tr_v[k + 1]), s);
+        let (k, s) = lerp_keys(&rot_t, &rot_v, t);
+        let rot = quat(&rot_v[k]).slerp(quat(&rot_v[k + 1]), s);
+        let want = Mat4::from_rotation_translation(rest_rot(0), tr) * Mat4::from_quat(rot);
+        let got = scene.at_time(t).instances[inner].transform;
+        assert!(got.abs_diff_eq(want, 1e-5), "t {t}: {got} vs {want}");
+        assert_eq!(
+            scene.at_time(t).instances[outer].transform,
+            scene.instances[outer].transform
+        );
+    }
+}
+
+#[test]
+fn khronos_animated_samples_load() {
+    for name in [
+        "AnimatedTriangle",
+        "AnimatedCube",
+        "BoxAnimated",
+        "InterpolationTest",
+        "AnimatedMorphCube",
+        "RiggedSimple",
+        "RiggedFigure",
+        "CesiumMan",
+        "Fox",
+    ] {
+        let Some(path) = animated_sample(name) else {
+            continue;
+        };
+        let doc: Value = if path.extension().is_some_and(|x| x == "gltf") {
+            serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap()
+        } else {
+            json!({})
+        };
+        let (scene, warnings) = load_warned(&path);
+        let scene = scene.unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!(
+            "{name}: {} animations, warnings {warnings:?}",
+            scene.animations.len()
+        );
+        let skinned = doc["skins"].as_array().is_some_and(|s| !s.is_empty())
+            || name.starts_with("Rigged")
+            || name == "CesiumMan"
+            || name == "Fox";
+        if skinned {
+            assert!(
+                warnings
+                    .iter()
+                    .any(|w| w.contains("skinning is not supported")),
+                "{name}: {warnings:?}"
+            );
+        } else if name == "AnimatedMorphCube" {
+            // Its only channels animate morph-target weights.
+            assert!(
+                warnings
+                    .iter()
+                    .any(|w| w.contains("morph-target weights are not supported")),
+                "{name}: {warnings:?}"
+            );
+        } else {
+            assert!(!scene.animations.is_empty(), "{name}");
+        }
+        for a in &scene.animations {
+            assert!(
+                a.duration() > 0.0 && a.duration().is_finite(),
+                "{name}: {}",
+                a.name
+            );
+            for t in [0.0, a.duration() * 0.37, a.duration()] {
+                let s = scene.at_time(t);
+                assert!(
+                    s.instances.iter().all(|i| i.transform.is_finite()),
+                    "{name} at {t}"
+                );
+                s.validate().unwrap();
+            }
+        }
+    }
 }
