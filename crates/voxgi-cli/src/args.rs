@@ -14,7 +14,8 @@ pub struct SceneArg {
     /// Scene file: .gltf, .glb, .obj, .ply, .cloud or .toml.
     #[arg(required_unless_present = "builtin", conflicts_with = "builtin")]
     pub scene: Option<PathBuf>,
-    /// A built-in scene instead of a file: cornell-box, open-plane, closed-box, two-rooms.
+    /// A built-in scene instead of a file: cornell-box, open-plane, closed-box, two-rooms,
+    /// cube.
     #[arg(long, value_name = "NAME")]
     pub builtin: Option<String>,
 }
@@ -72,6 +73,13 @@ pub struct SettingsArgs {
     /// Directional chain the voxel views read above the finest level: +x, -x, +y, -y, +z, -z.
     #[arg(long, value_name = "DIR", value_parser = lib(voxgi::parse_direction), allow_hyphen_values = true)]
     pub voxel_dir: Option<u32>,
+    /// Progressive bounces: one voxel bounce per frame on top of the last frame's light,
+    /// converging to unlimited bounces (sets --bounces unlimited).
+    #[arg(long)]
+    pub progressive: bool,
+    /// Voxel work on every K-th frame only (the voxels then trail moving meshes). Default 1.
+    #[arg(long, value_name = "K")]
+    pub update_interval: Option<u32>,
 }
 
 impl SettingsArgs {
@@ -117,10 +125,25 @@ impl SettingsArgs {
         set!(o.step_factor, self.step_factor);
         set!(f.debug_level, self.voxel_level);
         set!(f.debug_direction, self.voxel_dir);
+        if self.progressive {
+            o.progressive = true;
+            o.bounces = voxgi::UNLIMITED_BOUNCES;
+        }
+        set!(o.voxel_update_interval, self.update_interval);
         o.validate()?;
         f.validate(o.voxel_levels())?;
         Ok((o, f))
     }
+}
+
+/// The view when the scene gives none: as the renderer's (`Renderer::default_camera`), around
+/// everything the scene's animations sweep, so it is the same at every time.
+pub fn default_camera(scene: &Scene) -> Camera {
+    scene
+        .cameras
+        .first()
+        .cloned()
+        .unwrap_or_else(|| Camera::viewing(voxgi::swept_bounds(scene)))
 }
 
 /// A clap parser for one of the library's names.

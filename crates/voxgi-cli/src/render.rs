@@ -16,7 +16,8 @@ use voxgi::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArg,
-    /// Output image; the extension picks the format (.png or .exr).
+    /// Output image; the extension picks the format (.png or .exr). With --frames, a pattern
+    /// with the frame number as %d or %04d (e.g. out_%04d.png).
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
     /// Image size in pixels.
@@ -45,9 +46,46 @@ pub struct RenderArgs {
     /// Reference modes: random seed (the same seed gives the same image).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub seed: u32,
-    /// The scene's animations at this time, in seconds (default 0: the rest pose).
+    /// The scene's animations at this time, in seconds (default 0: the rest pose); with
+    /// --frames, the first frame's time.
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
     pub time: f32,
+    /// Render an image sequence of N frames, one renderer updated from frame to frame (only
+    /// what moved is re-voxelized).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// Frames per second of scene time in a sequence.
+    #[arg(long, value_name = "F", default_value_t = 30.0, requires = "frames")]
+    pub fps: f32,
+}
+
+/// The path of frame `k` of an output pattern: its one `%d` or `%0Nd` replaced by `k`.
+pub fn frame_path(pattern: &Path, k: u32) -> Result<PathBuf> {
+    let text = pattern.to_string_lossy();
+    let Some(start) = text.find('%') else {
+        bail!(
+            "{}: an image sequence needs the frame number in the name, as %d or %04d \
+             (e.g. out_%04d.png)",
+            pattern.display()
+        );
+    };
+    let rest = &text[start + 1..];
+    let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+    if !rest[digits.len()..].starts_with('d') {
+        bail!(
+            "{}: the frame number must be written %d or %0Nd",
+            pattern.display()
+        );
+    }
+    if text[start + 2 + digits.len()..].contains('%') {
+        bail!("{}: only one % is allowed", pattern.display());
+    }
+    let width: usize = digits.parse().unwrap_or(0);
+    Ok(PathBuf::from(format!(
+        "{}{k:0width$}{}",
+        &text[..start],
+        &text[start + 2 + digits.len()..]
+    )))
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -73,7 +111,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             args.output.display()
         );
     }
-    check_writable(&args.output)?;
+    let times: Vec<f32> = match args.frames {
+        None => vec![args.time],
+        Some(0) => bail!("--frames 0: nothing to render"),
+        Some(n) => {
+            if !(args.fps.is_finite() && args.fps > 0.0) {
+                bail!("--fps {} must be a positive number", args.fps);
+            }
+            (0..n).map(|k| args.time + k as f32 / args.fps).collect()
+        }
+    };
+    let first = if args.frames.is_some() {
+        frame_path(&args.output, 0)?
+    } else {
+        args.output.clone()
+    };
+    check_writable(&first)?;
     let label = scene_label(&args.scene);
     let (scene, table) = p.stage(&format!("loading {label}"), || {
         load_scene_and_settings(&args.scene)
@@ -82,12 +135,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("--time {} is not a finite number of seconds", args.time);
     }
     let mut scene = scene;
-    scene.set_time(args.time);
-    let default = scene
-        .cameras
-        .first()
-        .cloned()
-        .unwrap_or_else(|| scene.default_camera());
+    scene.set_time(times[0]);
+    let default = crate::args::default_camera(&scene);
     let camera = pick_camera(&scene, &default, args)?;
     let (options, frame) = args
         .settings
@@ -96,6 +145,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let ctx = p.stage("opening GPU", GpuContext::from_env)?;
     eprintln!("GPU: {} ({:?})", ctx.info.name, ctx.info.backend);
     let (w, h) = args.size;
+    if args.frames.is_some() {
+        return render_sequence(args, &ctx, &mut scene, &options, &frame, &times, &p);
+    }
     let out = if args.mode == ModeArg::Raster {
         let mut renderer = p
             .stage("uploading scene", || ctx.renderer(&scene, &options))
@@ -104,28 +156,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             headless::render(&ctx, &mut renderer, &frame, w, h)
         })?
     } else {
-        let opts = ReferenceOptions {
-            spp: args.spp,
-            bounces: match options.bounces {
-                0 => Bounces::DirectOnly,
-                1 => Bounces::One,
-                voxgi::UNLIMITED_BOUNCES => Bounces::Unlimited,
-                n => Bounces::Exactly(n),
-            },
-            mode: if args.mode == ModeArg::AoReference {
-                ReferenceMode::Ao {
-                    // The cone tracer's AO radius, so the two are comparable.
-                    radius: options.ao_radius.unwrap_or_else(|| {
-                        let b = scene.bounds();
-                        voxgi::voxel::Grid::around(b.min, b.max, options.voxel_resolution).extent()
-                            * 0.25
-                    }),
-                }
-            } else {
-                ReferenceMode::Radiance
-            },
-            seed: args.seed,
-        };
+        let opts = reference_options(args, &scene, &options);
         let mut tracer = p
             .stage("uploading scene and building the BVH", || {
                 PathTracer::new(&ctx.device, &ctx.queue, &scene, &options)
@@ -157,6 +188,93 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     eprintln!(
         "wrote {} ({w}x{h}) in {:.2} s",
         args.output.display(),
+        p.start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn reference_options(
+    args: &RenderArgs,
+    scene: &Scene,
+    options: &voxgi::RendererOptions,
+) -> ReferenceOptions {
+    ReferenceOptions {
+        spp: args.spp,
+        bounces: match options.bounces {
+            0 => Bounces::DirectOnly,
+            1 => Bounces::One,
+            voxgi::UNLIMITED_BOUNCES => Bounces::Unlimited,
+            n => Bounces::Exactly(n),
+        },
+        mode: if args.mode == ModeArg::AoReference {
+            ReferenceMode::Ao {
+                // The cone tracer's AO radius, so the two are comparable.
+                radius: options.ao_radius.unwrap_or_else(|| {
+                    let b = voxgi::swept_bounds(scene);
+                    voxgi::voxel::Grid::around(b.min, b.max, options.voxel_resolution).extent()
+                        * 0.25
+                }),
+            }
+        } else {
+            ReferenceMode::Radiance
+        },
+        seed: args.seed,
+    }
+}
+
+/// An image sequence: one renderer, moved to each frame's time (`Renderer::set_time`), or one
+/// path-traced image per frame. A line of progress with the ETA.
+fn render_sequence(
+    args: &RenderArgs,
+    ctx: &GpuContext,
+    scene: &mut Scene,
+    options: &voxgi::RendererOptions,
+    frame: &voxgi::FrameParams,
+    times: &[f32],
+    p: &Progress,
+) -> Result<()> {
+    let (w, h) = args.size;
+    let label = scene_label(&args.scene);
+    let mut renderer = if args.mode == ModeArg::Raster {
+        Some(
+            p.stage("uploading scene", || ctx.renderer(scene, options))
+                .with_context(|| label.clone())?,
+        )
+    } else {
+        None
+    };
+    let n = times.len();
+    eprintln!(
+        "rendering {n} frames of {w}x{h} at {} frames/s, t = {:.3} .. {:.3} s",
+        args.fps,
+        times[0],
+        times[n - 1]
+    );
+    let start = Instant::now();
+    for (k, &t) in times.iter().enumerate() {
+        let out = match &mut renderer {
+            Some(r) => {
+                r.set_time(t)?;
+                headless::render(ctx, r, frame, w, h)?
+            }
+            None => {
+                scene.set_time(t);
+                let mut tracer = PathTracer::new(&ctx.device, &ctx.queue, scene, options)?;
+                let opts = reference_options(args, scene, options);
+                tracer.render(frame, w, h, &opts, &mut |_, _| {})?
+            }
+        };
+        let path = frame_path(&args.output, k as u32)?;
+        out.save(&path)?;
+        let el = start.elapsed().as_secs_f64();
+        let done = k + 1;
+        let eta = el / done as f64 * (n - done) as f64;
+        eprint!("\r  frame {done}/{n}  t = {t:.3} s  {el:.1} s elapsed  ETA {eta:.1} s   ");
+    }
+    eprintln!(
+        "\nwrote {} .. {} in {:.2} s",
+        frame_path(&args.output, 0)?.display(),
+        frame_path(&args.output, n as u32 - 1)?.display(),
         p.start.elapsed().as_secs_f64()
     );
     Ok(())

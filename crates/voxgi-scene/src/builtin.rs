@@ -21,6 +21,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "two-rooms",
         "two rooms sharing a 1 cm wall, a point light in the left one",
     ),
+    (
+        "cube",
+        "a 1 m white cube centred on the origin, no light: an object to include and move",
+    ),
 ];
 
 pub fn by_name(name: &str) -> Result<Scene> {
@@ -29,6 +33,7 @@ pub fn by_name(name: &str) -> Result<Scene> {
         "open-plane" => Ok(open_plane(0.5)),
         "closed-box" => Ok(closed_box(0.5, 0.5)),
         "two-rooms" => Ok(two_rooms(0.01)),
+        "cube" => Ok(cube([0.8; 3])),
         _ => Err(SceneError::UnknownBuiltin {
             name: name.into(),
             available: BUILTINS.iter().map(|b| b.0).collect::<Vec<_>>().join(", "),
@@ -384,6 +389,22 @@ fn room_walls(q: &mut QuadList, a: Vec3, b: Vec3, inside: Vec3) {
         ],
         inside,
     );
+}
+
+/// A 1 m cube centred on the origin, Lambertian with `albedo`, without lights or camera.
+pub fn cube(albedo: [f32; 3]) -> Scene {
+    let mut scene = Scene {
+        name: "cube".into(),
+        ..Default::default()
+    };
+    let mut q = QuadList::default();
+    q.cuboid(Vec3::splat(-0.5), Vec3::splat(0.5));
+    scene.add_mesh(
+        q.into_mesh("cube"),
+        Material::diffuse("cube", albedo),
+        Mat4::IDENTITY,
+    );
+    scene
 }
 
 /// Two 1 m rooms side by side along x (room A: x in [-1, 0], room B: x in [0, 1]) separated by a

@@ -395,19 +395,7 @@ impl Scene {
     /// Camera used when neither the file nor the user gives one: in front of the bounds (+Z side,
     /// slightly above), looking at their centre, far enough back to see the bounding sphere.
     pub fn default_camera(&self) -> Camera {
-        let b = self.bounds();
-        let (center, radius) = if b.is_empty() {
-            (Vec3::ZERO, 1.0)
-        } else {
-            (b.center(), (b.size().length() * 0.5).max(1e-3))
-        };
-        let yfov = 45f32;
-        let dist = radius / (yfov.to_radians() * 0.5).sin();
-        let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
-        let mut cam = Camera::look_at(center + dir * dist, center, yfov);
-        cam.name = "default".into();
-        cam.znear = (dist - radius).max(radius * 1e-3);
-        cam
+        Camera::viewing(self.bounds())
     }
 
     /// A sun for scenes that have no light at all, so they render as something other than black:

@@ -258,6 +258,24 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// A camera in front of `bounds` (+Z side, slightly above), looking at their centre, far
+    /// enough back to see their bounding sphere (a unit sphere at the origin when empty).
+    pub fn viewing(bounds: Aabb) -> Camera {
+        let b = bounds;
+        let (center, radius) = if b.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (b.center(), (b.size().length() * 0.5).max(1e-3))
+        };
+        let yfov = 45f32;
+        let dist = radius / (yfov.to_radians() * 0.5).sin();
+        let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
+        let mut cam = Camera::look_at(center + dir * dist, center, yfov);
+        cam.name = "default".into();
+        cam.znear = (dist - radius).max(radius * 1e-3);
+        cam
+    }
+
     pub fn look_at(position: Vec3, target: Vec3, yfov_degrees: f32) -> Self {
         let forward = (target - position).normalize_or(Vec3::NEG_Z);
         let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);

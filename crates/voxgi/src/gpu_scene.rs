@@ -6,7 +6,7 @@
 use crate::{Error, RendererOptions, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use voxgi_scene::{AlphaMode, AreaShape, LightKind, Scene, pointcloud};
+use voxgi_scene::{AlphaMode, AreaShape, Light, LightKind, Scene, pointcloud};
 use wgpu::util::DeviceExt;
 
 /// Mirrors `Frame` in shaders/shared/scene.wgsl.
@@ -243,6 +243,9 @@ pub struct DrawCall {
     pub draw: u32,
     /// The area light this geometry shows; it does not shadow its own light.
     pub light: Option<usize>,
+    /// The instance may move (`Instance::dynamic`): it is voxelized every frame it moved,
+    /// apart from the static geometry, which is voxelized once.
+    pub dynamic: bool,
 }
 
 /// The scene's GPU buffers and textures, shared read-only by every pass, and the draw calls
@@ -282,57 +285,78 @@ pub struct GpuScene {
     pub gpu_lights: Vec<GpuLight>,
     /// Number of lights (`gpu_lights.len()`).
     pub light_count: u32,
+    /// CPU copy of `draws`, for updating one instance's transform.
+    pub gpu_draws: Vec<GpuDraw>,
+    /// Per scene instance, its index in `draws` (`None` for instances without triangles).
+    pub instance_draw: Vec<Option<u32>>,
 }
 
 fn mat(m: Mat4) -> [[f32; 4]; 4] {
     m.to_cols_array_2d()
 }
 
+/// The draw of an instance with `transform` (its normal matrix the inverse transpose, or the
+/// identity when `transform` is singular).
+fn gpu_draw(transform: Mat4, material: u32, light: Option<usize>) -> GpuDraw {
+    let normal_matrix = transform.inverse().transpose();
+    let normal_matrix = if normal_matrix.is_finite() {
+        normal_matrix
+    } else {
+        Mat4::IDENTITY
+    };
+    GpuDraw {
+        model: mat(transform),
+        normal_matrix: mat(normal_matrix),
+        material,
+        light: light.map_or(NO_INDEX, |l| l as u32),
+        _pad: [0; 2],
+    }
+}
+
 /// Converts scene lights to their GPU form (shadow fields left zero).
 pub fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
-    scene
-        .lights
-        .iter()
-        .map(|l| {
-            let mut g = GpuLight {
-                position: l.position.to_array(),
-                direction: l.direction.normalize().to_array(),
-                range: l.range.unwrap_or(0.0),
-                radiance: l.radiometric().to_array(),
-                area: l.area(),
-                size: (l.area() / std::f32::consts::PI).sqrt(),
-                ..Default::default()
-            };
-            match l.kind {
-                LightKind::Directional => g.kind = LIGHT_DIRECTIONAL,
-                LightKind::Point => g.kind = LIGHT_POINT,
-                LightKind::Spot {
-                    inner_angle,
-                    outer_angle,
-                } => {
-                    g.kind = LIGHT_SPOT;
-                    g.cos_inner = inner_angle.cos();
-                    g.cos_outer = outer_angle.cos();
-                }
-                LightKind::Area {
-                    shape: AreaShape::Rect { u, v },
-                } => {
-                    g.kind = LIGHT_RECT;
-                    g.axis_u = u.to_array();
-                    g.axis_v = v.to_array();
-                }
-                LightKind::Area {
-                    shape: AreaShape::Disc { radius },
-                } => {
-                    g.kind = LIGHT_DISC;
-                    let (t, b) = l.direction.normalize().any_orthonormal_pair();
-                    g.axis_u = (t * radius).to_array();
-                    g.axis_v = (b * radius).to_array();
-                }
-            }
-            g
-        })
-        .collect()
+    scene.lights.iter().map(gpu_light).collect()
+}
+
+/// One light in its GPU form (shadow fields left zero).
+pub fn gpu_light(l: &Light) -> GpuLight {
+    let mut g = GpuLight {
+        position: l.position.to_array(),
+        direction: l.direction.normalize().to_array(),
+        range: l.range.unwrap_or(0.0),
+        radiance: l.radiometric().to_array(),
+        area: l.area(),
+        size: (l.area() / std::f32::consts::PI).sqrt(),
+        ..Default::default()
+    };
+    match l.kind {
+        LightKind::Directional => g.kind = LIGHT_DIRECTIONAL,
+        LightKind::Point => g.kind = LIGHT_POINT,
+        LightKind::Spot {
+            inner_angle,
+            outer_angle,
+        } => {
+            g.kind = LIGHT_SPOT;
+            g.cos_inner = inner_angle.cos();
+            g.cos_outer = outer_angle.cos();
+        }
+        LightKind::Area {
+            shape: AreaShape::Rect { u, v },
+        } => {
+            g.kind = LIGHT_RECT;
+            g.axis_u = u.to_array();
+            g.axis_v = v.to_array();
+        }
+        LightKind::Area {
+            shape: AreaShape::Disc { radius },
+        } => {
+            g.kind = LIGHT_DISC;
+            let (t, b) = l.direction.normalize().any_orthonormal_pair();
+            g.axis_u = (t * radius).to_array();
+            g.axis_v = (b * radius).to_array();
+        }
+    }
+    g
 }
 
 impl GpuScene {
@@ -366,30 +390,22 @@ impl GpuScene {
         }
         let mut draws = Vec::with_capacity(scene.instances.len());
         let mut calls = Vec::with_capacity(scene.instances.len());
+        let mut instance_draw = Vec::with_capacity(scene.instances.len());
         for inst in &scene.instances {
             let mesh = &scene.meshes[inst.mesh];
             if mesh.indices.is_empty() {
+                instance_draw.push(None);
                 continue;
             }
-            let normal_matrix = inst.transform.inverse().transpose();
-            let normal_matrix = if normal_matrix.is_finite() {
-                normal_matrix
-            } else {
-                Mat4::IDENTITY
-            };
+            instance_draw.push(Some(draws.len() as u32));
             calls.push(DrawCall {
                 indices: ranges[inst.mesh].0.clone(),
                 base_vertex: ranges[inst.mesh].1,
                 draw: draws.len() as u32,
                 light: inst.light,
+                dynamic: inst.dynamic,
             });
-            draws.push(GpuDraw {
-                model: mat(inst.transform),
-                normal_matrix: mat(normal_matrix),
-                material: mesh.material as u32,
-                light: inst.light.map_or(NO_INDEX, |l| l as u32),
-                _pad: [0; 2],
-            });
+            draws.push(gpu_draw(inst.transform, mesh.material as u32, inst.light));
         }
         let (textures, layer_of) = upload_textures(device, queue, scene, settings)?;
         let materials: Vec<GpuMaterial> = scene
@@ -475,7 +491,21 @@ impl GpuScene {
             calls,
             light_count: lights.len() as u32,
             gpu_lights: lights,
+            gpu_draws: draws,
+            instance_draw,
         })
+    }
+
+    /// Writes a new object-to-world transform for draw `draw`.
+    pub fn set_transform(&mut self, queue: &wgpu::Queue, draw: u32, transform: Mat4) {
+        let d = &mut self.gpu_draws[draw as usize];
+        let light = (d.light != NO_INDEX).then_some(d.light as usize);
+        *d = gpu_draw(transform, d.material, light);
+        queue.write_buffer(
+            &self.draws,
+            draw as u64 * size_of::<GpuDraw>() as u64,
+            bytemuck::bytes_of(d),
+        );
     }
 
     /// Bytes of GPU memory per resource, for `voxgi bench` and `info`.
@@ -673,7 +703,11 @@ fn to_srgb8(img: &image::Rgba32FImage) -> Vec<u8> {
 
 /// World-space bounds of everything drawn, never empty (a unit box for empty scenes).
 pub fn scene_bounds(scene: &Scene) -> (Vec3, f32) {
-    let b = scene.bounds();
+    bounding_sphere(scene.bounds())
+}
+
+/// The sphere around `b` (centre, radius), never empty (a unit sphere for an empty box).
+pub fn bounding_sphere(b: voxgi_scene::Aabb) -> (Vec3, f32) {
     if b.is_empty() {
         return (Vec3::ZERO, 1.0);
     }

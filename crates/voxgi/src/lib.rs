@@ -48,6 +48,7 @@ pub mod output;
 #[cfg(feature = "reference")]
 pub mod reference;
 mod renderer;
+mod scene_state;
 pub mod screen;
 mod settings;
 mod targets;
@@ -63,7 +64,8 @@ pub use options::{
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use renderer::{Renderer, VoxelCounts};
+pub use renderer::{Renderer, VOXEL_PASSES, VoxelCounts};
+pub use scene_state::swept_bounds;
 pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
 pub use targets::{FrameTargets, Target};
 pub use voxel::ConeSet;

@@ -179,6 +179,15 @@ pub struct RendererOptions {
     /// Occupied voxels the first build has room for (at least 1024); `None`: a quarter of the
     /// fragment estimate. Grows like `fragment_capacity`.
     pub voxel_capacity: Option<u64>,
+    /// Progressive bounces: each voxel update adds one bounce, gathered from the previous
+    /// update's voxel radiance, so a still scene converges to the `UNLIMITED_BOUNCES` result
+    /// and a changing one costs one bounce per update (its light lags behind by a few
+    /// updates). Needs `bounces` = `UNLIMITED_BOUNCES`. Default false.
+    pub progressive: bool,
+    /// Voxel work (dynamic geometry, injection, filtering, bounces) runs on every k-th frame
+    /// only (1..=64); the frames between reuse the voxels, which then trail the meshes by up
+    /// to k - 1 frames. Shadow maps follow every frame. Default 1.
+    pub voxel_update_interval: u32,
 }
 
 impl Default for RendererOptions {
@@ -201,6 +210,8 @@ impl Default for RendererOptions {
             cone_shadows: false,
             fragment_capacity: None,
             voxel_capacity: None,
+            progressive: false,
+            voxel_update_interval: 1,
         }
     }
 }
@@ -261,6 +272,19 @@ impl RendererOptions {
         {
             return fail(format!(
                 "max cone distance {d} must be a positive number of metres"
+            ));
+        }
+        if self.progressive && self.bounces != UNLIMITED_BOUNCES {
+            return fail(format!(
+                "progressive bounces converge to unlimited bounces: set bounces to unlimited \
+                 (not {})",
+                self.bounces
+            ));
+        }
+        if !(1..=64).contains(&self.voxel_update_interval) {
+            return fail(format!(
+                "voxel update interval {} is outside 1..=64 frames",
+                self.voxel_update_interval
             ));
         }
         Ok(())

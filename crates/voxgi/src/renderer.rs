@@ -7,8 +7,13 @@
 //! `debug` runs only for the voxel views (`ViewMode::is_voxel`) and replaces the composite's
 //! output with the ray-marched volume. `tonemap` writes the caller's target.
 //!
-//! The voxel passes (and the shadow maps they read) run when the scene changed: on the first
-//! frame, after `invalidate`, and after a pool grew. Their overflow counters come back
+//! Voxel work follows what changed (DESIGN.md, seam 6). The static geometry is voxelized and
+//! built once (on the first frame, after `invalidate`, a pool's growth or a voxel option's
+//! change); the dynamic geometry is voxelized and merged in (`dense_update`) on frames after
+//! it moved, undoing the previous merge. Injection, filtering and bounces run after geometry
+//! or a light changed; with progressive bounces one bounce per frame until the light has
+//! converged. Shadow maps re-render only the views of lights that changed or that see
+//! something that moved. Camera motion alone does no voxel work. Overflow counters come back
 //! asynchronously (`gpu::feedback`): a build that overflowed is redone a frame later with room
 //! for everything, and no frame waits for the GPU.
 
@@ -18,12 +23,13 @@ use crate::fragments::{self, FragmentEstimate, Fragments, triangle_table};
 use crate::gpu::feedback::CounterReadback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
-use crate::gpu_scene::{GpuFrame, GpuScene, scene_bounds};
+use crate::gpu_scene::{GpuFrame, GpuScene, bounding_sphere, gpu_light};
 use crate::lighting::atlas::{self as shadow, ShadowAtlas};
 use crate::lighting::bounce::BouncePass;
 use crate::lighting::inject::InjectPass;
 use crate::lighting::shadow::ShadowPass;
 use crate::options::{FrameParams, RendererOptions, UNLIMITED_BOUNCES, validate_size};
+use crate::scene_state::SceneState;
 use crate::screen::composite::CompositePass;
 use crate::screen::gather::{self, GatherPass};
 use crate::screen::gbuffer::GbufferPass;
@@ -34,10 +40,22 @@ use crate::view::{camera_view_proj, lit_scene};
 use crate::voxel::dense::{DensePipelines, DenseVolume, SLOT_BYTES};
 use crate::voxel::{DebugView, GpuCones, Grid, VoxelStructure};
 use crate::{Error, Result};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use std::sync::Arc;
-use voxgi_scene::{Aabb, Camera, Scene, pointcloud};
+use voxgi_scene::{Aabb, Camera, Light, Scene, pointcloud};
 use wgpu::util::DeviceExt;
+
+/// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
+/// camera), in the order they run; every other pass is the screen's.
+pub const VOXEL_PASSES: [&str; 7] = [
+    "shadow",
+    "voxelize",
+    "dense_build",
+    "dense_update",
+    "inject",
+    "filter",
+    "bounce",
+];
 
 /// Every pass, by name.
 struct Passes {
@@ -127,12 +145,20 @@ pub struct Renderer {
     /// (and `volume()`, for tests) names the dense volume.
     volume: DenseVolume,
     dense_pipelines: Arc<DensePipelines>,
-    triangles: (wgpu::Buffer, u32),
+    /// Voxelize's triangle tables: the static instances' and the dynamic ones'.
+    static_triangles: (wgpu::Buffer, u32),
+    dynamic_triangles: (wgpu::Buffer, u32),
     cones: wgpu::Buffer,
     /// Voxel bounces per update (the per-pixel gather adds the last bounce).
     voxel_bounces: u32,
-    /// The voxels (and shadow maps) must be rebuilt in the next frame.
-    dirty: bool,
+    /// What changed since the voxels and shadow maps were last brought up to date.
+    pending: Pending,
+    /// Progressive bounces still to run before the voxel light has converged.
+    progressive_left: u32,
+    /// Frames rendered, for `voxel_update_interval`.
+    frame_index: u64,
+    /// Instances, lights and animations as last set.
+    state: SceneState,
     counters: CounterReadback,
     /// Counts every replacement of the fragments or the volume, so that counters read back
     /// from pools that are gone are not acted on.
@@ -147,9 +173,26 @@ pub struct Renderer {
     facts: SceneFacts,
 }
 
+/// What changed since the last voxel update.
+#[derive(Default)]
+struct Pending {
+    /// Everything: the static geometry too, and every shadow view.
+    rebuild: bool,
+    /// Dynamic geometry moved.
+    geometry: bool,
+    /// A light changed.
+    lights: bool,
+    /// Shadow views to re-render (by atlas layer); consumed every frame, unlike the rest,
+    /// which waits for the next voxel update.
+    views: Vec<bool>,
+}
+
 /// What `set_options` needs to know of the scene to rebuild what an option feeds.
 struct SceneFacts {
+    /// Everything the scene draws at any time (what animations move, at all their poses).
     bounds: Aabb,
+    /// Whether any instance is dynamic.
+    dynamic: bool,
     estimate: FragmentEstimate,
     /// The largest albedo of any material (the unlimited-bounce count's convergence).
     max_albedo: f32,
@@ -186,12 +229,15 @@ impl Renderer {
             estimate_point_attributes(scene.to_mut());
         }
         let scene = scene.as_ref();
-        let (center, radius) = scene_bounds(scene);
         let mut gpu_scene = checked(device, "scene upload", || {
             GpuScene::new(device, queue, scene, options)
         })??;
+        let state = SceneState::new(scene, &gpu_scene.instance_draw);
+        let bounds = state.swept_bounds(scene);
+        let (center, radius) = bounding_sphere(bounds);
         let facts = SceneFacts {
-            bounds: scene.bounds(),
+            bounds,
+            dynamic: scene.instances.iter().any(|i| i.dynamic),
             estimate: FragmentEstimate::of(scene),
             max_albedo: scene
                 .materials
@@ -225,8 +271,11 @@ impl Renderer {
             composite: composite_pass(device, &gpu_scene, &facts, options),
             tonemap: TonemapPass::new(device),
         })?;
-        let triangles = checked(device, "voxelization table", || {
-            triangle_table(device, &gpu_scene)
+        let (static_triangles, dynamic_triangles) = checked(device, "voxelization table", || {
+            Ok::<_, Error>((
+                triangle_table(device, &gpu_scene, false)?,
+                triangle_table(device, &gpu_scene, true)?,
+            ))
         })??;
         let brdf_tables = BrdfTables::new(device, queue);
         let voxel_bounces = voxel_bounce_count(facts.max_albedo, options.bounces);
@@ -235,11 +284,13 @@ impl Renderer {
             contents: bytemuck::bytes_of(&cone_uniforms(options, &grid)),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
+        // From the swept bounds, so that it is the same at every time of an animation.
         let default_camera = scene
             .cameras
             .first()
             .cloned()
-            .unwrap_or_else(|| scene.default_camera());
+            .unwrap_or_else(|| Camera::viewing(bounds));
+        let views = atlas.views.len();
         Ok(Renderer {
             device: device.clone(),
             queue: queue.clone(),
@@ -252,10 +303,18 @@ impl Renderer {
             fragments,
             volume,
             dense_pipelines,
-            triangles,
+            static_triangles,
+            dynamic_triangles,
             cones,
             voxel_bounces,
-            dirty: true,
+            pending: Pending {
+                rebuild: true,
+                views: vec![true; views],
+                ..Default::default()
+            },
+            progressive_left: 0,
+            frame_index: 0,
+            state,
             counters: CounterReadback::new("voxel counters readback", 2),
             pools: 0,
             last_counts: None,
@@ -372,9 +431,149 @@ impl Renderer {
             self.voxel_bounces = voxel_bounce_count(self.facts.max_albedo, new.bounces);
         }
         // The gather's resolution needs no work here: the next frame makes targets to match.
-        self.dirty |= volume || atlas || cones;
+        let progressive = old.progressive != new.progressive;
         self.options = options.clone();
+        if volume || atlas || cones || progressive {
+            self.invalidate();
+        }
         Ok(())
+    }
+
+    /// Moves instance `instance` (an index into the scene's instances) to `transform`. Only
+    /// dynamic instances move (`Instance::dynamic`); moving a static one is an error, as is a
+    /// transform that is not finite. The next voxel update re-voxelizes the dynamic geometry,
+    /// and the shadow views that see the instance's old or new place re-render. Geometry moved
+    /// outside the volume (the scene's bounds, with every pose of its animations) is not
+    /// voxelized there.
+    pub fn set_instance_transform(&mut self, instance: usize, transform: Mat4) -> Result<()> {
+        let count = self.state.instances.len();
+        let inst = self.state.instances.get(instance).ok_or_else(|| {
+            Error::Setting(format!(
+                "instance {instance} does not exist (the scene has {count})"
+            ))
+        })?;
+        if !transform.is_finite() {
+            return Err(Error::Setting(format!(
+                "instance '{}': the transform is not finite",
+                inst.name
+            )));
+        }
+        if transform == inst.transform {
+            return Ok(());
+        }
+        if !inst.dynamic {
+            return Err(Error::Setting(format!(
+                "instance '{}' is static: only dynamic instances move (mark it dynamic in the \
+                 scene: `dynamic = true` on its include)",
+                inst.name
+            )));
+        }
+        let (old, new) = (
+            inst.world_bounds(inst.transform),
+            inst.world_bounds(transform),
+        );
+        if let Some(draw) = inst.draw {
+            self.scene.set_transform(&self.queue, draw, transform);
+            for (i, v) in self.atlas.views.iter().enumerate() {
+                if shadow::view_sees(v, old.min, old.max) || shadow::view_sees(v, new.min, new.max)
+                {
+                    self.pending.views[i] = true;
+                }
+            }
+            self.pending.geometry = true;
+        }
+        self.state.instances[instance].transform = transform;
+        Ok(())
+    }
+
+    /// Changes light `index` (into the scene's lights) to `light`: its position, direction,
+    /// colour, intensity, range, cone angles or area shape. Its kind (directional, point,
+    /// spot, area) and whether it casts shadows are fixed once uploaded (an error: make a new
+    /// `Renderer`). The light's shadow views re-render and the voxel light is redone.
+    pub fn set_light(&mut self, index: usize, light: &Light) -> Result<()> {
+        let count = self.state.lights.len();
+        let old = self.state.lights.get(index).ok_or_else(|| {
+            Error::Setting(format!(
+                "light {index} does not exist (the scene has {count})"
+            ))
+        })?;
+        if old == light {
+            return Ok(());
+        }
+        let mut g = gpu_light(light);
+        let was = self.scene.gpu_lights[index];
+        let finite = light.position.is_finite()
+            && light.direction.is_finite()
+            && light.direction.length_squared() > 0.0
+            && light.color.iter().all(|c| c.is_finite() && *c >= 0.0)
+            && light.intensity.is_finite()
+            && light.intensity >= 0.0;
+        if !finite {
+            return Err(Error::Setting(format!(
+                "light '{}': position, direction, colour and intensity must be finite (and \
+                 colour and intensity not negative, the direction not zero)",
+                light.name
+            )));
+        }
+        if g.kind != was.kind || light.cast_shadows != old.cast_shadows {
+            return Err(Error::Setting(format!(
+                "light '{}': its kind and whether it casts shadows are fixed once uploaded; make \
+                 a new Renderer to change them",
+                light.name
+            )));
+        }
+        g.shadow_first = was.shadow_first;
+        g.shadow_count = was.shadow_count;
+        self.scene.gpu_lights[index] = g;
+        self.state.lights[index] = light.clone();
+        // Re-plan every view (a light's views follow its position and direction) and re-render
+        // those that changed: the moved light's.
+        let res = self.atlas.texture.width();
+        let (views, _) = shadow::plan_views(
+            &mut self.scene.gpu_lights,
+            &self.facts.casts,
+            self.center,
+            self.radius,
+            res,
+        );
+        for (i, (new, old)) in views.iter().zip(&self.atlas.views).enumerate() {
+            if bytemuck::bytes_of(new) != bytemuck::bytes_of(old) {
+                self.pending.views[i] = true;
+            }
+        }
+        self.atlas.update_views(&self.queue, views);
+        self.queue.write_buffer(
+            &self.scene.lights,
+            0,
+            bytemuck::cast_slice(&self.scene.gpu_lights),
+        );
+        self.pending.lights = true;
+        Ok(())
+    }
+
+    /// Sets the scene's time, in seconds: every animation moves its instances and lights to
+    /// their state at `t` (`Scene::set_time`), through `set_instance_transform` and
+    /// `set_light`. Only what changed is updated.
+    pub fn set_time(&mut self, t: f32) -> Result<()> {
+        let changes = self.state.set_time(t)?;
+        for (i, m) in changes.instances {
+            self.set_instance_transform(i, m)?;
+        }
+        for (l, light) in changes.lights {
+            self.set_light(l, &light)?;
+        }
+        Ok(())
+    }
+
+    /// The scene's animations (as `Scene::animations`).
+    pub fn animations(&self) -> &[voxgi_scene::animation::Animation] {
+        self.state.animations()
+    }
+
+    /// Whether the voxels (or progressive bounces) still have work queued for a coming frame:
+    /// false once everything set so far is in the voxels and the light has converged.
+    pub fn voxels_settled(&self) -> bool {
+        !self.voxel_work_pending()
     }
 
     /// The scene's own camera, or a view of its bounds.
@@ -419,50 +618,119 @@ impl Renderer {
         }
     }
 
-    /// Records shadow maps, voxelization, injection, filtering and voxel bounces: everything
-    /// that depends on the scene and its lights but not on the camera.
+    /// Records the shadow views that must be re-rendered (all after a rebuild).
+    fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let views = std::mem::take(&mut self.pending.views);
+        if views.iter().any(|&v| v) {
+            self.passes.shadow.record(
+                &self.device,
+                encoder,
+                &self.atlas,
+                &self.scene,
+                &views,
+                &mut self.timer,
+            );
+        }
+        self.pending.views = vec![false; self.atlas.views.len()];
+    }
+
+    /// Whether the next voxel update has work: something changed, or progressive bounces
+    /// have not converged.
+    fn voxel_work_pending(&self) -> bool {
+        let p = &self.pending;
+        p.rebuild || p.geometry || p.lights || self.progressive_left > 0
+    }
+
+    /// Records what the changes since the last voxel update need, in the fixed order:
+    /// voxelize the static geometry and build (after a rebuild), voxelize the dynamic geometry
+    /// and update (after it moved), inject, then filter and bounce; with progressive bounces,
+    /// one bounce per update until converged.
     fn record_voxels(&mut self, encoder: &mut wgpu::CommandEncoder) {
         let timer = &mut self.timer;
         let p = &self.passes;
-        p.shadow
-            .record(&self.device, encoder, &self.atlas, &self.scene, timer);
-        self.fragments.record_clear(encoder);
-        let triangles = (&self.triangles.0, self.triangles.1);
-        p.voxelize.record(
-            &self.device,
-            encoder,
-            &self.scene,
-            triangles,
-            &self.fragments,
-            timer,
-        );
-        self.volume
-            .record_build(&self.device, encoder, &self.fragments, timer);
-        // The kernels never write past their buffers, they only count: the counts come back
-        // a frame or more later and grow the pools then (`receive_feedback`).
-        if !self.counters.request(
-            &self.device,
-            encoder,
-            &[&self.fragments.count, self.volume.leaf_counter()],
-            self.pools,
-        ) {
-            log::warn!("voxel counters: too many readbacks in flight; is the encoder submitted?");
+        let pending = std::mem::take(&mut self.pending);
+        let geometry = pending.rebuild || pending.geometry;
+        if pending.rebuild {
+            self.fragments.record_clear(encoder);
+            let t = (&self.static_triangles.0, self.static_triangles.1);
+            p.voxelize.record(
+                &self.device,
+                encoder,
+                &self.scene,
+                t,
+                &self.fragments,
+                timer,
+            );
+            self.fragments.record_mark(encoder);
+            self.volume
+                .record_build(&self.device, encoder, &self.fragments, timer);
         }
-        p.inject.record(
-            &self.device,
-            encoder,
-            &self.scene,
-            &self.atlas,
-            &self.volume,
-            timer,
-        );
-        self.volume.record_filter(&self.device, encoder, timer);
-        for _ in 0..self.voxel_bounces {
+        if geometry && self.facts.dynamic {
+            self.fragments.record_truncate(encoder);
+            let t = (&self.dynamic_triangles.0, self.dynamic_triangles.1);
+            p.voxelize.record(
+                &self.device,
+                encoder,
+                &self.scene,
+                t,
+                &self.fragments,
+                timer,
+            );
+            self.volume
+                .record_update(&self.device, encoder, &self.fragments, timer);
+        }
+        if geometry {
+            // The kernels never write past their buffers, they only count: the counts come
+            // back a frame or more later and grow the pools then (`receive_feedback`).
+            if !self.counters.request(
+                &self.device,
+                encoder,
+                &[&self.fragments.count, self.volume.leaf_counter()],
+                self.pools,
+            ) {
+                log::warn!(
+                    "voxel counters: too many readbacks in flight; is the encoder submitted?"
+                );
+            }
+        }
+        let progressive = self.options.progressive;
+        if geometry || pending.lights {
+            let inject = if progressive {
+                InjectPass::record_direct_only
+            } else {
+                InjectPass::record
+            };
+            inject(
+                &p.inject,
+                &self.device,
+                encoder,
+                &self.scene,
+                &self.atlas,
+                &self.volume,
+                timer,
+            );
+            if progressive {
+                // One bounce per update from the previous update's light; after a change
+                // this many updates make every leaf's light converge again (the first from
+                // a cleared volume only reproduces the direct light).
+                self.progressive_left = self.voxel_bounces + 1;
+            } else {
+                self.volume.record_filter(&self.device, encoder, timer);
+                for _ in 0..self.voxel_bounces {
+                    p.bounce
+                        .record(&self.device, encoder, &self.volume, &self.cones, timer);
+                    self.volume.record_filter(&self.device, encoder, timer);
+                }
+            }
+        }
+        if progressive && self.progressive_left > 0 {
             p.bounce
                 .record(&self.device, encoder, &self.volume, &self.cones, timer);
             self.volume.record_filter(&self.device, encoder, timer);
+            self.progressive_left -= 1;
         }
-        self.dirty = false;
+        // The shadow views were consumed by `record_shadows` this frame.
+        self.pending.views = pending.views;
     }
 
     /// Acts on voxel counters that have come back since the last call: when a build had more
@@ -513,9 +781,9 @@ impl Renderer {
                 self.fragments.capacity,
                 self.volume.leaf_capacity()
             );
-            self.dirty = true;
+            self.invalidate();
         }
-        Ok(self.dirty)
+        Ok(self.pending.rebuild)
     }
 
     /// Voxel statistics of the most recent build whose counters have come back.
@@ -561,9 +829,11 @@ impl Renderer {
         self.timer.read(&self.device)
     }
 
-    /// Marks lights or geometry as changed: the next frame rebuilds shadows and voxels.
+    /// Marks everything as changed: the next frame re-renders every shadow view and rebuilds
+    /// the voxels, static geometry included.
     pub fn invalidate(&mut self) {
-        self.dirty = true;
+        self.pending.rebuild = true;
+        self.pending.views = vec![true; self.atlas.views.len()];
     }
 
     /// The linear HDR radiance of the last frame (before exposure and tone mapping),
@@ -608,9 +878,15 @@ impl Renderer {
                 FrameTargets::new(&self.device, width, height, half)
             })?);
         }
-        if self.dirty {
+        self.record_shadows(encoder);
+        let interval = self.options.voxel_update_interval.max(1) as u64;
+        // A rebuild (the first frame among them) never waits for its turn.
+        if self.voxel_work_pending()
+            && (self.pending.rebuild || self.frame_index.is_multiple_of(interval))
+        {
             self.record_voxels(encoder);
         }
+        self.frame_index += 1;
         let frame = self.frame_uniforms(params, width, height);
         let t = self.targets.as_ref().expect("targets were just created");
         self.queue
@@ -706,7 +982,14 @@ fn new_volume(
             .min(crate::gpu::max_entries(device, SLOT_BYTES)),
     )?;
     checked(device, "voxel volume", || {
-        DenseVolume::new(device, pipelines, grid, options.anisotropic, slots)
+        DenseVolume::new(
+            device,
+            pipelines,
+            grid,
+            options.anisotropic,
+            slots,
+            facts.dynamic,
+        )
     })
 }
 

@@ -45,6 +45,10 @@ pub struct SceneSettings {
     pub half_resolution: Option<bool>,
     /// `RendererOptions::cone_shadows`.
     pub cone_shadows: Option<bool>,
+    /// `RendererOptions::progressive` (and with it `bounces = "unlimited"`).
+    pub progressive: Option<bool>,
+    /// `RendererOptions::voxel_update_interval`, frames.
+    pub voxel_update_interval: Option<u32>,
     /// `FrameParams::exposure`, stops.
     pub exposure: Option<f32>,
     /// `FrameParams::tonemap`: "aces", "neutral" or "clamp".
@@ -128,6 +132,13 @@ impl SceneSettings {
         }
         set!(o.half_resolution, self.half_resolution);
         set!(o.cone_shadows, self.cone_shadows);
+        if let Some(p) = self.progressive {
+            o.progressive = p;
+            if p {
+                o.bounces = UNLIMITED_BOUNCES;
+            }
+        }
+        set!(o.voxel_update_interval, self.voxel_update_interval);
         set!(f.exposure, self.exposure);
         if let Some(t) = &self.tonemap {
             f.tonemap = Tonemap::parse(t)?;

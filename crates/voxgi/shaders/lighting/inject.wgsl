@@ -11,6 +11,10 @@
 @group(0) @binding(3) var shadow_maps: texture_2d_array<f32>;
 // Group 2: the structure's leaves, group 3: their radiance (voxels/<kind>/leaf_store.wgsl).
 
+// false for progressive bounces: the leaves keep last frame's radiance for the bounce to build
+// on, and only their direct light is renewed.
+override STORE_RADIANCE: bool = true;
+
 // Radiance leaving leaf `i`, with albedo a, averaged normal (xyz) and normal agreement (w).
 fn leaf_direct_light(i: u32) -> vec4<f32> {
     let albedo = leaf_albedo(i);
@@ -50,5 +54,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let r = leaf_direct_light(s);
     leaf_direct[s] = r;
-    store_leaf_radiance(s, r);
+    if STORE_RADIANCE {
+        store_leaf_radiance(s, r);
+    }
 }

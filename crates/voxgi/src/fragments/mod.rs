@@ -39,6 +39,9 @@ pub struct Fragments {
     pub buffer: wgpu::Buffer,
     /// `[0]`: fragments made by the last build, counted past the capacity.
     pub count: wgpu::Buffer,
+    /// `[0]`: the count when the static geometry was done (`record_mark`): fragments from
+    /// there on are the dynamic geometry's, redone every frame it moves.
+    pub mark: wgpu::Buffer,
     /// Fragments `buffer` holds; a build that makes more counts them and drops the rest.
     pub capacity: u32,
 }
@@ -74,6 +77,12 @@ impl Fragments {
                 usage: storage,
                 mapped_at_creation: false,
             }),
+            mark: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("static fragment count"),
+                size: 16,
+                usage: storage,
+                mapped_at_creation: false,
+            }),
             capacity,
         }
     }
@@ -81,6 +90,18 @@ impl Fragments {
     /// Records the start of a build: no fragments yet.
     pub fn record_clear(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.clear_buffer(&self.count, 0, None);
+    }
+
+    /// Records the end of the static geometry: the fragments so far are kept, and those
+    /// voxelized after this are the dynamic geometry's.
+    pub fn record_mark(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.count, 0, &self.mark, 0, 16);
+    }
+
+    /// Records the start of a dynamic update: the dynamic fragments of the last one are
+    /// dropped, the static ones kept.
+    pub fn record_truncate(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.mark, 0, &self.count, 0, 16);
     }
 
     /// GPU memory held, by buffer name, in bytes (the fragment buffer; the small buffers are left
@@ -135,11 +156,16 @@ impl FragmentEstimate {
     }
 }
 
-/// Keeps the triangle table voxelize reads: per triangle, its draw, first index, base vertex.
-/// An error when the table would not fit one storage binding of this device.
-pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> Result<(wgpu::Buffer, u32)> {
+/// The triangle table voxelize reads for the static (`dynamic` false) or the dynamic
+/// instances: per triangle, its draw, first index, base vertex. An error when the table would
+/// not fit one storage binding of this device.
+pub fn triangle_table(
+    device: &wgpu::Device,
+    scene: &GpuScene,
+    dynamic: bool,
+) -> Result<(wgpu::Buffer, u32)> {
     let mut t: Vec<[u32; 4]> = Vec::new();
-    for call in &scene.calls {
+    for call in scene.calls.iter().filter(|c| c.dynamic == dynamic) {
         // The visible surface of an area light is not voxelized, neither as an emitter (its
         // light reaches surfaces as the light's direct term, shaded per pixel and injected per
         // voxel, so it would count twice, and an isotropic voxel would shine sideways from a
@@ -167,7 +193,11 @@ pub fn triangle_table(device: &wgpu::Device, scene: &GpuScene) -> Result<(wgpu::
         )));
     }
     let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("voxelize triangles"),
+        label: Some(if dynamic {
+            "voxelize triangles (dynamic)"
+        } else {
+            "voxelize triangles (static)"
+        }),
         contents: bytemuck::cast_slice(&t),
         usage: wgpu::BufferUsages::STORAGE,
     });

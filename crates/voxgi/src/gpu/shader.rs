@@ -29,7 +29,9 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "lighting/shadow.wgsl",
     "screen/gbuffer.wgsl",
     "fragments/voxelize.wgsl",
+    "voxels/dense/build_shared.wgsl",
     "voxels/dense/dense_build.wgsl",
+    "voxels/dense/dense_update.wgsl",
     "lighting/inject.wgsl",
     "voxels/dense/filter.wgsl",
     "lighting/bounce.wgsl",
@@ -172,8 +174,13 @@ pub fn grouped_pipeline(
 pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
     SOURCES.iter().map(|(n, _)| *n).filter(|n| {
         !n.starts_with("shared/")
-            && !["sample.wgsl", "leaves.wgsl", "leaf_store.wgsl"]
-                .iter()
-                .any(|f| n.ends_with(&format!("/{f}")))
+            && ![
+                "sample.wgsl",
+                "leaves.wgsl",
+                "leaf_store.wgsl",
+                "build_shared.wgsl",
+            ]
+            .iter()
+            .any(|f| n.ends_with(&format!("/{f}")))
     })
 }

@@ -200,6 +200,35 @@ pub fn plan_views(
     (views, owner)
 }
 
+/// Whether anything inside the box `min..max` can show in `view`'s map: false only when all
+/// eight corners lie outside one of the view's clip planes (conservative: a box that misses
+/// the frustum diagonally still counts as seen).
+pub fn view_sees(view: &GpuShadowView, min: Vec3, max: Vec3) -> bool {
+    let m = Mat4::from_cols_array_2d(&view.view_proj);
+    let corners: Vec<glam::Vec4> = (0..8)
+        .map(|i| {
+            let p = Vec3::new(
+                if i & 1 == 0 { min.x } else { max.x },
+                if i & 2 == 0 { min.y } else { max.y },
+                if i & 4 == 0 { min.z } else { max.z },
+            );
+            m * p.extend(1.0)
+        })
+        .collect();
+    // wgpu clip space: -w <= x, y <= w and 0 <= z <= w.
+    let planes: [fn(glam::Vec4) -> f32; 6] = [
+        |c| c.w + c.x,
+        |c| c.w - c.x,
+        |c| c.w + c.y,
+        |c| c.w - c.y,
+        |c| c.z,
+        |c| c.w - c.z,
+    ];
+    !planes
+        .iter()
+        .any(|plane| corners.iter().all(|&c| plane(c) < 0.0))
+}
+
 /// Whether a cube face of an area light sees only what lies behind the emitter's plane, which
 /// the light cannot reach and so nobody looks up (the face opposite a one-sided emitter's
 /// direction): such a face is not rendered.
@@ -301,12 +330,12 @@ impl ShadowAtlas {
             uniforms: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("shadow view uniforms"),
                 contents: &uniform_bytes,
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             }),
             views_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("shadow views"),
                 contents: &view_bytes,
-                usage: wgpu::BufferUsages::STORAGE,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }),
             views,
             view_light,
@@ -315,6 +344,24 @@ impl ShadowAtlas {
             layer_views,
             depth_view: depth.create_view(&Default::default()),
         }
+    }
+
+    /// Replaces the views by `views` (re-planned after lights moved: the same number, owned by
+    /// the same lights), writing them where the passes read them. The maps are not re-rendered
+    /// here.
+    pub fn update_views(&mut self, queue: &wgpu::Queue, views: Vec<GpuShadowView>) {
+        debug_assert_eq!(views.len(), self.views.len());
+        for (i, v) in views.iter().enumerate() {
+            queue.write_buffer(
+                &self.uniforms,
+                i as u64 * UNIFORM_STRIDE,
+                bytemuck::bytes_of(v),
+            );
+        }
+        if !views.is_empty() {
+            queue.write_buffer(&self.views_buffer, 0, bytemuck::cast_slice(&views));
+        }
+        self.views = views;
     }
 
     /// Bindings 1, 2 and 3 of every shader that includes `shared/lights.wgsl`: the lights, the

@@ -13,6 +13,8 @@ use wgpu::util::DeviceExt;
 /// the uniform holding the scene's light count.
 pub struct InjectPass {
     pipeline: wgpu::ComputePipeline,
+    /// The same without storing the radiance (progressive bounces).
+    direct_only: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
     light_count: wgpu::Buffer,
 }
@@ -29,13 +31,15 @@ impl InjectPass {
         });
         let leaves = DenseVolume::leaves_layout(device);
         let store = DenseVolume::leaf_store_layout(device);
+        let layouts = [Some(&globals), None, Some(&leaves), Some(&store)];
         InjectPass {
-            pipeline: grouped_pipeline(
+            pipeline: grouped_pipeline(device, "inject", "lighting/inject.wgsl", &layouts, &[]),
+            direct_only: grouped_pipeline(
                 device,
                 "inject",
                 "lighting/inject.wgsl",
-                &[Some(&globals), None, Some(&leaves), Some(&store)],
-                &[],
+                &layouts,
+                &[("STORE_RADIANCE", 0.0)],
             ),
             globals,
             light_count: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -47,9 +51,46 @@ impl InjectPass {
     }
 
     /// Records the injection of direct light (shadowed by `atlas`) and emission into every leaf of
-    /// `voxels` as an indirect dispatch. Timed as "inject".
+    /// `voxels` as an indirect dispatch: the leaves' direct light and their radiance. Timed as
+    /// "inject".
     pub fn record(
         &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        atlas: &ShadowAtlas,
+        voxels: &dyn VoxelStructure,
+        timer: &mut GpuTimer,
+    ) {
+        self.record_with(&self.pipeline, device, encoder, scene, atlas, voxels, timer);
+    }
+
+    /// `record`, but the leaves' radiance is kept: only their direct light is renewed (for
+    /// progressive bounces, which build on the last update's radiance).
+    pub fn record_direct_only(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        atlas: &ShadowAtlas,
+        voxels: &dyn VoxelStructure,
+        timer: &mut GpuTimer,
+    ) {
+        self.record_with(
+            &self.direct_only,
+            device,
+            encoder,
+            scene,
+            atlas,
+            voxels,
+            timer,
+        );
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record_with(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
@@ -68,7 +109,7 @@ impl InjectPass {
             label: Some("inject"),
             timestamp_writes: timer.compute("inject"),
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &globals, &[]);
         pass.set_bind_group(2, voxels.leaves(), &[]);
         pass.set_bind_group(3, voxels.leaf_store(), &[]);

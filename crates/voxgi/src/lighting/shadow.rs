@@ -79,13 +79,15 @@ impl ShadowPass {
 
     /// Records one render pass per shadow view of `atlas` into its layer (skipping views that only
     /// see the back of their emitter), drawing every mesh except the light's own emitter, and the
-    /// points. Timed as "shadow" (summed over the views).
+    /// points. Only the views `views` marks are rendered (the others keep their maps). Timed as
+    /// "shadow" (summed over the views).
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         scene: &GpuScene,
+        views: &[bool],
         timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -104,7 +106,7 @@ impl ShadowPass {
             ]),
         });
         for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
-            if behind_emitter(&atlas.views[i]) {
+            if !views.get(i).copied().unwrap_or(true) || behind_emitter(&atlas.views[i]) {
                 continue;
             }
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

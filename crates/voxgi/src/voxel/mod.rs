@@ -36,9 +36,21 @@ pub trait VoxelStructure {
     fn kind(&self) -> &'static str;
     /// The grid of its finest voxels (the fragments' grid).
     fn grid(&self) -> Grid;
-    /// Records a build from `fragments`, replacing the previous one: leaves get albedo,
-    /// normal, emission and opacity; their radiance is cleared.
+    /// Records a build from `fragments` (the static geometry's), replacing the previous one:
+    /// leaves get albedo, normal, emission and opacity; their radiance is cleared.
     fn record_build(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    );
+    /// Records an update by the dynamic geometry's fragments (those past `Fragments::mark`):
+    /// what the previous update added is taken out (leaves it made vanish, static leaves it
+    /// shared get their static values back), then these fragments are merged in, so that the
+    /// structure equals a build of static and dynamic fragments together. Leaves' radiance is
+    /// left for the lighting passes to rewrite.
+    fn record_update(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,

@@ -6,6 +6,7 @@ mod analytic;
 mod common;
 mod compare;
 mod contract;
+mod dynamic;
 mod embed;
 mod errors;
 mod golden;

@@ -36,8 +36,10 @@ pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Snorm;
 pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// u32 sums per slot (`ACCUM_STRIDE` in dense_build.wgsl).
 const ACCUM_STRIDE: u64 = 10;
-/// Bytes of the largest per-slot buffer (the sums).
-pub const SLOT_BYTES: u64 = ACCUM_STRIDE * 4;
+/// u32 per slot of the dynamic part (`DYN_STRIDE` in build_shared.wgsl).
+const DYN_STRIDE: u64 = 12;
+/// Bytes of the largest per-slot buffer (the dynamic part).
+pub const SLOT_BYTES: u64 = DYN_STRIDE * 4;
 /// Directions of the anisotropic chains, in the order of `filter.wgsl`.
 pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
 
@@ -52,7 +54,9 @@ pub struct DenseVolume {
     pub volume: wgpu::Buffer,
     /// Occupied voxels the slot buffers hold.
     pub slot_capacity: u32,
-    /// `[0]` occupied voxels (slots, counted past the capacity), `[1]` slots of the previous build.
+    /// `[0]` occupied voxels (slots, counted past the capacity), `[1]` slots of the previous
+    /// build, `[2]` slots of the static geometry, `[3]` and `[4]` slots the dynamic geometry
+    /// touched in this and the previous update (see dense_update.wgsl).
     pub counters: wgpu::Buffer,
     /// Per finest voxel (x fastest): 0 empty, 2 + slot once allocated, or a lock value while
     /// allocating or past the capacity.
@@ -60,11 +64,18 @@ pub struct DenseVolume {
     /// Per slot: the linear index of its voxel.
     pub slot_voxel: wgpu::Buffer,
     accum: wgpu::Buffer,
+    /// The dynamic geometry's part (`dense_update`): per slot, the dynamic fragments' sums,
+    /// whether it is listed as touched, and an entry of the list of slots the last update
+    /// touched. One slot for a scene without dynamic instances.
+    dyn_accum: wgpu::Buffer,
+    /// Whether the pools have room for dynamic geometry.
+    pub dynamic: bool,
     /// Per slot: direct radiance (rgb) and opacity from inject, kept for the bounces (vec4 f32).
     pub slot_direct: wgpu::Buffer,
     /// Per slot: the last bounce's outgoing radiance and opacity (vec4 f32).
     pub slot_next: wgpu::Buffer,
-    /// Indirect dispatch sizes: [0..3] over slots, [3..6] over fragments.
+    /// Indirect dispatch sizes: [0..3] over slots, [3..6] over fragments, [6..9] over the
+    /// touched slots.
     pub args: wgpu::Buffer,
     /// Finest level: albedo and opacity per voxel (`ALBEDO_FORMAT`).
     pub albedo: wgpu::Texture,
@@ -92,8 +103,20 @@ pub struct DensePipelines {
     build_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
     build: BuildPipelines,
+    update: UpdatePipelines,
     filter: FilterPass,
     debug: DebugPass,
+}
+
+/// dense_update's entry points (shaders/voxels/dense/dense_update.wgsl).
+struct UpdatePipelines {
+    begin: wgpu::ComputePipeline,
+    restore: wgpu::ComputePipeline,
+    free: wgpu::ComputePipeline,
+    allocate: wgpu::ComputePipeline,
+    accumulate: wgpu::ComputePipeline,
+    prepare: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
 }
 
 struct BuildPipelines {
@@ -182,45 +205,65 @@ impl DensePipelines {
             label: Some("dense_build args"),
             entries: &[layout::storage(0, wgpu::ShaderStages::COMPUTE, false)],
         });
-        let module = shader::module(device, "voxels/dense/dense_build.wgsl");
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("dense_build"),
             bind_group_layouts: &[Some(&build_layout)],
             immediate_size: 0,
         });
+        // The kernels that write dispatch sizes bind the arguments too.
         let prepare_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("dense_build prepare"),
             bind_group_layouts: &[Some(&build_layout), Some(&args_layout)],
             immediate_size: 0,
         });
-        let pipe = |entry: &str| {
-            let prepare = entry.starts_with("prepare");
+        let pipe = |module: &wgpu::ShaderModule, label: &str, entry: &str, args: bool| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("dense_build"),
-                layout: Some(if prepare {
+                label: Some(label),
+                layout: Some(if args {
                     &prepare_layout
                 } else {
                     &pipeline_layout
                 }),
-                module: &module,
+                module,
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
             })
         };
+        let m = shader::module(device, "voxels/dense/dense_build.wgsl");
+        let b = |entry: &str| pipe(&m, "dense_build", entry, entry.starts_with("prepare"));
         let build = BuildPipelines {
-            begin: pipe("begin"),
-            clear_previous: pipe("clear_previous"),
-            prepare_fragments: pipe("prepare_fragments"),
-            allocate: pipe("allocate"),
-            accumulate: pipe("accumulate"),
-            prepare_slots: pipe("prepare_slots"),
-            resolve: pipe("resolve"),
+            begin: b("begin"),
+            clear_previous: b("clear_previous"),
+            prepare_fragments: b("prepare_fragments"),
+            allocate: b("allocate"),
+            accumulate: b("accumulate"),
+            prepare_slots: b("prepare_slots"),
+            resolve: b("resolve"),
+        };
+        let m = shader::module(device, "voxels/dense/dense_update.wgsl");
+        let u = |entry: &str| {
+            pipe(
+                &m,
+                "dense_update",
+                entry,
+                matches!(entry, "begin" | "prepare"),
+            )
+        };
+        let update = UpdatePipelines {
+            begin: u("begin"),
+            restore: u("restore"),
+            free: u("free"),
+            allocate: u("allocate"),
+            accumulate: u("accumulate"),
+            prepare: u("prepare"),
+            resolve: u("resolve"),
         };
         Arc::new(DensePipelines {
             build_layout,
             args_layout,
             build,
+            update,
             filter: FilterPass::new(device),
             debug: DebugPass::new(device),
         })
@@ -228,13 +271,15 @@ impl DensePipelines {
 }
 
 impl DenseVolume {
-    /// A volume on `grid` with room for `slot_capacity` occupied voxels.
+    /// A volume on `grid` with room for `slot_capacity` occupied voxels, and for updates by
+    /// dynamic geometry when `dynamic`.
     pub fn new(
         device: &wgpu::Device,
         pipelines: &Arc<DensePipelines>,
         grid: Grid,
         anisotropic: bool,
         slot_capacity: u32,
+        dynamic: bool,
     ) -> Self {
         let res = grid.resolution;
         let levels = grid.levels();
@@ -286,7 +331,8 @@ impl DenseVolume {
         let normal = texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT);
         let emission = texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT);
         let slot_voxel = storage_buffer(device, "voxel slots", slots * 4, no);
-        let counters = storage_buffer(device, "voxel counters", 16, no);
+        let counters = storage_buffer(device, "voxel counters", 32, no);
+        let dyn_slots = if dynamic { slots } else { 1 };
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
@@ -318,12 +364,14 @@ impl DenseVolume {
             occupancy: storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no),
             slot_voxel,
             accum: storage_buffer(device, "voxel sums", slots * ACCUM_STRIDE * 4, no),
+            dyn_accum: storage_buffer(device, "voxel dynamic sums", dyn_slots * DYN_STRIDE * 4, no),
+            dynamic,
             slot_direct,
             slot_next,
             args: storage_buffer(
                 device,
                 "voxel dispatch sizes",
-                6 * 4,
+                9 * 4,
                 wgpu::BufferUsages::INDIRECT,
             ),
             albedo,
@@ -355,6 +403,7 @@ impl DenseVolume {
                     + self.slot_direct.size()
                     + self.slot_next.size(),
             ),
+            ("voxel dynamic sums", self.dyn_accum.size()),
             ("voxel albedo", texture_bytes(res, 4, 1)),
             ("voxel normal", texture_bytes(res, 4, 1)),
             ("voxel emission", texture_bytes(res, 8, 1)),
@@ -454,6 +503,7 @@ impl DenseVolume {
         }
         encoder.clear_buffer(&self.occupancy, 0, None);
         encoder.clear_buffer(&self.accum, 0, None);
+        encoder.clear_buffer(&self.dyn_accum, 0, None);
         let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dense_build args"),
             layout: &self.pipelines.args_layout,
@@ -484,6 +534,57 @@ impl DenseVolume {
         }
     }
 
+    /// Records an update by the dynamic fragments (those past the build's): undo the
+    /// previous update, then merge these into the static build.
+    fn update(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        let bind = self.build_bind_group(device, fragments);
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dense_update args"),
+            layout: &self.pipelines.args_layout,
+            entries: &layout::entries(vec![self.args.as_entire_binding()]),
+        });
+        let u = &self.pipelines.update;
+        // Separate passes: each step reads what the one before wrote (dispatch sizes, slots).
+        enum Run {
+            /// One thread, writing dispatch sizes.
+            Prepare,
+            One,
+            /// Sized by the dispatch arguments at this offset.
+            Indirect(u64),
+        }
+        let steps = [
+            (&u.begin, Run::Prepare),
+            (&u.restore, Run::Indirect(24)),
+            (&u.free, Run::One),
+            (&u.allocate, Run::Indirect(12)),
+            (&u.accumulate, Run::Indirect(12)),
+            (&u.prepare, Run::Prepare),
+            (&u.resolve, Run::Indirect(24)),
+        ];
+        for (pipeline, run) in steps {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dense_update"),
+                timestamp_writes: timer.compute("dense_update"),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            match run {
+                Run::Prepare => {
+                    pass.set_bind_group(1, &args, &[]);
+                    pass.dispatch_workgroups(1, 1, 1);
+                }
+                Run::One => pass.dispatch_workgroups(1, 1, 1),
+                Run::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.args, offset),
+            }
+        }
+    }
+
     fn build_bind_group(&self, device: &wgpu::Device, fragments: &Fragments) -> wgpu::BindGroup {
         let v = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (a, n, e, r) = (
@@ -507,6 +608,7 @@ impl DenseVolume {
                 wgpu::BindingResource::TextureView(&n),
                 wgpu::BindingResource::TextureView(&e),
                 wgpu::BindingResource::TextureView(&r),
+                self.dyn_accum.as_entire_binding(),
             ]),
         })
     }
@@ -528,6 +630,7 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             layout::storage_texture_3d(8, NORMAL_FORMAT),
             layout::storage_texture_3d(9, EMISSION_FORMAT),
             layout::storage_texture_3d(10, RADIANCE_FORMAT),
+            layout::storage(11, c, false),
         ],
     })
 }
@@ -549,6 +652,16 @@ impl VoxelStructure for DenseVolume {
         timer: &mut GpuTimer,
     ) {
         self.build(device, encoder, fragments, timer);
+    }
+
+    fn record_update(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        self.update(device, encoder, fragments, timer);
     }
 
     fn record_filter(
@@ -576,6 +689,7 @@ impl VoxelStructure for DenseVolume {
                 self.grid,
                 self.anisotropic,
                 leaves.min(u32::MAX as u64) as u32,
+                self.dynamic,
             )
         })?;
         *self = grown;

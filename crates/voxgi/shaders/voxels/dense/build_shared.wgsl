@@ -1,0 +1,136 @@
+// The dense volume's build resources and helpers, shared by dense_build (the static geometry,
+// from scratch) and dense_update (the dynamic geometry, merged into the static build).
+
+//!include shared/volume.wgsl
+//!include shared/fragment.wgsl
+
+@group(0) @binding(0) var<uniform> vol: Volume;
+// The fragments, as voxelize (or any other source) left them: the only input.
+@group(0) @binding(1) var<storage, read> fragments: array<Fragment>;
+@group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
+// [0] slots (occupied voxels, counted past the capacity), [1] slots of the previous build,
+// [2] slots of the static geometry (slots below are static, above dynamic), [3] entries of
+// `touched` of this update, [4] of the previous update, [5] fragments of the static geometry
+// (those from there on are the dynamic geometry's).
+@group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>>;
+// Per voxel: 0 empty, 2 + slot once allocated, LOCKED while allocating (or past capacity).
+@group(0) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>>;
+// Per slot: the voxel's linear index.
+@group(0) @binding(5) var<storage, read_write> slot_voxel: array<u32>;
+// Per slot, ACCUM_STRIDE u32 sums: count, albedo rgb (8-bit units), normal xyz (snorm16 units,
+// two's complement), emission rgb (1/4096 units).
+@group(0) @binding(6) var<storage, read_write> accum: array<atomic<u32>>;
+@group(0) @binding(7) var albedo_out: texture_storage_3d<rgba8unorm, write>;
+@group(0) @binding(8) var normal_out: texture_storage_3d<rgba8snorm, write>;
+@group(0) @binding(9) var emission_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(10) var radiance_out: texture_storage_3d<rgba16float, write>;
+// Per slot, DYN_STRIDE u32: the ACCUM_STRIDE sums of the dynamic fragments, apart from the
+// static sums in `accum` so that undoing an update is zeroing them; then (static slots) 1
+// while the slot is listed as touched; then entry `slot` of the touched list: the slots the
+// dynamic fragments of this update fell into (static slots they share, and new slots above
+// the static ones), resolved now and restored by the next update. (Eight storage buffers per
+// stage is the minimum limit: the flag and the list share this one.)
+@group(0) @binding(11) var<storage, read_write> dyn_accum: array<atomic<u32>>;
+// Indirect dispatch arguments: [0..3] over slots, [3..6] over fragments, [6..9] over
+// `touched`. Only the prepare kernels bind them (a buffer cannot be storage and indirect in
+// one dispatch).
+@group(1) @binding(0) var<storage, read_write> args: array<u32>;
+
+const ACCUM_STRIDE: u32 = 10u;
+const DYN_STRIDE: u32 = 12u;
+const DYN_FLAG: u32 = 10u;
+const DYN_LIST: u32 = 11u;
+
+// Entry `i` of the touched list.
+fn touched(i: u32) -> u32 {
+    return atomicLoad(&dyn_accum[i * DYN_STRIDE + DYN_LIST]);
+}
+const LOCKED: u32 = 0xffffffffu;
+const EMISSION_SCALE: f32 = 4096.0;
+const WG: u32 = 64u;
+
+// Flat thread index for 2D indirect dispatches (65535 workgroups per dimension at most).
+fn flat(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WG;
+}
+
+fn write_args(offset: u32, count: u32) {
+    let groups = (count + WG - 1u) / WG;
+    let x = min(groups, 65535u);
+    args[offset] = max(x, 1u);
+    args[offset + 1u] = max((groups + 65534u) / 65535u, 1u);
+    args[offset + 2u] = 1u;
+}
+
+// Fragments made and kept: the count runs past the buffer when it overflowed.
+fn stored_fragments() -> u32 {
+    return min(fragment_count[0], arrayLength(&fragments));
+}
+
+fn slot_limit() -> u32 {
+    return arrayLength(&slot_voxel);
+}
+
+// Adds fragment `f`'s attributes to slot `s`'s static or dynamic sums.
+fn add_fragment(s: u32, f: Fragment, dynamic: bool) {
+    let albedo = unpack4x8unorm(f.albedo);
+    let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * 32767.0));
+    let e = vec3<u32>(round(unpack_rgb9e5(f.emission) * EMISSION_SCALE));
+    let v = array<u32, 10>(
+        1u,
+        u32(round(albedo.r * 255.0)),
+        u32(round(albedo.g * 255.0)),
+        u32(round(albedo.b * 255.0)),
+        bitcast<u32>(n.x),
+        bitcast<u32>(n.y),
+        bitcast<u32>(n.z),
+        e.r,
+        e.g,
+        e.b,
+    );
+    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+        if dynamic {
+            atomicAdd(&dyn_accum[s * DYN_STRIDE + k], v[k]);
+        } else {
+            atomicAdd(&accum[s * ACCUM_STRIDE + k], v[k]);
+        }
+    }
+}
+
+// Averages slot `s`'s sums (the static ones, plus the dynamic ones when `dynamic`) into the
+// finest level's albedo/opacity, normal and emission.
+fn resolve_slot(s: u32, dynamic: bool) {
+    let base = s * ACCUM_STRIDE;
+    var sum = array<u32, 10>();
+    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+        sum[k] = atomicLoad(&accum[base + k]);
+        if dynamic {
+            // Wrapping adds: the normal sums are two's complement.
+            sum[k] += atomicLoad(&dyn_accum[s * DYN_STRIDE + k]);
+        }
+    }
+    let count = f32(max(sum[0], 1u));
+    let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * count);
+    let nsum = vec3<f32>(
+        f32(bitcast<i32>(sum[4])),
+        f32(bitcast<i32>(sum[5])),
+        f32(bitcast<i32>(sum[6])),
+    ) / (32767.0 * count);
+    let e = vec3<f32>(f32(sum[7]), f32(sum[8]), f32(sum[9])) / (EMISSION_SCALE * count);
+    let c = voxel_coord(slot_voxel[s], vol.resolution);
+    // A voxel that geometry touches blocks all rays through it: opacity 1 (conservative).
+    textureStore(albedo_out, c, vec4<f32>(albedo, 1.0));
+    // w: how well the fragments' normals agree (1: one orientation, ~0: opposite faces).
+    let len = length(nsum);
+    textureStore(normal_out, c, vec4<f32>(select(vec3<f32>(0.0), nsum / len, len > 1e-4), len));
+    textureStore(emission_out, c, vec4<f32>(e, 1.0));
+}
+
+// Empties voxel `c` of the finest level.
+fn clear_voxel(c: vec3<u32>) {
+    textureStore(albedo_out, c, vec4<f32>(0.0));
+    textureStore(normal_out, c, vec4<f32>(0.0));
+    textureStore(emission_out, c, vec4<f32>(0.0));
+    textureStore(radiance_out, c, vec4<f32>(0.0));
+}
+

@@ -1,0 +1,201 @@
+//! What the renderer keeps of the scene after uploading it, to apply updates: each instance's
+//! transform, motion class and mesh bounds; the lights; the animations, and the space
+//! everything animated sweeps (which the voxel grid and the shadow views must cover).
+
+use crate::{Error, Result};
+use glam::{Mat4, Vec3};
+use voxgi_scene::animation::{Animation, AnimationTarget};
+use voxgi_scene::{Aabb, Light, Scene};
+
+/// Poses sampled per animation to find the space it sweeps.
+const SWEEP_SAMPLES: u32 = 256;
+
+/// One instance as the renderer knows it.
+#[derive(Clone, Debug)]
+pub struct InstanceState {
+    /// For messages.
+    pub name: String,
+    /// Only dynamic instances may move.
+    pub dynamic: bool,
+    /// Its draw in `GpuScene::draws` (`None`: a mesh without triangles, nothing to move).
+    pub draw: Option<u32>,
+    /// Its mesh's bounds in object space.
+    pub local: Aabb,
+    /// Object to world, now.
+    pub transform: Mat4,
+}
+
+impl InstanceState {
+    /// The world bounds of the instance under `transform` (the box around the transformed
+    /// corners of its mesh's bounds).
+    pub fn world_bounds(&self, transform: Mat4) -> Aabb {
+        transformed(self.local, transform)
+    }
+}
+
+fn transformed(b: Aabb, m: Mat4) -> Aabb {
+    let mut out = Aabb::EMPTY;
+    if b.is_empty() {
+        return out;
+    }
+    for i in 0..8 {
+        let p = Vec3::new(
+            if i & 1 == 0 { b.min.x } else { b.max.x },
+            if i & 2 == 0 { b.min.y } else { b.max.y },
+            if i & 4 == 0 { b.min.z } else { b.max.z },
+        );
+        out.grow(m.transform_point3(p));
+    }
+    out
+}
+
+/// The scene's mutable state: instances, lights and animations.
+pub struct SceneState {
+    /// Every scene instance, in the scene's order.
+    pub instances: Vec<InstanceState>,
+    /// Every light (the default sun included when one was added), as last set.
+    pub lights: Vec<Light>,
+    /// The animations, over a copy of the scene without its geometry (instances and lights
+    /// only: all that `Scene::set_time` touches).
+    animated: Scene,
+    /// Instances and lights that some animation moves.
+    animated_instances: Vec<usize>,
+    animated_lights: Vec<usize>,
+}
+
+/// The bounds of everything `scene` draws at any time of its animations (what the renderer's
+/// volume and default camera are placed around).
+pub fn swept_bounds(scene: &Scene) -> Aabb {
+    let draws: Vec<Option<u32>> = vec![None; scene.instances.len()];
+    SceneState::new(scene, &draws).swept_bounds(scene)
+}
+
+/// What `SceneState::set_time` changed.
+pub struct TimeChanges {
+    /// Instances with a new transform: (index, transform).
+    pub instances: Vec<(usize, Mat4)>,
+    /// Lights with new values: (index, light).
+    pub lights: Vec<(usize, Light)>,
+}
+
+impl SceneState {
+    /// The state of `scene` (as uploaded: after the default light was added).
+    pub fn new(scene: &Scene, draws: &[Option<u32>]) -> Self {
+        let instances = scene
+            .instances
+            .iter()
+            .enumerate()
+            .map(|(i, inst)| {
+                let mut local = Aabb::EMPTY;
+                for &p in &scene.meshes[inst.mesh].positions {
+                    local.grow(p);
+                }
+                InstanceState {
+                    name: inst.name.clone(),
+                    dynamic: inst.dynamic,
+                    draw: draws.get(i).copied().flatten(),
+                    local,
+                    transform: inst.transform,
+                }
+            })
+            .collect();
+        let mut animated_instances = Vec::new();
+        let mut animated_lights = Vec::new();
+        for a in &scene.animations {
+            match &a.target {
+                AnimationTarget::Instances {
+                    instances, lights, ..
+                } => {
+                    animated_instances.extend(instances.iter().copied());
+                    animated_lights.extend(lights.iter().map(|(l, _)| *l));
+                }
+                AnimationTarget::Light { light, .. } => animated_lights.push(*light),
+            }
+        }
+        animated_instances.sort_unstable();
+        animated_instances.dedup();
+        animated_lights.sort_unstable();
+        animated_lights.dedup();
+        SceneState {
+            instances,
+            lights: scene.lights.clone(),
+            animated: Scene {
+                instances: scene.instances.clone(),
+                lights: scene.lights.clone(),
+                animations: scene.animations.clone(),
+                ..Default::default()
+            },
+            animated_instances,
+            animated_lights,
+        }
+    }
+
+    /// The animations.
+    pub fn animations(&self) -> &[Animation] {
+        &self.animated.animations
+    }
+
+    /// The bounds of everything the scene draws at any time: what never moves where it is,
+    /// and what animations move at every pose they pass through (sampled finely, plus the
+    /// current pose). `scene` is the uploaded scene, for the exact bounds of the still part.
+    pub fn swept_bounds(&self, scene: &Scene) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for (i, inst) in scene.instances.iter().enumerate() {
+            if self.animated_instances.binary_search(&i).is_ok() {
+                continue;
+            }
+            if let Some(mesh) = scene.meshes.get(inst.mesh) {
+                for &p in &mesh.positions {
+                    b.grow(inst.transform.transform_point3(p));
+                }
+            }
+        }
+        for pc in &scene.point_clouds {
+            for &p in &pc.positions {
+                b.grow(pc.transform.transform_point3(p));
+            }
+        }
+        if self.animated_instances.is_empty() {
+            return b;
+        }
+        let mut probe = self.animated.clone();
+        let duration = self
+            .animations()
+            .iter()
+            .map(Animation::duration)
+            .fold(0.0f32, f32::max);
+        for k in 0..=SWEEP_SAMPLES {
+            probe.set_time(duration * k as f32 / SWEEP_SAMPLES as f32);
+            for &i in &self.animated_instances {
+                let inst = &self.instances[i];
+                b = b.union(&inst.world_bounds(probe.instances[i].transform));
+            }
+        }
+        b
+    }
+
+    /// Samples the animations at time `t` and lists what changed since the last state set.
+    pub fn set_time(&mut self, t: f32) -> Result<TimeChanges> {
+        if !t.is_finite() {
+            return Err(Error::Setting(format!("time {t} is not a finite number")));
+        }
+        self.animated.set_time(t);
+        let instances = self
+            .animated_instances
+            .iter()
+            .filter_map(|&i| {
+                let m = self.animated.instances[i].transform;
+                (m != self.instances[i].transform).then_some((i, m))
+            })
+            .collect();
+        let lights = self
+            .animated_lights
+            .iter()
+            .filter_map(|&l| {
+                let light = &self.animated.lights[l];
+                (*light != self.lights[l]).then(|| (l, light.clone()))
+            })
+            .collect();
+        Ok(TimeChanges { instances, lights })
+    }
+}
