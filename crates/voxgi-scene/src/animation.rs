@@ -96,7 +96,9 @@ impl Keyable for f32 {
 
 impl Keyable for Vec3 {
     fn lerp(a: Self, b: Self, s: f32) -> Self {
-        a.lerp(b, s)
+        // Not glam's a(1 - s) + bs: between equal keys the value must stay exactly the key,
+        // or a still object "moves" by a rounding step and is updated every frame.
+        a + (b - a) * s
     }
     fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
         let w = catmull_rom_weights(s);
@@ -113,7 +115,8 @@ impl Keyable for Vec3 {
 
 impl Keyable for Quat {
     fn lerp(a: Self, b: Self, s: f32) -> Self {
-        a.slerp(b, s)
+        // Equal keys hold still exactly (slerp would round).
+        if a == b { a } else { a.slerp(b, s) }
     }
     fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
         // Neighbours into p1's hemisphere, so the spline does not take the long way round.

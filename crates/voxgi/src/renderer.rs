@@ -24,7 +24,7 @@ use crate::gpu::feedback::CounterReadback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
 use crate::gpu_scene::{GpuFrame, GpuScene, bounding_sphere, gpu_light};
-use crate::lighting::atlas::{self as shadow, ShadowAtlas};
+use crate::lighting::atlas::{self as shadow, ShadowAtlas, ViewDirt};
 use crate::lighting::bounce::BouncePass;
 use crate::lighting::inject::InjectPass;
 use crate::lighting::shadow::ShadowPass;
@@ -182,9 +182,33 @@ struct Pending {
     geometry: bool,
     /// A light changed.
     lights: bool,
-    /// Shadow views to re-render (by atlas layer); consumed every frame, unlike the rest,
-    /// which waits for the next voxel update.
-    views: Vec<bool>,
+    /// What of each shadow view (by atlas layer) to re-render; consumed every frame, unlike
+    /// the rest, which waits for the next voxel update.
+    views: Vec<ViewDirt>,
+    /// What of each view changed since the last injection: the leaves reading only texels
+    /// outside it keep their direct light.
+    inject_views: Vec<ViewDirt>,
+    /// Where dynamic geometry was or is now since the last injection (world space): leaves
+    /// there are re-injected, their voxels may have changed.
+    moved: Option<Aabb>,
+}
+
+impl Pending {
+    /// Everything out of date, for an atlas of `views` views.
+    fn everything(views: usize) -> Self {
+        Pending {
+            rebuild: true,
+            views: vec![ViewDirt::All; views],
+            inject_views: vec![ViewDirt::All; views],
+            ..Default::default()
+        }
+    }
+
+    /// Marks view `i` out of date within `dirt`, for the shadow pass and for injection.
+    fn view(&mut self, i: usize, dirt: ViewDirt) {
+        self.views[i] = self.views[i].merge(dirt);
+        self.inject_views[i] = self.inject_views[i].merge(dirt);
+    }
 }
 
 /// What `set_options` needs to know of the scene to rebuild what an option feeds.
@@ -263,7 +287,7 @@ impl Renderer {
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             voxelize: VoxelizePass::new(device),
-            inject: InjectPass::new(device, gpu_scene.light_count),
+            inject: InjectPass::new(device, gpu_scene.light_count, atlas.views.len()),
             bounce: BouncePass::new(device, options.anisotropic),
             gbuffer: GbufferPass::new(device),
             gather: GatherPass::new(device, options, facts.glossy),
@@ -307,11 +331,7 @@ impl Renderer {
             dynamic_triangles,
             cones,
             voxel_bounces,
-            pending: Pending {
-                rebuild: true,
-                views: vec![true; views],
-                ..Default::default()
-            },
+            pending: Pending::everything(views),
             progressive_left: 0,
             frame_index: 0,
             state,
@@ -474,12 +494,14 @@ impl Renderer {
         );
         if let Some(draw) = inst.draw {
             self.scene.set_transform(&self.queue, draw, transform);
-            for (i, v) in self.atlas.views.iter().enumerate() {
-                if shadow::view_sees(v, old.min, old.max) || shadow::view_sees(v, new.min, new.max)
-                {
-                    self.pending.views[i] = true;
-                }
+            for i in 0..self.atlas.views.len() {
+                let v = &self.atlas.views[i];
+                let dirt = shadow::box_dirt(v, old.min, old.max)
+                    .merge(shadow::box_dirt(v, new.min, new.max));
+                self.pending.view(i, dirt);
             }
+            let moved = old.union(&new);
+            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
             self.pending.geometry = true;
         }
         self.state.instances[instance].transform = transform;
@@ -538,7 +560,7 @@ impl Renderer {
         );
         for (i, (new, old)) in views.iter().zip(&self.atlas.views).enumerate() {
             if bytemuck::bytes_of(new) != bytemuck::bytes_of(old) {
-                self.pending.views[i] = true;
+                self.pending.view(i, ViewDirt::All);
             }
         }
         self.atlas.update_views(&self.queue, views);
@@ -621,7 +643,7 @@ impl Renderer {
     /// Records the shadow views that must be re-rendered (all after a rebuild).
     fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder) {
         let views = std::mem::take(&mut self.pending.views);
-        if views.iter().any(|&v| v) {
+        if views.iter().any(|&v| v != ViewDirt::Clean) {
             self.passes.shadow.record(
                 &self.device,
                 encoder,
@@ -631,7 +653,7 @@ impl Renderer {
                 &mut self.timer,
             );
         }
-        self.pending.views = vec![false; self.atlas.views.len()];
+        self.pending.views = vec![ViewDirt::Clean; self.atlas.views.len()];
     }
 
     /// Whether the next voxel update has work: something changed, or progressive bounces
@@ -695,6 +717,15 @@ impl Renderer {
         }
         let progressive = self.options.progressive;
         if geometry || pending.lights {
+            p.inject.prepare(
+                &self.queue,
+                pending.rebuild || pending.lights,
+                // Bounces overwrite the radiance: it must start from the direct light again.
+                self.voxel_bounces > 0,
+                pending.moved,
+                &pending.inject_views,
+                self.atlas.texture.width(),
+            );
             let inject = if progressive {
                 InjectPass::record_direct_only
             } else {
@@ -729,8 +760,9 @@ impl Renderer {
             self.volume.record_filter(&self.device, encoder, timer);
             self.progressive_left -= 1;
         }
-        // The shadow views were consumed by `record_shadows` this frame.
+        // The shadow views were consumed by `record_shadows` this frame; injection's start over.
         self.pending.views = pending.views;
+        self.pending.inject_views = vec![ViewDirt::Clean; self.atlas.views.len()];
     }
 
     /// Acts on voxel counters that have come back since the last call: when a build had more
@@ -832,8 +864,7 @@ impl Renderer {
     /// Marks everything as changed: the next frame re-renders every shadow view and rebuilds
     /// the voxels, static geometry included.
     pub fn invalidate(&mut self) {
-        self.pending.rebuild = true;
-        self.pending.views = vec![true; self.atlas.views.len()];
+        self.pending = Pending::everything(self.atlas.views.len());
     }
 
     /// The linear HDR radiance of the last frame (before exposure and tone mapping),

@@ -94,3 +94,16 @@ fn occluder_distance(world: vec3<f32>) -> f32 {
 fn fs_main(in: VsOut) -> @location(0) f32 {
     return occluder_distance(in.world);
 }
+
+// Resetting a rectangle of a view before re-rendering only that part (the scissor limits the
+// triangle to it): "nothing seen", at the far plane, like the pass's clear.
+@vertex
+fn vs_clear(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 1.0, 1.0);
+}
+
+@fragment
+fn fs_clear() -> @location(0) f32 {
+    return 3.0e38;
+}

@@ -126,11 +126,19 @@ const PCF_TAPS: u32 = 12u;
 const PCSS_SEARCH_TAPS: u32 = 12u;
 const PCSS_TAPS: u32 = 24u;
 
-// Visibility of a light from p (normal n), in [0, 1].
-fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> f32 {
-    if light.shadow_count == 0u {
-        return 1.0;
-    }
+// What every shadow lookup of a light from p (normal n) starts from: the view, p's place
+// in it, the compared distance and bias, and the receiver plane. The light must cast shadows.
+struct ShadowSetup {
+    view: ShadowView,
+    uv: vec2<f32>,
+    d0: f32,
+    dist: f32,
+    bias: f32,
+    texel_uv: f32,
+    rp: ReceiverPlane,
+}
+
+fn shadow_setup(light: Light, p: vec3<f32>, n: vec3<f32>) -> ShadowSetup {
     let view = shadow_views[shadow_view_index(light, p)];
     let d0 = shadow_distance(view, p);
     let texel = shadow_texel_world(view, max(d0, view.near));
@@ -145,45 +153,141 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
     // texel for the rasterizer's rounding.
     let bias = texel * (1.0 + min(tan_t, 8.0));
     let uv = shadow_uv(view, p).xy;
-    let dist = d0 - bias;
-    let texel_uv = 1.0 / view.resolution;
-    let rp = receiver_plane(view, uv, p, n);
+    return ShadowSetup(view, uv, d0, d0 - bias, bias, 1.0 / view.resolution, receiver_plane(view, uv, p, n));
+}
 
+// Percentage-closer soft shadows (area lights): the blocker search's radius in uv, from the
+// light's size and p's distance.
+fn pcss_search(light: Light, view: ShadowView, d0: f32) -> f32 {
+    let tan_to_uv = 1.0 / (view.texel * view.resolution);
+    return clamp(light.size * tan_to_uv / max(0.25 * d0, view.near), 2.0 / view.resolution, 0.25);
+}
+
+// The blocker search: how many taps found an occluder (x) and their mean distance (y).
+fn pcss_blockers(s: ShadowSetup, search: f32) -> vec2<f32> {
+    var blockers = 0.0;
+    var blocker_sum = 0.0;
+    for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
+        let o = s.uv + vogel(i, PCSS_SEARCH_TAPS) * search;
+        let t = vec2<i32>(floor(o * s.view.resolution));
+        let z = shadow_texel(s.view, t);
+        if z < plane_at(s.rp, o) - s.bias {
+            blockers += 1.0;
+            blocker_sum += z;
+        }
+    }
+    return vec2<f32>(blockers, blocker_sum / max(blockers, 1.0));
+}
+
+// The penumbra's filter radius in uv: the width similar triangles give for blockers at mean
+// distance `zb` (`blockers.y`).
+fn pcss_radius(light: Light, s: ShadowSetup, blockers: vec2<f32>) -> f32 {
+    let tan_to_uv = 1.0 / (s.view.texel * s.view.resolution);
+    let zb = max(blockers.y, s.view.near);
+    return clamp(light.size * (s.dist - zb) / (zb * s.dist) * tan_to_uv, s.texel_uv, 0.25);
+}
+
+// Visibility of a light from p (normal n), in [0, 1].
+fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> f32 {
+    if light.shadow_count == 0u {
+        return 1.0;
+    }
+    let s = shadow_setup(light, p, n);
     if is_area_light(light) {
         // Percentage-closer soft shadows: the penumbra width follows the light's size and the
         // blocker/receiver distances, as similar triangles give it.
-        let tan_to_uv = 1.0 / (view.texel * view.resolution);
-        let half = light.size;
-        let search = clamp(half * tan_to_uv / max(0.25 * d0, view.near), 2.0 * texel_uv, 0.25);
-        var blockers = 0.0;
-        var blocker_sum = 0.0;
-        for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
-            let o = uv + vogel(i, PCSS_SEARCH_TAPS) * search;
-            let t = vec2<i32>(floor(o * view.resolution));
-            let z = shadow_texel(view, t);
-            if z < plane_at(rp, o) - bias {
-                blockers += 1.0;
-                blocker_sum += z;
-            }
-        }
-        if blockers == 0.0 {
+        let blockers = pcss_blockers(s, pcss_search(light, s.view, s.d0));
+        if blockers.x == 0.0 {
             return 1.0;
         }
-        let zb = max(blocker_sum / blockers, view.near);
-        let radius = clamp(half * (dist - zb) / (zb * dist) * tan_to_uv, texel_uv, 0.25);
+        let radius = pcss_radius(light, s, blockers);
         var lit = 0.0;
         for (var i = 0u; i < PCSS_TAPS; i++) {
-            lit += shadow_tap(view, uv + vogel(i, PCSS_TAPS) * radius, rp, bias);
+            lit += shadow_tap(s.view, s.uv + vogel(i, PCSS_TAPS) * radius, s.rp, s.bias);
         }
         return lit / f32(PCSS_TAPS);
     }
-
-    let radius = softness * texel_uv;
+    let radius = softness * s.texel_uv;
     var lit = 0.0;
     for (var i = 0u; i < PCF_TAPS; i++) {
-        lit += shadow_tap(view, uv + vogel(i, PCF_TAPS) * radius, rp, bias);
+        lit += shadow_tap(s.view, s.uv + vogel(i, PCF_TAPS) * radius, s.rp, s.bias);
     }
     return lit / f32(PCF_TAPS);
+}
+
+// Whether `light_visibility(light, p, n, softness)` reads a texel of the shadow view
+// `shadow_view_index(light, p)` inside the texel rectangle `dirt` (x, y from xy inclusive to
+// zw exclusive). Follows its reads tap by tap: the blocker search's texels and, when it found
+// blockers, each filter tap's 2x2 texels (the radius depends on the blockers, which are then
+// what they were: the search read no changed texel).
+fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>) -> bool {
+    // What decides the taps' places first, the rest of the lookup's setup only when needed.
+    let view = shadow_views[shadow_view_index(light, p)];
+    let uv = shadow_uv(view, p).xy;
+    var radius = softness / view.resolution;
+    var taps = PCF_TAPS;
+    if is_area_light(light) {
+        let search = pcss_search(light, view, shadow_distance(view, p));
+        for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
+            let o = uv + vogel(i, PCSS_SEARCH_TAPS) * search;
+            if texel_dirty(view, vec2<i32>(floor(o * view.resolution)), dirt) {
+                return true;
+            }
+        }
+        let s = shadow_setup(light, p, n);
+        let blockers = pcss_blockers(s, search);
+        if blockers.x == 0.0 {
+            return false;
+        }
+        radius = pcss_radius(light, s, blockers);
+        taps = PCSS_TAPS;
+    }
+    for (var i = 0u; i < taps; i++) {
+        if tap_dirty(view, uv + vogel(i, taps) * radius, dirt) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Whether `shadow_texel(view, t)` reads inside `dirt`.
+fn texel_dirty(view: ShadowView, t: vec2<i32>, dirt: vec4<f32>) -> bool {
+    let r = i32(view.resolution);
+    let c = vec2<f32>(clamp(t, vec2<i32>(0), vec2<i32>(r - 1)));
+    return all(c >= dirt.xy) && all(c < dirt.zw);
+}
+
+// Whether `shadow_tap(view, uv, ..)` reads inside `dirt`.
+fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: vec4<f32>) -> bool {
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+        return false;
+    }
+    let i = vec2<i32>(floor(uv * view.resolution - 0.5));
+    return texel_dirty(view, i, dirt)
+        || texel_dirty(view, i + vec2<i32>(1, 0), dirt)
+        || texel_dirty(view, i + vec2<i32>(0, 1), dirt)
+        || texel_dirty(view, i + vec2<i32>(1, 1), dirt);
+}
+
+// Whether `light_irradiance(light, p, n, softness)` reads a texel inside `dirt` of the view
+// it looks up (see `shadow_reads`); false when it returns before any lookup.
+fn irradiance_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>) -> bool {
+    if light.shadow_count == 0u || dirt.x >= dirt.z {
+        return false;
+    }
+    // (Area lights: the polygon integral that could rule the light out costs more than the
+    // lookups' test.)
+    if !is_area_light(light) {
+        var l = -light.direction;
+        if light.kind != LIGHT_DIRECTIONAL {
+            l = normalize(light.position - p);
+        }
+        // Clearly facing away only: light_irradiance's own test rounds differently.
+        if dot(n, l) < -1e-4 {
+            return false;
+        }
+    }
+    return shadow_reads(light, p, n, softness, dirt);
 }
 
 // Vertex i of an area light's polygon, relative to p: a rectangle's four corners, or a 16-gon

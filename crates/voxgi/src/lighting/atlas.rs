@@ -9,7 +9,7 @@ use crate::gpu_scene::{
 };
 use crate::options::RendererOptions;
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 /// Mirrors `ShadowView` in shaders/shared/scene.wgsl.
@@ -200,12 +200,70 @@ pub fn plan_views(
     (views, owner)
 }
 
-/// Whether anything inside the box `min..max` can show in `view`'s map: false only when all
-/// eight corners lie outside one of the view's clip planes (conservative: a box that misses
-/// the frustum diagonally still counts as seen).
-pub fn view_sees(view: &GpuShadowView, min: Vec3, max: Vec3) -> bool {
+/// What of a shadow view's map is out of date.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewDirt {
+    /// Nothing: the map is current.
+    Clean,
+    /// All of it (its light changed, or a rebuild).
+    All,
+    /// The texels within this rectangle of texture coordinates (0..1, v down), where
+    /// something moved.
+    Rect {
+        /// Lower corner.
+        min: Vec2,
+        /// Upper corner.
+        max: Vec2,
+    },
+}
+
+impl ViewDirt {
+    /// What is out of date after both `self` and `other`.
+    pub fn merge(self, other: ViewDirt) -> ViewDirt {
+        match (self, other) {
+            (ViewDirt::Clean, d) | (d, ViewDirt::Clean) => d,
+            (ViewDirt::All, _) | (_, ViewDirt::All) => ViewDirt::All,
+            (ViewDirt::Rect { min: a, max: b }, ViewDirt::Rect { min: c, max: d }) => {
+                ViewDirt::Rect {
+                    min: a.min(c),
+                    max: b.max(d),
+                }
+            }
+        }
+    }
+
+    /// The texels a `res`-texel map re-renders for this (`scissor`), as `vec4(x0, y0, x1, y1)`
+    /// (x1, y1 exclusive) for the shaders; an empty rectangle when clean.
+    pub fn to_gpu(self, res: u32) -> [f32; 4] {
+        match self.scissor(res) {
+            None => [1.0, 1.0, 0.0, 0.0],
+            Some((x, y, w, h)) => [x as f32, y as f32, (x + w) as f32, (y + h) as f32],
+        }
+    }
+
+    /// The texels of a `res`-texel map to re-render, as a scissor rectangle (x, y, width,
+    /// height), with a texel of margin for the rasterizer's rounding; `None` when clean.
+    pub fn scissor(self, res: u32) -> Option<(u32, u32, u32, u32)> {
+        match self {
+            ViewDirt::Clean => None,
+            ViewDirt::All => Some((0, 0, res, res)),
+            ViewDirt::Rect { min, max } => {
+                let r = res as f32;
+                let lo = |v: f32| ((v * r).floor() - 1.0).clamp(0.0, r) as u32;
+                let hi = |v: f32| ((v * r).ceil() + 1.0).clamp(0.0, r) as u32;
+                let (x0, y0, x1, y1) = (lo(min.x), lo(min.y), hi(max.x), hi(max.y));
+                (x1 > x0 && y1 > y0).then_some((x0, y0, x1 - x0, y1 - y0))
+            }
+        }
+    }
+}
+
+/// Where the box `min..max` can show in `view`'s map: `Clean` when all eight corners lie
+/// outside one of the view's clip planes, `All` when the box reaches behind a perspective
+/// view's origin, else the rectangle around the corners' projections, clamped to the map.
+pub fn box_dirt(view: &GpuShadowView, min: Vec3, max: Vec3) -> ViewDirt {
     let m = Mat4::from_cols_array_2d(&view.view_proj);
-    let corners: Vec<glam::Vec4> = (0..8)
+    let corners: Vec<Vec4> = (0..8)
         .map(|i| {
             let p = Vec3::new(
                 if i & 1 == 0 { min.x } else { max.x },
@@ -216,7 +274,7 @@ pub fn view_sees(view: &GpuShadowView, min: Vec3, max: Vec3) -> bool {
         })
         .collect();
     // wgpu clip space: -w <= x, y <= w and 0 <= z <= w.
-    let planes: [fn(glam::Vec4) -> f32; 6] = [
+    let planes: [fn(Vec4) -> f32; 6] = [
         |c| c.w + c.x,
         |c| c.w - c.x,
         |c| c.w + c.y,
@@ -224,9 +282,25 @@ pub fn view_sees(view: &GpuShadowView, min: Vec3, max: Vec3) -> bool {
         |c| c.z,
         |c| c.w - c.z,
     ];
-    !planes
+    if planes
         .iter()
         .any(|plane| corners.iter().all(|&c| plane(c) < 0.0))
+    {
+        return ViewDirt::Clean;
+    }
+    if corners.iter().any(|c| c.w <= 1e-6) {
+        return ViewDirt::All;
+    }
+    let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+    for c in &corners {
+        let uv = Vec2::new(c.x / c.w * 0.5 + 0.5, 0.5 - c.y / c.w * 0.5);
+        lo = lo.min(uv);
+        hi = hi.max(uv);
+    }
+    ViewDirt::Rect {
+        min: lo.clamp(Vec2::ZERO, Vec2::ONE),
+        max: hi.clamp(Vec2::ZERO, Vec2::ONE),
+    }
 }
 
 /// Whether a cube face of an area light sees only what lies behind the emitter's plane, which

@@ -1,52 +1,141 @@
 //! inject: direct light and emission into the voxel structure's leaves.
 
 use crate::gpu::layout;
-use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::lighting::atlas::ShadowAtlas;
+use crate::lighting::atlas::{ShadowAtlas, ViewDirt};
 use crate::voxel::VoxelStructure;
 use crate::voxel::dense::DenseVolume;
 use wgpu::util::DeviceExt;
 
 /// The inject compute pass (shaders/inject.wgsl): its pipeline, the layout of its globals, and
-/// the uniform holding the scene's light count.
+/// what changed since the last injection (`prepare`).
 pub struct InjectPass {
-    pipeline: wgpu::ComputePipeline,
-    /// The same without storing the radiance (progressive bounces).
-    direct_only: wgpu::ComputePipeline,
+    /// `mark` and `main`, storing the leaves' radiance, and the same without (progressive
+    /// bounces); `prepare` between them.
+    pipelines: [(wgpu::ComputePipeline, wgpu::ComputePipeline); 2],
+    prepare: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
-    light_count: wgpu::Buffer,
+    args_layout: wgpu::BindGroupLayout,
+    /// `main`'s dispatch size (written by `prepare`).
+    args: wgpu::Buffer,
+    /// The leaves to recompute (`todo` in the WGSL), sized to the structure's leaves.
+    todo: std::cell::RefCell<Option<wgpu::Buffer>>,
+    light_count: u32,
+    /// `InjectParams`: the light count, whether every leaf is recomputed, where geometry moved.
+    params: wgpu::Buffer,
+    /// Per shadow view, the rectangle of its map that changed.
+    dirt: wgpu::Buffer,
+}
+
+/// Mirrors `InjectParams` in shaders/lighting/inject.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuInjectParams {
+    light_count: u32,
+    all: u32,
+    store_all: u32,
+    _pad: u32,
+    moved_min: [f32; 4],
+    moved_max: [f32; 4],
 }
 
 impl InjectPass {
-    /// Compiles the pipeline for a scene of `light_count` lights (fixed until the pass is rebuilt).
-    pub fn new(device: &wgpu::Device, light_count: u32) -> Self {
+    /// Compiles the pipeline for a scene of `light_count` lights with `views` shadow views
+    /// (both fixed until the pass is rebuilt).
+    pub fn new(device: &wgpu::Device, light_count: u32, views: usize) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
         entries.extend(ShadowAtlas::lighting_layout(c));
+        entries.push(layout::storage(4, c, true));
+        entries.push(layout::storage(5, c, false));
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("inject globals"),
             entries: &entries,
         });
         let leaves = DenseVolume::leaves_layout(device);
         let store = DenseVolume::leaf_store_layout(device);
+        let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("inject args"),
+            entries: &[layout::storage(0, c, false)],
+        });
+        let module = crate::gpu::shader::module(device, "lighting/inject.wgsl");
+        let pipe = |entry: &str, layouts: &[Option<&wgpu::BindGroupLayout>], store: bool| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("inject"),
+                bind_group_layouts: layouts,
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("inject"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &[("STORE_RADIANCE", if store { 1.0 } else { 0.0 })],
+                    ..Default::default()
+                },
+                cache: None,
+            })
+        };
         let layouts = [Some(&globals), None, Some(&leaves), Some(&store)];
+        let both = |store| (pipe("mark", &layouts, store), pipe("main", &layouts, store));
         InjectPass {
-            pipeline: grouped_pipeline(device, "inject", "lighting/inject.wgsl", &layouts, &[]),
-            direct_only: grouped_pipeline(
-                device,
-                "inject",
-                "lighting/inject.wgsl",
-                &layouts,
-                &[("STORE_RADIANCE", 0.0)],
-            ),
-            globals,
-            light_count: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("inject light count"),
-                contents: bytemuck::cast_slice(&[light_count, 0, 0, 0]),
-                usage: wgpu::BufferUsages::UNIFORM,
+            pipelines: [both(true), both(false)],
+            prepare: pipe("prepare", &[Some(&globals), Some(&args_layout)], true),
+            args: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("inject dispatch size"),
+                size: 12,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+                mapped_at_creation: false,
             }),
+            todo: std::cell::RefCell::new(None),
+            args_layout,
+            globals,
+            light_count,
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("inject params"),
+                size: size_of::<GpuInjectParams>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            dirt: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("inject view dirt"),
+                contents: &vec![0u8; 16 * views.max(1)],
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            }),
+        }
+    }
+
+    /// Says what changed since the last injection, for the next `record`: everything (`all`),
+    /// or the box dynamic geometry moved through (`moved`) and the changed part of each shadow
+    /// view (`views`, one per atlas layer of `res` texels). Leaves whose inputs none of this touches keep
+    /// their direct light: what they would compute is the same, to the bit. Their radiance
+    /// is stored again only when `store_all` (something else wrote it since: the bounces).
+    pub fn prepare(
+        &self,
+        queue: &wgpu::Queue,
+        all: bool,
+        store_all: bool,
+        moved: Option<voxgi_scene::Aabb>,
+        views: &[ViewDirt],
+        res: u32,
+    ) {
+        let (lo, hi) = moved.map_or(([1.0, 1.0, 1.0, 0.0], [-1.0, -1.0, -1.0, 0.0]), |b| {
+            (b.min.extend(0.0).to_array(), b.max.extend(0.0).to_array())
+        });
+        let p = GpuInjectParams {
+            light_count: self.light_count,
+            all: all as u32,
+            store_all: store_all as u32,
+            _pad: 0,
+            moved_min: lo,
+            moved_max: hi,
+        };
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let dirt: Vec<[f32; 4]> = views.iter().map(|v| v.to_gpu(res)).collect();
+        if !dirt.is_empty() {
+            queue.write_buffer(&self.dirt, 0, bytemuck::cast_slice(&dirt));
         }
     }
 
@@ -62,7 +151,7 @@ impl InjectPass {
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
-        self.record_with(&self.pipeline, device, encoder, scene, atlas, voxels, timer);
+        self.record_with(0, device, encoder, scene, atlas, voxels, timer);
     }
 
     /// `record`, but the leaves' radiance is kept: only their direct light is renewed (for
@@ -76,21 +165,13 @@ impl InjectPass {
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
-        self.record_with(
-            &self.direct_only,
-            device,
-            encoder,
-            scene,
-            atlas,
-            voxels,
-            timer,
-        );
+        self.record_with(1, device, encoder, scene, atlas, voxels, timer);
     }
 
     #[allow(clippy::too_many_arguments)]
     fn record_with(
         &self,
-        pipeline: &wgpu::ComputePipeline,
+        which: usize,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
@@ -98,22 +179,64 @@ impl InjectPass {
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
-        let mut resources = vec![self.light_count.as_entire_binding()];
+        let needed = (voxels.leaf_capacity() + 1) * 4;
+        let mut todo = self.todo.borrow_mut();
+        if todo.as_ref().is_none_or(|b| b.size() < needed) {
+            *todo = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("inject todo"),
+                size: needed,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        let todo = todo.as_ref().expect("made above");
+        encoder.clear_buffer(todo, 0, Some(4));
+        let mut resources = vec![self.params.as_entire_binding()];
         resources.extend(atlas.lighting_resources(scene));
+        resources.push(self.dirt.as_entire_binding());
+        resources.push(todo.as_entire_binding());
         let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("inject globals"),
             layout: &self.globals,
             entries: &layout::entries(resources),
         });
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("inject args"),
+            layout: &self.args_layout,
+            entries: &layout::entries(vec![self.args.as_entire_binding()]),
+        });
+        let (mark, main) = &self.pipelines[which];
+        let (leaf_args, offset) = voxels.leaf_dispatch();
+        // Three passes: each reads what the one before wrote (the list, its dispatch size).
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("inject"),
+                timestamp_writes: timer.compute("inject"),
+            });
+            pass.set_pipeline(mark);
+            pass.set_bind_group(0, &globals, &[]);
+            pass.set_bind_group(2, voxels.leaves(), &[]);
+            pass.set_bind_group(3, voxels.leaf_store(), &[]);
+            pass.dispatch_workgroups_indirect(leaf_args, offset);
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("inject"),
+                timestamp_writes: timer.compute("inject"),
+            });
+            pass.set_pipeline(&self.prepare);
+            pass.set_bind_group(0, &globals, &[]);
+            pass.set_bind_group(1, &args, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("inject"),
             timestamp_writes: timer.compute("inject"),
         });
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(main);
         pass.set_bind_group(0, &globals, &[]);
         pass.set_bind_group(2, voxels.leaves(), &[]);
         pass.set_bind_group(3, voxels.leaf_store(), &[]);
-        let (args, offset) = voxels.leaf_dispatch();
-        pass.dispatch_workgroups_indirect(args, offset);
+        pass.dispatch_workgroups_indirect(&self.args, 0);
     }
 }

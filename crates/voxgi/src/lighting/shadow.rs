@@ -6,7 +6,7 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::lighting::atlas::{
-    ATLAS_FORMAT, GpuShadowView, ShadowAtlas, UNIFORM_STRIDE, behind_emitter,
+    ATLAS_FORMAT, GpuShadowView, ShadowAtlas, UNIFORM_STRIDE, ViewDirt, behind_emitter,
 };
 
 /// The shadow render pass (shaders/shadow.wgsl): the mesh and surfel pipelines writing distance
@@ -15,6 +15,8 @@ pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
     /// Point-cloud surfels: 6 vertices per point, no index buffer.
     points: wgpu::RenderPipeline,
+    /// Resets the scissored part of a view that is re-rendered only in part.
+    clear: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -38,7 +40,7 @@ impl ShadowPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let make = |label: &str, vs: &str, fs: &str| {
+        let make = |label: &str, vs: &str, fs: &str, depth: bool| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&pipeline_layout),
@@ -54,8 +56,12 @@ impl ShadowPass {
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: wgpu::TextureFormat::Depth32Float,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    depth_write_enabled: Some(depth),
+                    depth_compare: Some(if depth {
+                        wgpu::CompareFunction::Less
+                    } else {
+                        wgpu::CompareFunction::Always
+                    }),
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
@@ -71,23 +77,25 @@ impl ShadowPass {
             })
         };
         ShadowPass {
-            pipeline: make("shadow", "vs_main", "fs_main"),
-            points: make("shadow points", "vs_points", "fs_points"),
+            pipeline: make("shadow", "vs_main", "fs_main", true),
+            points: make("shadow points", "vs_points", "fs_points", true),
+            clear: make("shadow clear", "vs_clear", "fs_clear", false),
             layout,
         }
     }
 
     /// Records one render pass per shadow view of `atlas` into its layer (skipping views that only
     /// see the back of their emitter), drawing every mesh except the light's own emitter, and the
-    /// points. Only the views `views` marks are rendered (the others keep their maps). Timed as
-    /// "shadow" (summed over the views).
+    /// points. Only what `views` marks out of date is rendered: a whole view, or a rectangle of
+    /// it (scissored: the rest keeps its texels, which are what a full render would give since
+    /// nothing there changed). Timed as "shadow" (summed over the views).
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         scene: &GpuScene,
-        views: &[bool],
+        views: &[ViewDirt],
         timer: &mut GpuTimer,
     ) {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -106,9 +114,15 @@ impl ShadowPass {
             ]),
         });
         for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
-            if !views.get(i).copied().unwrap_or(true) || behind_emitter(&atlas.views[i]) {
+            let dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
+            let res = atlas.texture.width();
+            let Some(scissor) = dirt.scissor(res) else {
+                continue;
+            };
+            if behind_emitter(&atlas.views[i]) {
                 continue;
             }
+            let whole = dirt == ViewDirt::All;
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -117,12 +131,16 @@ impl ShadowPass {
                     resolve_target: None,
                     ops: wgpu::Operations {
                         // Nothing seen: the occluder is infinitely far.
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: 3.0e38,
-                            g: 0.0,
-                            b: 0.0,
-                            a: 0.0,
-                        }),
+                        load: if whole {
+                            wgpu::LoadOp::Clear(wgpu::Color {
+                                r: 3.0e38,
+                                g: 0.0,
+                                b: 0.0,
+                                a: 0.0,
+                            })
+                        } else {
+                            wgpu::LoadOp::Load
+                        },
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -138,8 +156,14 @@ impl ShadowPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
+            if !whole {
+                let (x, y, w, h) = scissor;
+                pass.set_scissor_rect(x, y, w, h);
+                pass.set_pipeline(&self.clear);
+                pass.draw(0..3, 0..1);
+            }
+            pass.set_pipeline(&self.pipeline);
             pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
             let owner = atlas.view_light[i];
             for call in &scene.calls {

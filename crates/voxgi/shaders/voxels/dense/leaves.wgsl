@@ -2,6 +2,8 @@
 // (inject, bounce, bounce_store) reach a structure's leaves through these names only:
 //
 //   fn leaf_count() -> u32                        leaves of the last build
+//   fn leaf_is_new(i) -> bool                     made by the last update: its slot held
+//                                                 another leaf before (or none)
 //   fn leaf_coord(i) -> vec3<u32>                 the leaf's finest-grid voxel
 //   fn leaf_center(i) -> vec3<f32>                its centre, metres
 //   fn leaf_size() -> f32                         its edge, metres
@@ -28,6 +30,11 @@
 
 fn leaf_count() -> u32 {
     return min(counters[0], arrayLength(&slot_voxel));
+}
+
+// Slots above the static geometry's are handed out anew by every update (dense_update).
+fn leaf_is_new(i: u32) -> bool {
+    return i >= counters[2];
 }
 
 fn leaf_coord(i: u32) -> vec3<u32> {
