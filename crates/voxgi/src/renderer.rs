@@ -19,7 +19,7 @@
 
 use crate::brdf::BrdfTables;
 use crate::fragments::voxelize::VoxelizePass;
-use crate::fragments::{self, FragmentEstimate, Fragments, triangle_table};
+use crate::fragments::{self, FragmentEstimate, Fragments, TriangleTable, triangle_table};
 use crate::gpu::feedback::CounterReadback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
@@ -146,8 +146,8 @@ pub struct Renderer {
     volume: DenseVolume,
     dense_pipelines: Arc<DensePipelines>,
     /// Voxelize's triangle tables: the static instances' and the dynamic ones'.
-    static_triangles: (wgpu::Buffer, u32),
-    dynamic_triangles: (wgpu::Buffer, u32),
+    static_triangles: TriangleTable,
+    dynamic_triangles: TriangleTable,
     cones: wgpu::Buffer,
     /// Voxel bounces per update (the per-pixel gather adds the last bounce).
     voxel_bounces: u32,
@@ -674,7 +674,7 @@ impl Renderer {
         let geometry = pending.rebuild || pending.geometry;
         if pending.rebuild {
             self.fragments.record_clear(encoder);
-            let t = (&self.static_triangles.0, self.static_triangles.1);
+            let t = &self.static_triangles;
             p.voxelize.record(
                 &self.device,
                 encoder,
@@ -689,7 +689,7 @@ impl Renderer {
         }
         if geometry && self.facts.dynamic {
             self.fragments.record_truncate(encoder);
-            let t = (&self.dynamic_triangles.0, self.dynamic_triangles.1);
+            let t = &self.dynamic_triangles;
             p.voxelize.record(
                 &self.device,
                 encoder,

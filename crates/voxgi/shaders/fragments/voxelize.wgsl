@@ -22,6 +22,23 @@
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
 @group(0) @binding(9) var<storage, read_write> fragment_count: array<atomic<u32>>;
 
+// The dynamic geometry's pass: a fragment's voxel is filled only by the part of it that lies
+// behind the surface (inside the solid), and the voxel behind it, inside, is filled wholly.
+// Static geometry fills every voxel it touches (a wall stays opaque whatever its thickness).
+override DYNAMIC_COVERAGE: bool = false;
+
+fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emission: vec3<f32>) {
+    let slot = atomicAdd(&fragment_count[0], 1u);
+    if slot < arrayLength(&fragments) {
+        fragments[slot] = Fragment(
+            pack_coord(vec3<u32>(cell)),
+            pack4x8unorm(vec4<f32>(albedo, coverage)),
+            pack2x16snorm(oct_encode(n)),
+            pack_rgb9e5(emission),
+        );
+    }
+}
+
 // Does the triangle (relative to the box centre) overlap the box of half-size h along axis a?
 fn separated(a: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, h: f32) -> bool {
     let p0 = dot(v0, a);
@@ -170,16 +187,20 @@ fn main(
             if m.emissive_texture >= 0 {
                 emission *= textureSampleLevel(textures, texture_sampler, uv, m.emissive_texture, lod).rgb;
             }
-            let coord = vec3<u32>(cell);
-            let slot = atomicAdd(&fragment_count[0], 1u);
-            if slot < arrayLength(&fragments) {
-                fragments[slot] = Fragment(
-                    pack_coord(coord),
-                    // Voxels bounce light diffusely: metals' diffuse albedo is zero.
-                    pack4x8unorm(vec4<f32>(albedo.rgb * (1.0 - m.metallic), 1.0)),
-                    pack2x16snorm(oct_encode(n)),
-                    pack_rgb9e5(emission),
-                );
+            // Voxels bounce light diffusely: metals' diffuse albedo is zero.
+            let diffuse = albedo.rgb * (1.0 - m.metallic);
+            if !DYNAMIC_COVERAGE {
+                emit(cell, diffuse, 1.0, n, emission);
+                continue;
+            }
+            // The share of the voxel behind the plane (the normal points out of the solid):
+            // exact for axis-aligned planes, linear in the plane's offset for the others.
+            let behind = clamp(0.5 - dot(center - a, n) / (abs(n.x) + abs(n.y) + abs(n.z)), 0.0, 1.0);
+            emit(cell, diffuse, behind, n, emission);
+            var inner = cell;
+            inner[w] -= select(-1, 1, n[w] > 0.0);
+            if inner[w] >= 0 && inner[w] < res {
+                emit(inner, diffuse, 1.0, n, emission);
             }
         }
     }

@@ -133,16 +133,18 @@ impl FragmentEstimate {
     /// space.
     pub fn of(scene: &voxgi_scene::Scene) -> Self {
         let mut e = FragmentEstimate::default();
-        // Area-light emitters make no fragments (`triangle_table`).
+        // Area-light emitters make no fragments (`triangle_table`); dynamic geometry makes
+        // two per voxel it crosses (voxelize.wgsl's coverage).
         for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
             let m = &scene.meshes[inst.mesh];
+            let k = if inst.dynamic { 2.0 } else { 1.0 };
             for t in m.indices.chunks_exact(3) {
                 let [a, b, c] = [t[0], t[1], t[2]]
                     .map(|i| inst.transform.transform_point3(m.positions[i as usize]));
                 let n = (b - a).cross(c - a);
-                e.area += 0.5 * n.abs().max_element() as f64;
-                e.perimeter += ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
-                e.triangles += 1;
+                e.area += k * 0.5 * n.abs().max_element() as f64;
+                e.perimeter += k * ((b - a).length() + (c - b).length() + (a - c).length()) as f64;
+                e.triangles += k as u64;
             }
         }
         e
@@ -156,14 +158,23 @@ impl FragmentEstimate {
     }
 }
 
-/// The triangle table voxelize reads for the static (`dynamic` false) or the dynamic
-/// instances: per triangle, its draw, first index, base vertex. An error when the table would
-/// not fit one storage binding of this device.
+/// The triangles voxelize reads: per triangle, its draw, first index and base vertex.
+pub struct TriangleTable {
+    /// `[u32; 4]` per triangle (the fourth unused); one zero entry when empty.
+    pub buffer: wgpu::Buffer,
+    /// Triangles in the table.
+    pub count: u32,
+    /// The dynamic instances' triangles (their fragments carry coverage), or the static ones'.
+    pub dynamic: bool,
+}
+
+/// The triangle table of the static (`dynamic` false) or the dynamic instances. An error when
+/// the table would not fit one storage binding of this device.
 pub fn triangle_table(
     device: &wgpu::Device,
     scene: &GpuScene,
     dynamic: bool,
-) -> Result<(wgpu::Buffer, u32)> {
+) -> Result<TriangleTable> {
     let mut t: Vec<[u32; 4]> = Vec::new();
     for call in scene.calls.iter().filter(|c| c.dynamic == dynamic) {
         // The visible surface of an area light is not voxelized, neither as an emitter (its
@@ -201,5 +212,9 @@ pub fn triangle_table(
         contents: bytemuck::cast_slice(&t),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    Ok((buffer, n))
+    Ok(TriangleTable {
+        buffer,
+        count: n,
+        dynamic,
+    })
 }

@@ -1,7 +1,7 @@
 //! voxelize: every mesh triangle into voxel fragments (conservative, exact overlap). It writes
 //! the fragments and their count, nothing else.
 
-use crate::fragments::Fragments;
+use crate::fragments::{Fragments, TriangleTable};
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
@@ -9,6 +9,8 @@ use crate::gpu_scene::GpuScene;
 /// The voxelize compute pass (shaders/fragments/voxelize.wgsl): its pipeline and bind group layout.
 pub struct VoxelizePass {
     pipeline: wgpu::ComputePipeline,
+    /// For the dynamic geometry: fragments weighted by how much of their voxel is inside.
+    dynamic: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -36,24 +38,32 @@ impl VoxelizePass {
                 layout::storage(9, c, false),
             ],
         });
-        let pipeline = crate::gpu::shader::compute_pipeline(
-            device,
-            "voxelize",
-            "fragments/voxelize.wgsl",
-            &layout,
-        );
-        VoxelizePass { pipeline, layout }
+        let layouts = [Some(&layout)];
+        let make = |coverage: f64| {
+            crate::gpu::shader::grouped_pipeline(
+                device,
+                "voxelize",
+                "fragments/voxelize.wgsl",
+                &layouts,
+                &[("DYNAMIC_COVERAGE", coverage)],
+            )
+        };
+        VoxelizePass {
+            pipeline: make(0.0),
+            dynamic: make(1.0),
+            layout,
+        }
     }
 
-    /// Records the pass over `triangles` (a buffer of per-triangle draw index, first index and base
-    /// vertex, and the triangle count), one workgroup per triangle, appending to `fragments` and
-    /// its count; clear the count first (`Fragments::record_clear`). Timed as "voxelize".
+    /// Records the pass over `triangles`, one workgroup per triangle, appending to `fragments` and
+    /// its count; clear the count first (`Fragments::record_clear`). A dynamic table's fragments
+    /// carry coverage. Timed as "voxelize".
     pub fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
-        triangles: (&wgpu::Buffer, u32),
+        triangles: &TriangleTable,
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
@@ -68,7 +78,7 @@ impl VoxelizePass {
                 scene.materials.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&scene.texture_view),
                 wgpu::BindingResource::Sampler(&scene.sampler),
-                triangles.0.as_entire_binding(),
+                triangles.buffer.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
             ]),
@@ -77,12 +87,16 @@ impl VoxelizePass {
             label: Some("voxelize"),
             timestamp_writes: timer.compute("voxelize"),
         });
-        if triangles.1 == 0 {
+        if triangles.count == 0 {
             return;
         }
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(if triangles.dynamic {
+            &self.dynamic
+        } else {
+            &self.pipeline
+        });
         pass.set_bind_group(0, &bind, &[]);
-        let (x, y) = layout::groups_2d(triangles.1, 1);
+        let (x, y) = layout::groups_2d(triangles.count, 1);
         pass.dispatch_workgroups(x, y, 1);
     }
 }

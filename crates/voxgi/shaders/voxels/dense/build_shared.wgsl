@@ -17,8 +17,9 @@
 @group(0) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>>;
 // Per slot: the voxel's linear index.
 @group(0) @binding(5) var<storage, read_write> slot_voxel: array<u32>;
-// Per slot, ACCUM_STRIDE u32 sums: count, albedo rgb (8-bit units), normal xyz (snorm16 units,
-// two's complement), emission rgb (1/4096 units).
+// Per slot, ACCUM_STRIDE u32: sums of count, albedo rgb (8-bit units), normal xyz (snorm16
+// units, two's complement), emission rgb (1/4096 units); then the largest coverage (8-bit
+// units: how much of the voxel a fragment's solid fills, 255 for every static fragment).
 @group(0) @binding(6) var<storage, read_write> accum: array<atomic<u32>>;
 @group(0) @binding(7) var albedo_out: texture_storage_3d<rgba8unorm, write>;
 @group(0) @binding(8) var normal_out: texture_storage_3d<rgba8snorm, write>;
@@ -36,10 +37,12 @@
 // one dispatch).
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
 
-const ACCUM_STRIDE: u32 = 10u;
-const DYN_STRIDE: u32 = 12u;
-const DYN_FLAG: u32 = 10u;
-const DYN_LIST: u32 = 11u;
+const ACCUM_STRIDE: u32 = 11u;
+const ACCUM_SUMS: u32 = 10u;
+const ACCUM_COVERAGE: u32 = 10u;
+const DYN_STRIDE: u32 = 13u;
+const DYN_FLAG: u32 = 11u;
+const DYN_LIST: u32 = 12u;
 
 // Entry `i` of the touched list.
 fn touched(i: u32) -> u32 {
@@ -88,12 +91,18 @@ fn add_fragment(s: u32, f: Fragment, dynamic: bool) {
         e.g,
         e.b,
     );
-    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+    let coverage = u32(round(albedo.a * 255.0));
+    for (var k = 0u; k < ACCUM_SUMS; k++) {
         if dynamic {
             atomicAdd(&dyn_accum[s * DYN_STRIDE + k], v[k]);
         } else {
             atomicAdd(&accum[s * ACCUM_STRIDE + k], v[k]);
         }
+    }
+    if dynamic {
+        atomicMax(&dyn_accum[s * DYN_STRIDE + ACCUM_COVERAGE], coverage);
+    } else {
+        atomicMax(&accum[s * ACCUM_STRIDE + ACCUM_COVERAGE], coverage);
     }
 }
 
@@ -102,12 +111,16 @@ fn add_fragment(s: u32, f: Fragment, dynamic: bool) {
 fn resolve_slot(s: u32, dynamic: bool) {
     let base = s * ACCUM_STRIDE;
     var sum = array<u32, 10>();
-    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+    for (var k = 0u; k < ACCUM_SUMS; k++) {
         sum[k] = atomicLoad(&accum[base + k]);
         if dynamic {
             // Wrapping adds: the normal sums are two's complement.
             sum[k] += atomicLoad(&dyn_accum[s * DYN_STRIDE + k]);
         }
+    }
+    var coverage = atomicLoad(&accum[base + ACCUM_COVERAGE]);
+    if dynamic {
+        coverage = max(coverage, atomicLoad(&dyn_accum[s * DYN_STRIDE + ACCUM_COVERAGE]));
     }
     let count = f32(max(sum[0], 1u));
     let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * count);
@@ -118,8 +131,10 @@ fn resolve_slot(s: u32, dynamic: bool) {
     ) / (32767.0 * count);
     let e = vec3<f32>(f32(sum[7]), f32(sum[8]), f32(sum[9])) / (EMISSION_SCALE * count);
     let c = voxel_coord(slot_voxel[s], vol.resolution);
-    // A voxel that geometry touches blocks all rays through it: opacity 1 (conservative).
-    textureStore(albedo_out, c, vec4<f32>(albedo, 1.0));
+    // A voxel static geometry touches blocks all rays through it: opacity 1 (conservative).
+    // Dynamic geometry fills the voxels its surface crosses by how much of them lies inside
+    // it (voxelize.wgsl), so it moves through the grid smoothly instead of a voxel at a time.
+    textureStore(albedo_out, c, vec4<f32>(albedo, f32(coverage) / 255.0));
     // w: how well the fragments' normals agree (1: one orientation, ~0: opposite faces).
     let len = length(nsum);
     textureStore(normal_out, c, vec4<f32>(select(vec3<f32>(0.0), nsum / len, len > 1e-4), len));
