@@ -33,6 +33,18 @@ fn options() -> RendererOptions {
     }
 }
 
+/// `options()`, and the same without voxel bounces, where injection stores only the leaves it
+/// recomputed (nothing else writes their radiance).
+fn both_paths() -> [RendererOptions; 2] {
+    [
+        options(),
+        RendererOptions {
+            bounces: 1,
+            ..options()
+        },
+    ]
+}
+
 fn params(r: &Renderer) -> FrameParams {
     clamped(r.default_camera())
 }
@@ -69,13 +81,19 @@ fn assert_same_image(a: &voxgi::RenderOutput, b: &voxgi::RenderOutput, what: &st
 /// maps identical to re-rendered ones, and the lighting passes recompute every leaf.
 #[test]
 fn a_sequence_of_moves_renders_like_a_fresh_renderer() {
+    for options in both_paths() {
+        sequence_of_moves(&options);
+    }
+}
+
+fn sequence_of_moves(options: &RendererOptions) {
     let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
     let light = scene
         .lights
         .iter()
         .position(|l| l.name == "ceiling light")
         .expect("the Cornell box's light");
-    let mut r = renderer(&scene, &options());
+    let mut r = renderer(&scene, options);
     let p = params(&r);
     frame(&mut r, &p, SIZE, SIZE);
     let mut moved_light = scene.lights[light].clone();
@@ -99,8 +117,9 @@ fn a_sequence_of_moves_renders_like_a_fresh_renderer() {
             // The emitter's surface is drawn where the scene says: keep it with the light.
         }
         let got = frame(&mut r, &p, SIZE, SIZE);
-        let mut fresh = renderer(&scene, &options());
+        let mut fresh = renderer(&scene, options);
         let want = frame(&mut fresh, &p, SIZE, SIZE);
+        let what = &format!("{what} ({} bounces)", options.bounces);
         assert_same_image(&got, &want, what);
         assert_eq!(
             r.voxel_counts().expect("counts").occupied,
@@ -138,11 +157,17 @@ fn a_moving_light_renders_like_a_fresh_renderer() {
 /// and light) and the image equal those of the box without the cube, to the bit.
 #[test]
 fn a_moved_object_leaves_nothing_behind() {
+    for options in both_paths() {
+        moved_object_leaves_nothing(&options);
+    }
+}
+
+fn moved_object_leaves_nothing(options: &RendererOptions) {
     let (scene, cube) = cornell_with_cube((0.40, 0.15));
-    let mut r = renderer(&scene, &options());
+    let mut r = renderer(&scene, options);
     let p = params(&r);
     frame(&mut r, &p, SIZE, SIZE);
-    let mut without = renderer(&builtin::cornell_box(), &options());
+    let mut without = renderer(&builtin::cornell_box(), options);
     let want = frame(&mut without, &p, SIZE, SIZE);
     let static_only = without.voxel_counts().expect("counts").occupied;
     assert!(
