@@ -153,7 +153,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .stage("uploading scene", || ctx.renderer(&scene, &options))
             .with_context(|| label.clone())?;
         p.stage(&format!("rendering {w}x{h}"), || {
-            headless::render(&ctx, &mut renderer, &frame, w, h)
+            // One image of a still scene: progressive bounces run to convergence (a sequence
+            // shows them building up frame by frame instead, as an application would).
+            let mut out = headless::render(&ctx, &mut renderer, &frame, w, h)?;
+            while !renderer.voxels_settled() {
+                out = headless::render(&ctx, &mut renderer, &frame, w, h)?;
+            }
+            Ok::<_, voxgi::Error>(out)
         })?
     } else {
         let opts = reference_options(args, &scene, &options);
