@@ -1,0 +1,281 @@
+//! Camera controllers: orbit about a target (drag to turn, pan, wheel to zoom) and fly (WASD/QE
+//! and mouse look). Both produce a `voxgi` `Camera`; both start from any camera, so switching
+//! between them, or to a scene's own camera, keeps the view.
+
+use glam::Vec3;
+use voxgi::scene::{Camera, Projection};
+
+/// Radians of turn per pixel of mouse motion.
+const TURN_PER_PIXEL: f32 = 0.005;
+/// Zoom factor per wheel step.
+const ZOOM_PER_STEP: f32 = 0.9;
+/// Pitch stays short of straight up or down, where yaw is undefined.
+const PITCH_LIMIT: f32 = 1.55;
+
+fn fov_degrees(c: &Camera) -> f32 {
+    match c.projection {
+        Projection::Perspective { yfov } => yfov.to_degrees(),
+        Projection::Orthographic { .. } => 45.0,
+    }
+}
+
+/// The direction of yaw `yaw` (about +Y, 0 looking down -Z) and pitch `pitch` (up positive).
+pub fn direction(yaw: f32, pitch: f32) -> Vec3 {
+    Vec3::new(
+        -yaw.sin() * pitch.cos(),
+        pitch.sin(),
+        -yaw.cos() * pitch.cos(),
+    )
+}
+
+/// Yaw and pitch of a direction (the inverse of `direction`).
+pub fn angles(d: Vec3) -> (f32, f32) {
+    let d = d.normalize_or(Vec3::NEG_Z);
+    (
+        (-d.x).atan2(-d.z),
+        d.y.clamp(-1.0, 1.0).asin().clamp(-PITCH_LIMIT, PITCH_LIMIT),
+    )
+}
+
+/// Orbit about `target` at `distance`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Orbit {
+    pub target: Vec3,
+    pub distance: f32,
+    pub yaw: f32,
+    pub pitch: f32,
+    pub fov: f32,
+    pub znear: f32,
+}
+
+impl Orbit {
+    /// The orbit that sees what `camera` sees, about the point `distance` ahead of it.
+    pub fn from_camera(camera: &Camera, distance: f32) -> Self {
+        let (yaw, pitch) = angles(camera.forward);
+        let distance = distance.max(1e-4);
+        Orbit {
+            target: camera.position + camera.forward.normalize_or(Vec3::NEG_Z) * distance,
+            distance,
+            yaw,
+            pitch,
+            fov: fov_degrees(camera),
+            znear: camera.znear,
+        }
+    }
+
+    pub fn eye(&self) -> Vec3 {
+        self.target - direction(self.yaw, self.pitch) * self.distance
+    }
+
+    /// Turns by a mouse drag of (dx, dy) pixels.
+    pub fn rotate(&mut self, dx: f32, dy: f32) {
+        self.yaw -= dx * TURN_PER_PIXEL;
+        self.pitch = (self.pitch - dy * TURN_PER_PIXEL).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+    }
+
+    /// Moves the target in the view plane by a drag of (dx, dy) pixels in a view `height`
+    /// pixels high, so the point under the cursor stays under it.
+    pub fn pan(&mut self, dx: f32, dy: f32, height: f32) {
+        let f = direction(self.yaw, self.pitch);
+        let right = f.cross(Vec3::Y).normalize_or(Vec3::X);
+        let up = right.cross(f);
+        let per_pixel = 2.0 * self.distance * (self.fov.to_radians() * 0.5).tan() / height.max(1.0);
+        self.target += (-right * dx + up * dy) * per_pixel;
+    }
+
+    /// Moves closer (positive steps) or farther.
+    pub fn zoom(&mut self, steps: f32) {
+        self.distance = (self.distance * ZOOM_PER_STEP.powf(steps)).max(1e-4);
+    }
+
+    pub fn camera(&self) -> Camera {
+        let mut c = Camera::look_at(self.eye(), self.target, self.fov);
+        c.name = "viewer".into();
+        c.znear = self.znear.min(self.distance * 0.5).max(1e-5);
+        c
+    }
+}
+
+/// Which way the fly keys push, each -1, 0 or 1: right, up, forward.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Movement {
+    pub right: f32,
+    pub up: f32,
+    pub forward: f32,
+}
+
+/// A free camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fly {
+    pub position: Vec3,
+    pub yaw: f32,
+    pub pitch: f32,
+    /// Metres per second.
+    pub speed: f32,
+    pub fov: f32,
+    pub znear: f32,
+}
+
+impl Fly {
+    /// A fly camera at `camera`, moving at `speed` metres per second.
+    pub fn from_camera(camera: &Camera, speed: f32) -> Self {
+        let (yaw, pitch) = angles(camera.forward);
+        Fly {
+            position: camera.position,
+            yaw,
+            pitch,
+            speed,
+            fov: fov_degrees(camera),
+            znear: camera.znear,
+        }
+    }
+
+    /// Turns by a mouse motion of (dx, dy) pixels.
+    pub fn look(&mut self, dx: f32, dy: f32) {
+        self.yaw -= dx * TURN_PER_PIXEL;
+        self.pitch = (self.pitch - dy * TURN_PER_PIXEL).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+    }
+
+    /// Moves for `dt` seconds: forward along the view, right across it, up along +Y.
+    pub fn step(&mut self, m: Movement, dt: f32) {
+        let f = direction(self.yaw, self.pitch);
+        let right = f.cross(Vec3::Y).normalize_or(Vec3::X);
+        let v = f * m.forward + right * m.right + Vec3::Y * m.up;
+        if v.length_squared() > 0.0 {
+            self.position += v.normalize() * self.speed * dt;
+        }
+    }
+
+    pub fn camera(&self) -> Camera {
+        let mut c = Camera::look_at(
+            self.position,
+            self.position + direction(self.yaw, self.pitch),
+            self.fov,
+        );
+        c.name = "viewer".into();
+        c.znear = self.znear;
+        c
+    }
+}
+
+/// The `voxgi render` flags that give `camera`'s view.
+pub fn render_flags(camera: &Camera) -> String {
+    let t = camera.position + camera.forward;
+    let p = camera.position;
+    format!(
+        "--eye {:.4},{:.4},{:.4} --target {:.4},{:.4},{:.4} --fov {:.2}",
+        p.x,
+        p.y,
+        p.z,
+        t.x,
+        t.y,
+        t.z,
+        fov_degrees(camera)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vec3, b: Vec3) -> bool {
+        (a - b).abs().max_element() < 1e-4
+    }
+
+    #[test]
+    fn angles_invert_direction() {
+        for d in [
+            Vec3::NEG_Z,
+            Vec3::X,
+            Vec3::new(0.3, -0.4, 0.8).normalize(),
+            Vec3::new(-0.7, 0.5, -0.2).normalize(),
+        ] {
+            let (y, p) = angles(d);
+            assert!(close(direction(y, p), d), "{d}");
+        }
+    }
+
+    #[test]
+    fn an_orbit_keeps_the_camera_it_starts_from() {
+        let cam = Camera::look_at(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.5, 0.0), 40.0);
+        let o = Orbit::from_camera(&cam, 2.0);
+        let c = o.camera();
+        assert!(
+            close(c.position, cam.position),
+            "{} vs {}",
+            c.position,
+            cam.position
+        );
+        assert!(close(c.forward, cam.forward));
+        assert!((fov_degrees(&c) - 40.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn orbiting_keeps_the_distance_to_the_target_and_looks_at_it() {
+        let mut o = Orbit::from_camera(&Camera::look_at(Vec3::Z * 3.0, Vec3::ZERO, 45.0), 3.0);
+        o.rotate(120.0, -40.0);
+        let c = o.camera();
+        assert!(((c.position - o.target).length() - 3.0).abs() < 1e-4);
+        assert!(close(c.forward, (o.target - c.position).normalize()));
+        // A quarter turn of drag (pi/2 / 0.005 px) from the +Z side lands on the -X side...
+        let mut o = Orbit::from_camera(&Camera::look_at(Vec3::Z * 3.0, Vec3::ZERO, 45.0), 3.0);
+        o.rotate(std::f32::consts::FRAC_PI_2 / TURN_PER_PIXEL, 0.0);
+        assert!(close(o.eye(), Vec3::new(-3.0, 0.0, 0.0)), "{}", o.eye());
+        // ...and pitch stops short of the pole.
+        o.rotate(0.0, -1e6);
+        assert!(o.pitch <= PITCH_LIMIT && o.camera().forward.is_finite());
+    }
+
+    #[test]
+    fn zoom_and_pan_move_as_documented() {
+        let mut o = Orbit::from_camera(&Camera::look_at(Vec3::Z * 4.0, Vec3::ZERO, 90.0), 4.0);
+        o.zoom(2.0);
+        assert!((o.distance - 4.0 * 0.81).abs() < 1e-5);
+        // fov 90: the view is 2 * distance high; half the height of drag moves the target by
+        // one distance, to the left for a drag to the right.
+        let d = o.distance;
+        o.pan(50.0, 0.0, 100.0);
+        assert!(close(o.target, Vec3::new(-d, 0.0, 0.0)), "{}", o.target);
+    }
+
+    #[test]
+    fn flying_moves_at_its_speed_along_the_view() {
+        let cam = Camera::look_at(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), 60.0);
+        let mut f = Fly::from_camera(&cam, 2.0);
+        f.step(
+            Movement {
+                forward: 1.0,
+                ..Default::default()
+            },
+            0.5,
+        );
+        assert!(
+            close(f.position, Vec3::new(1.0, 0.0, 0.0)),
+            "{}",
+            f.position
+        );
+        // Diagonal keys do not move faster.
+        f.step(
+            Movement {
+                forward: 1.0,
+                right: 1.0,
+                up: 0.0,
+            },
+            1.0,
+        );
+        assert!((f.position - Vec3::new(1.0, 0.0, 0.0)).length() - 2.0 < 1e-4);
+        let c = f.camera();
+        assert!(close(c.position, f.position));
+    }
+
+    #[test]
+    fn render_flags_reproduce_the_view() {
+        let cam = Camera::look_at(Vec3::new(0.5, 1.0, 2.0), Vec3::ZERO, 35.0);
+        let flags = render_flags(&cam);
+        assert!(
+            flags.starts_with("--eye 0.5000,1.0000,2.0000 --target "),
+            "{flags}"
+        );
+        assert!(flags.ends_with("--fov 35.00"), "{flags}");
+    }
+}
