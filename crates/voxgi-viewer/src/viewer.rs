@@ -105,6 +105,8 @@ struct Viewer {
     renderer: Renderer,
     scene_name: String,
     scene_radius: f32,
+    /// The scene's own cameras, to pick from.
+    cameras: Vec<voxgi::scene::Camera>,
     options: RendererOptions,
     draft: RendererOptions,
     params: FrameParams,
@@ -260,6 +262,7 @@ impl Viewer {
             timestamps,
             scene_name: scene_label(&scene),
             scene_radius: radius,
+            cameras: scene.cameras.clone(),
             draft: options.clone(),
             options,
             controller: Controller::Orbit(Orbit::from_camera(&default_camera, orbit_distance)),
@@ -690,6 +693,27 @@ impl Viewer {
                             });
                             ui.label(egui::RichText::new(flags).monospace().small());
                         });
+                    if !self.cameras.is_empty() {
+                        ui.horizontal(|ui| {
+                            ui.label("scene camera:");
+                            let mut pick = None;
+                            for (i, c) in self.cameras.iter().enumerate() {
+                                let name = if c.name.is_empty() {
+                                    format!("{i}")
+                                } else {
+                                    c.name.clone()
+                                };
+                                if ui.button(name).clicked() {
+                                    pick = Some(c.clone());
+                                }
+                            }
+                            if let Some(c) = pick {
+                                self.controller =
+                                    Controller::Orbit(Orbit::from_camera(&c, self.scene_radius));
+                            }
+                        });
+                    }
+                    ui.collapsing("lights", |ui| self.lights_ui(ui));
                     ui.collapsing("renderer", |ui| {
                         let dirty = self.draft != self.options;
                         let a = options_ui(ui, &mut self.draft, dirty);
@@ -716,6 +740,56 @@ impl Viewer {
                 });
             });
         actions
+    }
+
+    /// Each light's colour, intensity and placement; a change goes to `Renderer::set_light`,
+    /// which re-renders its shadow views and re-lights the voxels.
+    fn lights_ui(&mut self, ui: &mut egui::Ui) {
+        let lights: Vec<voxgi::scene::Light> = self.renderer.lights().to_vec();
+        for (i, light) in lights.iter().enumerate() {
+            let mut l = light.clone();
+            let kind = match l.kind {
+                voxgi::scene::LightKind::Directional => "directional",
+                voxgi::scene::LightKind::Point => "point",
+                voxgi::scene::LightKind::Spot { .. } => "spot",
+                voxgi::scene::LightKind::Area { .. } => "area",
+            };
+            ui.label(egui::RichText::new(format!("{} ({kind})", l.name)).strong());
+            let speed = 0.01 * l.intensity.max(0.1);
+            ui.horizontal(|ui| {
+                ui.color_edit_button_rgb(&mut l.color);
+                ui.add(
+                    egui::DragValue::new(&mut l.intensity)
+                        .speed(speed)
+                        .range(0.0..=1e6)
+                        .prefix("intensity "),
+                );
+            });
+            let step = self.scene_radius * 0.005;
+            if l.kind == voxgi::scene::LightKind::Directional {
+                ui.horizontal(|ui| {
+                    ui.label("direction");
+                    for c in 0..3 {
+                        ui.add(egui::DragValue::new(&mut l.direction[c]).speed(0.01));
+                    }
+                });
+            } else {
+                ui.horizontal(|ui| {
+                    ui.label("position");
+                    for c in 0..3 {
+                        ui.add(egui::DragValue::new(&mut l.position[c]).speed(step));
+                    }
+                });
+            }
+            if l != *light {
+                if l.direction.length_squared() < 1e-8 {
+                    l.direction = light.direction;
+                }
+                if let Err(e) = self.renderer.set_light(i, &l) {
+                    self.status = format!("{e}");
+                }
+            }
+        }
     }
 
     fn stats_ui(&self, ui: &mut egui::Ui) {

@@ -587,6 +587,12 @@ impl Renderer {
         Ok(())
     }
 
+    /// The lights as last set (the scene's, and the default sun when one was added), in the
+    /// order `set_light` indexes them.
+    pub fn lights(&self) -> &[Light] {
+        &self.state.lights
+    }
+
     /// The scene's animations (as `Scene::animations`).
     pub fn animations(&self) -> &[voxgi_scene::animation::Animation] {
         self.state.animations()
