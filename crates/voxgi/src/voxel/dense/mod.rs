@@ -96,6 +96,16 @@ pub struct DenseVolume {
     pipelines: Arc<DensePipelines>,
 }
 
+/// How a step of dense_build or dense_update is dispatched.
+enum Run {
+    /// One thread that writes dispatch sizes (it binds the arguments buffer).
+    Prepare,
+    /// One thread.
+    One,
+    /// Sized by the dispatch arguments at this byte offset.
+    Indirect(u64),
+}
+
 /// The dense volume's own pipelines (dense_build, filter, debug): made once per renderer and
 /// shared by every volume it makes, since a volume is remade whenever it grows or its
 /// resolution changes.
@@ -490,48 +500,21 @@ impl DenseVolume {
         timer: &mut GpuTimer,
     ) {
         let bind = self.build_bind_group(device, fragments);
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("dense_build"),
-                timestamp_writes: timer.compute("dense_build"),
-            });
-            pass.set_bind_group(0, &bind, &[]);
-            pass.set_pipeline(&self.pipelines.build.begin);
-            pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&self.pipelines.build.clear_previous);
-            pass.dispatch_workgroups_indirect(&self.args, 0);
-        }
+        let b = &self.pipelines.build;
+        // The previous build's slots, from its own dispatch size over them.
+        let forget = [(&b.begin, Run::One), (&b.clear_previous, Run::Indirect(0))];
+        self.run_steps(device, encoder, "dense_build", &bind, &forget, timer);
         encoder.clear_buffer(&self.occupancy, 0, None);
         encoder.clear_buffer(&self.accum, 0, None);
         encoder.clear_buffer(&self.dyn_accum, 0, None);
-        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dense_build args"),
-            layout: &self.pipelines.args_layout,
-            entries: &layout::entries(vec![self.args.as_entire_binding()]),
-        });
-        // Separate passes: the prepare kernels write the dispatch sizes the others read.
-        let steps: [(&wgpu::ComputePipeline, Option<u64>); 5] = [
-            (&self.pipelines.build.prepare_fragments, None),
-            (&self.pipelines.build.allocate, Some(12)),
-            (&self.pipelines.build.accumulate, Some(12)),
-            (&self.pipelines.build.prepare_slots, None),
-            (&self.pipelines.build.resolve, Some(0)),
+        let steps = [
+            (&b.prepare_fragments, Run::Prepare),
+            (&b.allocate, Run::Indirect(12)),
+            (&b.accumulate, Run::Indirect(12)),
+            (&b.prepare_slots, Run::Prepare),
+            (&b.resolve, Run::Indirect(0)),
         ];
-        for (pipeline, indirect) in steps {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("dense_build"),
-                timestamp_writes: timer.compute("dense_build"),
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            match indirect {
-                None => {
-                    pass.set_bind_group(1, &args, &[]);
-                    pass.dispatch_workgroups(1, 1, 1);
-                }
-                Some(offset) => pass.dispatch_workgroups_indirect(&self.args, offset),
-            }
-        }
+        self.run_steps(device, encoder, "dense_build", &bind, &steps, timer);
     }
 
     /// Records an update by the dynamic fragments (those past the build's): undo the
@@ -544,20 +527,7 @@ impl DenseVolume {
         timer: &mut GpuTimer,
     ) {
         let bind = self.build_bind_group(device, fragments);
-        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dense_update args"),
-            layout: &self.pipelines.args_layout,
-            entries: &layout::entries(vec![self.args.as_entire_binding()]),
-        });
         let u = &self.pipelines.update;
-        // Separate passes: each step reads what the one before wrote (dispatch sizes, slots).
-        enum Run {
-            /// One thread, writing dispatch sizes.
-            Prepare,
-            One,
-            /// Sized by the dispatch arguments at this offset.
-            Indirect(u64),
-        }
         let steps = [
             (&u.begin, Run::Prepare),
             (&u.restore, Run::Indirect(24)),
@@ -567,20 +537,39 @@ impl DenseVolume {
             (&u.prepare, Run::Prepare),
             (&u.resolve, Run::Indirect(24)),
         ];
+        self.run_steps(device, encoder, "dense_update", &bind, &steps, timer);
+    }
+
+    /// Records `steps` of dense_build or dense_update, one compute pass each: each step reads
+    /// what the one before wrote (dispatch sizes, slots). Timed as `label`.
+    fn run_steps(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &'static str,
+        bind: &wgpu::BindGroup,
+        steps: &[(&wgpu::ComputePipeline, Run)],
+        timer: &mut GpuTimer,
+    ) {
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dense args"),
+            layout: &self.pipelines.args_layout,
+            entries: &layout::entries(vec![self.args.as_entire_binding()]),
+        });
         for (pipeline, run) in steps {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("dense_update"),
-                timestamp_writes: timer.compute("dense_update"),
+                label: Some(label),
+                timestamp_writes: timer.compute(label),
             });
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind, &[]);
+            pass.set_bind_group(0, bind, &[]);
             match run {
                 Run::Prepare => {
                     pass.set_bind_group(1, &args, &[]);
                     pass.dispatch_workgroups(1, 1, 1);
                 }
                 Run::One => pass.dispatch_workgroups(1, 1, 1),
-                Run::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.args, offset),
+                Run::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.args, *offset),
             }
         }
     }
