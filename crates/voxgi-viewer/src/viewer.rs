@@ -434,9 +434,11 @@ impl Viewer {
     /// Draws one frame; returns true when the viewer should close (a screenshot was taken).
     fn redraw(&mut self) -> Result<bool> {
         let now = Instant::now();
-        let dt = (now - self.last_frame).as_secs_f32().min(0.25);
+        let elapsed = (now - self.last_frame).as_secs_f32();
         self.last_frame = now;
-        push(&mut self.frame_ms, dt * 1e3);
+        push(&mut self.frame_ms, elapsed * 1e3);
+        // Slow frames do not make the animation or the fly camera jump.
+        let dt = elapsed.min(0.25);
         if let Controller::Fly(f) = &mut self.controller {
             let k = |c: KeyCode| self.keys.contains(&c) as i32 as f32;
             f.step(
