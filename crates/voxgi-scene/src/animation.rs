@@ -77,41 +77,31 @@ fn catmull_rom_weights(s: f32) -> [f32; 4] {
     ]
 }
 
-impl Keyable for f32 {
-    fn lerp(a: Self, b: Self, s: f32) -> Self {
-        a + (b - a) * s
-    }
-    fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
-        let w = catmull_rom_weights(s);
-        w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
-    }
-    fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self {
-        let w = hermite_weights(dt, s);
-        w[0] * p0 + w[1] * b0 + w[2] * p1 + w[3] * a1
-    }
-    fn finite(&self) -> bool {
-        self.is_finite()
-    }
+/// Scalars and vectors interpolate the same way, component by component.
+macro_rules! keyable_vector {
+    ($($t:ty),*) => {$(
+        impl Keyable for $t {
+            fn lerp(a: Self, b: Self, s: f32) -> Self {
+                // Not glam's a(1 - s) + bs: between equal keys the value must stay exactly
+                // the key, or a still object "moves" by a rounding step every frame.
+                a + (b - a) * s
+            }
+            fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
+                let w = catmull_rom_weights(s);
+                w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
+            }
+            fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self {
+                let w = hermite_weights(dt, s);
+                w[0] * p0 + w[1] * b0 + w[2] * p1 + w[3] * a1
+            }
+            fn finite(&self) -> bool {
+                self.is_finite()
+            }
+        }
+    )*};
 }
 
-impl Keyable for Vec3 {
-    fn lerp(a: Self, b: Self, s: f32) -> Self {
-        // Not glam's a(1 - s) + bs: between equal keys the value must stay exactly the key,
-        // or a still object "moves" by a rounding step and is updated every frame.
-        a + (b - a) * s
-    }
-    fn catmull_rom(p0: Self, p1: Self, p2: Self, p3: Self, s: f32) -> Self {
-        let w = catmull_rom_weights(s);
-        w[0] * p0 + w[1] * p1 + w[2] * p2 + w[3] * p3
-    }
-    fn hermite(p0: Self, b0: Self, p1: Self, a1: Self, dt: f32, s: f32) -> Self {
-        let w = hermite_weights(dt, s);
-        w[0] * p0 + w[1] * b0 + w[2] * p1 + w[3] * a1
-    }
-    fn finite(&self) -> bool {
-        self.is_finite()
-    }
-}
+keyable_vector!(f32, Vec3);
 
 impl Keyable for Quat {
     fn lerp(a: Self, b: Self, s: f32) -> Self {
