@@ -1,5 +1,6 @@
 // reference: the ground-truth path tracer (and the AO reference). One invocation per pixel adds
-// `sample_count` samples to a float accumulation buffer; the host divides by the total.
+// `sample_count` samples to a float accumulation buffer (rgb: the sum, a: how many samples the
+// pixel has, which also numbers its next sample); the host divides by the count.
 //
 // Same scene, same materials (shared/brdf.wgsl) and same light model (shared/light_model.wgsl)
 // as the rasterizer, so any difference between the two images is the real-time approximation's
@@ -18,7 +19,8 @@ struct Params {
     light_count: u32,
     width: u32,
     height: u32,
-    sample_base: u32,
+    // The first column traced: a dispatch covers columns x0..x1 of the image.
+    x0: u32,
     sample_count: u32,
     seed: u32,
     // Number of indirect bounces: 0 direct only, 1, or a large cap for unlimited.
@@ -28,7 +30,7 @@ struct Params {
     ao_radius: f32,
     // Russian roulette from this path depth on (a huge value disables it).
     rr_depth: u32,
-    _pad0: u32,
+    x1: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -552,24 +554,28 @@ fn ambient_occlusion(px: vec2<u32>) -> f32 {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.width || id.y >= params.height {
+    let px = vec2<u32>(id.x + params.x0, id.y);
+    if px.x >= params.x1 || px.y >= params.height {
         return;
     }
-    let pixel = id.y * params.width + id.x;
+    let pixel = px.y * params.width + px.x;
+    // Each pixel numbers its own samples, so pixels traced in different frames (a split view
+    // whose divider moved) still draw distinct random sequences.
+    let base = u32(accum[pixel].w);
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < params.sample_count; k++) {
-        let sample = params.sample_base + k;
+        let sample = base + k;
         rng = pcg_hash(pcg_hash(pcg_hash(pixel ^ pcg_hash(params.seed)) + sample) ^ 0x9e3779b9u);
         var c: vec3<f32>;
         if params.mode == 1u {
-            c = vec3<f32>(ambient_occlusion(id.xy));
+            c = vec3<f32>(ambient_occlusion(px));
         } else {
-            c = radiance(id.xy);
+            c = radiance(px);
         }
         // A NaN or infinity from a degenerate sample would poison the pixel forever.
         if all(c == c) && all(c < vec3<f32>(FAR_AWAY)) {
             sum += c;
         }
     }
-    accum[pixel] += vec4<f32>(sum, 0.0);
+    accum[pixel] += vec4<f32>(sum, f32(params.sample_count));
 }

@@ -13,6 +13,7 @@ macro_rules! wgsl {
 /// Every WGSL file, by path relative to `crates/voxgi/shaders`.
 const SOURCES: &[(&str, &str)] = wgsl![
     "shared/scene.wgsl",
+    "shared/tone_curves.wgsl",
     "shared/globals.wgsl",
     "shared/brdf.wgsl",
     "shared/light_model.wgsl",
@@ -42,6 +43,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "voxels/dense/debug.wgsl",
     "screen/tonemap.wgsl",
     "reference.wgsl",
+    "reference_display.wgsl",
 ];
 
 /// Shader development: with `VOXGI_SHADER_DIR` set, WGSL is read from that directory (laid out

@@ -8,14 +8,17 @@
 
 use crate::gpu::{checked, layout, readback, shader};
 use crate::gpu_scene::{GpuScene, NO_INDEX, scene_bounds};
-use crate::options::{FrameParams, RendererOptions, validate_size};
+use crate::options::{FrameParams, RendererOptions};
 use crate::output::{RenderOutput, tonemap};
-use crate::view::{camera_view_proj, lit_scene};
+use crate::view::lit_scene;
 use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat3, Vec3};
 use voxgi_scene::Scene;
 use wgpu::util::DeviceExt;
+
+mod progressive;
+pub use progressive::Accumulation;
 
 /// How many indirect bounces the reference simulates (as the cone tracer counts them).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -84,14 +87,15 @@ struct GpuParams {
     light_count: u32,
     width: u32,
     height: u32,
-    sample_base: u32,
+    x0: u32,
     sample_count: u32,
     seed: u32,
     bounces: u32,
     mode: u32,
     ao_radius: f32,
     rr_depth: u32,
-    _pad: [u32; 3],
+    x1: u32,
+    _pad: [u32; 2],
 }
 
 /// Mirrors `Node` in shaders/reference.wgsl.
@@ -157,9 +161,9 @@ pub struct PathTracer {
     nodes: wgpu::Buffer,
     tris: wgpu::Buffer,
     shading: wgpu::Buffer,
-    params: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    display: progressive::DisplayPass,
 }
 
 /// World-space triangles in BVH order, and the flattened BVH over them.
@@ -347,13 +351,8 @@ impl PathTracer {
             });
             (layout, pipeline)
         })?;
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("reference params"),
-            size: size_of::<GpuParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         Ok(PathTracer {
+            display: progressive::DisplayPass::new(&device),
             device,
             queue,
             light_count: gpu_scene.light_count,
@@ -364,7 +363,6 @@ impl PathTracer {
             nodes: buffers.0,
             tris: buffers.1,
             shading: buffers.2,
-            params,
             layout,
             pipeline,
         })
@@ -386,91 +384,25 @@ impl PathTracer {
         opts: &ReferenceOptions,
         progress: &mut dyn FnMut(u32, u32),
     ) -> Result<RenderOutput> {
-        validate_size(width, height)?;
-        let camera = &frame.camera;
-        if !(camera.position.is_finite() && camera.forward.is_finite() && camera.up.is_finite()) {
-            return Err(Error::Setting(
-                "camera position and direction must be finite".into(),
-            ));
-        }
         if opts.spp == 0 {
             return Err(Error::Setting("spp must be at least 1".into()));
         }
-        let (mode, ao_radius) = match opts.mode {
-            ReferenceMode::Radiance => (0, 0.0),
-            ReferenceMode::Ao { radius } => {
-                if !(radius.is_finite() && radius > 0.0) {
-                    return Err(Error::Setting(format!(
-                        "AO radius {radius} must be positive and finite"
-                    )));
-                }
-                (1, radius)
-            }
-        };
-        let (bounces, rr_depth) = match opts.bounces {
-            Bounces::DirectOnly => (0, u32::MAX),
-            Bounces::One => (1, u32::MAX),
-            Bounces::Unlimited => (MAX_BOUNCES - 1, 3),
-            Bounces::Exactly(n) => (n.min(MAX_BOUNCES - 1), u32::MAX),
-        };
-        let view_proj = camera_view_proj(camera, width, height, self.center, self.radius);
+        let mut acc = self.accumulation(width, height)?;
         let pixels = width as u64 * height as u64;
-        let accum = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("reference accumulation"),
-            size: pixels * 16,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("reference"),
-            layout: &self.layout,
-            entries: &layout::entries(vec![
-                self.params.as_entire_binding(),
-                self.nodes.as_entire_binding(),
-                self.tris.as_entire_binding(),
-                self.shading.as_entire_binding(),
-                self.scene.materials.as_entire_binding(),
-                self.scene.lights.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&self.scene.texture_view),
-                wgpu::BindingResource::Sampler(&self.scene.sampler),
-                accum.as_entire_binding(),
-            ]),
-        });
         let batch = (PATHS_PER_SUBMIT / pixels).clamp(1, 64) as u32;
         let mut done = 0u32;
         while done < opts.spp {
             let count = batch.min(opts.spp - done);
-            let params = GpuParams {
-                inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-                background: frame.background,
-                light_count: self.light_count,
-                width,
-                height,
-                sample_base: done,
-                sample_count: count,
-                seed: opts.seed,
-                bounces,
-                mode,
-                ao_radius,
-                rr_depth,
-                _pad: [0; 3],
-            };
-            self.queue
-                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
             let mut enc = self
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("reference"),
                 });
-            {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("reference"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
-                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-            }
+            let batch_opts = ReferenceOptions {
+                spp: count,
+                ..*opts
+            };
+            self.accumulate(&mut enc, &mut acc, frame, &batch_opts, 0..width)?;
             self.queue.submit([enc.finish()]);
             self.device
                 .poll(wgpu::PollType::wait_indefinitely())
@@ -488,7 +420,7 @@ impl PathTracer {
             mapped_at_creation: false,
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&accum, 0, &staging, 0, pixels * 16);
+        enc.copy_buffer_to_buffer(acc.buffer(), 0, &staging, 0, pixels * 16);
         self.queue.submit([enc.finish()]);
         let bytes = readback::read_buffer(&self.device, &staging)?;
         let inv = 1.0 / opts.spp as f32;

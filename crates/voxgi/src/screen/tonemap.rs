@@ -65,47 +65,13 @@ impl TonemapPass {
         if self.pipelines.iter().any(|(f, _)| *f == format) {
             return Ok(());
         }
-        let renderable = format
-            .guaranteed_format_features(device.features())
-            .allowed_usages
-            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
-            && format
-                .sample_type(None, None)
-                .is_some_and(|t| matches!(t, wgpu::TextureSampleType::Float { .. }))
-            && !format.is_depth_stencil_format();
-        if !renderable {
-            return Err(Error::Setting(format!(
-                "the target format {format:?} is not a colour format voxgi can render to (use \
-                 an 8-bit UNORM or sRGB format, Rgb10a2Unorm, or a float format)"
-            )));
-        }
-        let constants = [("ENCODE_SRGB", encodes_srgb(format) as u32 as f64)];
-        let pipeline = checked(device, "tonemap pipeline", || {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("tonemap"),
-                layout: Some(&self.pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &self.module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &self.module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants: &constants,
-                        ..Default::default()
-                    },
-                    targets: &[Some(format.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })?;
+        let pipeline = output_pipeline(
+            device,
+            "tonemap",
+            &self.pipeline_layout,
+            &self.module,
+            format,
+        )?;
         self.pipelines.push((format, pipeline));
         Ok(())
     }
@@ -151,4 +117,57 @@ impl TonemapPass {
         pass.set_bind_group(2, &bind, &[]);
         pass.draw(0..3, 0..1);
     }
+}
+
+/// A full-screen pipeline (`vs_main`, `fs_main`) drawing into the caller's `format`: the
+/// tonemap pass's and the path tracer's display, which both end in the caller's target and
+/// adapt to its format alike (`ENCODE_SRGB`). An error when the format cannot be rendered to.
+pub(crate) fn output_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+) -> Result<wgpu::RenderPipeline> {
+    let renderable = format
+        .guaranteed_format_features(device.features())
+        .allowed_usages
+        .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        && format
+            .sample_type(None, None)
+            .is_some_and(|t| matches!(t, wgpu::TextureSampleType::Float { .. }))
+        && !format.is_depth_stencil_format();
+    if !renderable {
+        return Err(Error::Setting(format!(
+            "the target format {format:?} is not a colour format voxgi can render to (use an \
+             8-bit UNORM or sRGB format, Rgb10a2Unorm, or a float format)"
+        )));
+    }
+    let constants = [("ENCODE_SRGB", encodes_srgb(format) as u32 as f64)];
+    checked(device, &format!("{label} pipeline"), || {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    })
 }

@@ -446,3 +446,165 @@ fn cone_traced_cornell_box_agrees_with_the_path_tracer() {
     // cone weight shows as a 15 % region error above before it moves FLIP much.
     assert!(c.flip_mean < 0.16, "mean FLIP {}", c.flip_mean);
 }
+
+/// Draws `acc`'s running mean into a fresh `Rgba8Unorm` texture and reads it back.
+fn displayed(
+    pt: &mut PathTracer,
+    acc: &voxgi::reference::Accumulation,
+    p: &FrameParams,
+) -> Vec<u8> {
+    let (w, h) = (acc.width(), acc.height());
+    let texture = ctx()
+        .device
+        .create_texture(&voxgi::wgpu::TextureDescriptor {
+            label: Some("display test"),
+            size: voxgi::wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: voxgi::wgpu::TextureDimension::D2,
+            format: voxgi::wgpu::TextureFormat::Rgba8Unorm,
+            usage: voxgi::wgpu::TextureUsages::RENDER_ATTACHMENT
+                | voxgi::wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+    let view = texture.create_view(&Default::default());
+    let target = voxgi::Target::new(&view, voxgi::wgpu::TextureFormat::Rgba8Unorm, w, h);
+    let mut enc = ctx().device.create_command_encoder(&Default::default());
+    pt.display(&mut enc, acc, &target, p, 0..w)
+        .expect("display");
+    ctx().queue.submit([enc.finish()]);
+    voxgi::gpu::readback::read_texture(&ctx().device, &ctx().queue, &texture).expect("readback")
+}
+
+/// Adds `spp` samples to `columns` in one submit; returns the samples the call reports.
+fn accumulate(
+    pt: &PathTracer,
+    acc: &mut voxgi::reference::Accumulation,
+    p: &FrameParams,
+    spp: u32,
+    columns: std::ops::Range<u32>,
+) -> u32 {
+    let mut enc = ctx().device.create_command_encoder(&Default::default());
+    let n = pt
+        .accumulate(&mut enc, acc, p, &opts(spp, Bounces::Unlimited), columns)
+        .expect("accumulate");
+    ctx().queue.submit([enc.finish()]);
+    n
+}
+
+/// The largest difference of two 8-bit images, over the columns `x0..x1`.
+fn max_ldr_difference(a: &[u8], b: &[u8], w: u32, x0: u32, x1: u32) -> u8 {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .enumerate()
+        .filter(|(i, _)| (x0..x1).contains(&(*i as u32 % w)))
+        .flat_map(|(_, (p, q))| (0..3).map(move |c| p[c].abs_diff(q[c])))
+        .max()
+        .unwrap_or(0)
+}
+
+/// The window's progressive path tracing is the one-shot render spread over frames: every pixel
+/// numbers its own samples, so a pixel traced in three calls (1 + 2 + 5 samples) draws the very
+/// samples an 8-spp render draws, and the GPU display maps them as the CPU tone curve does.
+/// One 8-bit step of tolerance: the sums are added in another order (f32 rounding) and the
+/// curve runs on the GPU instead of the CPU.
+#[test]
+fn progressive_accumulation_matches_the_one_shot_render() {
+    let scene = builtin::cornell_box();
+    let params = FrameParams::new(scene.cameras[0].clone());
+    let (w, h) = (24, 16);
+    let mut pt = PathTracer::new(&ctx().device, &ctx().queue, &scene, &measuring()).unwrap();
+    let full = pt
+        .render(&params, w, h, &opts(8, Bounces::Unlimited), &mut |_, _| {})
+        .unwrap();
+    let half = pt
+        .render(&params, w, h, &opts(4, Bounces::Unlimited), &mut |_, _| {})
+        .unwrap();
+    let mut acc = pt.accumulation(w, h).unwrap();
+    assert_eq!(accumulate(&pt, &mut acc, &params, 1, 0..w), 1);
+    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..w), 3);
+    assert_eq!(accumulate(&pt, &mut acc, &params, 5, 0..w), 8);
+    let shown = displayed(&mut pt, &acc, &params);
+    let d = max_ldr_difference(&shown, &full.ldr, w, 0, w);
+    assert!(
+        d <= 1,
+        "progressive 1+2+5 spp differs from 8 spp by {d}/255"
+    );
+
+    // A split view: the right half joins after the left half has 4 samples. Each side then
+    // shows exactly its own count's image, and the count reported is the smaller one.
+    let mut acc = pt.accumulation(w, h).unwrap();
+    assert_eq!(accumulate(&pt, &mut acc, &params, 4, 0..w / 2), 4);
+    assert_eq!(accumulate(&pt, &mut acc, &params, 4, 0..w), 4);
+    let shown = displayed(&mut pt, &acc, &params);
+    let left = max_ldr_difference(&shown, &full.ldr, w, 0, w / 2);
+    let right = max_ldr_difference(&shown, &half.ldr, w, w / 2, w);
+    assert!(left <= 1, "the 8-spp half differs from 8 spp by {left}/255");
+    assert!(
+        right <= 1,
+        "the 4-spp half differs from 4 spp by {right}/255"
+    );
+    // Only the image should differ between the two halves' references: the test is blind if
+    // 4 and 8 spp look the same.
+    assert!(max_ldr_difference(&full.ldr, &half.ldr, w, 0, w) > 1);
+}
+
+/// A moved camera starts the image over; exposure does not (it only changes the display).
+#[test]
+fn progressive_accumulation_restarts_when_the_view_changes() {
+    let scene = builtin::cornell_box();
+    let mut params = FrameParams::new(scene.cameras[0].clone());
+    let mut pt = PathTracer::new(&ctx().device, &ctx().queue, &scene, &measuring()).unwrap();
+    let mut acc = pt.accumulation(8, 8).unwrap();
+    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 2);
+    params.exposure = 1.0;
+    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 4);
+    params.camera.position.x += 0.01;
+    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 2);
+    acc.reset();
+    assert_eq!(accumulate(&pt, &mut acc, &params, 3, 0..8), 3);
+
+    let mut enc = ctx().device.create_command_encoder(&Default::default());
+    #[allow(clippy::reversed_empty_ranges)]
+    let bad = [0..0, 4..9, 5..3];
+    for columns in bad {
+        let e = pt
+            .accumulate(
+                &mut enc,
+                &mut acc,
+                &params,
+                &opts(1, Bounces::One),
+                columns.clone(),
+            )
+            .err()
+            .unwrap_or_else(|| panic!("columns {columns:?} accepted"));
+        assert!(e.to_string().contains("columns"), "{e}");
+    }
+    let other = pt.accumulation(4, 4).unwrap();
+    let texture = ctx()
+        .device
+        .create_texture(&voxgi::wgpu::TextureDescriptor {
+            label: None,
+            size: voxgi::wgpu::Extent3d {
+                width: 8,
+                height: 8,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: voxgi::wgpu::TextureDimension::D2,
+            format: voxgi::wgpu::TextureFormat::Rgba8Unorm,
+            usage: voxgi::wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+    let view = texture.create_view(&Default::default());
+    let target = voxgi::Target::new(&view, voxgi::wgpu::TextureFormat::Rgba8Unorm, 8, 8);
+    let e = pt
+        .display(&mut enc, &other, &target, &params, 0..4)
+        .expect_err("a 4x4 accumulation shown on an 8x8 target");
+    assert!(e.to_string().contains("4x4"), "{e}");
+}
