@@ -206,12 +206,7 @@ fn reference_options(
 ) -> ReferenceOptions {
     ReferenceOptions {
         spp: args.spp,
-        bounces: match options.bounces {
-            0 => Bounces::DirectOnly,
-            1 => Bounces::One,
-            voxgi::UNLIMITED_BOUNCES => Bounces::Unlimited,
-            n => Bounces::Exactly(n),
-        },
+        bounces: Bounces::matching(options.bounces),
         mode: if args.mode == ModeArg::AoReference {
             ReferenceMode::Ao {
                 // The cone tracer's AO radius, so the two are comparable.

@@ -3,6 +3,8 @@
 //! device, the window and the frame, as any application would.
 
 mod camera;
+mod ground_truth;
+mod jobs;
 mod settings;
 mod viewer;
 
@@ -39,6 +41,24 @@ pub struct Args {
     /// Present without waiting for the display's refresh.
     #[arg(long)]
     pub no_vsync: bool,
+    /// What the window shows: cone tracing, voxgi's path tracer, or both split by a divider
+    /// (G cycles through them).
+    #[arg(long, value_enum, default_value_t = ground_truth::Display::ConeTraced)]
+    pub display: ground_truth::Display,
+    /// Where the split view's divider starts, as a fraction of the width.
+    #[arg(long, value_name = "F", default_value_t = 0.5, value_parser = parse_fraction)]
+    pub divider: f32,
+}
+
+fn parse_fraction(s: &str) -> Result<f32, String> {
+    let f: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    if !(0.0..=1.0).contains(&f) {
+        return Err(format!("{f} is not within 0..=1"));
+    }
+    Ok(f)
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -48,6 +48,12 @@ pub struct PanelActions {
     pub apply: bool,
     /// Put the draft back to the options in use.
     pub revert: bool,
+    /// Open the system's file dialog.
+    pub open_dialog: bool,
+    /// Open this file.
+    pub open: Option<std::path::PathBuf>,
+    /// Show this instead.
+    pub display: Option<crate::ground_truth::Display>,
 }
 
 /// The panel's creation-time options section: widgets over the draft.
@@ -98,7 +104,7 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
             actions.revert = true;
         }
         if dirty {
-            ui.label("(rebuilds what the changes feed)");
+            ui.label("(builds a new renderer; the window goes on meanwhile)");
         }
     });
     actions

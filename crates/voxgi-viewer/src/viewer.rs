@@ -2,11 +2,13 @@
 //! top, input to the camera controllers, animation playback, screenshots.
 
 use crate::camera::{Fly, Movement, Orbit, render_flags};
+use crate::ground_truth::{Display, GroundTruth};
+use crate::jobs::{Job, take};
 use crate::settings::{frame_ui, options_ui};
 use crate::{Args, load};
 use anyhow::{Context, Result, anyhow};
 use std::collections::HashSet;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 use voxgi::scene::Scene;
@@ -86,6 +88,15 @@ impl ApplicationHandler for App {
     }
 }
 
+/// A file loaded and its renderer built, off the window's thread.
+struct Opened {
+    path: PathBuf,
+    scene: Scene,
+    settings_params: FrameParams,
+    options: RendererOptions,
+    renderer: Renderer,
+}
+
 enum Controller {
     Orbit(Orbit),
     Fly(Fly),
@@ -103,6 +114,18 @@ struct Viewer {
     adapter: wgpu::AdapterInfo,
     timestamps: bool,
     renderer: Renderer,
+    /// The scene as loaded (at time 0): what new options and the path tracer build from.
+    scene: Arc<Scene>,
+    /// Counts changes of the scene's state (time, lights): the path tracer follows it.
+    version: u64,
+    last_time: f32,
+    ground: GroundTruth,
+    // Background work, each shown in the window while it runs.
+    rebuild: Option<(Job<Renderer>, RendererOptions)>,
+    opening: Option<Job<Opened>>,
+    dialog: Option<Job<Option<PathBuf>>>,
+    open_path: String,
+    vsync: bool,
     scene_name: String,
     scene_radius: f32,
     /// The scene's own cameras, to pick from.
@@ -128,6 +151,9 @@ struct Viewer {
     frame_ms: std::collections::VecDeque<f32>,
     pass_ms: Vec<(&'static str, std::collections::VecDeque<f32>)>,
     frames: u32,
+    /// Frames drawn with nothing in the background (the path tracer built): what
+    /// `--after-frames` counts, so a screenshot does not race a build.
+    ready_frames: u32,
     status: String,
     show_panel: bool,
     // Screenshots.
@@ -227,6 +253,8 @@ impl Viewer {
         }
         let mut renderer = Renderer::new(&device, &queue, &scene, &options)?;
         renderer.enable_timing(timestamps);
+        let mut ground = GroundTruth::new(args.display, cpu);
+        ground.divider = args.divider;
         let bounds = voxgi::swept_bounds(&scene);
         let radius = if bounds.is_empty() {
             1.0
@@ -263,11 +291,22 @@ impl Viewer {
             scene_name: scene_label(&scene),
             scene_radius: radius,
             cameras: scene.cameras.clone(),
+            // The path tracer shows a still scene: play with G's cone tracing.
+            playing: duration > 0.0 && args.display == Display::ConeTraced,
             draft: options.clone(),
             options,
             controller: Controller::Orbit(Orbit::from_camera(&default_camera, orbit_distance)),
             params,
             renderer,
+            scene: Arc::new(scene),
+            version: 0,
+            last_time: 0.0,
+            ground,
+            rebuild: None,
+            opening: None,
+            dialog: None,
+            open_path: String::new(),
+            vsync: !args.no_vsync,
             egui_ctx,
             egui_state,
             egui_renderer,
@@ -277,11 +316,11 @@ impl Viewer {
             cursor: None,
             duration,
             time: 0.0,
-            playing: duration > 0.0,
             last_frame: Instant::now(),
             frame_ms: Default::default(),
             pass_ms: Vec::new(),
             frames: 0,
+            ready_frames: 0,
             status: String::new(),
             show_panel: true,
             screenshot: args
@@ -380,6 +419,10 @@ impl Viewer {
                 };
             }
             KeyCode::KeyH => self.frame_scene(),
+            KeyCode::KeyG => {
+                let i = Display::ALL.iter().position(|d| *d == self.ground.display);
+                self.set_display(Display::ALL[(i.unwrap_or(0) + 1) % Display::ALL.len()]);
+            }
             KeyCode::Space => self.playing = !self.playing,
             KeyCode::Tab => self.show_panel = !self.show_panel,
             KeyCode::F12 | KeyCode::KeyP => self.screenshot_key = true,
@@ -393,46 +436,171 @@ impl Viewer {
         self.controller = Controller::Orbit(Orbit::from_camera(&cam, self.scene_radius * 2.0));
     }
 
-    /// Replaces the scene with the file at `path`; on failure the error shows and the scene
-    /// stays.
-    fn open(&mut self, path: &std::path::Path) {
-        let result = (|| -> Result<()> {
-            let (mut scene, settings) = load(Some(path), None)?;
+    /// Starts loading the file at `path` (and building its renderer) in the background; when it
+    /// is done it replaces the scene. On failure the error shows and the scene stays.
+    fn open(&mut self, path: &Path) {
+        let path = path.to_path_buf();
+        let (device, queue) = (self.device.clone(), self.queue.clone());
+        let (options, camera) = (self.options.clone(), self.params.camera.clone());
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        self.opening = Some(Job::spawn(format!("opening {name}"), move || {
+            let (mut scene, settings) = load(Some(&path), None)?;
             scene.set_time(0.0);
-            let mut options = self.options.clone();
-            let mut params = FrameParams::new(self.params.camera.clone());
+            let mut options = options;
+            let mut params = FrameParams::new(camera);
             if let Some(s) = &settings {
                 s.apply(&mut options, &mut params)?;
             }
-            let mut renderer = Renderer::new(&self.device, &self.queue, &scene, &options)
+            let renderer = Renderer::new(&device, &queue, &scene, &options)
                 .with_context(|| path.display().to_string())?;
-            renderer.enable_timing(self.timestamps);
-            self.renderer = renderer;
-            self.draft = options.clone();
-            self.options = options;
-            let bounds = voxgi::swept_bounds(&scene);
-            self.scene_radius = (bounds.size().length() * 0.5).max(1e-3);
-            self.duration = scene
-                .animations
-                .iter()
-                .map(|a| a.duration())
-                .fold(0.0f32, f32::max);
-            self.time = 0.0;
-            self.playing = self.duration > 0.0;
-            self.scene_name = scene_label(&scene);
-            self.window
-                .set_title(&format!("voxgi — {}", self.scene_name));
-            self.frame_scene();
-            Ok(())
-        })();
-        self.status = match result {
-            Ok(()) => format!("opened {}", path.display()),
-            Err(e) => format!("{e:#}"),
-        };
+            Ok(Opened {
+                path,
+                scene,
+                settings_params: params,
+                options,
+                renderer,
+            })
+        }));
+    }
+
+    /// The loaded file replaces the scene.
+    fn opened(&mut self, o: Opened) {
+        let mut renderer = o.renderer;
+        renderer.enable_timing(self.timestamps);
+        self.renderer = renderer;
+        self.draft = o.options.clone();
+        self.options = o.options;
+        // The file's view settings (exposure, tone curve, view mode); the camera is framed below.
+        self.params = o.settings_params;
+        let bounds = voxgi::swept_bounds(&o.scene);
+        self.scene_radius = (bounds.size().length() * 0.5).max(1e-3);
+        self.duration = o
+            .scene
+            .animations
+            .iter()
+            .map(|a| a.duration())
+            .fold(0.0f32, f32::max);
+        self.time = 0.0;
+        self.playing = self.duration > 0.0 && self.ground.display == Display::ConeTraced;
+        self.scene_name = scene_label(&o.scene);
+        self.cameras = o.scene.cameras.clone();
+        self.window
+            .set_title(&format!("voxgi — {}", self.scene_name));
+        self.scene = Arc::new(o.scene);
+        self.version += 1;
+        self.ground.clear();
+        self.pass_ms.clear();
+        self.frame_scene();
+        self.status = format!("opened {}", o.path.display());
+    }
+
+    /// Builds a renderer for the draft options in the background; the current one draws until
+    /// it is ready.
+    fn apply(&mut self) {
+        let (device, queue) = (self.device.clone(), self.queue.clone());
+        let (scene, options) = (self.scene.clone(), self.draft.clone());
+        let job = Job::spawn("rebuilding for the new options", move || {
+            Ok(Renderer::new(&device, &queue, &scene, &options)?)
+        });
+        self.rebuild = Some((job, self.draft.clone()));
+    }
+
+    /// The new options' renderer takes over, with the scene's time and the lights as edited.
+    fn rebuilt(&mut self, mut renderer: Renderer, options: RendererOptions) {
+        renderer.enable_timing(self.timestamps);
+        let lights = self.renderer.lights().to_vec();
+        if renderer.lights().len() == lights.len() {
+            for (i, l) in lights.iter().enumerate() {
+                // A light whose kind differs (the default sun switched) keeps the new one's.
+                let _ = renderer.set_light(i, l);
+            }
+        }
+        self.renderer = renderer;
+        self.options = options;
+        self.pass_ms.clear();
+        // default_light may have changed what the path tracer must see.
+        self.ground.clear();
+        self.version += 1;
+        self.status = "options applied".into();
+    }
+
+    /// Opens the system's file dialog on its own thread.
+    fn open_dialog(&mut self) {
+        self.dialog = Some(Job::spawn("waiting for the file dialog", || {
+            Ok(rfd::FileDialog::new()
+                .set_title("Open a scene")
+                .add_filter("scenes", voxgi::scene::io::EXTENSIONS)
+                .pick_file())
+        }));
+    }
+
+    /// Takes the results of finished background work.
+    fn poll_jobs(&mut self) {
+        if let Some((job, _)) = &self.rebuild
+            && let Some(result) = job.poll()
+        {
+            let (_, options) = self.rebuild.take().expect("polled above");
+            match result {
+                Ok(r) => self.rebuilt(r, options),
+                Err(e) => self.status = format!("the new options failed: {e:#}"),
+            }
+        }
+        match take(&mut self.opening) {
+            Some(Ok(o)) => self.opened(o),
+            Some(Err(e)) => self.status = format!("{e:#}"),
+            None => {}
+        }
+        match take(&mut self.dialog) {
+            Some(Ok(Some(path))) => self.open(&path),
+            Some(Ok(None)) => {
+                self.status = "no file chosen (the dialog needs xdg-desktop-portal or zenity; \
+                               a file dropped onto the window or a path typed above opens too)"
+                    .into()
+            }
+            Some(Err(e)) => self.status = format!("{e:#}"),
+            None => {}
+        }
+    }
+
+    fn set_display(&mut self, display: Display) {
+        if display != Display::ConeTraced && self.playing {
+            self.playing = false;
+            self.status = "paused: the path tracer shows a still scene".into();
+        }
+        self.ground.display = display;
+    }
+
+    /// The scene into `target`: cone tracing, then the path tracer over its columns. With
+    /// `accumulate` false the path tracer only shows what it has (a second drawing of the same
+    /// frame, for a screenshot).
+    fn draw_scene(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        accumulate: bool,
+    ) -> Result<()> {
+        if self.ground.needs_cone_tracing() {
+            self.renderer.render(encoder, target, &self.params)?;
+        }
+        let r = self.ground.record(
+            encoder,
+            target,
+            &self.params,
+            self.options.bounces,
+            accumulate,
+        );
+        if let Err(e) = r {
+            self.ground.error = Some(format!("{e:#}"));
+        }
+        Ok(())
     }
 
     /// Draws one frame; returns true when the viewer should close (a screenshot was taken).
     fn redraw(&mut self) -> Result<bool> {
+        self.poll_jobs();
         let now = Instant::now();
         let elapsed = (now - self.last_frame).as_secs_f32();
         self.last_frame = now;
@@ -454,10 +622,24 @@ impl Viewer {
             self.time = (self.time + dt) % self.duration.max(1e-3);
         }
         self.renderer.set_time(self.time)?;
+        if self.time != self.last_time {
+            self.last_time = self.time;
+            self.version += 1;
+            self.ground.scene_changed();
+        }
         self.params.camera = match &self.controller {
             Controller::Orbit(o) => o.camera(),
             Controller::Fly(f) => f.camera(),
         };
+        self.ground.update(
+            &self.device,
+            &self.queue,
+            &self.scene,
+            self.time,
+            self.renderer.lights(),
+            &self.options,
+            self.version,
+        );
 
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
@@ -475,11 +657,8 @@ impl Viewer {
         let view = frame.texture.create_view(&Default::default());
         let (w, h) = (self.config.width, self.config.height);
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.renderer.render(
-            &mut encoder,
-            &Target::new(&view, self.config.format, w, h),
-            &self.params,
-        )?;
+        let format = self.config.format;
+        self.draw_scene(&mut encoder, &Target::new(&view, format, w, h), true)?;
 
         // The UI, drawn over the image.
         let raw = self.egui_state.take_egui_input(&self.window);
@@ -512,15 +691,11 @@ impl Viewer {
             && self
                 .screenshot
                 .as_ref()
-                .is_some_and(|(_, after)| self.frames + 1 >= *after);
+                .is_some_and(|(_, after)| self.ready_frames + 1 >= *after);
         let ui_capture = if capture_ui {
             let texture = self.capture_texture(self.config.format);
             let v = texture.create_view(&Default::default());
-            self.renderer.render(
-                &mut encoder,
-                &Target::new(&v, self.config.format, w, h),
-                &self.params,
-            )?;
+            self.draw_scene(&mut encoder, &Target::new(&v, format, w, h), false)?;
             egui_pass(&self.egui_renderer, &mut encoder, &v, &jobs, &screen);
             Some(texture)
         } else {
@@ -546,19 +721,36 @@ impl Viewer {
             }
         }
         self.frames += 1;
+        let busy = self.rebuild.is_some()
+            || self.opening.is_some()
+            || (self.ground.display != Display::ConeTraced && self.ground.building());
+        if !busy {
+            self.ready_frames += 1;
+        }
 
         if actions.revert {
             self.draft = self.options.clone();
         }
         if actions.apply {
-            // Rebuilds only what the changes feed; a failure leaves the renderer as it was.
-            match self.renderer.set_options(&self.draft) {
-                Ok(()) => {
-                    self.options = self.draft.clone();
-                    self.status = "options applied".into();
-                }
-                Err(e) => self.status = format!("{e}"),
-            }
+            self.apply();
+        }
+        if actions.open_dialog {
+            self.open_dialog();
+        }
+        if let Some(path) = actions.open.take() {
+            self.open(&path);
+        }
+        if let Some(d) = actions.display {
+            self.set_display(d);
+        }
+        let present_mode = if self.vsync {
+            wgpu::PresentMode::AutoVsync
+        } else {
+            wgpu::PresentMode::AutoNoVsync
+        };
+        if present_mode != self.config.present_mode {
+            self.config.present_mode = present_mode;
+            self.surface.configure(&self.device, &self.config);
         }
         if self.screenshot_key {
             self.screenshot_key = false;
@@ -569,7 +761,7 @@ impl Viewer {
             };
         }
         if let Some((path, after)) = &self.screenshot
-            && self.frames >= *after
+            && self.ready_frames >= *after
         {
             let path = path.clone();
             match ui_capture {
@@ -636,11 +828,7 @@ impl Viewer {
         let texture = self.capture_texture(format);
         let view = texture.create_view(&Default::default());
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.renderer.render(
-            &mut encoder,
-            &Target::new(&view, format, w, h),
-            &self.params,
-        )?;
+        self.draw_scene(&mut encoder, &Target::new(&view, format, w, h), false)?;
         self.queue.submit([encoder.finish()]);
         let ldr = voxgi::gpu::readback::read_texture(&self.device, &self.queue, &texture)?;
         let hdr = match self.renderer.hdr_texture() {
@@ -663,6 +851,7 @@ impl Viewer {
 
     fn ui(&mut self, ui: &mut egui::Ui) -> crate::settings::PanelActions {
         let mut actions = crate::settings::PanelActions::default();
+        self.overlays_ui(ui);
         if !self.show_panel {
             return actions;
         }
@@ -677,8 +866,24 @@ impl Viewer {
                     ));
                     ui.label(
                         "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
-                         to look) · H: frame · Space: play · P: screenshot · Tab: panel",
+                         to look) · H: frame · G: path tracer / split · Space: play · \
+                         P: screenshot · Tab: panel",
                     );
+                    ui.horizontal(|ui| {
+                        if ui.button("Open…").clicked() {
+                            actions.open_dialog = true;
+                        }
+                        let edit = ui.add(
+                            egui::TextEdit::singleline(&mut self.open_path)
+                                .hint_text("or a path, then Enter")
+                                .desired_width(150.0),
+                        );
+                        let enter =
+                            edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                        if enter && !self.open_path.trim().is_empty() {
+                            actions.open = Some(PathBuf::from(self.open_path.trim()));
+                        }
+                    });
                     if !self.status.is_empty() {
                         ui.colored_label(egui::Color32::YELLOW, &self.status);
                     }
@@ -715,6 +920,13 @@ impl Viewer {
                             }
                         });
                     }
+                    egui::CollapsingHeader::new("ground truth")
+                        .default_open(true)
+                        .show(ui, |ui| {
+                            if let Some(d) = self.ground_ui(ui) {
+                                actions.display = Some(d);
+                            }
+                        });
                     ui.collapsing("lights", |ui| self.lights_ui(ui));
                     ui.collapsing("renderer", |ui| {
                         let dirty = self.draft != self.options;
@@ -742,6 +954,122 @@ impl Viewer {
                 });
             });
         actions
+    }
+
+    /// The path tracer's controls: what the window shows, the divider, samples per frame.
+    fn ground_ui(&mut self, ui: &mut egui::Ui) -> Option<Display> {
+        let mut pick = None;
+        ui.horizontal(|ui| {
+            for d in Display::ALL {
+                if ui
+                    .selectable_label(self.ground.display == d, d.name())
+                    .clicked()
+                {
+                    pick = Some(d);
+                }
+            }
+        });
+        if self.ground.display == Display::Split {
+            ui.add(egui::Slider::new(&mut self.ground.divider, 0.0..=1.0).text("divider"));
+        }
+        ui.add(
+            egui::Slider::new(&mut self.ground.samples_per_frame, 1..=64)
+                .logarithmic(true)
+                .text("samples per frame"),
+        );
+        ui.add(
+            egui::Slider::new(&mut self.ground.paths_per_frame, 1 << 10..=1 << 26)
+                .logarithmic(true)
+                .text("paths per frame"),
+        );
+        ui.add(
+            egui::Slider::new(&mut self.ground.max_samples, 16..=65536)
+                .logarithmic(true)
+                .text("stop at spp"),
+        );
+        if self.ground.display != Display::ConeTraced {
+            ui.label(self.ground.label());
+            if self.params.view != voxgi::ViewMode::Final {
+                ui.label("(the path tracer shows the final image in every view mode)");
+            }
+        }
+        pick
+    }
+
+    /// Over the image: what runs in the background, the split view's divider and the names of
+    /// its sides.
+    fn overlays_ui(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let mut running: Vec<String> = Vec::new();
+        if let Some((job, _)) = &self.rebuild {
+            running.push(job.label());
+        }
+        if let Some(job) = &self.opening {
+            running.push(job.label());
+        }
+        if let Some(job) = &self.dialog {
+            running.push(job.label());
+        }
+        if self.ground.display != Display::ConeTraced && self.ground.building() {
+            running.push(self.ground.label());
+        }
+        if !running.is_empty() {
+            egui::Area::new(egui::Id::unique("jobs"))
+                .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        for r in &running {
+                            ui.horizontal(|ui| {
+                                ui.spinner();
+                                ui.label(r);
+                            });
+                        }
+                    });
+                });
+        }
+        let screen = ctx.content_rect();
+        let caption = |ui: &mut egui::Ui, text: String| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(text));
+        };
+        match self.ground.display {
+            Display::ConeTraced => {}
+            Display::PathTraced => {
+                let text = self.ground.label();
+                egui::Area::new(egui::Id::unique("path traced"))
+                    .anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0])
+                    .show(&ctx, |ui| caption(ui, text));
+            }
+            Display::Split => {
+                let x = screen.left() + screen.width() * self.ground.divider;
+                let text = self.ground.label();
+                egui::Area::new(egui::Id::unique("path traced"))
+                    .anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0])
+                    .show(&ctx, |ui| caption(ui, text));
+                egui::Area::new(egui::Id::unique("cone traced"))
+                    .pivot(egui::Align2::RIGHT_BOTTOM)
+                    .fixed_pos(egui::pos2(x - 12.0, screen.bottom() - 8.0))
+                    .show(&ctx, |ui| caption(ui, "cone traced".into()));
+                // The divider: a line with a handle, dragged sideways.
+                let response = egui::Area::new(egui::Id::unique("divider"))
+                    .fixed_pos(egui::pos2(x - 6.0, screen.top()))
+                    .show(&ctx, |ui| {
+                        let (rect, response) = ui.allocate_exact_size(
+                            egui::vec2(12.0, screen.height()),
+                            egui::Sense::drag(),
+                        );
+                        let painter = ui.painter();
+                        let stroke = egui::Stroke::new(2.0, egui::Color32::WHITE);
+                        painter.line_segment([rect.center_top(), rect.center_bottom()], stroke);
+                        painter.circle(rect.center(), 7.0, egui::Color32::from_gray(40), stroke);
+                        response.on_hover_cursor(egui::CursorIcon::ResizeHorizontal)
+                    })
+                    .inner;
+                if response.dragged() {
+                    let moved = response.drag_delta().x / screen.width().max(1.0);
+                    self.ground.divider = (self.ground.divider + moved).clamp(0.0, 1.0);
+                }
+            }
+        }
     }
 
     /// Each light's colour, intensity and placement; a change goes to `Renderer::set_light`,
@@ -787,14 +1115,18 @@ impl Viewer {
                 if l.direction.length_squared() < 1e-8 {
                     l.direction = light.direction;
                 }
-                if let Err(e) = self.renderer.set_light(i, &l) {
-                    self.status = format!("{e}");
+                match self.renderer.set_light(i, &l) {
+                    Ok(()) => {
+                        self.version += 1;
+                        self.ground.scene_changed();
+                    }
+                    Err(e) => self.status = format!("{e}"),
                 }
             }
         }
     }
 
-    fn stats_ui(&self, ui: &mut egui::Ui) {
+    fn stats_ui(&mut self, ui: &mut egui::Ui) {
         let mean =
             |v: &std::collections::VecDeque<f32>| v.iter().sum::<f32>() / v.len().max(1) as f32;
         let frame = mean(&self.frame_ms);
@@ -839,6 +1171,7 @@ impl Viewer {
                 ));
             });
         }
+        ui.checkbox(&mut self.vsync, "vsync");
         ui.separator();
         let memory = self.renderer.memory();
         let total: u64 = memory.iter().map(|(_, b)| b).sum();

@@ -19,7 +19,8 @@ struct Params {
     light_count: u32,
     width: u32,
     height: u32,
-    // The first column traced: a dispatch covers columns x0..x1 of the image.
+    // The first column and row traced: a dispatch covers columns x0..x1 and rows y0..y1 of
+    // the image.
     x0: u32,
     sample_count: u32,
     seed: u32,
@@ -31,8 +32,8 @@ struct Params {
     // Russian roulette from this path depth on (a huge value disables it).
     rr_depth: u32,
     x1: u32,
-    _pad1: u32,
-    _pad2: u32,
+    y0: u32,
+    y1: u32,
 }
 
 // A BVH node: inner nodes (count 0) have children `first` and `first + 1`; leaves hold triangles
@@ -554,8 +555,8 @@ fn ambient_occlusion(px: vec2<u32>) -> f32 {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let px = vec2<u32>(id.x + params.x0, id.y);
-    if px.x >= params.x1 || px.y >= params.height {
+    let px = id.xy + vec2<u32>(params.x0, params.y0);
+    if px.x >= params.x1 || px.y >= params.y1 {
         return;
     }
     let pixel = px.y * params.width + px.x;

@@ -18,7 +18,7 @@ use voxgi_scene::Scene;
 use wgpu::util::DeviceExt;
 
 mod progressive;
-pub use progressive::Accumulation;
+pub use progressive::{Accumulation, Region};
 
 /// How many indirect bounces the reference simulates (as the cone tracer counts them).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -34,6 +34,19 @@ pub enum Bounces {
     Unlimited,
     /// Exactly this many indirect bounces (no Russian roulette).
     Exactly(u32),
+}
+
+impl Bounces {
+    /// The bounces the renderer computes with `RendererOptions::bounces` = `n`, so the two
+    /// images compare like with like.
+    pub fn matching(n: u32) -> Bounces {
+        match n {
+            0 => Bounces::DirectOnly,
+            1 => Bounces::One,
+            crate::options::UNLIMITED_BOUNCES => Bounces::Unlimited,
+            n => Bounces::Exactly(n),
+        }
+    }
 }
 
 /// Path-length cap for [`Bounces::Unlimited`].
@@ -95,7 +108,8 @@ struct GpuParams {
     ao_radius: f32,
     rr_depth: u32,
     x1: u32,
-    _pad: [u32; 2],
+    y0: u32,
+    y1: u32,
 }
 
 /// Mirrors `Node` in shaders/reference.wgsl.
@@ -402,7 +416,13 @@ impl PathTracer {
                 spp: count,
                 ..*opts
             };
-            self.accumulate(&mut enc, &mut acc, frame, &batch_opts, 0..width)?;
+            self.accumulate(
+                &mut enc,
+                &mut acc,
+                frame,
+                &batch_opts,
+                Region::all(width, height),
+            )?;
             self.queue.submit([enc.finish()]);
             self.device
                 .poll(wgpu::PollType::wait_indefinitely())

@@ -24,11 +24,43 @@ struct Key {
     seed: u32,
 }
 
+/// The pixels a call covers: columns `columns` of rows `rows`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Region {
+    /// The columns, left to right.
+    pub columns: Range<u32>,
+    /// The rows, top to bottom.
+    pub rows: Range<u32>,
+}
+
+impl Region {
+    /// The whole of a `width` x `height` image.
+    pub fn all(width: u32, height: u32) -> Self {
+        Region {
+            columns: 0..width,
+            rows: 0..height,
+        }
+    }
+
+    fn check(&self, width: u32, height: u32) -> Result<()> {
+        let (c, r) = (&self.columns, &self.rows);
+        if c.start >= c.end || c.end > width || r.start >= r.end || r.end > height {
+            return Err(Error::Setting(format!(
+                "region columns {}..{}, rows {}..{} is not a non-empty part of the {width}x\
+                 {height} image",
+                c.start, c.end, r.start, r.end
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// A path-traced image accumulating over several submits, made by
 /// [`PathTracer::accumulation`] and used only with that path tracer.
 ///
-/// Each pixel counts its own samples, so columns can be traced in different frames (a split
-/// view whose divider moves) and every pixel still shows an unbiased mean.
+/// Each pixel counts its own samples, so parts of the image can be traced in different frames
+/// (a split view whose divider moves, a band of rows a frame on a slow GPU) and every pixel
+/// still shows an unbiased mean of its own samples.
 pub struct Accumulation {
     width: u32,
     height: u32,
@@ -39,8 +71,10 @@ pub struct Accumulation {
     display_params: wgpu::Buffer,
     display_group: wgpu::BindGroup,
     key: Option<Key>,
-    samples: u32,
-    covered: Range<u32>,
+    /// The columns `rows` counts samples for.
+    columns: Range<u32>,
+    /// For each row, the samples every pixel of `columns` in it has at least.
+    rows: Vec<u32>,
 }
 
 impl Accumulation {
@@ -54,9 +88,9 @@ impl Accumulation {
         self.height
     }
 
-    /// Samples that every pixel of the columns last traced has, at least.
+    /// Samples that every pixel of the columns last traced has, at least (over all rows).
     pub fn samples(&self) -> u32 {
-        self.samples
+        self.rows.iter().copied().min().unwrap_or(0)
     }
 
     /// Forgets the samples so far: the next `accumulate` starts a new image. Needed when the
@@ -132,17 +166,30 @@ impl DisplayPass {
     }
 }
 
-fn check_columns(columns: &Range<u32>, width: u32) -> Result<()> {
-    if columns.start >= columns.end || columns.end > width {
-        return Err(Error::Setting(format!(
-            "columns {}..{} are not a non-empty range within the image's width {width}",
-            columns.start, columns.end
-        )));
-    }
-    Ok(())
-}
-
 impl PathTracer {
+    fn key(&self, acc: &Accumulation, frame: &FrameParams, opts: &ReferenceOptions) -> Key {
+        let view_proj = camera_view_proj(
+            &frame.camera,
+            acc.width,
+            acc.height,
+            self.center,
+            self.radius,
+        );
+        Key {
+            view_proj: view_proj.to_cols_array(),
+            background: frame.background,
+            bounces: opts.bounces,
+            mode: opts.mode,
+            seed: opts.seed,
+        }
+    }
+
+    /// Whether `acc` holds samples of this view with these options (other than `spp`): what
+    /// `accumulate` would add to rather than start over.
+    pub fn shows(&self, acc: &Accumulation, frame: &FrameParams, opts: &ReferenceOptions) -> bool {
+        acc.key == Some(self.key(acc, frame, opts))
+    }
+
     /// An empty accumulation image of `width` x `height` pixels.
     pub fn accumulation(&self, width: u32, height: u32) -> Result<Accumulation> {
         validate_size(width, height)?;
@@ -197,23 +244,23 @@ impl PathTracer {
             display_params,
             display_group,
             key: None,
-            samples: 0,
-            covered: 0..0,
+            columns: 0..0,
+            rows: vec![0; height as usize],
         })
     }
 
-    /// Records `opts.spp` more samples per pixel for the pixels in `columns` of `acc`, starting
-    /// the image over first when the camera, the background or `opts` (other than `spp`)
-    /// changed since the last call. Returns the samples every pixel of `columns` now has, at
-    /// least. One call per accumulation per submit: the call's parameters are written to the
-    /// queue, which a second call before the submit would overwrite.
+    /// Records `opts.spp` more samples per pixel for the pixels of `region`, starting the image
+    /// over first when the camera, the background or `opts` (other than `spp`) changed since
+    /// the last call. Returns the samples every pixel of the region's columns (in all rows) now
+    /// has, at least. One call per accumulation per submit: the call's parameters are written
+    /// to the queue, which a second call before the submit would overwrite.
     pub fn accumulate(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         acc: &mut Accumulation,
         frame: &FrameParams,
         opts: &ReferenceOptions,
-        columns: Range<u32>,
+        region: Region,
     ) -> Result<u32> {
         let camera = &frame.camera;
         if !(camera.position.is_finite() && camera.forward.is_finite() && camera.up.is_finite()) {
@@ -224,7 +271,7 @@ impl PathTracer {
         if opts.spp == 0 {
             return Err(Error::Setting("spp must be at least 1".into()));
         }
-        check_columns(&columns, acc.width)?;
+        region.check(acc.width, acc.height)?;
         let (mode, ao_radius) = match opts.mode {
             ReferenceMode::Radiance => (0, 0.0),
             ReferenceMode::Ao { radius } => {
@@ -243,23 +290,20 @@ impl PathTracer {
             Bounces::Exactly(n) => (n.min(MAX_BOUNCES - 1), u32::MAX),
         };
         let view_proj = camera_view_proj(camera, acc.width, acc.height, self.center, self.radius);
-        let key = Key {
-            view_proj: view_proj.to_cols_array(),
-            background: frame.background,
-            bounces: opts.bounces,
-            mode: opts.mode,
-            seed: opts.seed,
-        };
+        let key = self.key(acc, frame, opts);
+        let columns = region.columns.clone();
         if acc.key != Some(key) {
             encoder.clear_buffer(&acc.buffer, 0, None);
             acc.key = Some(key);
-            acc.samples = 0;
-            acc.covered = columns.clone();
+            acc.rows.fill(0);
+        } else if !(acc.columns.start <= columns.start && columns.end <= acc.columns.end) {
+            // Columns not traced with the rest so far may have had no sample yet.
+            acc.rows.fill(0);
         }
-        // Columns not traced with the rest so far may have had no sample yet.
-        let within = acc.covered.start <= columns.start && columns.end <= acc.covered.end;
-        acc.samples = if within { acc.samples } else { 0 } + opts.spp;
-        acc.covered = columns.clone();
+        acc.columns = columns.clone();
+        for n in &mut acc.rows[region.rows.start as usize..region.rows.end as usize] {
+            *n += opts.spp;
+        }
         let params = GpuParams {
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             background: frame.background,
@@ -274,7 +318,8 @@ impl PathTracer {
             ao_radius,
             rr_depth,
             x1: columns.end,
-            _pad: [0; 2],
+            y0: region.rows.start,
+            y1: region.rows.end,
         };
         self.queue
             .write_buffer(&acc.params, 0, bytemuck::bytes_of(&params));
@@ -286,10 +331,10 @@ impl PathTracer {
         pass.set_bind_group(0, &acc.trace_group, &[]);
         pass.dispatch_workgroups(
             (columns.end - columns.start).div_ceil(8),
-            acc.height.div_ceil(8),
+            (region.rows.end - region.rows.start).div_ceil(8),
             1,
         );
-        Ok(acc.samples)
+        Ok(acc.samples())
     }
 
     /// Records drawing the running mean of `acc` into the pixels of `columns` of `target` (the
@@ -310,7 +355,11 @@ impl PathTracer {
                 target.width, target.height, acc.width, acc.height
             )));
         }
-        check_columns(&columns, acc.width)?;
+        Region {
+            columns: columns.clone(),
+            rows: 0..acc.height,
+        }
+        .check(acc.width, acc.height)?;
         let ao = matches!(
             acc.key,
             Some(Key {

@@ -4,6 +4,7 @@
 use crate::common::*;
 use std::f32::consts::PI;
 use voxgi::compare::{Image, compare};
+use voxgi::reference::Region;
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Light, LightKind, Material, Mesh, Scene, builtin};
 use voxgi::{
@@ -488,9 +489,20 @@ fn accumulate(
     spp: u32,
     columns: std::ops::Range<u32>,
 ) -> u32 {
+    let rows = 0..acc.height();
+    accumulate_region(pt, acc, p, spp, Region { columns, rows })
+}
+
+fn accumulate_region(
+    pt: &PathTracer,
+    acc: &mut voxgi::reference::Accumulation,
+    p: &FrameParams,
+    spp: u32,
+    region: Region,
+) -> u32 {
     let mut enc = ctx().device.create_command_encoder(&Default::default());
     let n = pt
-        .accumulate(&mut enc, acc, p, &opts(spp, Bounces::Unlimited), columns)
+        .accumulate(&mut enc, acc, p, &opts(spp, Bounces::Unlimited), region)
         .expect("accumulate");
     ctx().queue.submit([enc.finish()]);
     n
@@ -548,9 +560,38 @@ fn progressive_accumulation_matches_the_one_shot_render() {
         right <= 1,
         "the 4-spp half differs from 4 spp by {right}/255"
     );
-    // Only the image should differ between the two halves' references: the test is blind if
-    // 4 and 8 spp look the same.
+    // The test is blind if 4 and 8 spp look the same.
     assert!(max_ldr_difference(&full.ldr, &half.ldr, w, 0, w) > 1);
+
+    // Bands of rows, as a slow GPU traces them: the top and bottom halves in turn, twice with
+    // 4 samples, give every pixel the 8-spp image, and the count waits for the last band.
+    let mut acc = pt.accumulation(w, h).unwrap();
+    let band = |rows: std::ops::Range<u32>| Region {
+        columns: 0..w,
+        rows,
+    };
+    assert_eq!(
+        accumulate_region(&pt, &mut acc, &params, 4, band(0..h / 2)),
+        0
+    );
+    assert_eq!(
+        accumulate_region(&pt, &mut acc, &params, 4, band(h / 2..h)),
+        4
+    );
+    assert_eq!(
+        accumulate_region(&pt, &mut acc, &params, 4, band(0..h / 2)),
+        4
+    );
+    assert_eq!(
+        accumulate_region(&pt, &mut acc, &params, 4, band(h / 2..h)),
+        8
+    );
+    let shown = displayed(&mut pt, &acc, &params);
+    let d = max_ldr_difference(&shown, &full.ldr, w, 0, w);
+    assert!(
+        d <= 1,
+        "8 spp in bands of rows differs from 8 spp by {d}/255"
+    );
 }
 
 /// A moved camera starts the image over; exposure does not (it only changes the display).
@@ -562,8 +603,10 @@ fn progressive_accumulation_restarts_when_the_view_changes() {
     let mut acc = pt.accumulation(8, 8).unwrap();
     assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 2);
     params.exposure = 1.0;
+    assert!(pt.shows(&acc, &params, &opts(7, Bounces::Unlimited)));
     assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 4);
     params.camera.position.x += 0.01;
+    assert!(!pt.shows(&acc, &params, &opts(7, Bounces::Unlimited)));
     assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 2);
     acc.reset();
     assert_eq!(accumulate(&pt, &mut acc, &params, 3, 0..8), 3);
@@ -572,18 +615,22 @@ fn progressive_accumulation_restarts_when_the_view_changes() {
     #[allow(clippy::reversed_empty_ranges)]
     let bad = [0..0, 4..9, 5..3];
     for columns in bad {
+        let region = Region {
+            columns: columns.clone(),
+            rows: 0..8,
+        };
         let e = pt
-            .accumulate(
-                &mut enc,
-                &mut acc,
-                &params,
-                &opts(1, Bounces::One),
-                columns.clone(),
-            )
+            .accumulate(&mut enc, &mut acc, &params, &opts(1, Bounces::One), region)
             .err()
             .unwrap_or_else(|| panic!("columns {columns:?} accepted"));
-        assert!(e.to_string().contains("columns"), "{e}");
+        assert!(e.to_string().contains("region"), "{e}");
     }
+    let rows = Region {
+        columns: 0..8,
+        rows: 2..9,
+    };
+    let e = pt.accumulate(&mut enc, &mut acc, &params, &opts(1, Bounces::One), rows);
+    assert!(e.is_err(), "rows 2..9 of an 8-row image accepted");
     let other = pt.accumulation(4, 4).unwrap();
     let texture = ctx()
         .device

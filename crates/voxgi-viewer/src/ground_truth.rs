@@ -1,0 +1,253 @@
+//! The path tracer in the window: voxgi's ground truth, accumulating a few samples a frame while
+//! the view stands still, either in place of cone tracing or right of a draggable divider.
+//!
+//! The path tracer sees the scene as it was built (its BVH is of the instances' poses then), so
+//! a change of time or of a light builds a new one, in the background, while the last image
+//! stays up.
+
+use crate::jobs::Job;
+use anyhow::Result;
+use std::ops::Range;
+use std::sync::Arc;
+use voxgi::reference::{Accumulation, Region};
+use voxgi::scene::{Light, Scene};
+use voxgi::{
+    Bounces, FrameParams, PathTracer, ReferenceMode, ReferenceOptions, RendererOptions, Target,
+    wgpu,
+};
+
+/// What the window shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Display {
+    /// Cone tracing only.
+    #[value(name = "cone-traced")]
+    ConeTraced,
+    /// The path tracer only.
+    #[value(name = "path-traced")]
+    PathTraced,
+    /// Cone tracing left of the divider, the path tracer right of it.
+    Split,
+}
+
+impl Display {
+    pub const ALL: [Display; 3] = [Display::ConeTraced, Display::PathTraced, Display::Split];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Display::ConeTraced => "cone traced",
+            Display::PathTraced => "path traced",
+            Display::Split => "split",
+        }
+    }
+}
+
+/// A path tracer of one state of the scene, and its image.
+struct Traced {
+    tracer: PathTracer,
+    accumulation: Option<Accumulation>,
+    version: u64,
+}
+
+/// The window's ground truth.
+pub struct GroundTruth {
+    pub display: Display,
+    /// Where the split view's divider is, as a fraction of the window's width.
+    pub divider: f32,
+    /// Samples per pixel each frame adds.
+    pub samples_per_frame: u32,
+    /// The image stops improving (and costs nothing) once it has this many.
+    pub max_samples: u32,
+    /// Paths traced a frame at most: fewer pixels than the image has are traced a band of rows
+    /// at a time, so a slow GPU keeps the window responsive.
+    pub paths_per_frame: u32,
+    /// The first row of the next band.
+    next_row: u32,
+    /// Rows in the last band.
+    band_rows: u32,
+    traced: Option<Traced>,
+    building: Option<(Job<PathTracer>, u64)>,
+    pub error: Option<String>,
+}
+
+impl GroundTruth {
+    pub fn new(display: Display, cpu: bool) -> Self {
+        GroundTruth {
+            display,
+            divider: 0.5,
+            // A CPU driver traces a sample a frame and stays responsive; a GPU does more.
+            samples_per_frame: if cpu { 1 } else { 4 },
+            max_samples: 4096,
+            paths_per_frame: if cpu { 1 << 14 } else { 1 << 24 },
+            next_row: 0,
+            band_rows: 0,
+            traced: None,
+            building: None,
+            error: None,
+        }
+    }
+
+    /// Forgets the path tracer (a new scene or new options): the next frame builds another.
+    pub fn clear(&mut self) {
+        self.traced = None;
+        self.building = None;
+        self.error = None;
+    }
+
+    /// The columns the path tracer draws in a `width`-wide window; `None` when it draws none.
+    pub fn columns(&self, width: u32) -> Option<Range<u32>> {
+        match self.display {
+            Display::ConeTraced => None,
+            Display::PathTraced => Some(0..width),
+            Display::Split => {
+                let x = ((self.divider.clamp(0.0, 1.0) * width as f32) as u32).min(width - 1);
+                Some(x..width)
+            }
+        }
+    }
+
+    /// Whether the cone tracer's image is needed this frame: for its side of the split, or in
+    /// place of a path tracer that is not built yet.
+    pub fn needs_cone_tracing(&self) -> bool {
+        self.display != Display::PathTraced || self.traced.is_none()
+    }
+
+    /// Takes a finished build, and starts one when the scene (its `version`) moved on from the
+    /// path tracer's; called once a frame while the path tracer is shown.
+    #[allow(clippy::too_many_arguments)]
+    pub fn update(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Arc<Scene>,
+        time: f32,
+        lights: &[Light],
+        options: &RendererOptions,
+        version: u64,
+    ) {
+        if self.display == Display::ConeTraced {
+            return;
+        }
+        if let Some((job, built_for)) = &mut self.building
+            && let Some(result) = job.poll()
+        {
+            let built_for = *built_for;
+            self.building = None;
+            match result {
+                Ok(tracer) => {
+                    self.error = None;
+                    self.traced = Some(Traced {
+                        tracer,
+                        accumulation: None,
+                        version: built_for,
+                    })
+                }
+                Err(e) => self.error = Some(format!("{e:#}")),
+            }
+        }
+        let current = self.traced.as_ref().is_some_and(|t| t.version == version);
+        let failed_here = self.error.is_some();
+        if current || self.building.is_some() || failed_here {
+            return;
+        }
+        let (device, queue, scene) = (device.clone(), queue.clone(), scene.clone());
+        let (lights, options) = (lights.to_vec(), options.clone());
+        let job = Job::spawn("building the path tracer", move || -> Result<PathTracer> {
+            let mut scene = (*scene).clone();
+            scene.set_time(time);
+            // The lights as the renderer has them now: animated, then edited in the window.
+            if lights.len() == scene.lights.len() {
+                scene.lights = lights;
+            }
+            Ok(PathTracer::new(&device, &queue, &scene, &options)?)
+        });
+        self.building = Some((job, version));
+    }
+
+    /// The scene changed in a way that makes a built path tracer wrong now and again: a failed
+    /// build is retried for the new state.
+    pub fn scene_changed(&mut self) {
+        self.error = None;
+    }
+
+    /// Whether a path tracer is being built.
+    pub fn building(&self) -> bool {
+        self.building.is_some()
+    }
+
+    /// What the path tracer is doing, for the window: building, or how many samples it has.
+    pub fn label(&self) -> String {
+        if let Some(e) = &self.error {
+            return format!("path tracer: {e}");
+        }
+        let samples = self
+            .traced
+            .as_ref()
+            .and_then(|t| t.accumulation.as_ref())
+            .map(|a| a.samples());
+        let band = match self.traced.as_ref().and_then(|t| t.accumulation.as_ref()) {
+            Some(a) if self.band_rows < a.height() => format!(", {} rows a frame", self.band_rows),
+            _ => String::new(),
+        };
+        match (&self.building, samples) {
+            (Some((job, _)), Some(n)) => {
+                format!("path traced, {n} spp (the scene moved: {})", job.label())
+            }
+            (Some((job, _)), None) => job.label(),
+            (None, Some(n)) if n >= self.max_samples => format!("path traced, {n} spp (done)"),
+            (None, Some(n)) => format!("path traced, {n} spp{band}"),
+            (None, None) => "path tracer starting".into(),
+        }
+    }
+
+    /// Records this frame's samples (with `accumulate`) and draws the image into its columns of
+    /// `target` (over the cone-traced image in a split view).
+    pub fn record(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        params: &FrameParams,
+        bounces: u32,
+        accumulate: bool,
+    ) -> Result<()> {
+        let Some(columns) = self.columns(target.width) else {
+            return Ok(());
+        };
+        let Some(t) = &mut self.traced else {
+            return Ok(());
+        };
+        let size = (target.width, target.height);
+        if t.accumulation.as_ref().map(|a| (a.width(), a.height())) != Some(size) {
+            t.accumulation = Some(t.tracer.accumulation(size.0, size.1)?);
+        }
+        let acc = t.accumulation.as_mut().expect("made above");
+        let opts = ReferenceOptions {
+            spp: self.samples_per_frame.max(1),
+            bounces: Bounces::matching(bounces),
+            mode: ReferenceMode::Radiance,
+            seed: 0,
+        };
+        // Past the cap the image is left as it is, unless the view changed (which the
+        // accumulation tells by restarting, so ask it with one more call).
+        let moved = !t.tracer.shows(acc, params, &opts);
+        if accumulate && (acc.samples() < self.max_samples || moved) {
+            if moved {
+                self.next_row = 0;
+            }
+            let h = target.height;
+            let width = (columns.end - columns.start) as u64;
+            let per_row = (width * opts.spp as u64).max(1);
+            let rows = (self.paths_per_frame as u64 / per_row).clamp(1, h as u64) as u32;
+            let start = if self.next_row >= h { 0 } else { self.next_row };
+            let end = (start + rows).min(h);
+            self.band_rows = end - start;
+            self.next_row = end % h;
+            let region = Region {
+                columns: columns.clone(),
+                rows: start..end,
+            };
+            t.tracer.accumulate(encoder, acc, params, &opts, region)?;
+        }
+        t.tracer.display(encoder, acc, target, params, columns)?;
+        Ok(())
+    }
+}
