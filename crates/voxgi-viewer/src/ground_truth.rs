@@ -60,6 +60,10 @@ pub struct GroundTruth {
     /// Paths traced a frame at most: fewer pixels than the image has are traced a band of rows
     /// at a time, so a slow GPU keeps the window responsive.
     pub paths_per_frame: u32,
+    /// When set, `paths_per_frame` follows the frame time towards this many milliseconds.
+    pub frame_target_ms: Option<f32>,
+    /// Whether the last frame traced paths (so its time says something about them).
+    traced_last_frame: bool,
     /// The first row of the next band.
     next_row: u32,
     /// Rows in the last band.
@@ -77,7 +81,11 @@ impl GroundTruth {
             // A CPU driver traces a sample a frame and stays responsive; a GPU does more.
             samples_per_frame: if cpu { 1 } else { 4 },
             max_samples: 4096,
-            paths_per_frame: if cpu { 1 << 14 } else { 1 << 24 },
+            paths_per_frame: if cpu { 1 << 14 } else { 1 << 22 },
+            // A CPU driver draws a frame in a few hundred milliseconds at best; a GPU stays
+            // interactive.
+            frame_target_ms: Some(if cpu { 500.0 } else { 33.0 }),
+            traced_last_frame: false,
             next_row: 0,
             band_rows: 0,
             traced: None,
@@ -144,6 +152,10 @@ impl GroundTruth {
                 Err(e) => self.error = Some(format!("{e:#}")),
             }
         }
+        if let Some(why) = Self::unsupported(scene) {
+            self.error = Some(why.into());
+            return;
+        }
         let current = self.traced.as_ref().is_some_and(|t| t.version == version);
         let failed_here = self.error.is_some();
         if current || self.building.is_some() || failed_here {
@@ -169,9 +181,26 @@ impl GroundTruth {
         self.error = None;
     }
 
+    /// Adapts the paths a frame to the last frame's time, `frame_ms`, when a target is set.
+    pub fn frame_done(&mut self, frame_ms: f32) {
+        if let Some(target) = self.frame_target_ms
+            && std::mem::take(&mut self.traced_last_frame)
+        {
+            self.paths_per_frame = next_budget(self.paths_per_frame, frame_ms, target);
+        }
+    }
+
     /// Whether a path tracer is being built.
     pub fn building(&self) -> bool {
         self.building.is_some()
+    }
+
+    /// Why the path tracer cannot show this scene, if it cannot.
+    pub fn unsupported(scene: &Scene) -> Option<&'static str> {
+        (scene.triangle_count() == 0).then_some(
+            "the path tracer traces triangles, and this scene has none (a point cloud is cone \
+             traced only)",
+        )
     }
 
     /// What the path tracer is doing, for the window: building, or how many samples it has.
@@ -246,8 +275,45 @@ impl GroundTruth {
                 rows: start..end,
             };
             t.tracer.accumulate(encoder, acc, params, &opts, region)?;
+            self.traced_last_frame = true;
         }
         t.tracer.display(encoder, acc, target, params, columns)?;
         Ok(())
+    }
+}
+
+/// The paths a frame for the next frame: scaled by how far the last frame's time was from the
+/// target, by at most a factor of two down and a quarter up a frame, so a single slow frame
+/// (a rebuild, a resize) does not throw it far, and within 1024 (some progress) to 2^26.
+pub fn next_budget(paths: u32, frame_ms: f32, target_ms: f32) -> u32 {
+    let ratio = (target_ms / frame_ms.max(1e-3)).clamp(0.5, 1.25);
+    ((paths as f32 * ratio) as u32).clamp(1 << 10, 1 << 26)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A frame costs a fixed part plus a part per path; the budget settles where the frame
+    /// takes the target time.
+    #[test]
+    fn the_budget_settles_at_the_target_frame_time() {
+        for (fixed, per_path, start) in [(100.0, 0.02, 1u32 << 14), (5.0, 1e-5, 1 << 22)] {
+            let target = 500.0;
+            let mut paths = start;
+            for _ in 0..60 {
+                paths = next_budget(paths, fixed + per_path * paths as f32, target);
+            }
+            let frame = fixed + per_path * paths as f32;
+            assert!((frame / target - 1.0).abs() < 0.02, "settled at {frame} ms");
+        }
+    }
+
+    /// A scene slower than the target still traces a little each frame; a fast one is capped.
+    #[test]
+    fn the_budget_stays_within_its_bounds() {
+        assert_eq!(next_budget(1 << 10, 10_000.0, 33.0), 1 << 10);
+        assert_eq!(next_budget(1 << 26, 0.1, 33.0), 1 << 26);
+        assert_eq!(next_budget(1 << 20, 1e9, 33.0), 1 << 19);
     }
 }

@@ -126,6 +126,8 @@ struct Viewer {
     dialog: Option<Job<Option<PathBuf>>>,
     open_path: String,
     vsync: bool,
+    /// The adapter is a CPU driver (lavapipe, WARP): smaller defaults.
+    cpu: bool,
     scene_name: String,
     scene_radius: f32,
     /// The scene's own cameras, to pick from.
@@ -255,6 +257,10 @@ impl Viewer {
         renderer.enable_timing(timestamps);
         let mut ground = GroundTruth::new(args.display, cpu);
         ground.divider = args.divider;
+        if let Some(n) = args.paths_per_frame {
+            ground.paths_per_frame = n;
+            ground.frame_target_ms = None;
+        }
         let bounds = voxgi::swept_bounds(&scene);
         let radius = if bounds.is_empty() {
             1.0
@@ -307,6 +313,7 @@ impl Viewer {
             dialog: None,
             open_path: String::new(),
             vsync: !args.no_vsync,
+            cpu,
             egui_ctx,
             egui_state,
             egui_renderer,
@@ -605,6 +612,7 @@ impl Viewer {
         let elapsed = (now - self.last_frame).as_secs_f32();
         self.last_frame = now;
         push(&mut self.frame_ms, elapsed * 1e3);
+        self.ground.frame_done(elapsed * 1e3);
         // Slow frames do not make the animation or the fly camera jump.
         let dt = elapsed.min(0.25);
         if let Controller::Fly(f) = &mut self.controller {
@@ -977,11 +985,28 @@ impl Viewer {
                 .logarithmic(true)
                 .text("samples per frame"),
         );
-        ui.add(
-            egui::Slider::new(&mut self.ground.paths_per_frame, 1 << 10..=1 << 26)
-                .logarithmic(true)
-                .text("paths per frame"),
-        );
+        let mut auto = self.ground.frame_target_ms.is_some();
+        ui.horizontal(|ui| {
+            ui.add_enabled(
+                !auto,
+                egui::Slider::new(&mut self.ground.paths_per_frame, 1 << 10..=1 << 26)
+                    .logarithmic(true)
+                    .text("paths a frame"),
+            );
+            ui.checkbox(&mut auto, "auto");
+        });
+        match (auto, self.ground.frame_target_ms) {
+            (true, None) => self.ground.frame_target_ms = Some(if self.cpu { 500.0 } else { 33.0 }),
+            (false, Some(_)) => self.ground.frame_target_ms = None,
+            _ => {}
+        }
+        if let Some(t) = &mut self.ground.frame_target_ms {
+            ui.add(
+                egui::Slider::new(t, 10.0..=2000.0)
+                    .logarithmic(true)
+                    .text("ms a frame"),
+            );
+        }
         ui.add(
             egui::Slider::new(&mut self.ground.max_samples, 16..=65536)
                 .logarithmic(true)
