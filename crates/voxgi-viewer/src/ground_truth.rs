@@ -60,8 +60,11 @@ pub struct GroundTruth {
     /// Paths traced a frame at most: fewer pixels than the image has are traced a band of rows
     /// at a time, so a slow GPU keeps the window responsive.
     pub paths_per_frame: u32,
-    /// When set, `paths_per_frame` follows the frame time towards this many milliseconds.
+    /// When set, `paths_per_frame` follows the path tracer's GPU time a frame towards this many
+    /// milliseconds (on a GPU without timestamps it stays as it is).
     pub frame_target_ms: Option<f32>,
+    /// Time the path tracer's passes on the GPU.
+    timing: bool,
     /// Whether the last frame traced paths (so its time says something about them).
     traced_last_frame: bool,
     /// The first row of the next band.
@@ -74,7 +77,7 @@ pub struct GroundTruth {
 }
 
 impl GroundTruth {
-    pub fn new(display: Display, cpu: bool) -> Self {
+    pub fn new(display: Display, cpu: bool, timing: bool) -> Self {
         GroundTruth {
             display,
             divider: 0.5,
@@ -82,9 +85,8 @@ impl GroundTruth {
             samples_per_frame: if cpu { 1 } else { 4 },
             max_samples: 4096,
             paths_per_frame: if cpu { 1 << 14 } else { 1 << 22 },
-            // A CPU driver draws a frame in a few hundred milliseconds at best; a GPU stays
-            // interactive.
-            frame_target_ms: Some(if cpu { 500.0 } else { 33.0 }),
+            frame_target_ms: Some(default_target_ms(cpu)),
+            timing,
             traced_last_frame: false,
             next_row: 0,
             band_rows: 0,
@@ -141,7 +143,8 @@ impl GroundTruth {
             let built_for = *built_for;
             self.building = None;
             match result {
-                Ok(tracer) => {
+                Ok(mut tracer) => {
+                    tracer.enable_timing(self.timing);
                     self.error = None;
                     self.traced = Some(Traced {
                         tracer,
@@ -181,13 +184,23 @@ impl GroundTruth {
         self.error = None;
     }
 
-    /// Adapts the paths a frame to the last frame's time, `frame_ms`, when a target is set.
-    pub fn frame_done(&mut self, frame_ms: f32) {
-        if let Some(target) = self.frame_target_ms
+    /// The path tracer's GPU milliseconds per pass in the frame just submitted (empty without
+    /// timestamps), and the paths a frame adapted to them when a target is set.
+    pub fn frame_done(&mut self) -> Vec<(&'static str, f64)> {
+        let Some(t) = &mut self.traced else {
+            return Vec::new();
+        };
+        let times = t.tracer.pass_times().unwrap_or_default();
+        let traced = times
+            .iter()
+            .find(|(n, _)| *n == "reference")
+            .map(|(_, ms)| *ms as f32);
+        if let (Some(target), Some(ms)) = (self.frame_target_ms, traced)
             && std::mem::take(&mut self.traced_last_frame)
         {
-            self.paths_per_frame = next_budget(self.paths_per_frame, frame_ms, target);
+            self.paths_per_frame = next_budget(self.paths_per_frame, ms, target);
         }
+        times
     }
 
     /// Whether a path tracer is being built.
@@ -282,8 +295,14 @@ impl GroundTruth {
     }
 }
 
-/// The paths a frame for the next frame: scaled by how far the last frame's time was from the
-/// target, by at most a factor of two down and a quarter up a frame, so a single slow frame
+/// How long the path tracer may take a frame by default: a CPU driver draws a frame in a few
+/// hundred milliseconds at best; a GPU stays interactive beside cone tracing.
+pub fn default_target_ms(cpu: bool) -> f32 {
+    if cpu { 250.0 } else { 10.0 }
+}
+
+/// The paths a frame for the next frame: scaled by how far the last frame's path tracing time
+/// was from the target, by at most a factor of two down and a quarter up a frame, so a single slow frame
 /// (a rebuild, a resize) does not throw it far, and within 1024 (some progress) to 2^26.
 pub fn next_budget(paths: u32, frame_ms: f32, target_ms: f32) -> u32 {
     let ratio = (target_ms / frame_ms.max(1e-3)).clamp(0.5, 1.25);
@@ -294,8 +313,8 @@ pub fn next_budget(paths: u32, frame_ms: f32, target_ms: f32) -> u32 {
 mod tests {
     use super::*;
 
-    /// A frame costs a fixed part plus a part per path; the budget settles where the frame
-    /// takes the target time.
+    /// Tracing costs a fixed part plus a part per path; the budget settles where it takes the
+    /// target time.
     #[test]
     fn the_budget_settles_at_the_target_frame_time() {
         for (fixed, per_path, start) in [(100.0, 0.02, 1u32 << 14), (5.0, 1e-5, 1 << 22)] {

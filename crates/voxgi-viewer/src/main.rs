@@ -46,7 +46,8 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = ground_truth::Display::ConeTraced)]
     pub display: ground_truth::Display,
     /// Paths the path tracer traces a frame (a band of rows when fewer than the image has).
-    /// Default: adapted to keep frames near 500 ms on a CPU driver, 33 ms on a GPU.
+    /// Default: adapted to keep the path tracer's GPU time near 250 ms a frame on a CPU driver,
+    /// 10 ms on a GPU.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1024..=1 << 26))]
     pub paths_per_frame: Option<u32>,
     /// Where the split view's divider starts, as a fraction of the width.

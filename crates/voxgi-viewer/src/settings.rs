@@ -103,10 +103,10 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
         if ui.add_enabled(dirty, egui::Button::new("Revert")).clicked() {
             actions.revert = true;
         }
-        if dirty {
-            ui.label("(builds a new renderer; the window goes on meanwhile)");
-        }
     });
+    if dirty {
+        ui.label("Apply builds a new renderer; the window goes on meanwhile.");
+    }
     actions
 }
 

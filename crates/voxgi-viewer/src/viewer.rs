@@ -255,7 +255,7 @@ impl Viewer {
         }
         let mut renderer = Renderer::new(&device, &queue, &scene, &options)?;
         renderer.enable_timing(timestamps);
-        let mut ground = GroundTruth::new(args.display, cpu);
+        let mut ground = GroundTruth::new(args.display, cpu, timestamps);
         ground.divider = args.divider;
         if let Some(n) = args.paths_per_frame {
             ground.paths_per_frame = n;
@@ -526,10 +526,12 @@ impl Viewer {
             }
         }
         self.renderer = renderer;
+        // The path tracer sees the scene's lights, and the default sun when there are none.
+        if options.default_light != self.options.default_light {
+            self.ground.clear();
+        }
         self.options = options;
         self.pass_ms.clear();
-        // default_light may have changed what the path tracer must see.
-        self.ground.clear();
         self.version += 1;
         self.status = "options applied".into();
     }
@@ -612,7 +614,6 @@ impl Viewer {
         let elapsed = (now - self.last_frame).as_secs_f32();
         self.last_frame = now;
         push(&mut self.frame_ms, elapsed * 1e3);
-        self.ground.frame_done(elapsed * 1e3);
         // Slow frames do not make the animation or the fly camera jump.
         let dt = elapsed.min(0.25);
         if let Controller::Fly(f) = &mut self.controller {
@@ -716,16 +717,27 @@ impl Viewer {
             .submit(extra.into_iter().chain([encoder.finish()]));
         self.window.pre_present_notify();
         self.queue.present(frame);
+        let reference = self.ground.frame_done();
         if self.timestamps {
-            for (name, ms) in self.renderer.pass_times()? {
-                match self.pass_ms.iter_mut().find(|(n, _)| *n == name) {
-                    Some((_, v)) => push(v, ms as f32),
-                    None => {
-                        let mut v = std::collections::VecDeque::new();
-                        push(&mut v, ms as f32);
-                        self.pass_ms.push((name, v));
-                    }
+            let times: Vec<_> = self
+                .renderer
+                .pass_times()?
+                .into_iter()
+                .chain(reference)
+                .collect();
+            for (name, _) in &times {
+                if !self.pass_ms.iter().any(|(n, _)| n == name) {
+                    self.pass_ms.push((name, Default::default()));
                 }
+            }
+            // A pass that did not run this frame (the voxel passes of a still scene) took 0 ms
+            // of it: the means are per frame, not per run.
+            for (name, v) in &mut self.pass_ms {
+                let ms = times
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map_or(0.0, |(_, ms)| *ms);
+                push(v, ms as f32);
             }
         }
         self.frames += 1;
@@ -996,15 +1008,17 @@ impl Viewer {
             ui.checkbox(&mut auto, "auto");
         });
         match (auto, self.ground.frame_target_ms) {
-            (true, None) => self.ground.frame_target_ms = Some(if self.cpu { 500.0 } else { 33.0 }),
+            (true, None) => {
+                self.ground.frame_target_ms = Some(crate::ground_truth::default_target_ms(self.cpu))
+            }
             (false, Some(_)) => self.ground.frame_target_ms = None,
             _ => {}
         }
         if let Some(t) = &mut self.ground.frame_target_ms {
             ui.add(
-                egui::Slider::new(t, 10.0..=2000.0)
+                egui::Slider::new(t, 1.0..=2000.0)
                     .logarithmic(true)
-                    .text("ms a frame"),
+                    .text("ms of tracing a frame"),
             );
         }
         ui.add(
@@ -1077,6 +1091,7 @@ impl Viewer {
                 // The divider: a line with a handle, dragged sideways.
                 let response = egui::Area::new(egui::Id::unique("divider"))
                     .fixed_pos(egui::pos2(x - 6.0, screen.top()))
+                    .movable(false)
                     .show(&ctx, |ui| {
                         let (rect, response) = ui.allocate_exact_size(
                             egui::vec2(12.0, screen.height()),

@@ -6,6 +6,7 @@
 //! (`shaders/reference.wgsl`) walks with a stack. Samples accumulate in an f32 buffer, a batch
 //! per submit, so long renders report progress and never hold the GPU for long.
 
+use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, layout, readback, shader};
 use crate::gpu_scene::{GpuScene, NO_INDEX, scene_bounds};
 use crate::options::{FrameParams, RendererOptions};
@@ -178,6 +179,7 @@ pub struct PathTracer {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
     display: progressive::DisplayPass,
+    timer: GpuTimer,
 }
 
 /// World-space triangles in BVH order, and the flattened BVH over them.
@@ -367,6 +369,7 @@ impl PathTracer {
         })?;
         Ok(PathTracer {
             display: progressive::DisplayPass::new(&device),
+            timer: GpuTimer::disabled(&queue),
             device,
             queue,
             light_count: gpu_scene.light_count,
@@ -380,6 +383,22 @@ impl PathTracer {
             layout,
             pipeline,
         })
+    }
+
+    /// Turns GPU timing of `accumulate` ("reference") and `display` ("reference_display") on
+    /// or off (when the device has `TIMESTAMP_QUERY`).
+    pub fn enable_timing(&mut self, on: bool) {
+        self.timer = if on {
+            GpuTimer::new(&self.device, &self.queue, true)
+        } else {
+            GpuTimer::disabled(&self.queue)
+        };
+    }
+
+    /// Milliseconds per pass recorded since the last call, once submitted (this waits for the
+    /// GPU); empty without timing.
+    pub fn pass_times(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        self.timer.read(&self.device)
     }
 
     /// Number of world-space triangles traced.

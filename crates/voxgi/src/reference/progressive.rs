@@ -255,7 +255,7 @@ impl PathTracer {
     /// has, at least. One call per accumulation per submit: the call's parameters are written
     /// to the queue, which a second call before the submit would overwrite.
     pub fn accumulate(
-        &self,
+        &mut self,
         encoder: &mut wgpu::CommandEncoder,
         acc: &mut Accumulation,
         frame: &FrameParams,
@@ -323,17 +323,21 @@ impl PathTracer {
         };
         self.queue
             .write_buffer(&acc.params, 0, bytemuck::bytes_of(&params));
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("reference"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &acc.trace_group, &[]);
-        pass.dispatch_workgroups(
-            (columns.end - columns.start).div_ceil(8),
-            (region.rows.end - region.rows.start).div_ceil(8),
-            1,
-        );
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("reference"),
+                timestamp_writes: self.timer.compute("reference"),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &acc.trace_group, &[]);
+            pass.dispatch_workgroups(
+                (columns.end - columns.start).div_ceil(8),
+                (region.rows.end - region.rows.start).div_ceil(8),
+                1,
+            );
+        }
+        // Resolved after each pass: a caller may trace without displaying, or the reverse.
+        self.timer.resolve(encoder);
         Ok(acc.samples())
     }
 
@@ -393,7 +397,7 @@ impl PathTracer {
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: None,
+            timestamp_writes: self.timer.render("reference_display"),
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -401,6 +405,8 @@ impl PathTracer {
         pass.set_bind_group(0, &acc.display_group, &[]);
         pass.set_scissor_rect(columns.start, 0, columns.end - columns.start, acc.height);
         pass.draw(0..3, 0..1);
+        drop(pass);
+        self.timer.resolve(encoder);
         Ok(())
     }
 }

@@ -483,7 +483,7 @@ fn displayed(
 
 /// Adds `spp` samples to `columns` in one submit; returns the samples the call reports.
 fn accumulate(
-    pt: &PathTracer,
+    pt: &mut PathTracer,
     acc: &mut voxgi::reference::Accumulation,
     p: &FrameParams,
     spp: u32,
@@ -494,7 +494,7 @@ fn accumulate(
 }
 
 fn accumulate_region(
-    pt: &PathTracer,
+    pt: &mut PathTracer,
     acc: &mut voxgi::reference::Accumulation,
     p: &FrameParams,
     spp: u32,
@@ -537,9 +537,9 @@ fn progressive_accumulation_matches_the_one_shot_render() {
         .render(&params, w, h, &opts(4, Bounces::Unlimited), &mut |_, _| {})
         .unwrap();
     let mut acc = pt.accumulation(w, h).unwrap();
-    assert_eq!(accumulate(&pt, &mut acc, &params, 1, 0..w), 1);
-    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..w), 3);
-    assert_eq!(accumulate(&pt, &mut acc, &params, 5, 0..w), 8);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 1, 0..w), 1);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 2, 0..w), 3);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 5, 0..w), 8);
     let shown = displayed(&mut pt, &acc, &params);
     let d = max_ldr_difference(&shown, &full.ldr, w, 0, w);
     assert!(
@@ -550,8 +550,8 @@ fn progressive_accumulation_matches_the_one_shot_render() {
     // A split view: the right half joins after the left half has 4 samples. Each side then
     // shows exactly its own count's image, and the count reported is the smaller one.
     let mut acc = pt.accumulation(w, h).unwrap();
-    assert_eq!(accumulate(&pt, &mut acc, &params, 4, 0..w / 2), 4);
-    assert_eq!(accumulate(&pt, &mut acc, &params, 4, 0..w), 4);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 4, 0..w / 2), 4);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 4, 0..w), 4);
     let shown = displayed(&mut pt, &acc, &params);
     let left = max_ldr_difference(&shown, &full.ldr, w, 0, w / 2);
     let right = max_ldr_difference(&shown, &half.ldr, w, w / 2, w);
@@ -571,19 +571,19 @@ fn progressive_accumulation_matches_the_one_shot_render() {
         rows,
     };
     assert_eq!(
-        accumulate_region(&pt, &mut acc, &params, 4, band(0..h / 2)),
+        accumulate_region(&mut pt, &mut acc, &params, 4, band(0..h / 2)),
         0
     );
     assert_eq!(
-        accumulate_region(&pt, &mut acc, &params, 4, band(h / 2..h)),
+        accumulate_region(&mut pt, &mut acc, &params, 4, band(h / 2..h)),
         4
     );
     assert_eq!(
-        accumulate_region(&pt, &mut acc, &params, 4, band(0..h / 2)),
+        accumulate_region(&mut pt, &mut acc, &params, 4, band(0..h / 2)),
         4
     );
     assert_eq!(
-        accumulate_region(&pt, &mut acc, &params, 4, band(h / 2..h)),
+        accumulate_region(&mut pt, &mut acc, &params, 4, band(h / 2..h)),
         8
     );
     let shown = displayed(&mut pt, &acc, &params);
@@ -601,15 +601,33 @@ fn progressive_accumulation_restarts_when_the_view_changes() {
     let mut params = FrameParams::new(scene.cameras[0].clone());
     let mut pt = PathTracer::new(&ctx().device, &ctx().queue, &scene, &measuring()).unwrap();
     let mut acc = pt.accumulation(8, 8).unwrap();
-    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 2);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 2, 0..8), 2);
     params.exposure = 1.0;
     assert!(pt.shows(&acc, &params, &opts(7, Bounces::Unlimited)));
-    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 4);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 2, 0..8), 4);
     params.camera.position.x += 0.01;
     assert!(!pt.shows(&acc, &params, &opts(7, Bounces::Unlimited)));
-    assert_eq!(accumulate(&pt, &mut acc, &params, 2, 0..8), 2);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 2, 0..8), 2);
     acc.reset();
-    assert_eq!(accumulate(&pt, &mut acc, &params, 3, 0..8), 3);
+    assert_eq!(accumulate(&mut pt, &mut acc, &params, 3, 0..8), 3);
+
+    // Timed, the two passes report under their names (where the device has timestamps).
+    pt.enable_timing(true);
+    accumulate(&mut pt, &mut acc, &params, 1, 0..8);
+    displayed(&mut pt, &acc, &params);
+    let times = pt.pass_times().unwrap();
+    if ctx()
+        .device
+        .features()
+        .contains(voxgi::wgpu::Features::TIMESTAMP_QUERY)
+    {
+        let names: Vec<&str> = times.iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, ["reference", "reference_display"]);
+        assert!(
+            times.iter().all(|(_, ms)| *ms >= 0.0 && ms.is_finite()),
+            "{times:?}"
+        );
+    }
 
     let mut enc = ctx().device.create_command_encoder(&Default::default());
     #[allow(clippy::reversed_empty_ranges)]
