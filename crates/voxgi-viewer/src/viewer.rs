@@ -799,6 +799,9 @@ impl Viewer {
                 1e3 / mean.max(1e-3),
                 recent.len()
             );
+            if self.ground.display != Display::ConeTraced {
+                eprintln!("{}", self.ground.label());
+            }
             return Ok(true);
         }
         Ok(false)
