@@ -73,6 +73,11 @@ impl Orbit {
         self.pitch = (self.pitch - dy * TURN_PER_PIXEL).clamp(-PITCH_LIMIT, PITCH_LIMIT);
     }
 
+    /// Turns around the target by `radians` (positive: to the left, as a drag to the right).
+    pub fn turn(&mut self, radians: f32) {
+        self.yaw -= radians;
+    }
+
     /// Moves the target in the view plane by a drag of (dx, dy) pixels in a view `height`
     /// pixels high, so the point under the cursor stays under it.
     pub fn pan(&mut self, dx: f32, dy: f32, height: f32) {

@@ -65,6 +65,8 @@ pub struct GroundTruth {
     pub frame_target_ms: Option<f32>,
     /// Time the path tracer's passes on the GPU.
     timing: bool,
+    /// Adapt the paths a frame to the frame's wall time instead of the GPU's timestamps.
+    wall_clock: bool,
     /// Whether the last frame traced paths (so its time says something about them).
     traced_last_frame: bool,
     /// The first row of the next band.
@@ -87,6 +89,7 @@ impl GroundTruth {
             paths_per_frame: if cpu { 1 << 14 } else { 1 << 22 },
             frame_target_ms: Some(default_target_ms(cpu)),
             timing,
+            wall_clock: cpu || !timing,
             traced_last_frame: false,
             next_row: 0,
             band_rows: 0,
@@ -185,7 +188,7 @@ impl GroundTruth {
     }
 
     /// The path tracer's GPU milliseconds per pass in the frame just submitted (empty without
-    /// timestamps), and the paths a frame adapted to them when a target is set.
+    /// timestamps); on a GPU clock, the paths a frame adapted to them when a target is set.
     pub fn frame_done(&mut self) -> Vec<(&'static str, f64)> {
         let Some(t) = &mut self.traced else {
             return Vec::new();
@@ -195,12 +198,33 @@ impl GroundTruth {
             .iter()
             .find(|(n, _)| *n == "reference")
             .map(|(_, ms)| *ms as f32);
-        if let (Some(target), Some(ms)) = (self.frame_target_ms, traced)
+        log::debug!("path tracer: {times:?} for {} paths", self.paths_per_frame);
+        if !self.wall_clock
+            && let Some(ms) = traced
+        {
+            self.adapt(ms);
+        }
+        times
+    }
+
+    /// On the wall clock (a CPU driver, whose compute timestamps read about 0 ms, or no
+    /// timestamps at all): the last frame's wall time, `frame_ms`, adapts the paths a frame
+    /// when that frame did little else than trace (`tracing_only`: cone tracing showed its last
+    /// image again, or was not drawn).
+    pub fn frame_time(&mut self, frame_ms: f32, tracing_only: bool) {
+        if self.wall_clock && tracing_only {
+            self.adapt(frame_ms);
+        } else if self.wall_clock {
+            self.traced_last_frame = false;
+        }
+    }
+
+    fn adapt(&mut self, ms: f32) {
+        if let Some(target) = self.frame_target_ms
             && std::mem::take(&mut self.traced_last_frame)
         {
             self.paths_per_frame = next_budget(self.paths_per_frame, ms, target);
         }
-        times
     }
 
     /// Whether a path tracer is being built.
@@ -296,9 +320,10 @@ impl GroundTruth {
 }
 
 /// How long the path tracer may take a frame by default: a CPU driver draws a frame in a few
-/// hundred milliseconds at best; a GPU stays interactive beside cone tracing.
+/// hundred milliseconds at best (and its budget is a whole frame's wall time); a GPU stays
+/// interactive beside cone tracing.
 pub fn default_target_ms(cpu: bool) -> f32 {
-    if cpu { 250.0 } else { 10.0 }
+    if cpu { 300.0 } else { 10.0 }
 }
 
 /// The paths a frame for the next frame: scaled by how far the last frame's path tracing time

@@ -46,10 +46,19 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = ground_truth::Display::ConeTraced)]
     pub display: ground_truth::Display,
     /// Paths the path tracer traces a frame (a band of rows when fewer than the image has).
-    /// Default: adapted to keep the path tracer's GPU time near 250 ms a frame on a CPU driver,
-    /// 10 ms on a GPU.
+    /// Default: adapted so that tracing takes about 10 ms of GPU time a frame, or on a CPU
+    /// driver so that a still view's frames take about 300 ms.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1024..=1 << 26))]
     pub paths_per_frame: Option<u32>,
+    /// Turn the orbit camera by this many degrees each frame: a turntable, for demos and for
+    /// measuring the frame rate of a moving view.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub turntable: f32,
     /// Where the split view's divider starts, as a fraction of the width.
     #[arg(long, value_name = "F", default_value_t = 0.5, value_parser = parse_fraction)]
     pub divider: f32,

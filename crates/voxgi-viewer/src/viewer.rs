@@ -88,6 +88,13 @@ impl ApplicationHandler for App {
     }
 }
 
+/// The image cone tracing drew last, kept to show again while nothing changes.
+struct LastImage {
+    texture: Option<wgpu::Texture>,
+    /// The frame parameters and scene state (`Viewer::version`) it shows.
+    shows: Option<(FrameParams, u64)>,
+}
+
 /// A file loaded and its renderer built, off the window's thread.
 struct Opened {
     path: PathBuf,
@@ -126,6 +133,13 @@ struct Viewer {
     dialog: Option<Job<Option<PathBuf>>>,
     open_path: String,
     vsync: bool,
+    /// The cone-traced image of the last frame that drew one, and what it showed; `None` when
+    /// the surface cannot be copied into (every frame draws).
+    last_image: Option<LastImage>,
+    /// Whether this frame showed the last image again instead of drawing.
+    reused: bool,
+    /// Degrees the orbit turns each frame (`--turntable`).
+    turntable: f32,
     /// The adapter is a CPU driver (lavapipe, WARP): smaller defaults.
     cpu: bool,
     scene_name: String,
@@ -228,6 +242,11 @@ impl Viewer {
             .get_default_config(&adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| anyhow!("{} cannot draw into this window", info.name))?;
         config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        // A still view is drawn once into an image and copied into each frame after that.
+        let keeps_image = caps.usages.contains(wgpu::TextureUsages::COPY_DST);
+        if keeps_image {
+            config.usage |= wgpu::TextureUsages::COPY_DST;
+        }
         config.format = format;
         config.present_mode = if args.no_vsync {
             wgpu::PresentMode::AutoNoVsync
@@ -313,6 +332,12 @@ impl Viewer {
             dialog: None,
             open_path: String::new(),
             vsync: !args.no_vsync,
+            last_image: keeps_image.then_some(LastImage {
+                texture: None,
+                shows: None,
+            }),
+            reused: false,
+            turntable: args.turntable,
             cpu,
             egui_ctx,
             egui_state,
@@ -582,6 +607,72 @@ impl Viewer {
         self.ground.display = display;
     }
 
+    /// The frame's scene into the surface texture: as `draw_scene`, but a cone-traced image
+    /// that would come out as the last one (same parameters, same scene, the renderer idle) is
+    /// copied from the last instead of drawn, so a still view costs next to nothing.
+    fn draw_frame(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        surface: &wgpu::Texture,
+        view: &wgpu::TextureView,
+    ) -> Result<()> {
+        let (w, h, format) = (self.config.width, self.config.height, self.config.format);
+        self.reused = false;
+        let Some(last) = self
+            .last_image
+            .as_mut()
+            .filter(|_| self.ground.needs_cone_tracing())
+        else {
+            return self.draw_scene(encoder, &Target::new(view, format, w, h), true);
+        };
+        if last.texture.as_ref().map(|t| (t.width(), t.height())) != Some((w, h)) {
+            last.texture = Some(self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("last image"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            }));
+            last.shows = None;
+        }
+        let texture = last.texture.clone().expect("made above");
+        // Counters that came back may ask for a rebuild: then the renderer is not idle.
+        self.renderer.receive_feedback()?;
+        let shows = Some((self.params.clone(), self.version));
+        if last.shows == shows && self.renderer.is_idle() {
+            self.reused = true;
+        } else {
+            let v = texture.create_view(&Default::default());
+            self.renderer
+                .render(encoder, &Target::new(&v, format, w, h), &self.params)?;
+            last.shows = shows;
+        }
+        let size = wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        };
+        encoder.copy_texture_to_texture(texture.as_image_copy(), surface.as_image_copy(), size);
+        let r = self.ground.record(
+            encoder,
+            &Target::new(view, format, w, h),
+            &self.params,
+            self.options.bounces,
+            true,
+        );
+        if let Err(e) = r {
+            self.ground.error = Some(format!("{e:#}"));
+        }
+        Ok(())
+    }
+
     /// The scene into `target`: cone tracing, then the path tracer over its columns. With
     /// `accumulate` false the path tracer only shows what it has (a second drawing of the same
     /// frame, for a screenshot).
@@ -614,6 +705,8 @@ impl Viewer {
         let elapsed = (now - self.last_frame).as_secs_f32();
         self.last_frame = now;
         push(&mut self.frame_ms, elapsed * 1e3);
+        let tracing_only = self.reused || !self.ground.needs_cone_tracing();
+        self.ground.frame_time(elapsed * 1e3, tracing_only);
         // Slow frames do not make the animation or the fly camera jump.
         let dt = elapsed.min(0.25);
         if let Controller::Fly(f) = &mut self.controller {
@@ -626,6 +719,11 @@ impl Viewer {
                 },
                 dt,
             );
+        }
+        if let Controller::Orbit(o) = &mut self.controller
+            && self.turntable != 0.0
+        {
+            o.turn(self.turntable.to_radians());
         }
         if self.playing && self.duration > 0.0 {
             self.time = (self.time + dt) % self.duration.max(1e-3);
@@ -667,7 +765,7 @@ impl Viewer {
         let (w, h) = (self.config.width, self.config.height);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         let format = self.config.format;
-        self.draw_scene(&mut encoder, &Target::new(&view, format, w, h), true)?;
+        self.draw_frame(&mut encoder, &frame.texture, &view)?;
 
         // The UI, drawn over the image.
         let raw = self.egui_state.take_egui_input(&self.window);
@@ -1177,6 +1275,9 @@ impl Viewer {
             "frame {frame:.1} ms ({:.1} fps)",
             1e3 / frame.max(1e-3)
         ));
+        if self.reused {
+            ui.label("cone tracing: nothing changed, the last image is shown again");
+        }
         if let Some(c) = self.renderer.last_voxel_counts() {
             ui.label(format!("{} fragments, {} voxels", c.fragments, c.occupied));
         }

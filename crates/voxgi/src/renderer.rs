@@ -604,6 +604,14 @@ impl Renderer {
         !self.voxel_work_pending()
     }
 
+    /// Whether rendering again with the same frame parameters and target would give the same
+    /// image: the voxels are settled and no voxel counter is still on its way back (one that
+    /// overflowed would make the next frame rebuild). An application may then show its last
+    /// image instead of rendering.
+    pub fn is_idle(&self) -> bool {
+        self.voxels_settled() && !self.counters.pending()
+    }
+
     /// The scene's own camera, or a view of its bounds.
     pub fn default_camera(&self) -> &Camera {
         &self.default_camera

@@ -85,6 +85,15 @@ impl CounterReadback {
         true
     }
 
+    /// Whether some read has not been taken yet (in flight, or completed and waiting for
+    /// `take_ready`).
+    pub fn pending(&self) -> bool {
+        self.slots.iter().any(|s| {
+            let state = s.state.load(Ordering::Acquire);
+            state == IN_FLIGHT || state == READY
+        })
+    }
+
     /// Every read completed since the last call, as (tag, u32 words). Call after a
     /// non-blocking `Device::poll` so that completed maps have run their callbacks.
     pub fn take_ready(&mut self) -> Vec<(u64, Vec<u32>)> {

@@ -202,6 +202,52 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
     }
 }
 
+/// `is_idle` is what lets an application skip frames: once it says so, the next frame is the
+/// last one again, to the bit. An overflowing first build is not idle (its counters are on the
+/// way back and will make a frame rebuild), and neither is a moved light.
+#[test]
+fn an_idle_renderer_draws_its_last_image_again() {
+    let scene = builtin::cornell_box();
+    let (w, h) = (32, 32);
+    let small = RendererOptions {
+        voxel_resolution: 32,
+        fragment_capacity: Some(1),
+        voxel_capacity: Some(1),
+        ..RendererOptions::default()
+    };
+    let mut r = renderer(&scene, &small);
+    let params = FrameParams::new(r.default_camera().clone());
+    let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
+    draw(&mut r, &params, &t);
+    let mut last = rgba8(&t);
+    assert!(
+        !r.is_idle(),
+        "idle right after a build whose counters are still out"
+    );
+    let mut idle_at = None;
+    for i in 1..10 {
+        r.receive_feedback().unwrap();
+        let idle = r.is_idle();
+        draw(&mut r, &params, &t);
+        let now = rgba8(&t);
+        if idle {
+            assert!(
+                now == last,
+                "frame {i} changed although the renderer was idle"
+            );
+            idle_at.get_or_insert(i);
+        }
+        last = now;
+    }
+    let idle_at = idle_at.expect("never idle");
+    // The pools grow once or twice (see the test above), each a frame or two later.
+    assert!(idle_at <= 6, "idle only at frame {idle_at}");
+    let mut light = r.lights()[0].clone();
+    light.intensity *= 0.5;
+    r.set_light(0, &light).unwrap();
+    assert!(!r.is_idle(), "idle with a light change waiting");
+}
+
 /// A target format the tone mapping cannot write is an error naming it, every time it is
 /// asked for, and the renderer keeps working for good formats.
 #[test]
