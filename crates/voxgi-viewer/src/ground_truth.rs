@@ -227,6 +227,11 @@ impl GroundTruth {
         }
     }
 
+    /// What the path tracer's build is doing, while one runs.
+    pub fn job_label(&self) -> Option<String> {
+        self.building.as_ref().map(|(job, _)| job.label())
+    }
+
     /// Whether a path tracer is being built.
     pub fn building(&self) -> bool {
         self.building.is_some()
@@ -256,7 +261,7 @@ impl GroundTruth {
         };
         match (&self.building, samples) {
             (Some((job, _)), Some(n)) => {
-                format!("path traced, {n} spp (the scene moved: {})", job.label())
+                format!("path traced, {n} spp (the scene changed: {})", job.label())
             }
             (Some((job, _)), None) => job.label(),
             (None, Some(n)) if n >= self.max_samples => format!("path traced, {n} spp (done)"),

@@ -1150,8 +1150,10 @@ impl Viewer {
         if let Some(job) = &self.dialog {
             running.push(job.label());
         }
-        if self.ground.display != Display::ConeTraced && self.ground.building() {
-            running.push(self.ground.label());
+        if self.ground.display != Display::ConeTraced
+            && let Some(l) = self.ground.job_label()
+        {
+            running.push(l);
         }
         if !running.is_empty() {
             egui::Area::new(egui::Id::unique("jobs"))
@@ -1227,32 +1229,41 @@ impl Viewer {
             };
             ui.label(egui::RichText::new(format!("{} ({kind})", l.name)).strong());
             let speed = 0.01 * l.intensity.max(0.1);
+            // Only what the user changed counts: the colour button rounds its value through
+            // HSV when first shown, which is not an edit.
+            let mut changed = false;
             ui.horizontal(|ui| {
-                ui.color_edit_button_rgb(&mut l.color);
-                ui.add(
-                    egui::DragValue::new(&mut l.intensity)
-                        .speed(speed)
-                        .range(0.0..=1e6)
-                        .prefix("intensity "),
-                );
+                changed |= ui.color_edit_button_rgb(&mut l.color).changed();
+                changed |= ui
+                    .add(
+                        egui::DragValue::new(&mut l.intensity)
+                            .speed(speed)
+                            .range(0.0..=1e6)
+                            .prefix("intensity "),
+                    )
+                    .changed();
             });
             let step = self.scene_radius * 0.005;
             if l.kind == voxgi::scene::LightKind::Directional {
                 ui.horizontal(|ui| {
                     ui.label("direction");
                     for c in 0..3 {
-                        ui.add(egui::DragValue::new(&mut l.direction[c]).speed(0.01));
+                        changed |= ui
+                            .add(egui::DragValue::new(&mut l.direction[c]).speed(0.01))
+                            .changed();
                     }
                 });
             } else {
                 ui.horizontal(|ui| {
                     ui.label("position");
                     for c in 0..3 {
-                        ui.add(egui::DragValue::new(&mut l.position[c]).speed(step));
+                        changed |= ui
+                            .add(egui::DragValue::new(&mut l.position[c]).speed(step))
+                            .changed();
                     }
                 });
             }
-            if l != *light {
+            if changed && l != *light {
                 if l.direction.length_squared() < 1e-8 {
                     l.direction = light.direction;
                 }
