@@ -618,28 +618,18 @@ impl Viewer {
     ) -> Result<()> {
         let (w, h, format) = (self.config.width, self.config.height, self.config.format);
         self.reused = false;
-        let Some(last) = self
-            .last_image
-            .as_mut()
-            .filter(|_| self.ground.needs_cone_tracing())
-        else {
+        if self.last_image.is_none() || !self.ground.needs_cone_tracing() {
             return self.draw_scene(encoder, &Target::new(view, format, w, h), true);
-        };
-        if last.texture.as_ref().map(|t| (t.width(), t.height())) != Some((w, h)) {
-            last.texture = Some(self.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("last image"),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            }));
+        }
+        let stale = self
+            .last_image
+            .as_ref()
+            .and_then(|l| l.texture.as_ref())
+            .is_none_or(|t| (t.width(), t.height()) != (w, h));
+        let fresh = stale.then(|| self.capture_texture(format));
+        let last = self.last_image.as_mut().expect("checked above");
+        if let Some(t) = fresh {
+            last.texture = Some(t);
             last.shows = None;
         }
         let texture = last.texture.clone().expect("made above");

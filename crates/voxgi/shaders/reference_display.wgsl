@@ -4,6 +4,7 @@
 
 //!include shared/scene.wgsl
 //!include shared/tone_curves.wgsl
+//!include shared/fullscreen.wgsl
 
 struct Display {
     // Linear exposure scale (2^EV).
@@ -19,12 +20,6 @@ struct Display {
 
 // True for an 8-bit target without an sRGB view, as in the tonemap pass.
 override ENCODE_SRGB: bool = false;
-
-@vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

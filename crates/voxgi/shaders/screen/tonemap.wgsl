@@ -5,18 +5,12 @@
 
 //!include shared/globals.wgsl
 //!include shared/tone_curves.wgsl
+//!include shared/fullscreen.wgsl
 
 @group(2) @binding(0) var hdr: texture_2d<f32>;
 
 // True for an 8-bit target without an sRGB view: the shader applies the sRGB curve itself.
 override ENCODE_SRGB: bool = false;
-
-@vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    // One triangle covering the screen: (-1,-1), (3,-1), (-1,3).
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

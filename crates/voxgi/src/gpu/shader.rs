@@ -14,6 +14,7 @@ macro_rules! wgsl {
 const SOURCES: &[(&str, &str)] = wgsl![
     "shared/scene.wgsl",
     "shared/tone_curves.wgsl",
+    "shared/fullscreen.wgsl",
     "shared/globals.wgsl",
     "shared/brdf.wgsl",
     "shared/light_model.wgsl",
