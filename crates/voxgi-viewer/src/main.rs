@@ -24,7 +24,8 @@ pub struct Args {
     /// cornell-box when no file is given.
     #[arg(long, value_name = "NAME")]
     pub builtin: Option<String>,
-    /// Window size in pixels. Default 960x540 on a GPU, 640x360 on a CPU driver.
+    /// Window size in pixels. Default 1280x720 on a GPU, 960x480 on a CPU driver (the 3D view
+    /// is what the settings panel leaves of it).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Write the frame to this PNG after --after-frames frames and exit (for tests and
@@ -59,7 +60,8 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub turntable: f32,
-    /// Where the split view's divider starts, as a fraction of the width.
+    /// Where the split view's divider starts, as a fraction of the 3D view's width (right of
+    /// the panel).
     #[arg(long, value_name = "F", default_value_t = 0.5, value_parser = parse_fraction)]
     pub divider: f32,
 }

@@ -88,10 +88,13 @@ impl ApplicationHandler for App {
     }
 }
 
-/// The image cone tracing drew last, kept to show again while nothing changes.
-struct LastImage {
-    texture: Option<wgpu::Texture>,
-    /// The frame parameters and scene state (`Viewer::version`) it shows.
+/// The 3D view's images, the size of the part of the window right of the panel: what cone
+/// tracing drew last (kept to show again while nothing changes) and the frame's view (cone
+/// tracing with the path tracer over its columns), copied into the window beside the panel.
+struct ViewImages {
+    cone: Option<wgpu::Texture>,
+    view: Option<wgpu::Texture>,
+    /// The frame parameters and scene state (`Viewer::version`) `cone` shows.
     shows: Option<(FrameParams, u64)>,
 }
 
@@ -133,9 +136,12 @@ struct Viewer {
     dialog: Option<Job<Option<PathBuf>>>,
     open_path: String,
     vsync: bool,
-    /// The cone-traced image of the last frame that drew one, and what it showed; `None` when
-    /// the surface cannot be copied into (every frame draws).
-    last_image: Option<LastImage>,
+    /// The view's images; `None` when the surface cannot be copied into (then every frame
+    /// draws the whole window, under the panel too).
+    images: Option<ViewImages>,
+    /// Where the panel ends, physical pixels from the window's left (0 without the panel):
+    /// the 3D view starts there.
+    panel_px: u32,
     /// Whether this frame showed the last image again instead of drawing.
     reused: bool,
     /// Degrees the orbit turns each frame (`--turntable`).
@@ -220,7 +226,7 @@ impl Viewer {
         .with_context(|| format!("cannot open {}", info.name))?;
         let (w, h) = args
             .size
-            .unwrap_or(if cpu { (640, 360) } else { (960, 540) });
+            .unwrap_or(if cpu { (960, 480) } else { (1280, 720) });
         let _ = window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
         let size = window.inner_size();
         let caps = surface.get_capabilities(&adapter);
@@ -332,10 +338,12 @@ impl Viewer {
             dialog: None,
             open_path: String::new(),
             vsync: !args.no_vsync,
-            last_image: keeps_image.then_some(LastImage {
-                texture: None,
+            images: keeps_image.then_some(ViewImages {
+                cone: None,
+                view: None,
                 shows: None,
             }),
+            panel_px: 0,
             reused: false,
             turntable: args.turntable,
             cpu,
@@ -354,7 +362,8 @@ impl Viewer {
             frames: 0,
             ready_frames: 0,
             status: String::new(),
-            show_panel: true,
+            // A screenshot without the UI is of the whole window.
+            show_panel: args.screenshot.is_none() || args.with_ui,
             screenshot: args
                 .screenshot
                 .clone()
@@ -607,60 +616,142 @@ impl Viewer {
         self.ground.display = display;
     }
 
-    /// The frame's scene into the surface texture: as `draw_scene`, but a cone-traced image
-    /// that would come out as the last one (same parameters, same scene, the renderer idle) is
-    /// copied from the last instead of drawn, so a still view costs next to nothing.
+    /// The 3D view's columns of the window: right of the panel, or all of the window when the
+    /// panel is hidden, leaves less than a quarter, or the view cannot be copied beside it.
+    fn view_columns(&self) -> (u32, u32) {
+        let w = self.config.width;
+        let x0 = if self.images.is_some() && self.panel_px * 4 <= w * 3 {
+            self.panel_px
+        } else {
+            0
+        };
+        (x0, w - x0)
+    }
+
+    /// The frame's scene into `surface` (the window's texture, or a capture of it) right of
+    /// the panel: cone tracing, with the path tracer over its columns. A cone-traced image that
+    /// would come out as the last one (same parameters, same scene, the renderer idle) is
+    /// copied from the last instead of drawn, so a still view costs next to nothing. With
+    /// `accumulate` false the path tracer only shows what it has (the frame drawn again).
     fn draw_frame(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         surface: &wgpu::Texture,
-        view: &wgpu::TextureView,
+        accumulate: bool,
     ) -> Result<()> {
         let (w, h, format) = (self.config.width, self.config.height, self.config.format);
-        self.reused = false;
-        if self.last_image.is_none() || !self.ground.needs_cone_tracing() {
-            return self.draw_scene(encoder, &Target::new(view, format, w, h), true);
+        let surface_view = surface.create_view(&Default::default());
+        if accumulate {
+            self.reused = false;
         }
+        if self.images.is_none() {
+            return self.draw_scene(
+                encoder,
+                &Target::new(&surface_view, format, w, h),
+                accumulate,
+            );
+        }
+        let (x0, vw) = self.view_columns();
         let stale = self
-            .last_image
+            .images
             .as_ref()
-            .and_then(|l| l.texture.as_ref())
-            .is_none_or(|t| (t.width(), t.height()) != (w, h));
-        let fresh = stale.then(|| self.capture_texture(format));
-        let last = self.last_image.as_mut().expect("checked above");
-        if let Some(t) = fresh {
-            last.texture = Some(t);
-            last.shows = None;
+            .and_then(|i| i.view.as_ref())
+            .is_none_or(|t| (t.width(), t.height()) != (vw, h));
+        let fresh = stale.then(|| {
+            (
+                self.image_texture("cone-traced view", vw, h),
+                self.image_texture("view", vw, h),
+            )
+        });
+        let images = self.images.as_mut().expect("checked above");
+        if let Some((cone, view)) = fresh {
+            images.cone = Some(cone);
+            images.view = Some(view);
+            images.shows = None;
         }
-        let texture = last.texture.clone().expect("made above");
-        // Counters that came back may ask for a rebuild: then the renderer is not idle.
-        self.renderer.receive_feedback()?;
-        let shows = Some((self.params.clone(), self.version));
-        if last.shows == shows && self.renderer.is_idle() {
-            self.reused = true;
-        } else {
-            let v = texture.create_view(&Default::default());
-            self.renderer
-                .render(encoder, &Target::new(&v, format, w, h), &self.params)?;
-            last.shows = shows;
-        }
-        let size = wgpu::Extent3d {
-            width: w,
+        let cone = images.cone.clone().expect("made above");
+        let view = images.view.clone().expect("made above");
+        let extent = wgpu::Extent3d {
+            width: vw,
             height: h,
             depth_or_array_layers: 1,
         };
-        encoder.copy_texture_to_texture(texture.as_image_copy(), surface.as_image_copy(), size);
+        if self.ground.needs_cone_tracing() {
+            // Counters that came back may ask for a rebuild: then the renderer is not idle.
+            self.renderer.receive_feedback()?;
+            let shows = Some((self.params.clone(), self.version));
+            let images = self.images.as_mut().expect("checked above");
+            if images.shows == shows && self.renderer.is_idle() {
+                self.reused |= accumulate;
+            } else {
+                let v = cone.create_view(&Default::default());
+                self.renderer
+                    .render(encoder, &Target::new(&v, format, vw, h), &self.params)?;
+                images.shows = shows;
+            }
+            encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
+        }
+        let v = view.create_view(&Default::default());
         let r = self.ground.record(
             encoder,
-            &Target::new(view, format, w, h),
+            &Target::new(&v, format, vw, h),
             &self.params,
             self.options.bounces,
-            true,
+            accumulate,
         );
         if let Err(e) = r {
             self.ground.error = Some(format!("{e:#}"));
         }
+        if x0 > 0 {
+            // Under the panel: black, not whatever the surface held.
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("clear"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &surface_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        }
+        encoder.copy_texture_to_texture(
+            view.as_image_copy(),
+            wgpu::TexelCopyTextureInfo {
+                texture: surface,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: x0, y: 0, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            extent,
+        );
         Ok(())
+    }
+
+    /// An image of the window's format that the view is drawn into and copied from.
+    fn image_texture(&self, label: &str, w: u32, h: u32) -> wgpu::Texture {
+        self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.config.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
     }
 
     /// The scene into `target`: cone tracing, then the path tracer over its columns. With
@@ -754,8 +845,7 @@ impl Viewer {
         let view = frame.texture.create_view(&Default::default());
         let (w, h) = (self.config.width, self.config.height);
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        let format = self.config.format;
-        self.draw_frame(&mut encoder, &frame.texture, &view)?;
+        self.draw_frame(&mut encoder, &frame.texture, true)?;
 
         // The UI, drawn over the image.
         let raw = self.egui_state.take_egui_input(&self.window);
@@ -792,7 +882,7 @@ impl Viewer {
         let ui_capture = if capture_ui {
             let texture = self.capture_texture(self.config.format);
             let v = texture.create_view(&Default::default());
-            self.draw_scene(&mut encoder, &Target::new(&v, format, w, h), false)?;
+            self.draw_frame(&mut encoder, &texture, false)?;
             egui_pass(&self.egui_renderer, &mut encoder, &v, &jobs, &screen);
             Some(texture)
         } else {
@@ -908,7 +998,9 @@ impl Viewer {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         })
     }
@@ -934,6 +1026,10 @@ impl Viewer {
 
     /// Renders the current view (without the UI) into an image and writes it as a PNG.
     fn save_screenshot(&mut self, path: &std::path::Path) -> Result<()> {
+        // The frame as shown right of the panel.
+        if let Some(view) = self.images.as_ref().and_then(|i| i.view.clone()) {
+            return self.save_texture(&view, path);
+        }
         let (w, h) = (self.config.width, self.config.height);
         let format = wgpu::TextureFormat::Rgba8Unorm;
         let texture = self.capture_texture(format);
@@ -964,9 +1060,10 @@ impl Viewer {
         let mut actions = crate::settings::PanelActions::default();
         self.overlays_ui(ui);
         if !self.show_panel {
+            self.panel_px = 0;
             return actions;
         }
-        egui::Panel::left("settings")
+        let panel = egui::Panel::left("settings")
             .default_size(260.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
@@ -1064,6 +1161,9 @@ impl Viewer {
                         .show(ui, |ui| self.stats_ui(ui));
                 });
             });
+        let ppp = ui.ctx().pixels_per_point();
+        let right = panel.response.rect.right() - ui.ctx().content_rect().left();
+        self.panel_px = ((right * ppp).round().max(0.0) as u32).min(self.config.width);
         actions
     }
 
@@ -1172,7 +1272,10 @@ impl Viewer {
                     .show(&ctx, |ui| caption(ui, text));
             }
             Display::Split => {
-                let x = screen.left() + screen.width() * self.ground.divider;
+                let ppp = ctx.pixels_per_point();
+                let (x0, vw) = self.view_columns();
+                let (left, width) = (screen.left() + x0 as f32 / ppp, vw as f32 / ppp);
+                let x = left + width * self.ground.divider;
                 let text = self.ground.label();
                 egui::Area::new(egui::Id::unique("path traced"))
                     .anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0])
@@ -1198,7 +1301,7 @@ impl Viewer {
                     })
                     .inner;
                 if response.dragged() {
-                    let moved = response.drag_delta().x / screen.width().max(1.0);
+                    let moved = response.drag_delta().x / width.max(1.0);
                     self.ground.divider = (self.ground.divider + moved).clamp(0.0, 1.0);
                 }
             }
