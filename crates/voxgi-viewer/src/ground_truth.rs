@@ -169,6 +169,7 @@ impl GroundTruth {
         }
         let (device, queue, scene) = (device.clone(), queue.clone(), scene.clone());
         let (lights, options) = (lights.to_vec(), options.clone());
+        log::debug!("building a path tracer for scene state {version}");
         let job = Job::spawn("building the path tracer", move || -> Result<PathTracer> {
             let mut scene = (*scene).clone();
             scene.set_time(time);
@@ -300,6 +301,9 @@ impl GroundTruth {
         // Past the cap the image is left as it is, unless the view changed (which the
         // accumulation tells by restarting, so ask it with one more call).
         let moved = !t.tracer.shows(acc, params, &opts);
+        if moved && accumulate {
+            log::debug!("path tracer restarts: the view or the options changed");
+        }
         if accumulate && (acc.samples() < self.max_samples || moved) {
             if moved {
                 self.next_row = 0;

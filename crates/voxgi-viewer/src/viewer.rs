@@ -112,6 +112,9 @@ enum Controller {
     Fly(Fly),
 }
 
+/// The settings panel's width, points.
+const PANEL_WIDTH: f32 = 370.0;
+
 /// Per-pass GPU milliseconds of recent frames, for the rolling graph.
 const HISTORY: usize = 120;
 
@@ -384,6 +387,22 @@ impl Viewer {
             }
             WindowEvent::RedrawRequested if self.redraw()? => event_loop.exit(),
             WindowEvent::DroppedFile(path) => self.open(&path),
+            // A release always ends a drag or a held key, even over the panel: swallowed, it
+            // would leave the camera turning or flying.
+            WindowEvent::MouseInput {
+                state: ElementState::Released,
+                button,
+                ..
+            } => match button {
+                MouseButton::Left => self.left_down = false,
+                MouseButton::Right | MouseButton::Middle => self.right_down = false,
+                _ => {}
+            },
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Released => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    self.keys.remove(&code);
+                }
+            }
             _ if response.consumed => {}
             WindowEvent::KeyboardInput { event, .. } => {
                 if let PhysicalKey::Code(code) = event.physical_key {
@@ -663,6 +682,9 @@ impl Viewer {
                 self.image_texture("view", vw, h),
             )
         });
+        if stale {
+            log::debug!("view images: {vw}x{h} at column {x0}");
+        }
         let images = self.images.as_mut().expect("checked above");
         if let Some((cone, view)) = fresh {
             images.cone = Some(cone);
@@ -1063,8 +1085,10 @@ impl Viewer {
             self.panel_px = 0;
             return actions;
         }
+        // A fixed width: a panel that followed its content would resize the 3D view (and
+        // restart the path tracer) whenever a label grew.
         let panel = egui::Panel::left("settings")
-            .default_size(260.0)
+            .exact_size(PANEL_WIDTH)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     ui.heading(&self.scene_name);
