@@ -71,7 +71,7 @@ pub struct GroundTruth {
     traced_last_frame: bool,
     /// The first row of the next band.
     next_row: u32,
-    /// Rows in the last band.
+    /// Rows a band has (the last one of a sweep may be cut short by the image's bottom).
     band_rows: u32,
     traced: Option<Traced>,
     building: Option<(Job<PathTracer>, u64)>,
@@ -314,7 +314,7 @@ impl GroundTruth {
             let rows = (self.paths_per_frame as u64 / per_row).clamp(1, h as u64) as u32;
             let start = if self.next_row >= h { 0 } else { self.next_row };
             let end = (start + rows).min(h);
-            self.band_rows = end - start;
+            self.band_rows = rows;
             self.next_row = end % h;
             let region = Region {
                 columns: columns.clone(),
