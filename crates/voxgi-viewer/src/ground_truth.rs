@@ -46,6 +46,8 @@ struct Traced {
     tracer: PathTracer,
     accumulation: Option<Accumulation>,
     version: u64,
+    /// The lights it has (as `Renderer::lights` numbers them): an edit is set in place.
+    lights: Vec<Light>,
 }
 
 /// The window's ground truth.
@@ -74,7 +76,7 @@ pub struct GroundTruth {
     /// Rows a band has (the last one of a sweep may be cut short by the image's bottom).
     band_rows: u32,
     traced: Option<Traced>,
-    building: Option<(Job<PathTracer>, u64)>,
+    building: Option<(Job<PathTracer>, u64, Vec<Light>)>,
     pub error: Option<String>,
 }
 
@@ -140,11 +142,10 @@ impl GroundTruth {
         if self.display == Display::ConeTraced {
             return;
         }
-        if let Some((job, built_for)) = &mut self.building
+        if let Some((job, _, _)) = &self.building
             && let Some(result) = job.poll()
         {
-            let built_for = *built_for;
-            self.building = None;
+            let (_, built_for, built_lights) = self.building.take().expect("polled above");
             match result {
                 Ok(mut tracer) => {
                     tracer.enable_timing(self.timing);
@@ -153,9 +154,30 @@ impl GroundTruth {
                         tracer,
                         accumulation: None,
                         version: built_for,
+                        lights: built_lights,
                     })
                 }
                 Err(e) => self.error = Some(format!("{e:#}")),
+            }
+        }
+        // Lights edited since: set in place (the triangles do not move), the image starts over.
+        if let Some(t) = &mut self.traced
+            && t.lights.len() == lights.len()
+            && t.lights != lights
+        {
+            let mut failed = false;
+            for (i, l) in lights.iter().enumerate() {
+                if t.lights[i] != *l {
+                    failed |= t.tracer.set_light(i, l).is_err();
+                }
+            }
+            t.lights = lights.to_vec();
+            if let Some(a) = &mut t.accumulation {
+                a.reset();
+            }
+            if failed {
+                // A light the path tracer cannot take in place: build it anew.
+                t.version = u64::MAX;
             }
         }
         if let Some(why) = Self::unsupported(scene) {
@@ -168,7 +190,7 @@ impl GroundTruth {
             return;
         }
         let (device, queue, scene) = (device.clone(), queue.clone(), scene.clone());
-        let (lights, options) = (lights.to_vec(), options.clone());
+        let (built_lights, lights, options) = (lights.to_vec(), lights.to_vec(), options.clone());
         log::debug!("building a path tracer for scene state {version}");
         let job = Job::spawn("building the path tracer", move || -> Result<PathTracer> {
             let mut scene = (*scene).clone();
@@ -179,7 +201,7 @@ impl GroundTruth {
             }
             Ok(PathTracer::new(&device, &queue, &scene, &options)?)
         });
-        self.building = Some((job, version));
+        self.building = Some((job, version, built_lights));
     }
 
     /// The scene changed in a way that makes a built path tracer wrong now and again: a failed
@@ -230,7 +252,7 @@ impl GroundTruth {
 
     /// What the path tracer's build is doing, while one runs.
     pub fn job_label(&self) -> Option<String> {
-        self.building.as_ref().map(|(job, _)| job.label())
+        self.building.as_ref().map(|(job, _, _)| job.label())
     }
 
     /// Whether a path tracer is being built.
@@ -261,10 +283,10 @@ impl GroundTruth {
             _ => String::new(),
         };
         match (&self.building, samples) {
-            (Some((job, _)), Some(n)) => {
+            (Some((job, _, _)), Some(n)) => {
                 format!("path traced, {n} spp (the scene changed: {})", job.label())
             }
-            (Some((job, _)), None) => job.label(),
+            (Some((job, _, _)), None) => job.label(),
             (None, Some(n)) if n >= self.max_samples => format!("path traced, {n} spp (done)"),
             (None, Some(n)) => format!("path traced, {n} spp{band}"),
             (None, None) => "path tracer starting".into(),

@@ -1384,11 +1384,9 @@ impl Viewer {
                 if l.direction.length_squared() < 1e-8 {
                     l.direction = light.direction;
                 }
+                // The path tracer takes the edit from `renderer.lights()` in its next update.
                 match self.renderer.set_light(i, &l) {
-                    Ok(()) => {
-                        self.version += 1;
-                        self.ground.scene_changed();
-                    }
+                    Ok(()) => self.ground.scene_changed(),
                     Err(e) => self.status = format!("{e}"),
                 }
             }

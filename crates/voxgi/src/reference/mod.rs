@@ -8,14 +8,14 @@
 
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, layout, readback, shader};
-use crate::gpu_scene::{GpuScene, NO_INDEX, scene_bounds};
+use crate::gpu_scene::{GpuLight, GpuScene, NO_INDEX, gpu_light, scene_bounds};
 use crate::options::{FrameParams, RendererOptions};
 use crate::output::{RenderOutput, tonemap};
 use crate::view::lit_scene;
 use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat3, Vec3};
-use voxgi_scene::Scene;
+use voxgi_scene::{Light, Scene};
 use wgpu::util::DeviceExt;
 
 mod progressive;
@@ -399,6 +399,47 @@ impl PathTracer {
     /// GPU); empty without timing.
     pub fn pass_times(&mut self) -> Result<Vec<(&'static str, f64)>> {
         self.timer.read(&self.device)
+    }
+
+    /// Changes light `index` (as `Renderer::lights` numbers them: the scene's, and the default
+    /// sun when one was added) to `light`, as `Renderer::set_light` does: everything but its
+    /// kind. The triangles stay where they were built, area lights' emitters included, so this
+    /// is exactly a path tracer built afresh with the new light. Accumulations made before show
+    /// the old light: `Accumulation::reset` them.
+    pub fn set_light(&mut self, index: usize, light: &Light) -> Result<()> {
+        let count = self.scene.gpu_lights.len();
+        let was = *self.scene.gpu_lights.get(index).ok_or_else(|| {
+            Error::Setting(format!(
+                "light {index} does not exist (the path tracer has {count})"
+            ))
+        })?;
+        let finite = light.position.is_finite()
+            && light.direction.is_finite()
+            && light.direction.length_squared() > 0.0
+            && light.color.iter().all(|c| c.is_finite() && *c >= 0.0)
+            && light.intensity.is_finite()
+            && light.intensity >= 0.0;
+        if !finite {
+            return Err(Error::Setting(format!(
+                "light '{}': position, direction, colour and intensity must be finite (and \
+                 colour and intensity not negative, the direction not zero)",
+                light.name
+            )));
+        }
+        let g = gpu_light(light);
+        if g.kind != was.kind {
+            return Err(Error::Setting(format!(
+                "light '{}': its kind is fixed once uploaded; make a new PathTracer to change it",
+                light.name
+            )));
+        }
+        self.scene.gpu_lights[index] = g;
+        self.queue.write_buffer(
+            &self.scene.lights,
+            (index * size_of::<GpuLight>()) as u64,
+            bytemuck::bytes_of(&g),
+        );
+        Ok(())
     }
 
     /// Number of world-space triangles traced.

@@ -673,3 +673,43 @@ fn progressive_accumulation_restarts_when_the_view_changes() {
         .expect_err("a 4x4 accumulation shown on an 8x8 target");
     assert!(e.to_string().contains("4x4"), "{e}");
 }
+
+/// A light changed in place gives what a path tracer built afresh with that light gives, to
+/// the bit: the window edits lights without rebuilding the BVH.
+#[test]
+fn a_light_set_in_place_equals_a_fresh_path_tracer() {
+    let mut scene = builtin::cornell_box();
+    let params = clamped(&scene.cameras[0]);
+    let o = opts(4, Bounces::One);
+    let mut edited = PathTracer::new(&ctx().device, &ctx().queue, &scene, &measuring()).unwrap();
+    let before = edited.render(&params, 16, 16, &o, &mut |_, _| {}).unwrap();
+    let mut light = scene.lights[0].clone();
+    light.intensity *= 0.5;
+    light.color = [1.0, 0.5, 0.25];
+    edited.set_light(0, &light).unwrap();
+    let after = edited.render(&params, 16, 16, &o, &mut |_, _| {}).unwrap();
+    scene.lights[0] = light.clone();
+    let fresh = trace_with(&scene, &measuring(), &params, 16, 16, o);
+    assert!(
+        after.hdr == fresh.hdr,
+        "set_light differs from a fresh path tracer"
+    );
+    assert!(
+        after.hdr != before.hdr,
+        "the edit changed nothing: the test is blind"
+    );
+
+    assert!(
+        edited.set_light(7, &light).is_err(),
+        "a light that does not exist"
+    );
+    let mut point = light.clone();
+    point.kind = LightKind::Point;
+    let e = edited
+        .set_light(0, &point)
+        .expect_err("an area light made a point light");
+    assert!(e.to_string().contains("kind"), "{e}");
+    let mut nan = light;
+    nan.intensity = f32::NAN;
+    assert!(edited.set_light(0, &nan).is_err(), "a NaN intensity");
+}
