@@ -5,7 +5,7 @@
 //! a change of time or of a light builds a new one, in the background, while the last image
 //! stays up.
 
-use crate::jobs::Job;
+use crate::jobs::{Job, take};
 use anyhow::Result;
 use std::ops::Range;
 use std::sync::Arc;
@@ -50,6 +50,9 @@ struct Traced {
     lights: Vec<Light>,
 }
 
+/// A path tracer and what it was built for: the scene state (`version`) and the lights.
+type Built = (PathTracer, u64, Vec<Light>);
+
 /// The window's ground truth.
 pub struct GroundTruth {
     pub display: Display,
@@ -76,7 +79,8 @@ pub struct GroundTruth {
     /// Rows a band has (the last one of a sweep may be cut short by the image's bottom).
     band_rows: u32,
     traced: Option<Traced>,
-    building: Option<(Job<PathTracer>, u64, Vec<Light>)>,
+    /// A path tracer being built, with the scene state and the lights it is built for.
+    building: Option<Job<Built>>,
     pub error: Option<String>,
 }
 
@@ -142,12 +146,9 @@ impl GroundTruth {
         if self.display == Display::ConeTraced {
             return;
         }
-        if let Some((job, _, _)) = &self.building
-            && let Some(result) = job.poll()
-        {
-            let (_, built_for, built_lights) = self.building.take().expect("polled above");
+        if let Some(result) = take(&mut self.building) {
             match result {
-                Ok(mut tracer) => {
+                Ok((mut tracer, built_for, built_lights)) => {
                     tracer.enable_timing(self.timing);
                     self.error = None;
                     self.traced = Some(Traced {
@@ -190,18 +191,21 @@ impl GroundTruth {
             return;
         }
         let (device, queue, scene) = (device.clone(), queue.clone(), scene.clone());
-        let (built_lights, lights, options) = (lights.to_vec(), lights.to_vec(), options.clone());
+        let (lights, options) = (lights.to_vec(), options.clone());
         log::debug!("building a path tracer for scene state {version}");
-        let job = Job::spawn("building the path tracer", move || -> Result<PathTracer> {
-            let mut scene = (*scene).clone();
-            scene.set_time(time);
-            // The lights as the renderer has them now: animated, then edited in the window.
-            if lights.len() == scene.lights.len() {
-                scene.lights = lights;
-            }
-            Ok(PathTracer::new(&device, &queue, &scene, &options)?)
-        });
-        self.building = Some((job, version, built_lights));
+        self.building = Some(Job::spawn(
+            "building the path tracer",
+            move || -> Result<Built> {
+                let mut scene = (*scene).clone();
+                scene.set_time(time);
+                // The lights as the renderer has them now: animated, then edited in the window.
+                if lights.len() == scene.lights.len() {
+                    scene.lights = lights.clone();
+                }
+                let tracer = PathTracer::new(&device, &queue, &scene, &options)?;
+                Ok((tracer, version, lights))
+            },
+        ));
     }
 
     /// The scene changed in a way that makes a built path tracer wrong now and again: a failed
@@ -252,7 +256,7 @@ impl GroundTruth {
 
     /// What the path tracer's build is doing, while one runs.
     pub fn job_label(&self) -> Option<String> {
-        self.building.as_ref().map(|(job, _, _)| job.label())
+        self.building.as_ref().map(Job::label)
     }
 
     /// Whether a path tracer is being built.
@@ -261,7 +265,7 @@ impl GroundTruth {
     }
 
     /// Why the path tracer cannot show this scene, if it cannot.
-    pub fn unsupported(scene: &Scene) -> Option<&'static str> {
+    fn unsupported(scene: &Scene) -> Option<&'static str> {
         (scene.triangle_count() == 0).then_some(
             "the path tracer traces triangles, and this scene has none (a point cloud is cone \
              traced only)",
@@ -283,10 +287,10 @@ impl GroundTruth {
             _ => String::new(),
         };
         match (&self.building, samples) {
-            (Some((job, _, _)), Some(n)) => {
+            (Some(job), Some(n)) => {
                 format!("path traced, {n} spp (the scene changed: {})", job.label())
             }
-            (Some((job, _, _)), None) => job.label(),
+            (Some(job), None) => job.label(),
             (None, Some(n)) if n >= self.max_samples => format!("path traced, {n} spp (done)"),
             (None, Some(n)) => format!("path traced, {n} spp{band}"),
             (None, None) => "path tracer starting".into(),

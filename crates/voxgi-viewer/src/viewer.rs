@@ -134,7 +134,7 @@ struct Viewer {
     last_time: f32,
     ground: GroundTruth,
     // Background work, each shown in the window while it runs.
-    rebuild: Option<(Job<Renderer>, RendererOptions)>,
+    rebuild: Option<Job<(Renderer, RendererOptions)>>,
     opening: Option<Job<Opened>>,
     dialog: Option<Job<Option<PathBuf>>>,
     open_path: String,
@@ -404,29 +404,20 @@ impl Viewer {
                 }
             }
             _ if response.consumed => {}
+            // Presses only: releases were taken above.
             WindowEvent::KeyboardInput { event, .. } => {
                 if let PhysicalKey::Code(code) = event.physical_key {
-                    match event.state {
-                        ElementState::Pressed => {
-                            if !event.repeat {
-                                self.key_pressed(code);
-                            }
-                            self.keys.insert(code);
-                        }
-                        ElementState::Released => {
-                            self.keys.remove(&code);
-                        }
+                    if !event.repeat {
+                        self.key_pressed(code);
                     }
+                    self.keys.insert(code);
                 }
             }
-            WindowEvent::MouseInput { state, button, .. } => {
-                let down = state == ElementState::Pressed;
-                match button {
-                    MouseButton::Left => self.left_down = down,
-                    MouseButton::Right | MouseButton::Middle => self.right_down = down,
-                    _ => {}
-                }
-            }
+            WindowEvent::MouseInput { button, .. } => match button {
+                MouseButton::Left => self.left_down = true,
+                MouseButton::Right | MouseButton::Middle => self.right_down = true,
+                _ => {}
+            },
             WindowEvent::CursorMoved { position, .. } => {
                 let p = (position.x as f32, position.y as f32);
                 if let Some(last) = self.cursor
@@ -562,10 +553,9 @@ impl Viewer {
     fn apply(&mut self) {
         let (device, queue) = (self.device.clone(), self.queue.clone());
         let (scene, options) = (self.scene.clone(), self.draft.clone());
-        let job = Job::spawn("rebuilding for the new options", move || {
-            Ok(Renderer::new(&device, &queue, &scene, &options)?)
-        });
-        self.rebuild = Some((job, self.draft.clone()));
+        self.rebuild = Some(Job::spawn("rebuilding for the new options", move || {
+            Ok((Renderer::new(&device, &queue, &scene, &options)?, options))
+        }));
     }
 
     /// The new options' renderer takes over, with the scene's time and the lights as edited.
@@ -601,14 +591,10 @@ impl Viewer {
 
     /// Takes the results of finished background work.
     fn poll_jobs(&mut self) {
-        if let Some((job, _)) = &self.rebuild
-            && let Some(result) = job.poll()
-        {
-            let (_, options) = self.rebuild.take().expect("polled above");
-            match result {
-                Ok(r) => self.rebuilt(r, options),
-                Err(e) => self.status = format!("the new options failed: {e:#}"),
-            }
+        match take(&mut self.rebuild) {
+            Some(Ok((r, options))) => self.rebuilt(r, options),
+            Some(Err(e)) => self.status = format!("the new options failed: {e:#}"),
+            None => {}
         }
         match take(&mut self.opening) {
             Some(Ok(o)) => self.opened(o),
@@ -678,8 +664,8 @@ impl Viewer {
             .is_none_or(|t| (t.width(), t.height()) != (vw, h));
         let fresh = stale.then(|| {
             (
-                self.image_texture("cone-traced view", vw, h),
-                self.image_texture("view", vw, h),
+                self.image_texture("cone-traced view", format, vw, h),
+                self.image_texture("view", format, vw, h),
             )
         });
         if stale {
@@ -726,22 +712,12 @@ impl Viewer {
         }
         if x0 > 0 {
             // Under the panel: black, not whatever the surface held.
-            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("clear"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &surface_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            color_pass(
+                encoder,
+                "clear",
+                &surface_view,
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            );
         }
         encoder.copy_texture_to_texture(
             view.as_image_copy(),
@@ -754,26 +730,6 @@ impl Viewer {
             extent,
         );
         Ok(())
-    }
-
-    /// An image of the window's format that the view is drawn into and copied from.
-    fn image_texture(&self, label: &str, w: u32, h: u32) -> wgpu::Texture {
-        self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: self.config.format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        })
     }
 
     /// The scene into `target`: cone tracing, then the path tracer over its columns. With
@@ -1006,14 +962,20 @@ impl Viewer {
         }
         Ok(false)
     }
-
-    /// An image the size of the window to capture a frame into.
-    fn capture_texture(&self, format: wgpu::TextureFormat) -> wgpu::Texture {
+    /// An image the view is drawn into, copied from and read back (screenshots, the view's
+    /// cone-traced and composed images).
+    fn image_texture(
+        &self,
+        label: &str,
+        format: wgpu::TextureFormat,
+        w: u32,
+        h: u32,
+    ) -> wgpu::Texture {
         self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("screenshot"),
+            label: Some(label),
             size: wgpu::Extent3d {
-                width: self.config.width,
-                height: self.config.height,
+                width: w,
+                height: h,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -1025,6 +987,11 @@ impl Viewer {
                 | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         })
+    }
+
+    /// An image the size of the window to capture a frame into.
+    fn capture_texture(&self, format: wgpu::TextureFormat) -> wgpu::Texture {
+        self.image_texture("screenshot", format, self.config.width, self.config.height)
     }
 
     /// Writes an 8-bit capture (RGBA or BGRA) as a PNG.
@@ -1255,7 +1222,7 @@ impl Viewer {
     fn overlays_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         let mut running: Vec<String> = Vec::new();
-        if let Some((job, _)) = &self.rebuild {
+        if let Some(job) = &self.rebuild {
             running.push(job.label());
         }
         if let Some(job) = &self.opening {
@@ -1467,14 +1434,25 @@ fn egui_pass(
     jobs: &[egui::ClippedPrimitive],
     screen: &egui_wgpu::ScreenDescriptor,
 ) {
-    let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("egui"),
+    let pass = color_pass(encoder, "egui", view, wgpu::LoadOp::Load);
+    renderer.render(&mut pass.forget_lifetime(), jobs, screen);
+}
+
+/// A render pass into `view` alone, loading or clearing it.
+fn color_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    view: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
             view,
             depth_slice: None,
             resolve_target: None,
             ops: wgpu::Operations {
-                load: wgpu::LoadOp::Load,
+                load,
                 store: wgpu::StoreOp::Store,
             },
         })],
@@ -1482,8 +1460,7 @@ fn egui_pass(
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,
-    });
-    renderer.render(&mut pass.forget_lifetime(), jobs, screen);
+    })
 }
 
 fn push(v: &mut std::collections::VecDeque<f32>, x: f32) {

@@ -318,6 +318,25 @@ pub fn gpu_lights(scene: &Scene) -> Vec<GpuLight> {
     scene.lights.iter().map(gpu_light).collect()
 }
 
+/// An error unless `light` can be uploaded as a change: finite position, direction, colour
+/// and intensity, colour and intensity not negative, the direction not zero.
+pub fn check_light(light: &Light) -> Result<()> {
+    let finite = light.position.is_finite()
+        && light.direction.is_finite()
+        && light.direction.length_squared() > 0.0
+        && light.color.iter().all(|c| c.is_finite() && *c >= 0.0)
+        && light.intensity.is_finite()
+        && light.intensity >= 0.0;
+    if !finite {
+        return Err(Error::Setting(format!(
+            "light '{}': position, direction, colour and intensity must be finite (and colour \
+             and intensity not negative, the direction not zero)",
+            light.name
+        )));
+    }
+    Ok(())
+}
+
 /// One light in its GPU form (shadow fields left zero).
 pub fn gpu_light(l: &Light) -> GpuLight {
     let mut g = GpuLight {

@@ -23,7 +23,7 @@ use crate::fragments::{self, FragmentEstimate, Fragments, TriangleTable, triangl
 use crate::gpu::feedback::CounterReadback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
-use crate::gpu_scene::{GpuFrame, GpuScene, bounding_sphere, gpu_light};
+use crate::gpu_scene::{GpuFrame, GpuScene, bounding_sphere, check_light, gpu_light};
 use crate::lighting::atlas::{self as shadow, ShadowAtlas, ViewDirt};
 use crate::lighting::bounce::BouncePass;
 use crate::lighting::inject::InjectPass;
@@ -524,19 +524,7 @@ impl Renderer {
         }
         let mut g = gpu_light(light);
         let was = self.scene.gpu_lights[index];
-        let finite = light.position.is_finite()
-            && light.direction.is_finite()
-            && light.direction.length_squared() > 0.0
-            && light.color.iter().all(|c| c.is_finite() && *c >= 0.0)
-            && light.intensity.is_finite()
-            && light.intensity >= 0.0;
-        if !finite {
-            return Err(Error::Setting(format!(
-                "light '{}': position, direction, colour and intensity must be finite (and \
-                 colour and intensity not negative, the direction not zero)",
-                light.name
-            )));
-        }
+        check_light(light)?;
         if g.kind != was.kind || light.cast_shadows != old.cast_shadows {
             return Err(Error::Setting(format!(
                 "light '{}': its kind and whether it casts shadows are fixed once uploaded; make \
@@ -862,11 +850,7 @@ impl Renderer {
 
     /// Turns per-pass GPU timing on or off (when the device has `TIMESTAMP_QUERY`).
     pub fn enable_timing(&mut self, on: bool) {
-        self.timer = if on {
-            GpuTimer::new(&self.device, &self.queue, true)
-        } else {
-            GpuTimer::disabled(&self.queue)
-        };
+        self.timer = GpuTimer::new(&self.device, &self.queue, on);
     }
 
     /// Milliseconds per pass of everything recorded since the last call, once it has been

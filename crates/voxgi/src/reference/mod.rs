@@ -8,7 +8,7 @@
 
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, layout, readback, shader};
-use crate::gpu_scene::{GpuLight, GpuScene, NO_INDEX, gpu_light, scene_bounds};
+use crate::gpu_scene::{GpuLight, GpuScene, NO_INDEX, check_light, gpu_light, scene_bounds};
 use crate::options::{FrameParams, RendererOptions};
 use crate::output::{RenderOutput, tonemap};
 use crate::view::lit_scene;
@@ -388,11 +388,7 @@ impl PathTracer {
     /// Turns GPU timing of `accumulate` ("reference") and `display` ("reference_display") on
     /// or off (when the device has `TIMESTAMP_QUERY`).
     pub fn enable_timing(&mut self, on: bool) {
-        self.timer = if on {
-            GpuTimer::new(&self.device, &self.queue, true)
-        } else {
-            GpuTimer::disabled(&self.queue)
-        };
+        self.timer = GpuTimer::new(&self.device, &self.queue, on);
     }
 
     /// Milliseconds per pass recorded since the last call, once submitted (this waits for the
@@ -413,19 +409,7 @@ impl PathTracer {
                 "light {index} does not exist (the path tracer has {count})"
             ))
         })?;
-        let finite = light.position.is_finite()
-            && light.direction.is_finite()
-            && light.direction.length_squared() > 0.0
-            && light.color.iter().all(|c| c.is_finite() && *c >= 0.0)
-            && light.intensity.is_finite()
-            && light.intensity >= 0.0;
-        if !finite {
-            return Err(Error::Setting(format!(
-                "light '{}': position, direction, colour and intensity must be finite (and \
-                 colour and intensity not negative, the direction not zero)",
-                light.name
-            )));
-        }
+        check_light(light)?;
         let g = gpu_light(light);
         if g.kind != was.kind {
             return Err(Error::Setting(format!(

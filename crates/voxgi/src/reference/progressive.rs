@@ -289,8 +289,8 @@ impl PathTracer {
             Bounces::Unlimited => (MAX_BOUNCES - 1, 3),
             Bounces::Exactly(n) => (n.min(MAX_BOUNCES - 1), u32::MAX),
         };
-        let view_proj = camera_view_proj(camera, acc.width, acc.height, self.center, self.radius);
         let key = self.key(acc, frame, opts);
+        let view_proj = glam::Mat4::from_cols_array(&key.view_proj);
         let columns = region.columns.clone();
         if acc.key != Some(key) {
             encoder.clear_buffer(&acc.buffer, 0, None);

@@ -137,6 +137,17 @@ fn every_target_format_gets_the_same_image() {
     assert!(d <= 1, "Rgba16Float: differs by {d} steps");
 }
 
+/// A 32³ volume whose fragment and voxel pools start at the minimum: the Cornell box overflows
+/// both.
+fn tiny_pools() -> RendererOptions {
+    RendererOptions {
+        voxel_resolution: 32,
+        fragment_capacity: Some(1),
+        voxel_capacity: Some(1),
+        ..RendererOptions::default()
+    }
+}
+
 /// A renderer whose pools are far too small for the scene still gets the right image: the
 /// first build counts what did not fit, the counters come back without any frame waiting, the
 /// pools grow and a later frame rebuilds. From then on every frame equals, to the bit, the
@@ -145,12 +156,7 @@ fn every_target_format_gets_the_same_image() {
 fn overflowing_pools_grow_and_converge_to_the_right_image() {
     let scene = builtin::cornell_box();
     let (w, h) = (32, 32);
-    let small = RendererOptions {
-        voxel_resolution: 32,
-        fragment_capacity: Some(1),
-        voxel_capacity: Some(1),
-        ..RendererOptions::default()
-    };
+    let small = tiny_pools();
     let mut r = renderer(&scene, &small);
     let (frags0, slots0) = (r.fragments().capacity, r.volume().slot_capacity);
     let params = FrameParams::new(r.default_camera().clone());
@@ -209,12 +215,7 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
 fn an_idle_renderer_draws_its_last_image_again() {
     let scene = builtin::cornell_box();
     let (w, h) = (32, 32);
-    let small = RendererOptions {
-        voxel_resolution: 32,
-        fragment_capacity: Some(1),
-        voxel_capacity: Some(1),
-        ..RendererOptions::default()
-    };
+    let small = tiny_pools();
     let mut r = renderer(&scene, &small);
     let params = FrameParams::new(r.default_camera().clone());
     let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
