@@ -37,7 +37,11 @@ pub struct SettingsArgs {
     /// Shadow map resolution per view, in texels. Default 1024.
     #[arg(long, value_name = "N")]
     pub shadow_map_size: Option<u32>,
-    /// Voxels per side of the volume (power of two, 16..=512). Default 128.
+    /// Voxel structure: dense (the mip-mapped volume) or octree (the sparse voxel octree,
+    /// memory in proportion to the occupied voxels). Default dense.
+    #[arg(long, value_parser = names(voxgi::VoxelKind::ALL.map(voxgi::VoxelKind::name)))]
+    pub voxels: Option<String>,
+    /// Voxels per side of the volume (power of two, 16..=512; the octree 16..=1024). Default 128.
     #[arg(long, value_name = "N")]
     pub voxel_resolution: Option<u32>,
     /// Indirect bounces: 0 ("direct": direct light only) to 8, or "unlimited". Default 2.
@@ -109,6 +113,9 @@ impl SettingsArgs {
             f.view = ViewMode::parse(v)?;
         }
         set!(o.shadow_map_size, self.shadow_map_size);
+        if let Some(v) = &self.voxels {
+            o.voxels = voxgi::VoxelKind::parse(v)?;
+        }
         set!(o.voxel_resolution, self.voxel_resolution);
         set!(o.bounces, self.bounces);
         set!(o.cones, self.cones);

@@ -92,8 +92,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let view = texture.create_view(&Default::default());
     let target = Target::new(&view, headless::OUTPUT_FORMAT, w, h);
     eprintln!(
-        "bench: {label}, {w}x{h}, voxels {}³, {} frames after {} warm-up, on {} ({:?})",
-        settings.voxel_resolution, args.frames, args.warmup, ctx.info.name, ctx.info.backend
+        "bench: {label}, {w}x{h}, {} voxels {}³, {} frames after {} warm-up, on {} ({:?})",
+        settings.voxels.name(),
+        settings.voxel_resolution,
+        args.frames,
+        args.warmup,
+        ctx.info.name,
+        ctx.info.backend
     );
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = Vec::new();
     let mut totals = Vec::new();
@@ -218,6 +223,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "size": [w, h],
             "frames": args.frames,
             "settings": {
+                "voxels": settings.voxels.name(),
                 "voxel_resolution": settings.voxel_resolution,
                 "anisotropic": settings.anisotropic,
                 "cones": settings.cones.name(),

@@ -68,7 +68,7 @@ pub use renderer::{Renderer, VOXEL_PASSES, VoxelCounts};
 pub use scene_state::swept_bounds;
 pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
 pub use targets::{FrameTargets, Target};
-pub use voxel::ConeSet;
+pub use voxel::{ConeSet, VoxelKind};
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;
 /// The wgpu voxgi is built on: use it to create the device and textures you hand to voxgi.

@@ -1,7 +1,7 @@
 //! The renderer's knobs with their documented defaults and range checks: creation-time
 //! options apart from per-frame parameters.
 
-use crate::voxel::ConeSet;
+use crate::voxel::{ConeSet, VoxelKind};
 use crate::{Error, Result};
 use voxgi_scene::Camera;
 
@@ -40,6 +40,10 @@ pub enum ViewMode {
     VoxelOpacity,
     /// The radiance (un-premultiplied) of the first voxel with opacity > 0.5 at `debug_level`.
     VoxelRadiance,
+    /// The structure's occupied cells at `debug_level`: the octree's nodes of that level that
+    /// have children (at level 0 its occupied leaves), the dense volume's cells with any
+    /// opacity; coloured by level, shaded by face, edges darkened.
+    VoxelNodes,
 }
 
 impl Tonemap {
@@ -71,7 +75,7 @@ impl Tonemap {
 
 impl ViewMode {
     /// Every view, in the order of their ids.
-    pub const ALL: [ViewMode; 9] = [
+    pub const ALL: [ViewMode; 10] = [
         ViewMode::Final,
         ViewMode::Albedo,
         ViewMode::Normal,
@@ -81,6 +85,7 @@ impl ViewMode {
         ViewMode::VoxelAlbedo,
         ViewMode::VoxelOpacity,
         ViewMode::VoxelRadiance,
+        ViewMode::VoxelNodes,
     ];
 
     /// The name scene files and the CLI use.
@@ -95,6 +100,7 @@ impl ViewMode {
             ViewMode::VoxelAlbedo => "voxel-albedo",
             ViewMode::VoxelOpacity => "voxel-opacity",
             ViewMode::VoxelRadiance => "voxel-radiance",
+            ViewMode::VoxelNodes => "voxel-nodes",
         }
     }
 
@@ -118,7 +124,10 @@ impl ViewMode {
     pub fn is_voxel(&self) -> bool {
         matches!(
             self,
-            ViewMode::VoxelAlbedo | ViewMode::VoxelOpacity | ViewMode::VoxelRadiance
+            ViewMode::VoxelAlbedo
+                | ViewMode::VoxelOpacity
+                | ViewMode::VoxelRadiance
+                | ViewMode::VoxelNodes
         )
     }
 }
@@ -140,8 +149,10 @@ pub struct RendererOptions {
     /// Add a sun when the scene has no light and nothing emissive, instead of rendering black.
     /// Default true.
     pub default_light: bool,
-    /// Voxels per side of the volume at the finest level: a power of two in 16..=512.
-    /// Default 128.
+    /// The voxel structure: the dense volume (default) or the sparse voxel octree.
+    pub voxels: VoxelKind,
+    /// Voxels per side of the volume at the finest level: a power of two in 16..=512 (the
+    /// octree: 16..=1024). Default 128.
     pub voxel_resolution: u32,
     /// Six directional values per voxel above the finest level (true, default) or one.
     pub anisotropic: bool,
@@ -196,6 +207,7 @@ impl Default for RendererOptions {
             shadow_map_size: 1024,
             max_texture_size: 1024,
             default_light: true,
+            voxels: VoxelKind::Dense,
             voxel_resolution: 128,
             anisotropic: true,
             gather_axes: 3,
@@ -233,9 +245,16 @@ impl RendererOptions {
             ));
         }
         let r = self.voxel_resolution;
-        if !(16..=512).contains(&r) || !r.is_power_of_two() {
+        // The fragments' 10-bit coordinates reach 1024; a dense volume past 512 is 1 GiB a
+        // texture.
+        let top = match self.voxels {
+            VoxelKind::Dense => 512,
+            VoxelKind::Octree => 1024,
+        };
+        if !(16..=top).contains(&r) || !r.is_power_of_two() {
             return fail(format!(
-                "voxel resolution {r} is not a power of two in 16..=512"
+                "voxel resolution {r} is not a power of two in 16..={top} (the {} structure)",
+                self.voxels.name()
             ));
         }
         if self.bounces > MAX_BOUNCES && self.bounces != UNLIMITED_BOUNCES {

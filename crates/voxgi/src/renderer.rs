@@ -38,7 +38,8 @@ use crate::screen::upsample::UpsamplePass;
 use crate::targets::{FrameTargets, Target};
 use crate::view::{camera_view_proj, lit_scene};
 use crate::voxel::dense::{DensePipelines, DenseVolume, SLOT_BYTES};
-use crate::voxel::{DebugView, GpuCones, Grid, VoxelStructure};
+use crate::voxel::octree::{OctreePipelines, OctreePools, OctreeVolume};
+use crate::voxel::{DebugView, GpuCones, Grid, POOL_COUNTERS, VoxelKind, Voxels};
 use crate::{Error, Result};
 use glam::{Mat4, Vec3};
 use std::sync::Arc;
@@ -47,13 +48,15 @@ use wgpu::util::DeviceExt;
 
 /// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
 /// camera), in the order they run; every other pass is the screen's.
-pub const VOXEL_PASSES: [&str; 7] = [
+pub const VOXEL_PASSES: [&str; 9] = [
     "shadow",
     "voxelize",
     "dense_build",
     "dense_update",
+    "octree_build",
     "inject",
     "filter",
+    "octree_filter",
     "bounce",
 ];
 
@@ -142,9 +145,9 @@ pub struct Renderer {
     globals_layout: wgpu::BindGroupLayout,
     fragments: Fragments,
     /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
-    /// (and `volume()`, for tests) names the dense volume.
-    volume: DenseVolume,
-    dense_pipelines: Arc<DensePipelines>,
+    /// (and `volume()`, for tests) names its kind.
+    volume: Voxels,
+    structure_pipelines: StructurePipelines,
     /// Voxelize's triangle tables: the static instances' and the dynamic ones'.
     static_triangles: TriangleTable,
     dynamic_triangles: TriangleTable,
@@ -282,13 +285,18 @@ impl Renderer {
         )?;
         let grid = grid(&facts, options);
         let fragments = new_fragments(device, &facts, options, grid, None)?;
-        let dense_pipelines = checked(device, "pipeline creation", || DensePipelines::new(device))?;
-        let volume = new_volume(device, &dense_pipelines, &facts, options, grid, None)?;
+        let mut structure_pipelines = StructurePipelines::default();
+        let volume = new_volume(device, &mut structure_pipelines, &facts, options, grid)?;
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             voxelize: VoxelizePass::new(device),
-            inject: InjectPass::new(device, gpu_scene.light_count, atlas.views.len()),
-            bounce: BouncePass::new(device, options.anisotropic),
+            inject: InjectPass::new(
+                device,
+                options.voxels,
+                gpu_scene.light_count,
+                atlas.views.len(),
+            ),
+            bounce: BouncePass::new(device, options.voxels, options.anisotropic),
             gbuffer: GbufferPass::new(device),
             gather: GatherPass::new(device, options, facts.glossy),
             upsample: UpsamplePass::new(device),
@@ -326,7 +334,7 @@ impl Renderer {
             globals_layout: crate::globals::layout(device),
             fragments,
             volume,
-            dense_pipelines,
+            structure_pipelines,
             static_triangles,
             dynamic_triangles,
             cones,
@@ -335,7 +343,7 @@ impl Renderer {
             progressive_left: 0,
             frame_index: 0,
             state,
-            counters: CounterReadback::new("voxel counters readback", 2),
+            counters: CounterReadback::new("voxel counters readback", 1 + POOL_COUNTERS),
             pools: 0,
             last_counts: None,
             timer: GpuTimer::disabled(queue),
@@ -366,8 +374,10 @@ impl Renderer {
             ));
         }
         let device = &self.device;
-        let volume =
-            old.voxel_resolution != new.voxel_resolution || old.anisotropic != new.anisotropic;
+        let kind = old.voxels != new.voxels;
+        let volume = kind
+            || old.voxel_resolution != new.voxel_resolution
+            || old.anisotropic != new.anisotropic;
         let atlas = old.shadow_map_size != new.shadow_map_size
             || old.cone_shadows != new.cone_shadows
             || shadow::atlas_resolution(old, &self.scene.gpu_lights)
@@ -404,25 +414,29 @@ impl Renderer {
         let volume_new = if volume {
             Some(new_volume(
                 device,
-                &self.dense_pipelines,
+                &mut self.structure_pipelines,
                 &self.facts,
                 new,
                 grid,
-                None,
             )?)
         } else {
             None
         };
         let gather = volume || old.gather_axes != new.gather_axes;
-        let (gather_new, bounce_new, composite_new) = checked(device, "pipeline creation", || {
-            (
-                gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
-                (old.anisotropic != new.anisotropic)
-                    .then(|| BouncePass::new(device, new.anisotropic)),
-                (old.cone_shadows != new.cone_shadows)
-                    .then(|| composite_pass(device, &self.scene, &self.facts, new)),
-            )
-        })?;
+        let views = self.atlas.views.len();
+        let (gather_new, bounce_new, composite_new, inject_new) =
+            checked(device, "pipeline creation", || {
+                (
+                    gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
+                    (kind || old.anisotropic != new.anisotropic)
+                        .then(|| BouncePass::new(device, new.voxels, new.anisotropic)),
+                    (old.cone_shadows != new.cone_shadows)
+                        .then(|| composite_pass(device, &self.scene, &self.facts, new)),
+                    kind.then(|| {
+                        InjectPass::new(device, new.voxels, self.scene.light_count, views)
+                    }),
+                )
+            })?;
         if let Some(a) = atlas_new {
             self.atlas = a;
         }
@@ -441,6 +455,9 @@ impl Renderer {
         }
         if let Some(p) = composite_new {
             self.passes.composite = p;
+        }
+        if let Some(p) = inject_new {
+            self.passes.inject = p;
         }
         if cones {
             self.queue.write_buffer(
@@ -615,7 +632,7 @@ impl Renderer {
         let mut m = self.scene.memory();
         m.push(("shadow atlas", self.atlas.bytes()));
         m.extend(self.fragments.memory());
-        m.extend(self.volume.memory());
+        m.extend(self.volume.get().memory());
         if let Some(t) = &self.targets {
             m.push(("render targets", t.bytes()));
         }
@@ -687,6 +704,7 @@ impl Renderer {
             );
             self.fragments.record_mark(encoder);
             self.volume
+                .get()
                 .record_build(&self.device, encoder, &self.fragments, timer);
         }
         if geometry && self.facts.dynamic {
@@ -701,6 +719,7 @@ impl Renderer {
                 timer,
             );
             self.volume
+                .get()
                 .record_update(&self.device, encoder, &self.fragments, timer);
         }
         if geometry {
@@ -709,7 +728,10 @@ impl Renderer {
             if !self.counters.request(
                 &self.device,
                 encoder,
-                &[&self.fragments.count, self.volume.leaf_counter()],
+                &[
+                    (&self.fragments.count, 1),
+                    (self.volume.get().pool_counter(), POOL_COUNTERS),
+                ],
                 self.pools,
             ) {
                 log::warn!(
@@ -739,7 +761,7 @@ impl Renderer {
                 encoder,
                 &self.scene,
                 &self.atlas,
-                &self.volume,
+                self.volume.get(),
                 timer,
             );
             if progressive {
@@ -748,18 +770,24 @@ impl Renderer {
                 // a cleared volume only reproduces the direct light).
                 self.progressive_left = self.voxel_bounces + 1;
             } else {
-                self.volume.record_filter(&self.device, encoder, timer);
+                self.volume
+                    .get()
+                    .record_filter(&self.device, encoder, timer);
                 for _ in 0..self.voxel_bounces {
                     p.bounce
-                        .record(&self.device, encoder, &self.volume, &self.cones, timer);
-                    self.volume.record_filter(&self.device, encoder, timer);
+                        .record(&self.device, encoder, self.volume.get(), &self.cones, timer);
+                    self.volume
+                        .get()
+                        .record_filter(&self.device, encoder, timer);
                 }
             }
         }
         if progressive && self.progressive_left > 0 {
             p.bounce
-                .record(&self.device, encoder, &self.volume, &self.cones, timer);
-            self.volume.record_filter(&self.device, encoder, timer);
+                .record(&self.device, encoder, self.volume.get(), &self.cones, timer);
+            self.volume
+                .get()
+                .record_filter(&self.device, encoder, timer);
             self.progressive_left -= 1;
         }
         // The shadow views were consumed by `record_shadows` this frame; injection's start over.
@@ -782,9 +810,12 @@ impl Renderer {
                 fragments: words[0] as u64,
                 occupied: words[1] as u64,
             };
+            let mut pools = [0u32; POOL_COUNTERS];
+            pools.copy_from_slice(&words[1..1 + POOL_COUNTERS]);
             self.last_counts = Some(counts);
-            let (frags, leaves) = (self.fragments.capacity as u64, self.volume.leaf_capacity());
-            if counts.fragments <= frags && counts.occupied <= leaves {
+            let frags = self.fragments.capacity as u64;
+            let grow_volume = self.volume.get().needs_growth(&pools);
+            if counts.fragments <= frags && !grow_volume {
                 continue;
             }
             // Build what grows first and swap it in only when all of it succeeded. A count
@@ -799,9 +830,8 @@ impl Renderer {
             } else {
                 None
             };
-            if counts.occupied > leaves {
-                let slots = slot_capacity(&self.device, counts.occupied)?;
-                self.volume.grow(&self.device, slots as u64)?;
+            if grow_volume {
+                self.volume.get_mut().grow(&self.device, &pools)?;
             }
             if let Some(f) = fragments {
                 self.fragments = f;
@@ -813,7 +843,7 @@ impl Renderer {
                 counts.fragments,
                 counts.occupied,
                 self.fragments.capacity,
-                self.volume.leaf_capacity()
+                self.volume.get().leaf_capacity()
             );
             self.invalidate();
         }
@@ -834,7 +864,7 @@ impl Renderer {
         };
         Ok(VoxelCounts {
             fragments: read(&self.fragments.count)?,
-            occupied: read(self.volume.leaf_counter())?,
+            occupied: read(self.volume.get().pool_counter())?,
         })
     }
 
@@ -843,8 +873,8 @@ impl Renderer {
         &self.fragments
     }
 
-    /// The dense volume, for tests and debugging.
-    pub fn volume(&self) -> &DenseVolume {
+    /// The voxel structure, for tests and debugging.
+    pub fn volume(&self) -> &Voxels {
         &self.volume
     }
 
@@ -936,13 +966,13 @@ impl Renderer {
         p.gbuffer
             .record(&self.device, encoder, t, &self.scene, timer);
         p.gather
-            .record(&self.device, encoder, t, &globals, &self.volume, timer);
+            .record(&self.device, encoder, t, &globals, self.volume.get(), timer);
         p.upsample.record(&self.device, encoder, t, &globals, timer);
         p.composite
             .record(&self.device, encoder, t, &globals, timer);
         // Only for the voxel views: replaces the composite's output.
         if params.view.is_voxel() {
-            self.volume.record_debug(
+            self.volume.get().record_debug(
                 &self.device,
                 encoder,
                 t,
@@ -987,39 +1017,60 @@ fn new_fragments(
     })
 }
 
-/// A dense volume on `grid` with room for `leaves` occupied voxels, or for as many as the
-/// options or the scene's estimate say.
+/// The structures' own pipelines, each made when a structure of its kind is first made and
+/// shared by every one made after it (a structure is remade whenever it grows).
+#[derive(Default)]
+struct StructurePipelines {
+    dense: Option<Arc<DensePipelines>>,
+    octree: Option<Arc<OctreePipelines>>,
+}
+
+/// The structure `options.voxels` names on `grid`, with pools for as many occupied voxels as
+/// the options or the scene's estimate say.
 fn new_volume(
     device: &wgpu::Device,
-    pipelines: &Arc<DensePipelines>,
+    pipelines: &mut StructurePipelines,
     facts: &SceneFacts,
     options: &RendererOptions,
     grid: Grid,
-    leaves: Option<u64>,
-) -> Result<DenseVolume> {
-    check_volume_fits(device, &grid)?;
+) -> Result<Voxels> {
     // Slots: at most one per voxel, usually far fewer than fragments, and the fragment
     // estimate is itself an upper bound. Start at a quarter; the first build's counters grow
     // the pools to the exact count if that is short.
-    let wanted = leaves
-        .or(options.voxel_capacity)
-        .unwrap_or_else(|| facts.estimate.at(&grid) / 4);
-    let slots = slot_capacity(
-        device,
-        wanted
-            .min((grid.resolution as u64).pow(3))
-            .min(crate::gpu::max_entries(device, SLOT_BYTES)),
-    )?;
-    checked(device, "voxel volume", || {
-        DenseVolume::new(
-            device,
-            pipelines,
-            grid,
-            options.anisotropic,
-            slots,
-            facts.dynamic,
-        )
-    })
+    let wanted = options
+        .voxel_capacity
+        .unwrap_or_else(|| facts.estimate.at(&grid) / 4)
+        .min((grid.resolution as u64).pow(3));
+    match options.voxels {
+        VoxelKind::Dense => {
+            check_volume_fits(device, &grid)?;
+            let slots = slot_capacity(
+                device,
+                wanted.min(crate::gpu::max_entries(device, SLOT_BYTES)),
+            )?;
+            let p = match &pipelines.dense {
+                Some(p) => p.clone(),
+                None => checked(device, "pipeline creation", || DensePipelines::new(device))?,
+            };
+            pipelines.dense = Some(p.clone());
+            let v = checked(device, "voxel volume", || {
+                DenseVolume::new(device, &p, grid, options.anisotropic, slots, facts.dynamic)
+            })?;
+            Ok(Voxels::Dense(v))
+        }
+        VoxelKind::Octree => {
+            let p = match &pipelines.octree {
+                Some(p) => p.clone(),
+                None => checked(device, "pipeline creation", || OctreePipelines::new(device))?,
+            };
+            pipelines.octree = Some(p.clone());
+            let pools = OctreePools::for_leaves(wanted);
+            let v = checked(device, "voxel octree", || {
+                OctreeVolume::new(device, &p, grid, options.anisotropic, pools)
+            })??;
+            Ok(Voxels::Octree(v))
+        }
+    }
 }
 
 /// Plans the shadow views for the options (writing each light's views into `scene`'s

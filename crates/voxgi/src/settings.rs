@@ -4,8 +4,8 @@
 use crate::options::{
     FrameParams, MAX_BOUNCES, RendererOptions, Tonemap, UNLIMITED_BOUNCES, ViewMode,
 };
-use crate::voxel::ConeSet;
 use crate::voxel::dense::DIRECTIONS;
+use crate::voxel::{ConeSet, VoxelKind};
 use crate::{Error, Result};
 use serde::Deserialize;
 
@@ -21,6 +21,8 @@ pub struct SceneSettings {
     pub max_texture_size: Option<u32>,
     /// `RendererOptions::default_light`.
     pub default_light: Option<bool>,
+    /// `RendererOptions::voxels`: "dense" or "octree".
+    pub voxels: Option<String>,
     /// `RendererOptions::voxel_resolution`.
     pub voxel_resolution: Option<u32>,
     /// `RendererOptions::anisotropic`.
@@ -54,7 +56,7 @@ pub struct SceneSettings {
     /// `FrameParams::tonemap`: "aces", "neutral" or "clamp".
     pub tonemap: Option<String>,
     /// `FrameParams::view`: "final", "albedo", "normal", "direct", "ao", "indirect",
-    /// "voxel-albedo", "voxel-opacity" or "voxel-radiance".
+    /// "voxel-albedo", "voxel-opacity", "voxel-radiance" or "voxel-nodes".
     pub view: Option<String>,
     /// `FrameParams::background`, linear radiance.
     pub background: Option<[f32; 3]>,
@@ -109,6 +111,9 @@ impl SceneSettings {
         set!(o.shadow_map_size, self.shadow_map_size);
         set!(o.max_texture_size, self.max_texture_size);
         set!(o.default_light, self.default_light);
+        if let Some(v) = &self.voxels {
+            o.voxels = VoxelKind::parse(v)?;
+        }
         set!(o.voxel_resolution, self.voxel_resolution);
         set!(o.anisotropic, self.anisotropic);
         set!(o.gather_axes, self.gather_axes);

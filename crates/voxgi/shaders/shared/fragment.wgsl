@@ -75,3 +75,61 @@ fn unpack_rgb9e5(v: u32) -> vec3<f32> {
     let scale = exp2(f32(e - 9));
     return vec3<f32>(f32(v & 511u), f32((v >> 9u) & 511u), f32((v >> 18u) & 511u)) * scale;
 }
+
+// A voxel's attributes are integer sums of its fragments' (so the result does not depend on
+// the order atomics add them: deterministic), then averages. FRAGMENT_SUMS u32 per voxel:
+// count, albedo rgb (8-bit units), normal xyz (snorm16 units, two's complement), emission
+// rgb (1/EMISSION_SCALE units); the coverage (how much of the voxel a fragment's solid fills,
+// 8-bit units) is kept as a maximum beside them.
+const FRAGMENT_SUMS: u32 = 10u;
+const EMISSION_SCALE: f32 = 4096.0;
+
+fn fragment_sums(f: Fragment) -> array<u32, 10> {
+    let albedo = unpack4x8unorm(f.albedo);
+    let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * 32767.0));
+    let e = vec3<u32>(round(unpack_rgb9e5(f.emission) * EMISSION_SCALE));
+    return array<u32, 10>(
+        1u,
+        u32(round(albedo.r * 255.0)),
+        u32(round(albedo.g * 255.0)),
+        u32(round(albedo.b * 255.0)),
+        bitcast<u32>(n.x),
+        bitcast<u32>(n.y),
+        bitcast<u32>(n.z),
+        e.r,
+        e.g,
+        e.b,
+    );
+}
+
+fn fragment_coverage(f: Fragment) -> u32 {
+    return u32(round(unpack4x8unorm(f.albedo).a * 255.0));
+}
+
+// What a voxel's sums resolve to: albedo (rgb) and opacity, mean normal (xyz) and how well the
+// fragments' normals agree (w: 1 one orientation, ~0 opposite faces), emitted radiance.
+struct VoxelAttributes {
+    albedo: vec4<f32>,
+    normal: vec4<f32>,
+    emission: vec3<f32>,
+}
+
+fn resolve_sums(sum: array<u32, 10>, coverage: u32) -> VoxelAttributes {
+    let count = f32(max(sum[0], 1u));
+    let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * count);
+    let nsum = vec3<f32>(
+        f32(bitcast<i32>(sum[4])),
+        f32(bitcast<i32>(sum[5])),
+        f32(bitcast<i32>(sum[6])),
+    ) / (32767.0 * count);
+    let e = vec3<f32>(f32(sum[7]), f32(sum[8]), f32(sum[9])) / (EMISSION_SCALE * count);
+    let len = length(nsum);
+    // A voxel static geometry touches blocks all rays through it: opacity 1 (conservative).
+    // Dynamic geometry fills the voxels its surface crosses by how much of them lies inside
+    // it (voxelize.wgsl), so it moves through the grid smoothly instead of a voxel at a time.
+    return VoxelAttributes(
+        vec4<f32>(albedo, f32(coverage) / 255.0),
+        vec4<f32>(select(vec3<f32>(0.0), nsum / len, len > 1e-4), len),
+        e,
+    );
+}

@@ -14,6 +14,7 @@ const VIEW_INDIRECT: u32 = 5u;
 const VIEW_VOXEL_ALBEDO: u32 = 6u;
 const VIEW_VOXEL_OPACITY: u32 = 7u;
 const VIEW_VOXEL_RADIANCE: u32 = 8u;
+const VIEW_VOXEL_NODES: u32 = 9u;
 
 // Frame.tonemap: Tonemap::id() in src/options.rs.
 const TONEMAP_ACES: u32 = 0u;

@@ -22,7 +22,7 @@ struct Slot {
     tag: u64,
 }
 
-/// A pool of readback buffers for `count` counters, each the first `u32` of its own buffer.
+/// A pool of readback buffers for `count` counter words, taken from the start of a few buffers.
 pub struct CounterReadback {
     label: &'static str,
     count: usize,
@@ -40,17 +40,17 @@ impl CounterReadback {
         }
     }
 
-    /// Records a copy of the first `u32` of each of `sources` (`count` of them) and the map
-    /// on submission; `tag` comes back with the values. Returns false when too many reads are
-    /// still in flight (nothing is recorded).
+    /// Records a copy of the first `words` u32 of each of `sources` (`count` words in all) and
+    /// the map on submission; `tag` comes back with the values, in order. Returns false when
+    /// too many reads are still in flight (nothing is recorded).
     pub fn request(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        sources: &[&wgpu::Buffer],
+        sources: &[(&wgpu::Buffer, usize)],
         tag: u64,
     ) -> bool {
-        debug_assert_eq!(sources.len(), self.count);
+        debug_assert_eq!(sources.iter().map(|s| s.1).sum::<usize>(), self.count);
         let i = match self
             .slots
             .iter()
@@ -75,8 +75,10 @@ impl CounterReadback {
         let slot = &mut self.slots[i];
         slot.tag = tag;
         slot.state.store(IN_FLIGHT, Ordering::Release);
-        for (i, src) in sources.iter().enumerate() {
-            encoder.copy_buffer_to_buffer(src, 0, &slot.buffer, 4 * i as u64, 4);
+        let mut at = 0;
+        for (src, words) in sources {
+            encoder.copy_buffer_to_buffer(src, 0, &slot.buffer, at, 4 * *words as u64);
+            at += 4 * *words as u64;
         }
         let state = slot.state.clone();
         encoder.map_buffer_on_submit(&slot.buffer, wgpu::MapMode::Read, .., move |r| {

@@ -24,6 +24,13 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "voxels/dense/sample.wgsl",
     "voxels/dense/leaves.wgsl",
     "voxels/dense/leaf_store.wgsl",
+    "voxels/octree/tree.wgsl",
+    "voxels/octree/sample.wgsl",
+    "voxels/octree/leaves.wgsl",
+    "voxels/octree/leaf_store.wgsl",
+    "voxels/octree/octree_build.wgsl",
+    "voxels/octree/octree_filter.wgsl",
+    "voxels/octree/debug.wgsl",
     "shared/cone.wgsl",
     "shared/surfel.wgsl",
     "shared/interleave.wgsl",
@@ -77,14 +84,12 @@ fn raw(name: &str) -> std::borrow::Cow<'static, str> {
 }
 
 /// The voxel structures whose WGSL lives under `shaders/voxels/<kind>/`.
-pub const STRUCTURES: &[&str] = &["dense"];
+pub const STRUCTURES: &[&str] = &["dense", "octree"];
 
-/// The structure the renderer builds today.
-const STRUCTURE: &str = "dense";
-
-/// The full WGSL of shader `name` with its includes expanded, for the dense volume.
+/// The full WGSL of shader `name` with its includes expanded; `voxels/` includes come from
+/// the dense volume (shaders that include none are the same for every structure).
 pub fn compose(name: &str) -> String {
-    compose_for(name, STRUCTURE)
+    compose_for(name, "dense")
 }
 
 /// The full WGSL of shader `name` with `voxels/` includes taken from structure `kind`.
@@ -116,9 +121,14 @@ fn expand(name: &str, kind: &str, out: &mut String, seen: &mut Vec<String>) {
 
 /// Compiles shader `name`; the label is the shader's name so pipelines and timings agree.
 pub fn module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
+    module_for(device, name, "dense")
+}
+
+/// Compiles shader `name` for voxel structure `kind` (its `voxels/` includes).
+pub fn module_for(device: &wgpu::Device, name: &str, kind: &str) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
-        source: wgpu::ShaderSource::Wgsl(compose(name).into()),
+        source: wgpu::ShaderSource::Wgsl(compose_for(name, kind).into()),
     })
 }
 
@@ -154,7 +164,19 @@ pub fn grouped_pipeline(
     layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    let module = module(device, file);
+    voxel_pipeline(device, label, file, "dense", layouts, constants)
+}
+
+/// `grouped_pipeline` for a shader that reaches voxel structure `kind` (`voxels/` includes).
+pub fn voxel_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    kind: &str,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    let module = module_for(device, file, kind);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: layouts,
@@ -182,6 +204,7 @@ pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
                 "leaves.wgsl",
                 "leaf_store.wgsl",
                 "build_shared.wgsl",
+                "tree.wgsl",
             ]
             .iter()
             .any(|f| n.ends_with(&format!("/{f}")))

@@ -3,10 +3,9 @@
 //! and written in one).
 
 use crate::gpu::layout;
-use crate::gpu::shader::grouped_pipeline;
+use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::voxel::VoxelStructure;
-use crate::voxel::dense::DenseVolume;
+use crate::voxel::{VoxelKind, VoxelStructure};
 
 /// The bounce pass (shaders/bounce.wgsl and bounce_store.wgsl): the gather and store pipelines
 /// and the layout of their cone uniform.
@@ -17,29 +16,31 @@ pub struct BouncePass {
 }
 
 impl BouncePass {
-    /// Compiles both pipelines; `anisotropic` must match the volume's mode (the gather samples all
-    /// three axes of an anisotropic volume).
-    pub fn new(device: &wgpu::Device, anisotropic: bool) -> Self {
+    /// Compiles both pipelines for structure `kind`; `anisotropic` must match the structure's
+    /// mode (the gather samples all three axes of an anisotropic one).
+    pub fn new(device: &wgpu::Device, kind: VoxelKind, anisotropic: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bounce globals"),
             entries: &[layout::uniform(0, c, false)],
         });
-        let voxels = DenseVolume::sampling_layout(device);
-        let leaves = DenseVolume::leaves_layout(device);
-        let store = DenseVolume::leaf_store_layout(device);
+        let voxels = kind.sampling_layout(device);
+        let leaves = kind.leaves_layout(device);
+        let store = kind.leaf_store_layout(device);
         BouncePass {
-            gather: grouped_pipeline(
+            gather: voxel_pipeline(
                 device,
                 "bounce",
                 "lighting/bounce.wgsl",
+                kind.name(),
                 &[Some(&globals), Some(&voxels), Some(&leaves)],
-                &DenseVolume::sampling_constants(anisotropic, 3),
+                &kind.sampling_constants(anisotropic, 3),
             ),
-            store: grouped_pipeline(
+            store: voxel_pipeline(
                 device,
                 "bounce",
                 "lighting/bounce_store.wgsl",
+                kind.name(),
                 &[None, None, Some(&leaves), Some(&store)],
                 &[],
             ),

@@ -4,8 +4,7 @@ use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::lighting::atlas::{ShadowAtlas, ViewDirt};
-use crate::voxel::VoxelStructure;
-use crate::voxel::dense::DenseVolume;
+use crate::voxel::{VoxelKind, VoxelStructure};
 use wgpu::util::DeviceExt;
 
 /// The inject compute pass (shaders/inject.wgsl): its pipeline, the layout of its globals, and
@@ -43,7 +42,7 @@ struct GpuInjectParams {
 impl InjectPass {
     /// Compiles the pipeline for a scene of `light_count` lights with `views` shadow views
     /// (both fixed until the pass is rebuilt).
-    pub fn new(device: &wgpu::Device, light_count: u32, views: usize) -> Self {
+    pub fn new(device: &wgpu::Device, kind: VoxelKind, light_count: u32, views: usize) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
         entries.extend(ShadowAtlas::lighting_layout(c));
@@ -53,13 +52,13 @@ impl InjectPass {
             label: Some("inject globals"),
             entries: &entries,
         });
-        let leaves = DenseVolume::leaves_layout(device);
-        let store = DenseVolume::leaf_store_layout(device);
+        let leaves = kind.leaves_layout(device);
+        let store = kind.leaf_store_layout(device);
         let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("inject args"),
             entries: &[layout::storage(0, c, false)],
         });
-        let module = crate::gpu::shader::module(device, "lighting/inject.wgsl");
+        let module = crate::gpu::shader::module_for(device, "lighting/inject.wgsl", kind.name());
         let pipe = |entry: &str, layouts: &[Option<&wgpu::BindGroupLayout>], store: bool| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("inject"),

@@ -3,12 +3,11 @@
 //! Bind groups: 0 the frame's globals, 1 the voxel structure's sampling group, 2 its own.
 
 use crate::gpu::layout;
-use crate::gpu::shader::grouped_pipeline;
+use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::RendererOptions;
 use crate::targets::FrameTargets;
 use crate::voxel::VoxelStructure;
-use crate::voxel::dense::DenseVolume;
 use voxgi_scene::Scene;
 
 /// Format of the gather's indirect-light target: rgb the indirect radiance towards the camera,
@@ -52,15 +51,16 @@ impl GatherPass {
             label: Some("gather"),
             entries: &entries,
         });
-        let [iso, axes] =
-            DenseVolume::sampling_constants(settings.anisotropic, settings.gather_axes);
+        let kind = settings.voxels;
+        let [iso, axes] = kind.sampling_constants(settings.anisotropic, settings.gather_axes);
         let constants = [iso, axes, ("GLOSSY", f64::from(u8::from(glossy)))];
-        let voxels = DenseVolume::sampling_layout(device);
+        let voxels = kind.sampling_layout(device);
         GatherPass {
-            pipeline: grouped_pipeline(
+            pipeline: voxel_pipeline(
                 device,
                 "gather",
                 "screen/gather.wgsl",
+                kind.name(),
                 &[Some(&globals), Some(&voxels), Some(&layout)],
                 &constants,
             ),

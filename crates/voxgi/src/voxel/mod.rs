@@ -3,10 +3,12 @@
 //! A structure is anything cone tracing can sample (DESIGN.md, seam 2). In Rust it implements
 //! `VoxelStructure`; in WGSL it provides `shaders/voxels/<kind>/sample.wgsl`, the contract of
 //! names cone tracing uses (`shaders/shared/cone.wgsl`), reading only its own `@group(1)`.
-//! The dense mip-mapped volume (`dense/`) is the first structure.
+//! Two structures: the dense mip-mapped volume (`dense/`) and the sparse voxel octree
+//! (`octree/`); `RendererOptions::voxels` picks one.
 
 pub mod cpu;
 pub mod dense;
+pub mod octree;
 
 use crate::fragments::Fragments;
 use crate::gpu::timer::GpuTimer;
@@ -64,14 +66,18 @@ pub trait VoxelStructure {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut GpuTimer,
     );
-    /// A buffer whose first `u32` is the number of leaves the last build needed, counted past
-    /// the capacity (read back asynchronously to grow the pools).
-    fn leaf_counter(&self) -> &wgpu::Buffer;
+    /// A buffer whose first `POOL_COUNTERS` u32 count what the last build asked of each of the
+    /// structure's pools, past their capacity (read back asynchronously to grow them). Word 0
+    /// is always the leaves (occupied finest voxels); the others are the structure's own (zero
+    /// where it has fewer pools).
+    fn pool_counter(&self) -> &wgpu::Buffer;
     /// Leaves the pools hold.
     fn leaf_capacity(&self) -> u64;
-    /// Makes room for `leaves` leaves; the contents are lost (the next build refills them). On
-    /// an error (out of memory, a device limit) the structure is left as it was.
-    fn grow(&mut self, device: &wgpu::Device, leaves: u64) -> crate::Result<()>;
+    /// Whether a build that counted `counted` (`pool_counter`'s words) overflowed a pool.
+    fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool;
+    /// Makes room for what a build counted; the contents are lost (the next build refills
+    /// them). On an error (out of memory, a device limit) the structure is left as it was.
+    fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()>;
     /// Bytes per GPU resource.
     fn memory(&self) -> Vec<(&'static str, u64)>;
     /// The bind group of the WGSL contract's resources, `@group(1)`.
@@ -93,6 +99,116 @@ pub trait VoxelStructure {
         view: DebugView,
         timer: &mut GpuTimer,
     );
+}
+
+/// Words of `VoxelStructure::pool_counter` read back after each build.
+pub const POOL_COUNTERS: usize = 4;
+
+/// Which voxel structure a renderer builds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VoxelKind {
+    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
+    #[default]
+    Dense,
+    /// The sparse voxel octree: memory in proportion to the occupied voxels.
+    Octree,
+}
+
+impl VoxelKind {
+    /// Both, in the order of their names.
+    pub const ALL: [VoxelKind; 2] = [VoxelKind::Dense, VoxelKind::Octree];
+
+    /// The name settings and the command line use, also the WGSL folder `shaders/voxels/<name>/`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VoxelKind::Dense => "dense",
+            VoxelKind::Octree => "octree",
+        }
+    }
+
+    /// The structure named `s`.
+    pub fn parse(s: &str) -> crate::Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                crate::Error::Setting(format!("voxel structure '{s}' is not dense or octree"))
+            })
+    }
+
+    /// The layout of @group(1), the structure's sampling resources.
+    pub fn sampling_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        match self {
+            VoxelKind::Dense => dense::DenseVolume::sampling_layout(device),
+            VoxelKind::Octree => octree::OctreeVolume::sampling_layout(device),
+        }
+    }
+
+    /// The layout of @group(2) of the lighting passes, the structure's leaves.
+    pub fn leaves_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        match self {
+            VoxelKind::Dense => dense::DenseVolume::leaves_layout(device),
+            VoxelKind::Octree => octree::OctreeVolume::leaves_layout(device),
+        }
+    }
+
+    /// The layout of @group(3) of the passes that store leaf radiance.
+    pub fn leaf_store_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        match self {
+            VoxelKind::Dense => dense::DenseVolume::leaf_store_layout(device),
+            VoxelKind::Octree => octree::OctreeVolume::leaf_store_layout(device),
+        }
+    }
+
+    /// Values for the `override` constants of the structure's sample.wgsl.
+    pub fn sampling_constants(self, anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
+        match self {
+            VoxelKind::Dense => dense::DenseVolume::sampling_constants(anisotropic, axes),
+            VoxelKind::Octree => octree::OctreeVolume::sampling_constants(anisotropic, axes),
+        }
+    }
+}
+
+/// The renderer's voxel structure, whichever kind it is.
+pub enum Voxels {
+    /// The dense volume.
+    Dense(dense::DenseVolume),
+    /// The sparse voxel octree.
+    Octree(octree::OctreeVolume),
+}
+
+impl Voxels {
+    /// The structure, for the passes (which know it only through the trait).
+    pub fn get(&self) -> &dyn VoxelStructure {
+        match self {
+            Voxels::Dense(v) => v,
+            Voxels::Octree(v) => v,
+        }
+    }
+
+    /// The structure, mutably (to grow it).
+    pub fn get_mut(&mut self) -> &mut dyn VoxelStructure {
+        match self {
+            Voxels::Dense(v) => v,
+            Voxels::Octree(v) => v,
+        }
+    }
+
+    /// The dense volume, if that is the kind.
+    pub fn dense(&self) -> Option<&dense::DenseVolume> {
+        match self {
+            Voxels::Dense(v) => Some(v),
+            Voxels::Octree(_) => None,
+        }
+    }
+
+    /// The octree, if that is the kind.
+    pub fn octree(&self) -> Option<&octree::OctreeVolume> {
+        match self {
+            Voxels::Octree(v) => Some(v),
+            Voxels::Dense(_) => None,
+        }
+    }
 }
 
 /// Mirrors `Volume` in shaders/shared/volume.wgsl.

@@ -243,7 +243,7 @@ fn probe_matches_cpu(anisotropic: bool) {
     let mut r = renderer(&builtin::cornell_box(), &options);
     let params = FrameParams::new(r.default_camera().clone());
     frame(&mut r, &params, 8, 8);
-    let vol = r.volume();
+    let vol = r.volume().dense().unwrap();
     let grid = vol.grid;
 
     // Points over the volume and a little outside it (where the answer is 0), diameters of

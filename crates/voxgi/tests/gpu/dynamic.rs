@@ -51,7 +51,7 @@ fn params(r: &Renderer) -> FrameParams {
 
 /// Every texture of the volume's finest level and its mip chains, read back.
 fn volume_bytes(r: &Renderer) -> Vec<(&'static str, Vec<u8>)> {
-    let v = r.volume();
+    let v = r.volume().dense().unwrap();
     let c = ctx();
     [
         ("albedo", &v.albedo),

@@ -82,7 +82,7 @@ fn ao_beside_a_wall_matches_the_closed_form() {
         ..clamped(&cam)
     };
     let out = frame(&mut r, &params, 64, 64);
-    let voxel = r.volume().grid.voxel_size;
+    let voxel = r.volume().get().grid().voxel_size;
     // A floor point at distance x from a wall far taller and wider than the AO radius R sees
     // the wall along every direction with a component towards it above x / R: with cosine
     // weighting (directions uniform on the unit disc below them) the occluded share is the

@@ -36,7 +36,7 @@ fn triangle_scene(tris: &[[Vec3; 3]]) -> Scene {
 /// values themselves.
 fn occupied(r: &Renderer) -> (BTreeSet<[u32; 3]>, Vec<u32>) {
     let (device, queue) = (&ctx().device, &ctx().queue);
-    let vol = r.volume();
+    let vol = r.volume().dense().unwrap();
     let bytes = read_buffer_copy(device, queue, &vol.occupancy).expect("occupancy readback");
     let words: &[u32] = bytemuck::cast_slice(&bytes);
     let res = vol.grid.resolution;
@@ -104,7 +104,7 @@ fn voxelize_matches_cpu_exactly() {
         ..measuring()
     };
     let mut r = renderer(&scene, &settings);
-    assert_eq!(r.volume().grid, grid);
+    assert_eq!(r.volume().get().grid(), grid);
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 16, 16);
 
@@ -170,7 +170,7 @@ fn walls_on_voxel_faces_leave_no_holes() {
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 8, 8);
     let (gpu, _) = occupied(&r);
-    let grid = r.volume().grid;
+    let grid = r.volume().get().grid();
     let voxel = |m: f32, axis: usize| (m * 0.001 - grid.origin[axis]) / grid.voxel_size;
 
     // (wall, axis of its normal, its plane in mm, and its extent in mm along the other two
@@ -316,7 +316,7 @@ fn check_filtering(anisotropic: bool) {
     let mut r = cornell(16, anisotropic);
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 16, 16);
-    let vol = r.volume();
+    let vol = r.volume().dense().unwrap();
     let levels = vol.grid.levels();
     let (finest, res) = read_level(&vol.radiance, 0);
     assert_eq!(res, 16);

@@ -17,9 +17,8 @@
 @group(0) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>>;
 // Per slot: the voxel's linear index.
 @group(0) @binding(5) var<storage, read_write> slot_voxel: array<u32>;
-// Per slot, ACCUM_STRIDE u32: sums of count, albedo rgb (8-bit units), normal xyz (snorm16
-// units, two's complement), emission rgb (1/4096 units); then the largest coverage (8-bit
-// units: how much of the voxel a fragment's solid fills, 255 for every static fragment).
+// Per slot, ACCUM_STRIDE u32: the FRAGMENT_SUMS of shared/fragment.wgsl, then the largest
+// coverage.
 @group(0) @binding(6) var<storage, read_write> accum: array<atomic<u32>>;
 @group(0) @binding(7) var albedo_out: texture_storage_3d<rgba8unorm, write>;
 @group(0) @binding(8) var normal_out: texture_storage_3d<rgba8snorm, write>;
@@ -49,7 +48,6 @@ fn touched(i: u32) -> u32 {
     return atomicLoad(&dyn_accum[i * DYN_STRIDE + DYN_LIST]);
 }
 const LOCKED: u32 = 0xffffffffu;
-const EMISSION_SCALE: f32 = 4096.0;
 const WG: u32 = 64u;
 
 // Flat thread index for 2D indirect dispatches (65535 workgroups per dimension at most).
@@ -76,22 +74,8 @@ fn slot_limit() -> u32 {
 
 // Adds fragment `f`'s attributes to slot `s`'s static or dynamic sums.
 fn add_fragment(s: u32, f: Fragment, dynamic: bool) {
-    let albedo = unpack4x8unorm(f.albedo);
-    let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * 32767.0));
-    let e = vec3<u32>(round(unpack_rgb9e5(f.emission) * EMISSION_SCALE));
-    let v = array<u32, 10>(
-        1u,
-        u32(round(albedo.r * 255.0)),
-        u32(round(albedo.g * 255.0)),
-        u32(round(albedo.b * 255.0)),
-        bitcast<u32>(n.x),
-        bitcast<u32>(n.y),
-        bitcast<u32>(n.z),
-        e.r,
-        e.g,
-        e.b,
-    );
-    let coverage = u32(round(albedo.a * 255.0));
+    let v = fragment_sums(f);
+    let coverage = fragment_coverage(f);
     for (var k = 0u; k < ACCUM_SUMS; k++) {
         if dynamic {
             atomicAdd(&dyn_accum[s * DYN_STRIDE + k], v[k]);
@@ -122,23 +106,11 @@ fn resolve_slot(s: u32, dynamic: bool) {
     if dynamic {
         coverage = max(coverage, atomicLoad(&dyn_accum[s * DYN_STRIDE + ACCUM_COVERAGE]));
     }
-    let count = f32(max(sum[0], 1u));
-    let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * count);
-    let nsum = vec3<f32>(
-        f32(bitcast<i32>(sum[4])),
-        f32(bitcast<i32>(sum[5])),
-        f32(bitcast<i32>(sum[6])),
-    ) / (32767.0 * count);
-    let e = vec3<f32>(f32(sum[7]), f32(sum[8]), f32(sum[9])) / (EMISSION_SCALE * count);
+    let a = resolve_sums(sum, coverage);
     let c = voxel_coord(slot_voxel[s], vol.resolution);
-    // A voxel static geometry touches blocks all rays through it: opacity 1 (conservative).
-    // Dynamic geometry fills the voxels its surface crosses by how much of them lies inside
-    // it (voxelize.wgsl), so it moves through the grid smoothly instead of a voxel at a time.
-    textureStore(albedo_out, c, vec4<f32>(albedo, f32(coverage) / 255.0));
-    // w: how well the fragments' normals agree (1: one orientation, ~0: opposite faces).
-    let len = length(nsum);
-    textureStore(normal_out, c, vec4<f32>(select(vec3<f32>(0.0), nsum / len, len > 1e-4), len));
-    textureStore(emission_out, c, vec4<f32>(e, 1.0));
+    textureStore(albedo_out, c, a.albedo);
+    textureStore(normal_out, c, a.normal);
+    textureStore(emission_out, c, vec4<f32>(a.emission, 1.0));
 }
 
 // Empties voxel `c` of the finest level.

@@ -5,7 +5,10 @@
 //                      crosses inside the hit cell; failing that, the mean occupied albedo of
 //                      the cell),
 //   mode 1 (opacity):  the hit cell's opacity as grey,
-//   mode 2 (radiance): the hit cell's radiance, un-premultiplied.
+//   mode 2 (radiance): the hit cell's radiance, un-premultiplied,
+//   mode 3 (nodes):    the first cell with any opacity, coloured by level and shaded by the
+//                      face the ray entered, edges darkened (the octree's view of the same
+//                      name shows its nodes).
 // Level 0 reads the finest (isotropic) radiance; level L > 0 reads mip L - 1 of the chosen
 // directional chain (the host binds it; in isotropic mode the one chain). Rays that hit nothing
 // get the background.
@@ -35,6 +38,14 @@ struct DebugParams {
 const MODE_ALBEDO: u32 = 0u;
 const MODE_OPACITY: u32 = 1u;
 const MODE_RADIANCE: u32 = 2u;
+const MODE_NODES: u32 = 3u;
+
+// A colour per level (the octree's debug view uses the same).
+fn level_colour(lvl: u32) -> vec3<f32> {
+    let h = f32(lvl) * 0.618034;
+    let k = fract(vec3<f32>(h, h + 0.333333, h + 0.666667)) * 6.283185;
+    return 0.55 + 0.4 * cos(k);
+}
 
 fn cell_value(c: vec3<i32>) -> vec4<f32> {
     if params.level == 0u {
@@ -139,10 +150,26 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         var t_max = (next - oc) * inv_dc;
         let t_delta = abs(inv_dc);
         var t_enter = span.x / s;
+        let first = oc + d * t_enter - vec3<f32>(c);
+        let edge = min(first, 1.0 - first);
+        var axis = select(select(2u, 1u, edge.y <= edge.z), 0u, edge.x <= edge.y && edge.x <= edge.z);
         for (var i = 0; i < 3 * res + 3; i++) {
             let v = cell_value(c);
             let t_exit = min(t_max.x, min(t_max.y, t_max.z));
-            if v.a > 0.5 {
+            if params.mode == MODE_NODES && v.a > 0.0 {
+                let f = fract(oc + d * t_enter);
+                let e = min(f, 1.0 - f);
+                var m = vec2<f32>(e.y, e.z);
+                if axis == 1u {
+                    m = vec2<f32>(e.x, e.z);
+                } else if axis == 2u {
+                    m = vec2<f32>(e.x, e.y);
+                }
+                let shade = array<f32, 3>(0.8, 1.0, 0.6)[axis];
+                out = level_colour(params.level) * shade * select(1.0, 0.35, min(m.x, m.y) < 0.06);
+                break;
+            }
+            if params.mode != MODE_NODES && v.a > 0.5 {
                 switch params.mode {
                     case MODE_ALBEDO: {
                         out = albedo_under(o, d, inv_d, c, scale, t_enter * s);
@@ -160,12 +187,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             if t_max.x < t_max.y && t_max.x < t_max.z {
                 c.x += stp.x;
                 t_max.x += t_delta.x;
+                axis = 0u;
             } else if t_max.y < t_max.z {
                 c.y += stp.y;
                 t_max.y += t_delta.y;
+                axis = 1u;
             } else {
                 c.z += stp.z;
                 t_max.z += t_delta.z;
+                axis = 2u;
             }
             if any(c < vec3<i32>(0)) || any(c >= vec3<i32>(res)) {
                 break;

@@ -57,6 +57,7 @@ impl DebugPass {
         let mode: u32 = match view {
             ViewMode::VoxelAlbedo => 0,
             ViewMode::VoxelOpacity => 1,
+            ViewMode::VoxelNodes => 3,
             _ => 2,
         };
         let level = level.min(vol.grid.levels() - 1);

@@ -19,7 +19,7 @@ use crate::fragments::Fragments;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::targets::FrameTargets;
-use crate::voxel::{DebugView, VoxelStructure};
+use crate::voxel::{DebugView, POOL_COUNTERS, VoxelStructure};
 use debug::DebugPass;
 use filter::FilterPass;
 use std::sync::Arc;
@@ -662,7 +662,8 @@ impl VoxelStructure for DenseVolume {
         self.pipelines.filter.record(device, encoder, self, timer);
     }
 
-    fn leaf_counter(&self) -> &wgpu::Buffer {
+    fn pool_counter(&self) -> &wgpu::Buffer {
+        // Word 0 counts the slots; the dense volume's other counters are not pools.
         &self.counters
     }
 
@@ -670,14 +671,20 @@ impl VoxelStructure for DenseVolume {
         self.slot_capacity as u64
     }
 
-    fn grow(&mut self, device: &wgpu::Device, leaves: u64) -> crate::Result<()> {
+    fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
+        counted[0] > self.slot_capacity
+    }
+
+    fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {
+        let slots =
+            crate::gpu::pool_capacity(device, counted[0] as u64, SLOT_BYTES, "occupied voxels")?;
         let grown = crate::gpu::checked(device, "voxel pools", || {
             DenseVolume::new(
                 device,
                 &self.pipelines,
                 self.grid,
                 self.anisotropic,
-                leaves.min(u32::MAX as u64) as u32,
+                slots,
                 self.dynamic,
             )
         })?;

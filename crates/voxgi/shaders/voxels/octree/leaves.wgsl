@@ -1,0 +1,50 @@
+// The octree's leaves: the occupied finest voxels, one slot each (the names are those of the
+// dense volume's leaves.wgsl, which lists them). All at @group(2); `OctreeVolume::leaves_layout`
+// is the twin.
+
+//!include shared/volume.wgsl
+//!include shared/fragment.wgsl
+//!include voxels/tree.wgsl
+
+@group(2) @binding(0) var<uniform> leaf_tree: Octree;
+// Per slot, SLOT_STRIDE u32 (voxels/octree/tree.wgsl).
+@group(2) @binding(1) var<storage, read> leaf_slots: array<u32>;
+@group(2) @binding(2) var<storage, read_write> leaf_direct: array<vec4<f32>>;
+@group(2) @binding(3) var<storage, read_write> leaf_next: array<vec4<f32>>;
+// The header (its word 0: slots of the last build, counted past the capacity), then the nodes.
+@group(2) @binding(4) var<storage, read> leaf_nodes: array<u32>;
+
+fn leaf_count() -> u32 {
+    return min(leaf_nodes[0], leaf_tree.slots);
+}
+
+// Every build and every update hands out all slots anew (OctreeVolume::record_update).
+fn leaf_is_new(i: u32) -> bool {
+    return true;
+}
+
+fn leaf_coord(i: u32) -> vec3<u32> {
+    return unpack_coord(leaf_slots[i * SLOT_STRIDE]);
+}
+
+fn leaf_center(i: u32) -> vec3<f32> {
+    return leaf_tree.origin + (vec3<f32>(leaf_coord(i)) + 0.5) * leaf_tree.voxel_size;
+}
+
+fn leaf_size() -> f32 {
+    return leaf_tree.voxel_size;
+}
+
+fn leaf_albedo(i: u32) -> vec4<f32> {
+    return unpack4x8unorm(leaf_slots[i * SLOT_STRIDE + 2u]);
+}
+
+fn leaf_normal(i: u32) -> vec4<f32> {
+    return unpack4x8snorm(leaf_slots[i * SLOT_STRIDE + 3u]);
+}
+
+fn leaf_emission(i: u32) -> vec3<f32> {
+    let rg = unpack2x16float(leaf_slots[i * SLOT_STRIDE + 4u]);
+    let b = unpack2x16float(leaf_slots[i * SLOT_STRIDE + 5u]);
+    return vec3<f32>(rg, b.x);
+}

@@ -1,0 +1,302 @@
+// octree_build: voxel fragments -> the sparse voxel octree, level by level from the root, with
+// indirect dispatches and no locks (Crassin and Green, "Octree-Based Sparse Voxelization Using
+// the GPU Hardware Rasterizer", OpenGL Insights 2012). Per depth t, from 0 down:
+//   flag     each fragment descends to its node at depth t and marks it CONTENT
+//   dilate   each CONTENT node marks its seven negative neighbours NEEDED (their bricks hold
+//            its voxels as their positive border)
+//   mark     remember where this depth's tiles start in their class
+//   allocate each marked node takes a tile of eight children (and so a brick)
+//   finish   the new tiles' range and the dispatch size over their nodes
+//   init     the new nodes: no children, their negative neighbours, a cleared brick
+// then at depth D (the finest voxels): flag, one leaf slot per occupied voxel, integer sums of
+// the fragments per slot (deterministic), and the averages. Allocation order varies from run
+// to run; what is allocated, and every value, does not.
+//
+// Every pool counts what it was asked for past its capacity; a node whose tile did not fit
+// stays a leaf without children (its geometry is missing until the pools grow and the next
+// build runs), never an overrun.
+
+//!include shared/fragment.wgsl
+//!include voxels/tree.wgsl
+
+struct Level {
+    // The depth this dispatch works on.
+    t: u32,
+}
+
+@group(0) @binding(0) var<uniform> tree: Octree;
+@group(0) @binding(1) var<storage, read> fragments: array<Fragment>;
+@group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
+// The header (counters, voxels/octree/tree.wgsl), then the nodes.
+@group(0) @binding(3) var<storage, read_write> nodes: array<atomic<u32>>;
+// Per tile: its parent node.
+@group(0) @binding(4) var<storage, read_write> tile_parent: array<u32>;
+@group(0) @binding(5) var<storage, read_write> slots: array<atomic<u32>>;
+@group(0) @binding(6) var even_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(7) var odd_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(8) var<uniform> level: Level;
+// Indirect dispatch sizes: [0..3] over fragments, [3..6] over leaf slots, from [6] per depth
+// t over the nodes of depth t. Only the one-thread kernels bind them.
+@group(1) @binding(0) var<storage, read_write> args: array<u32>;
+
+const WG: u32 = 64u;
+
+fn flat(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WG;
+}
+
+fn write_args(offset: u32, count: u32) {
+    let groups = (count + WG - 1u) / WG;
+    args[offset] = max(min(groups, 65535u), 1u);
+    args[offset + 1u] = max((groups + 65534u) / 65535u, 1u);
+    args[offset + 2u] = 1u;
+}
+
+fn stored_fragments() -> u32 {
+    return min(fragment_count[0], arrayLength(&fragments));
+}
+
+fn child(n: u32) -> u32 {
+    return atomicLoad(&nodes[NODE_HEADER + n * NODE_STRIDE]);
+}
+
+fn neighbour(n: u32, axis: u32) -> u32 {
+    return atomicLoad(&nodes[NODE_HEADER + n * NODE_STRIDE + 1u + axis]);
+}
+
+// The node of depth t (whose children are allocated down to it) that holds finest voxel c, or
+// NONE where a pool overflowed above it.
+fn descend(c: vec3<u32>, t: u32) -> u32 {
+    var node = 0u;
+    for (var i = 0u; i < t; i++) {
+        let tile = child(node);
+        if tile == 0u || tile >= NEEDED {
+            return NONE;
+        }
+        node = tile * 8u + octant_of(c, tree.depth - 1u - i);
+    }
+    return node;
+}
+
+// Node `i` of depth t (threads over the depth's tiles, eight nodes each), or NONE.
+fn node_of_depth(i: u32, t: u32) -> u32 {
+    if i >= atomicLoad(&nodes[RANGES + 2u * t + 1u]) * 8u {
+        return NONE;
+    }
+    return atomicLoad(&nodes[RANGES + 2u * t]) * 8u + i;
+}
+
+fn class_capacity(c: u32) -> u32 {
+    return class_end(tree, c) - class_base(tree, c);
+}
+
+@compute @workgroup_size(1)
+fn begin() {
+    for (var i = 0u; i < 4u; i++) {
+        atomicStore(&nodes[i], 0u);
+    }
+    // Depth 0 is the root tile: tile 0, whose node 0 is the root.
+    atomicStore(&nodes[RANGES], 0u);
+    atomicStore(&nodes[RANGES + 1u], 1u);
+    for (var t = 1u; t <= tree.depth; t++) {
+        atomicStore(&nodes[RANGES + 2u * t], 0u);
+        atomicStore(&nodes[RANGES + 2u * t + 1u], 0u);
+    }
+    for (var i = 0u; i < 8u * NODE_STRIDE; i++) {
+        atomicStore(&nodes[NODE_HEADER + i], 0u);
+    }
+    write_args(0u, stored_fragments());
+    write_args(6u, 8u);
+}
+
+@compute @workgroup_size(64)
+fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat(gid, nwg);
+    if i >= stored_fragments() {
+        return;
+    }
+    let node = descend(unpack_coord(fragments[i].coord), level.t);
+    if node != NONE {
+        atomicMax(&nodes[NODE_HEADER + node * NODE_STRIDE], CONTENT);
+    }
+}
+
+@compute @workgroup_size(64)
+fn dilate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), level.t);
+    if n == NONE || child(n) != CONTENT {
+        return;
+    }
+    // The nodes n - (0|1, 0|1, 0|1): each holds a voxel of n in its brick's border. They all
+    // exist (their parents were subdivided for the same reason one level up).
+    let x = neighbour(n, 0u);
+    let y = neighbour(n, 1u);
+    let z = neighbour(n, 2u);
+    var around = array<u32, 7>(x, y, z, 0u, 0u, 0u, 0u);
+    if x != 0u {
+        around[3] = neighbour(x, 1u);
+        around[4] = neighbour(x, 2u);
+    }
+    if y != 0u {
+        around[5] = neighbour(y, 2u);
+    }
+    if around[3] != 0u {
+        around[6] = neighbour(around[3], 2u);
+    }
+    for (var k = 0u; k < 7u; k++) {
+        if around[k] != 0u {
+            atomicMax(&nodes[NODE_HEADER + around[k] * NODE_STRIDE], NEEDED);
+        }
+    }
+}
+
+@compute @workgroup_size(1)
+fn mark() {
+    let c = brick_class(tree.depth - 1u - level.t);
+    atomicStore(&nodes[4], atomicLoad(&nodes[1u + c]));
+}
+
+@compute @workgroup_size(64)
+fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), level.t);
+    if n == NONE || child(n) < NEEDED {
+        return;
+    }
+    let c = brick_class(tree.depth - 1u - level.t);
+    let k = atomicAdd(&nodes[1u + c], 1u);
+    if k >= class_capacity(c) {
+        atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
+        return;
+    }
+    let tile = class_base(tree, c) + k;
+    atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], tile);
+    tile_parent[tile] = n;
+}
+
+@compute @workgroup_size(1)
+fn finish() {
+    let c = brick_class(tree.depth - 1u - level.t);
+    let start = atomicLoad(&nodes[4]);
+    let end = min(atomicLoad(&nodes[1u + c]), class_capacity(c));
+    let count = select(0u, end - start, end > start);
+    let u = level.t + 1u;
+    atomicStore(&nodes[RANGES + 2u * u], class_base(tree, c) + start);
+    atomicStore(&nodes[RANGES + 2u * u + 1u], count);
+    write_args(6u + 3u * u, count * 8u);
+}
+
+// Clears the texels of brick `tile` (holding `lvl`) that octant thread `o` owns: every eighth.
+fn clear_brick(tile: u32, lvl: u32, o: u32) {
+    let dirs = select(1u, tree.dirs, lvl > 0u);
+    let bricks = atlas_bricks(tree, lvl);
+    for (var d = 0u; d < dirs; d++) {
+        let base = slot_texel(brick_slot(tree, tile, lvl, d), bricks);
+        for (var k = o; k < 27u; k += 8u) {
+            let p = base + vec3<u32>(k % 3u, (k / 3u) % 3u, k / 9u);
+            if (lvl & 1u) == 0u {
+                textureStore(even_out, p, vec4<f32>(0.0));
+            } else {
+                textureStore(odd_out, p, vec4<f32>(0.0));
+            }
+        }
+    }
+}
+
+// The nodes of depth level.t, just allocated.
+@compute @workgroup_size(64)
+fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let u = level.t;
+    let n = node_of_depth(flat(gid, nwg), u);
+    if n == NONE {
+        return;
+    }
+    let tile = n / 8u;
+    let o = n % 8u;
+    atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
+    let parent = tile_parent[tile];
+    for (var a = 0u; a < 3u; a++) {
+        var nb = 0u;
+        if u < tree.depth {
+            if ((o >> a) & 1u) == 1u {
+                nb = tile * 8u + (o ^ (1u << a));
+            } else {
+                let pn = neighbour(parent, a);
+                if pn != 0u {
+                    let pt = child(pn);
+                    if pt != 0u {
+                        nb = pt * 8u + (o | (1u << a));
+                    }
+                }
+            }
+        }
+        atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE + 1u + a], nb);
+    }
+    clear_brick(tile, tree.depth - u, o);
+}
+
+// Depth D: one leaf slot per occupied finest voxel.
+@compute @workgroup_size(64)
+fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), tree.depth);
+    if n == NONE || child(n) != CONTENT {
+        return;
+    }
+    let s = atomicAdd(&nodes[0], 1u);
+    if s >= tree.slots {
+        atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
+        return;
+    }
+    atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], s + 1u);
+    atomicStore(&slots[s * SLOT_STRIDE + 1u], tile_parent[n / 8u] | ((n % 8u) << 29u));
+    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+        atomicStore(&slots[s * SLOT_STRIDE + SLOT_ACCUM + k], 0u);
+    }
+}
+
+@compute @workgroup_size(64)
+fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat(gid, nwg);
+    if i >= stored_fragments() {
+        return;
+    }
+    let f = fragments[i];
+    let node = descend(unpack_coord(f.coord), tree.depth);
+    if node == NONE {
+        return;
+    }
+    let v = child(node);
+    if v == 0u || v >= NEEDED {
+        return;
+    }
+    let base = (v - 1u) * SLOT_STRIDE;
+    // Every fragment of the voxel has its coordinate.
+    atomicStore(&slots[base], f.coord);
+    let sums = fragment_sums(f);
+    for (var k = 0u; k < FRAGMENT_SUMS; k++) {
+        atomicAdd(&slots[base + SLOT_ACCUM + k], sums[k]);
+    }
+    atomicMax(&slots[base + SLOT_ACCUM + FRAGMENT_SUMS], fragment_coverage(f));
+}
+
+@compute @workgroup_size(1)
+fn prepare_slots() {
+    write_args(3u, min(atomicLoad(&nodes[0]), tree.slots));
+}
+
+@compute @workgroup_size(64)
+fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = flat(gid, nwg);
+    if s >= min(atomicLoad(&nodes[0]), tree.slots) {
+        return;
+    }
+    let base = s * SLOT_STRIDE;
+    var sum = array<u32, 10>();
+    for (var k = 0u; k < FRAGMENT_SUMS; k++) {
+        sum[k] = atomicLoad(&slots[base + SLOT_ACCUM + k]);
+    }
+    let a = resolve_sums(sum, atomicLoad(&slots[base + SLOT_ACCUM + FRAGMENT_SUMS]));
+    atomicStore(&slots[base + 2u], pack4x8unorm(a.albedo));
+    atomicStore(&slots[base + 3u], pack4x8snorm(a.normal));
+    atomicStore(&slots[base + 4u], pack2x16float(a.emission.rg));
+    atomicStore(&slots[base + 5u], pack2x16float(vec2<f32>(a.emission.b, 0.0)));
+}

@@ -1,0 +1,101 @@
+// octree_filter: the levels above the leaves, one depth per dispatch from the finest up. Each
+// thread takes one node c of depth t + 1 whose children have a brick (level k - 1) and writes
+// c's value at level k into its parent's brick, and into the positive borders of the bricks
+// of the parent's negative neighbours that hold it. The value is the dense volume's filter
+// (voxels/dense/filter.wgsl) applied to the eight voxels of c's brick: the mean in isotropic
+// mode; per direction, front-to-back pairs along it averaged, otherwise. Level k - 1 is read
+// from one atlas and level k written into the other (they alternate by level).
+
+//!include shared/volume.wgsl
+//!include voxels/tree.wgsl
+
+struct Level {
+    t: u32,
+}
+
+@group(0) @binding(0) var<uniform> tree: Octree;
+@group(0) @binding(1) var<storage, read> nodes: array<u32>;
+@group(0) @binding(2) var<storage, read> tile_parent: array<u32>;
+// Level k - 1's atlas (read) and level k's (written).
+@group(0) @binding(3) var src: texture_3d<f32>;
+@group(0) @binding(4) var dst: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(5) var<uniform> level: Level;
+
+fn child(n: u32) -> u32 {
+    return nodes[NODE_HEADER + n * NODE_STRIDE];
+}
+
+fn neighbour(n: u32, axis: u32) -> u32 {
+    return nodes[NODE_HEADER + n * NODE_STRIDE + 1u + axis];
+}
+
+fn source(base: vec3<u32>, o: vec3<u32>) -> vec4<f32> {
+    return from_depth(textureLoad(src, base + o, 0));
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    // Nodes of depth u = t + 1, whose values are level k = D - u.
+    let u = level.t + 1u;
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if i >= nodes[RANGES + 2u * u + 1u] * 8u {
+        return;
+    }
+    let c = nodes[RANGES + 2u * u] * 8u + i;
+    let below = child(c);
+    if below == 0u {
+        // No brick below: c and its positive neighbours are empty, and so is its value.
+        return;
+    }
+    let tile = c / 8u;
+    let o = c % 8u;
+    let k = tree.depth - u;
+    let m = tile_parent[tile];
+    let x = neighbour(m, 0u);
+    let y = neighbour(m, 1u);
+    let xy = neighbour(x, 1u);
+    let around = array<u32, 8>(m, x, y, xy, neighbour(m, 2u), neighbour(x, 2u), neighbour(y, 2u), neighbour(xy, 2u));
+    var targets = array<u32, 8>();
+    for (var s = 0u; s < 8u; s++) {
+        var t = 0u;
+        if border_holds(o, s) && (s == 0u || around[s] != 0u) {
+            t = child(around[s]);
+        }
+        targets[s] = t;
+    }
+    let src_bricks = atlas_bricks(tree, k - 1u);
+    let dst_bricks = atlas_bricks(tree, k);
+    let dirs = select(1u, tree.dirs, tree.anisotropic != 0u);
+    for (var d = 0u; d < dirs; d++) {
+        let base = slot_texel(brick_slot(tree, below, k - 1u, d), src_bricks);
+        var value = vec4<f32>(0.0);
+        if tree.anisotropic == 0u {
+            for (var j = 0u; j < 8u; j++) {
+                value += source(base, octant_offset(j));
+            }
+            value *= 0.125;
+        } else {
+            let axis = d / 2u;
+            let positive = (d & 1u) == 0u;
+            for (var j = 0u; j < 4u; j++) {
+                var front = vec3<u32>(0u);
+                front[(axis + 1u) % 3u] = j & 1u;
+                front[(axis + 2u) % 3u] = j >> 1u;
+                var back = front;
+                front[axis] = select(1u, 0u, positive);
+                back[axis] = select(0u, 1u, positive);
+                let f = source(base, front);
+                let b = source(base, back);
+                value += f + (1.0 - f.a) * b;
+            }
+            value *= 0.25;
+        }
+        let stored = to_depth(value);
+        for (var s = 0u; s < 8u; s++) {
+            if targets[s] != 0u {
+                let p = slot_texel(brick_slot(tree, targets[s], k, d), dst_bricks) + border_local(o, s);
+                textureStore(dst, p, stored);
+            }
+        }
+    }
+}

@@ -1,0 +1,142 @@
+// The sparse voxel octree's side of the voxel contract (the dense volume's sample.wgsl lists
+// it; the test `every_structure_defines_the_voxel_contract` checks the signatures).
+//
+// A sample at level-of-detail lod blends the two levels around it (quadrilinear): for each,
+// one descent from the root to the node whose brick holds the level's voxel under the sample,
+// then trilinear fetches inside that brick (voxels/octree/tree.wgsl has the layout). Both
+// descents run in one loop without branches; a missing child parks a descent on node 1 (an
+// unused node of the root tile whose child pointer stays 0), which reads as empty. Levels
+// alternate between the even and the odd atlas, so of the two levels one is read from each,
+// without a branch.
+//
+// Everything here reads @group(1) only; `OctreeVolume::sampling_layout` is its twin.
+
+//!include shared/volume.wgsl
+//!include voxels/tree.wgsl
+
+@group(1) @binding(0) var<uniform> tree: Octree;
+@group(1) @binding(1) var<storage, read> tree_nodes: array<u32>;
+@group(1) @binding(2) var even_atlas: texture_3d<f32>;
+@group(1) @binding(3) var odd_atlas: texture_3d<f32>;
+@group(1) @binding(4) var voxel_sampler: sampler;
+
+const WIDE_SAMPLE: f32 = 2.0;
+
+// True when the pipeline serves an isotropic octree: one fetch per level instead of three.
+override ISOTROPIC_ONLY: bool = false;
+// Directional blocks a sample reads: 3, every axis by its weight, or 2, the two of largest
+// weight (as the dense volume's).
+override SAMPLE_AXES: u32 = 3u;
+
+fn voxels_voxel_size() -> f32 {
+    return tree.voxel_size;
+}
+
+fn voxels_contains(p: vec3<f32>) -> bool {
+    return inside_tree(tree_uvw(p));
+}
+
+fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
+    return from_depth(sample_depth(pos, diameter, dir));
+}
+
+fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
+    let uvw = tree_uvw(pos);
+    let lod = clamp(log2(max(diameter / tree.voxel_size, 1.0)), 0.0, f32(tree.depth - 1u));
+    return select(vec4<f32>(0.0), sample_levels(uvw, lod, dir), inside_tree(uvw));
+}
+
+fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
+    let uvw = tree_uvw(pos);
+    let lod = clamp(log2(diameter / tree.voxel_size), 1.0, f32(tree.depth - 1u));
+    return select(vec4<f32>(0.0), sample_levels(uvw, lod, dir), inside_tree(uvw));
+}
+
+fn tree_uvw(pos: vec3<f32>) -> vec3<f32> {
+    return (pos - tree.origin) / (tree.voxel_size * f32(tree.resolution));
+}
+
+fn inside_tree(uvw: vec3<f32>) -> bool {
+    return all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0));
+}
+
+fn tree_child(n: u32) -> u32 {
+    return tree_nodes[NODE_HEADER + n * NODE_STRIDE];
+}
+
+// One step of a descent: the child of `node` in octant `o`, or node 1 (empty) when it has none.
+fn descend_step(node: u32, o: u32) -> u32 {
+    let tile = tree_child(node);
+    return select(tile * 8u + o, 1u, tile == 0u);
+}
+
+// Level `lvl` of the brick of `tile` in `atlas` (the level's), at brick-local texel position
+// `local`, along `dir`.
+fn fetch_level(atlas: texture_3d<f32>, tile: u32, lvl: u32, local: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
+    let even = (lvl & 1u) == 0u;
+    let bricks = atlas_bricks(tree, lvl);
+    let texel = select(tree.odd_texel.xyz, tree.even_texel.xyz, even);
+    // A tile of 0 (no brick) reads some texel and is masked below.
+    let t = max(tile, class_base(tree, brick_class(lvl)));
+    var v: vec4<f32>;
+    if ISOTROPIC_ONLY {
+        let uvw = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, 0u), bricks)) + local) * texel;
+        v = textureSampleLevel(atlas, voxel_sampler, uvw, 0.0);
+    } else {
+        let bx = select(1u, 0u, dir.x >= 0.0);
+        let by = select(3u, 2u, dir.y >= 0.0);
+        let bz = select(5u, 4u, dir.z >= 0.0);
+        let w = dir * dir;
+        let ux = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, bx), bricks)) + local) * texel;
+        let uy = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, by), bricks)) + local) * texel;
+        let uz = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, bz), bricks)) + local) * texel;
+        if SAMPLE_AXES == 2u {
+            // The two axes of largest weight, renormalised (as the dense volume's).
+            let drop_x = w.x <= w.y && w.x <= w.z;
+            let drop_y = !drop_x && w.y <= w.z;
+            let u0 = select(ux, uy, drop_x);
+            let w0 = select(w.x, w.y, drop_x);
+            let u1 = select(select(uy, uz, drop_y), uz, drop_x);
+            let w1 = select(select(w.y, w.z, drop_y), w.z, drop_x);
+            let s0 = textureSampleLevel(atlas, voxel_sampler, u0, 0.0);
+            let s1 = textureSampleLevel(atlas, voxel_sampler, u1, 0.0);
+            v = (w0 * s0 + w1 * s1) / max(w0 + w1, 1e-6);
+        } else {
+            let x = textureSampleLevel(atlas, voxel_sampler, ux, 0.0);
+            let y = textureSampleLevel(atlas, voxel_sampler, uy, 0.0);
+            let z = textureSampleLevel(atlas, voxel_sampler, uz, 0.0);
+            v = w.x * x + w.y * y + w.z * z;
+        }
+    }
+    return select(vec4<f32>(0.0), v, tile != 0u);
+}
+
+// Optical depth at lod, blended between the levels floor(lod) and floor(lod) + 1.
+fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
+    let lo = min(u32(lod), tree.depth - 2u);
+    let f = lod - f32(lo);
+    let ra = f32(tree.resolution >> lo);
+    let rb = 0.5 * ra;
+    // Voxel coordinates at the two levels, clamped as a clamp-to-edge sampler would.
+    let qa = clamp(uvw * ra - 0.5, vec3<f32>(0.0), vec3<f32>(ra - 1.0));
+    let qb = clamp(uvw * rb - 0.5, vec3<f32>(0.0), vec3<f32>(rb - 1.0));
+    let na = vec3<u32>(qa) >> vec3<u32>(1u);
+    let nb = vec3<u32>(qb) >> vec3<u32>(1u);
+    // The node holding level lo's voxels is at depth da; level lo + 1's one above it.
+    let da = tree.depth - 1u - lo;
+    var a = 0u;
+    var b = 0u;
+    for (var i = 0u; i < da; i++) {
+        a = descend_step(a, octant_of(na, da - 1u - i));
+        b = select(b, descend_step(b, octant_of(nb, (da - 2u - i) & 31u)), i + 1u < da);
+    }
+    let la = qa - 2.0 * vec3<f32>(na) + 0.5;
+    let lb = qb - 2.0 * vec3<f32>(nb) + 0.5;
+    let ta = tree_child(a);
+    let tb = tree_child(b);
+    // One of the two levels is even: read it from the even atlas and the other from the odd.
+    let a_even = (lo & 1u) == 0u;
+    let se = fetch_level(even_atlas, select(tb, ta, a_even), select(lo + 1u, lo, a_even), select(lb, la, a_even), dir);
+    let so = fetch_level(odd_atlas, select(ta, tb, a_even), select(lo, lo + 1u, a_even), select(la, lb, a_even), dir);
+    return mix(select(so, se, a_even), select(se, so, a_even), f);
+}

@@ -1,0 +1,139 @@
+// The sparse voxel octree's layout, shared by its build, filter, sampling, leaves and debug
+// view (twin: `GpuOctree` in src/voxel/octree/mod.rs; docs/ARCHITECTURE.md has the picture).
+//
+// Nodes come in tiles of 2x2x2. Tile 0 holds the root (node 0; nodes 1..7 are unused), so a
+// child pointer of 0 means "none". A node's record is four u32: its child pointer (the tile
+// of its eight children, which also names its brick), and its neighbours along -x, -y and -z
+// at the same depth (0: none). Only the negative neighbours are kept: the build and the
+// filter push each value into the bricks that hold it as a border, and those lie on the
+// negative side.
+//
+// A node at depth t < D (D = log2 of the finest resolution) that has children has a brick:
+// the values of its eight children (the voxels of level k = D - 1 - t, voxel-centred, 2x2x2)
+// with a border of one voxel on the positive side copied from the neighbouring bricks, stored
+// as 3x3x3 texels. A trilinear fetch anywhere in [0.5, 2.5] texels then blends exactly the
+// eight voxels a dense volume's trilinear fetch would, so the octree samples the same function
+// as the dense volume. A sample at level-k voxel coordinate q reads the brick of the node that
+// holds voxel floor(q): for that brick to exist wherever one of the eight voxels is occupied,
+// a node is subdivided when it or one of its seven positive neighbours holds geometry (the
+// build's `dilate`).
+//
+// Nodes at depth D are the finest voxels themselves: their child pointer is 1 + their leaf
+// slot. Tiles are numbered per class so that a brick's place in its atlas is its tile's index
+// in the class:
+//   class V: tiles at depth D (leaf voxels); their parents' bricks hold level 0 (isotropic),
+//            in the even atlas at slots [0, cap_v);
+//   class E: tiles whose parents' bricks hold an even level k > 0: even atlas, `dirs` slots
+//            each after the V slots;
+//   class O: odd levels: odd atlas, `dirs` slots each.
+// Levels alternate between the two atlases so that filtering level k + 1 from level k reads
+// one texture and writes the other.
+
+struct Octree {
+    // World position of the volume's minimum corner.
+    origin: vec3<f32>,
+    // Finest voxels per side (2^depth).
+    resolution: u32,
+    // World size of a finest voxel.
+    voxel_size: f32,
+    // log2(resolution): depth of the leaf voxels below the root.
+    depth: u32,
+    // 1: six directional values per voxel above the finest level, 0: one.
+    anisotropic: u32,
+    // Atlas slots per brick above level 0: 6 or 1.
+    dirs: u32,
+    // First tile of classes V, E and O, and the end of the pool.
+    base_v: u32,
+    base_e: u32,
+    base_o: u32,
+    tiles: u32,
+    // Leaf slots the pool holds.
+    slots: u32,
+    _pad0: u32,
+    // Bricks per row and per layer of the even and odd atlases.
+    even_bricks: vec2<u32>,
+    odd_bricks: vec2<u32>,
+    _pad1: vec2<u32>,
+    // 1 / (atlas size in texels), even and odd.
+    even_texel: vec4<f32>,
+    odd_texel: vec4<f32>,
+}
+
+// The node buffer starts with a header of counters, so that every pass reaching the nodes
+// reaches them too (one storage binding fewer: inject's stage holds the minimum eight): [0]
+// leaf slots, [1..4] tiles of classes V, E and O (all counted past the capacity: the host
+// reads these four back to grow the pools), [4] where the tiles of the depth being allocated
+// start in their class; from [RANGES], per depth t, the first tile and the number of tiles.
+const NODE_HEADER: u32 = 32u;
+const RANGES: u32 = 8u;
+const NODE_STRIDE: u32 = 4u;
+// A node's child field while the build flags it: geometry lies in it (CONTENT) or in one of
+// its positive neighbours (NEEDED). Allocation replaces both by a tile index.
+const CONTENT: u32 = 0xffffffffu;
+const NEEDED: u32 = 0xfffffffeu;
+const NONE: u32 = 0xffffffffu;
+// Per leaf slot, u32: packed coordinate, parent node | octant << 29, albedo (rgba8unorm),
+// normal (rgba8snorm), emission (2 x f16), then ACCUM_STRIDE sums of the build.
+const SLOT_STRIDE: u32 = 17u;
+const SLOT_ACCUM: u32 = 6u;
+const ACCUM_STRIDE: u32 = 11u;
+
+fn octant_of(c: vec3<u32>, shift: u32) -> u32 {
+    let b = (c >> vec3<u32>(shift)) & vec3<u32>(1u);
+    return b.x | (b.y << 1u) | (b.z << 2u);
+}
+
+fn octant_offset(o: u32) -> vec3<u32> {
+    return vec3<u32>(o & 1u, (o >> 1u) & 1u, (o >> 2u) & 1u);
+}
+
+// The class (0 V, 1 E, 2 O) of the tiles at depth t + 1, whose parents' bricks hold level
+// depth - 1 - t.
+fn brick_class(level: u32) -> u32 {
+    if level == 0u {
+        return 0u;
+    }
+    return select(2u, 1u, (level & 1u) == 0u);
+}
+
+fn class_base(tree: Octree, cls: u32) -> u32 {
+    return select(select(tree.base_o, tree.base_e, cls == 1u), tree.base_v, cls == 0u);
+}
+
+fn class_end(tree: Octree, cls: u32) -> u32 {
+    return select(select(tree.tiles, tree.base_o, cls == 1u), tree.base_e, cls == 0u);
+}
+
+// The atlas slot of direction block `dir` of the brick of tile `tile`, which holds `level`.
+fn brick_slot(tree: Octree, tile: u32, level: u32, dir: u32) -> u32 {
+    if level == 0u {
+        return tile - tree.base_v;
+    }
+    let d = select(0u, dir, tree.dirs > 1u);
+    if (level & 1u) == 0u {
+        return (tree.base_e - tree.base_v) + (tile - tree.base_e) * tree.dirs + d;
+    }
+    return (tile - tree.base_o) * tree.dirs + d;
+}
+
+// First texel of a slot in an atlas of `bricks` bricks per row and per layer.
+fn slot_texel(slot: u32, bricks: vec2<u32>) -> vec3<u32> {
+    return 3u * vec3<u32>(slot % bricks.x, (slot / bricks.x) % bricks.y, slot / (bricks.x * bricks.y));
+}
+
+fn atlas_bricks(tree: Octree, level: u32) -> vec2<u32> {
+    return select(tree.odd_bricks, tree.even_bricks, (level & 1u) == 0u);
+}
+
+// A value of voxel octant `o` of a node m's brick also lies in the positive border of the bricks
+// of m's negative neighbours: those along the axes of `s` (bits: 1 x, 2 y, 4 z), when `o` is
+// 0 along each of them. `around[s]` is m shifted by -1 along the axes of s (0: none).
+fn border_holds(o: u32, s: u32) -> bool {
+    return (s & o) == 0u;
+}
+
+// Where in that neighbour's brick the value lies: 2 along the axes of s, o's bit elsewhere.
+fn border_local(o: u32, s: u32) -> vec3<u32> {
+    let bits = octant_offset(o);
+    return select(bits, vec3<u32>(2u), octant_offset(s) == vec3<u32>(1u));
+}
