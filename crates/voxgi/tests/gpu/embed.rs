@@ -158,7 +158,10 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
     let (w, h) = (32, 32);
     let small = tiny_pools();
     let mut r = renderer(&scene, &small);
-    let (frags0, slots0) = (r.fragments().capacity, r.volume().dense().unwrap().slot_capacity);
+    let (frags0, slots0) = (
+        r.fragments().capacity,
+        r.volume().dense().unwrap().slot_capacity,
+    );
     let params = FrameParams::new(r.default_camera().clone());
     let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
     let mut frames = Vec::new();
@@ -167,7 +170,10 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
         frames.push(rgba8(&t));
     }
     let counts = r.last_voxel_counts().expect("counters came back");
-    let (frags1, slots1) = (r.fragments().capacity, r.volume().dense().unwrap().slot_capacity);
+    let (frags1, slots1) = (
+        r.fragments().capacity,
+        r.volume().dense().unwrap().slot_capacity,
+    );
     // The Cornell box at 32³ has several thousand fragments and occupied voxels: the
     // 1024-entry minimum pools overflowed, and grew to the exact counts.
     assert!(

@@ -445,3 +445,76 @@ fn voxel_debug_views_are_plausible() {
         assert!(voxgi::headless::render(ctx(), &mut r, &bad, 8, 8).is_err());
     }
 }
+
+/// The octree's GPU build against its CPU twin: from the fragments of the Cornell box at 32³,
+/// the same nodes get children at every depth (exactly: the twin takes the voxels the dense
+/// build found occupied, which `voxelize_matches_cpu_exactly` ties to the CPU voxelizer), and
+/// every leaf holds exactly the attributes the dense volume's voxel holds (both average the same
+/// integer sums with the same rounding).
+#[test]
+fn octree_build_matches_its_cpu_twin() {
+    use voxgi::voxel::octree::{SLOT_WORDS, cpu as ocpu};
+    let (device, queue) = (&ctx().device, &ctx().queue);
+    let scene = builtin::cornell_box();
+    let dense_options = RendererOptions {
+        voxel_resolution: 32,
+        ..measuring()
+    };
+    let octree_options = RendererOptions {
+        voxels: voxgi::VoxelKind::Octree,
+        ..dense_options.clone()
+    };
+    let params = |r: &Renderer| FrameParams::new(r.default_camera().clone());
+    let mut dense = renderer(&scene, &dense_options);
+    let p = params(&dense);
+    frame(&mut dense, &p, 8, 8);
+    let (want_voxels, _) = occupied(&dense);
+    let mut octree = renderer(&scene, &octree_options);
+    let p = params(&octree);
+    frame(&mut octree, &p, 8, 8);
+    let tree = octree.volume().octree().unwrap();
+    let nodes_bytes = read_buffer_copy(device, queue, &tree.nodes).expect("nodes");
+    let nodes: &[u32] = bytemuck::cast_slice(&nodes_bytes);
+    let got = ocpu::walk(nodes, &tree.layout);
+    let want = ocpu::subdivided(&want_voxels, tree.depth());
+    for (t, (g, w)) in got.iter().zip(&want).enumerate() {
+        eprintln!("depth {t}: {} nodes with children", g.len());
+        assert_eq!(
+            g, w,
+            "depth {t}: the GPU's nodes differ from the CPU twin's"
+        );
+    }
+    assert_eq!(got[5].len(), want_voxels.len());
+    assert!(want_voxels.len() > 1000, "the scene must fill the tree");
+
+    // Leaves: every slot's attributes equal the dense volume's at its voxel.
+    let vol = dense.volume().dense().unwrap();
+    let res = vol.grid.resolution;
+    let texels = |t: &wgpu::Texture| read_texture_3d(device, queue, t, 0).expect("texture");
+    let (albedo, normal, emission) = (
+        texels(&vol.albedo),
+        texels(&vol.normal),
+        texels(&vol.emission),
+    );
+    let slots_bytes = read_buffer_copy(device, queue, &tree.slots).expect("slots");
+    let slots: &[u32] = bytemuck::cast_slice(&slots_bytes);
+    let count = nodes[0] as usize;
+    assert_eq!(count, want_voxels.len(), "one leaf per occupied voxel");
+    let mut seen = BTreeSet::new();
+    for s in slots.chunks_exact(SLOT_WORDS as usize).take(count) {
+        let c = [s[0] & 1023, (s[0] >> 10) & 1023, s[0] >> 20];
+        assert!(seen.insert(c), "voxel {c:?} has two leaves");
+        let i = (c[0] + res * (c[1] + res * c[2])) as usize;
+        let word =
+            |bytes: &[u8], at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+        assert_eq!(s[2], word(&albedo, 4 * i), "albedo of {c:?}");
+        assert_eq!(s[3], word(&normal, 4 * i), "normal of {c:?}");
+        assert_eq!(s[4], word(&emission, 8 * i), "emission (rg) of {c:?}");
+        assert_eq!(
+            s[5] & 0xffff,
+            word(&emission, 8 * i + 4) & 0xffff,
+            "emission (b) of {c:?}"
+        );
+    }
+    assert_eq!(seen, want_voxels);
+}

@@ -105,6 +105,15 @@ fn begin() {
     for (var i = 0u; i < 8u * NODE_STRIDE; i++) {
         atomicStore(&nodes[NODE_HEADER + i], 0u);
     }
+    // The level above the root's brick (one voxel, level D): the first tile of its class,
+    // reserved here, is its brick, and node TOP_NODE of the root tile points to it.
+    let top_class = brick_class(tree.depth);
+    atomicStore(&nodes[1u + top_class], 1u);
+    let top = class_base(tree, top_class);
+    atomicStore(&nodes[NODE_HEADER + TOP_NODE * NODE_STRIDE], top);
+    for (var o = 0u; o < 8u; o++) {
+        clear_brick(top, tree.depth, o);
+    }
     write_args(0u, stored_fragments());
     write_args(6u, 8u);
 }

@@ -63,39 +63,58 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         }
         targets[s] = t;
     }
-    let src_bricks = atlas_bricks(tree, k - 1u);
-    let dst_bricks = atlas_bricks(tree, k);
     let dirs = select(1u, tree.dirs, tree.anisotropic != 0u);
+    let dst_bricks = atlas_bricks(tree, k);
     for (var d = 0u; d < dirs; d++) {
-        let base = slot_texel(brick_slot(tree, below, k - 1u, d), src_bricks);
-        var value = vec4<f32>(0.0);
-        if tree.anisotropic == 0u {
-            for (var j = 0u; j < 8u; j++) {
-                value += source(base, octant_offset(j));
-            }
-            value *= 0.125;
-        } else {
-            let axis = d / 2u;
-            let positive = (d & 1u) == 0u;
-            for (var j = 0u; j < 4u; j++) {
-                var front = vec3<u32>(0u);
-                front[(axis + 1u) % 3u] = j & 1u;
-                front[(axis + 2u) % 3u] = j >> 1u;
-                var back = front;
-                front[axis] = select(1u, 0u, positive);
-                back[axis] = select(0u, 1u, positive);
-                let f = source(base, front);
-                let b = source(base, back);
-                value += f + (1.0 - f.a) * b;
-            }
-            value *= 0.25;
-        }
-        let stored = to_depth(value);
+        let stored = filtered(below, k, d);
         for (var s = 0u; s < 8u; s++) {
             if targets[s] != 0u {
                 let p = slot_texel(brick_slot(tree, targets[s], k, d), dst_bricks) + border_local(o, s);
                 textureStore(dst, p, stored);
             }
         }
+    }
+}
+
+// The value at level k, direction block d, of the node whose children's brick is `below`
+// (level k - 1): the dense volume's filter over its eight voxels, as stored optical depth.
+fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
+    let base = slot_texel(brick_slot(tree, below, k - 1u, d), atlas_bricks(tree, k - 1u));
+    var value = vec4<f32>(0.0);
+    if tree.anisotropic == 0u {
+        for (var j = 0u; j < 8u; j++) {
+            value += source(base, octant_offset(j));
+        }
+        return to_depth(value * 0.125);
+    }
+    let axis = d / 2u;
+    let positive = (d & 1u) == 0u;
+    for (var j = 0u; j < 4u; j++) {
+        var front = vec3<u32>(0u);
+        front[(axis + 1u) % 3u] = j & 1u;
+        front[(axis + 2u) % 3u] = j >> 1u;
+        var back = front;
+        front[axis] = select(1u, 0u, positive);
+        back[axis] = select(0u, 1u, positive);
+        let f = source(base, front);
+        let b = source(base, back);
+        value += f + (1.0 - f.a) * b;
+    }
+    return to_depth(value * 0.25);
+}
+
+// Level D, the volume as one voxel, from the root's brick, into the brick TOP_NODE names (its
+// texel 0: level D is sampled at exactly that texel's centre).
+@compute @workgroup_size(1)
+fn top() {
+    let below = child(0u);
+    let top = child(TOP_NODE);
+    if below == 0u || top == 0u {
+        return;
+    }
+    let k = tree.depth;
+    let dirs = select(1u, tree.dirs, tree.anisotropic != 0u);
+    for (var d = 0u; d < dirs; d++) {
+        textureStore(dst, slot_texel(brick_slot(tree, top, k, d), atlas_bricks(tree, k)), filtered(below, k, d));
     }
 }

@@ -42,13 +42,13 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
 
 fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let uvw = tree_uvw(pos);
-    let lod = clamp(log2(max(diameter / tree.voxel_size, 1.0)), 0.0, f32(tree.depth - 1u));
+    let lod = clamp(log2(max(diameter / tree.voxel_size, 1.0)), 0.0, f32(tree.depth));
     return select(vec4<f32>(0.0), sample_levels(uvw, lod, dir), inside_tree(uvw));
 }
 
 fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let uvw = tree_uvw(pos);
-    let lod = clamp(log2(diameter / tree.voxel_size), 1.0, f32(tree.depth - 1u));
+    let lod = clamp(log2(diameter / tree.voxel_size), 1.0, f32(tree.depth));
     return select(vec4<f32>(0.0), sample_levels(uvw, lod, dir), inside_tree(uvw));
 }
 
@@ -113,7 +113,7 @@ fn fetch_level(atlas: texture_3d<f32>, tile: u32, lvl: u32, local: vec3<f32>, di
 
 // Optical depth at lod, blended between the levels floor(lod) and floor(lod) + 1.
 fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
-    let lo = min(u32(lod), tree.depth - 2u);
+    let lo = min(u32(lod), tree.depth - 1u);
     let f = lod - f32(lo);
     let ra = f32(tree.resolution >> lo);
     let rb = 0.5 * ra;
@@ -122,10 +122,11 @@ fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let qb = clamp(uvw * rb - 0.5, vec3<f32>(0.0), vec3<f32>(rb - 1.0));
     let na = vec3<u32>(qa) >> vec3<u32>(1u);
     let nb = vec3<u32>(qb) >> vec3<u32>(1u);
-    // The node holding level lo's voxels is at depth da; level lo + 1's one above it.
+    // The node holding level lo's voxels is at depth da; level lo + 1's one above it (above
+    // the root: TOP_NODE, whose brick is level D).
     let da = tree.depth - 1u - lo;
     var a = 0u;
-    var b = 0u;
+    var b = select(0u, TOP_NODE, da == 0u);
     for (var i = 0u; i < da; i++) {
         a = descend_step(a, octant_of(na, da - 1u - i));
         b = select(b, descend_step(b, octant_of(nb, (da - 2u - i) & 31u)), i + 1u < da);

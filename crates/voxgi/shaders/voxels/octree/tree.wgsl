@@ -67,6 +67,10 @@ struct Octree {
 const NODE_HEADER: u32 = 32u;
 const RANGES: u32 = 8u;
 const NODE_STRIDE: u32 = 4u;
+// Node 2 of the root tile stands above the root: its child pointer names the brick of level D,
+// the whole volume as one voxel (the dense volume's top mip), filtered from the root's brick.
+// (Node 1 stays empty: descents that lose their way park there.)
+const TOP_NODE: u32 = 2u;
 // A node's child field while the build flags it: geometry lies in it (CONTENT) or in one of
 // its positive neighbours (NEEDED). Allocation replaces both by a tile index.
 const CONTENT: u32 = 0xffffffffu;

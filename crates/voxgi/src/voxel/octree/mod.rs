@@ -14,6 +14,7 @@
 //! Built on the GPU level by level from the fragment list (octree_build.wgsl): a level-synchronous
 //! scheme that needs no locks, deterministic in everything but allocation order.
 
+pub mod cpu;
 pub mod debug;
 
 use super::{DebugView, Grid, POOL_COUNTERS, VoxelStructure};
@@ -148,6 +149,7 @@ pub struct OctreePipelines {
     filter_layout: wgpu::BindGroupLayout,
     build: BuildPipelines,
     filter: wgpu::ComputePipeline,
+    filter_top: wgpu::ComputePipeline,
     debug: DebugPass,
 }
 
@@ -232,20 +234,32 @@ impl OctreePipelines {
                 layout::uniform(5, c, true),
             ],
         });
-        let filter = shader::voxel_pipeline(
-            device,
-            "octree_filter",
-            "voxels/octree/octree_filter.wgsl",
-            "octree",
-            &[Some(&filter_layout)],
-            &[],
-        );
+        let filter_module =
+            shader::module_for(device, "voxels/octree/octree_filter.wgsl", "octree");
+        let filter_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("octree_filter"),
+                bind_group_layouts: &[Some(&filter_layout)],
+                immediate_size: 0,
+            });
+        let f = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("octree_filter"),
+                layout: Some(&filter_pipeline_layout),
+                module: &filter_module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (filter, filter_top) = (f("main"), f("top"));
         Arc::new(OctreePipelines {
             build_layout,
             args_layout,
             filter_layout,
             build,
             filter,
+            filter_top,
             debug: DebugPass::new(device),
         })
     }
@@ -664,6 +678,10 @@ impl OctreeVolume {
             pass.set_bind_group(0, group, &[(t as u64 * LEVEL_STRIDE) as u32]);
             pass.dispatch_workgroups_indirect(&self.args, (6 + 3 * (t as u64 + 1)) * 4);
         }
+        // Level D, the whole volume as one voxel, from the root's brick.
+        pass.set_pipeline(&self.pipelines.filter_top);
+        pass.set_bind_group(0, &self.filter[(depth & 1) as usize], &[0]);
+        pass.dispatch_workgroups(1, 1, 1);
     }
 
     fn memory_report(&self) -> Vec<(&'static str, u64)> {
