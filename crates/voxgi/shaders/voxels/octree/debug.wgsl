@@ -55,7 +55,8 @@ fn cell_value(c: vec3<u32>, lvl: u32) -> vec4<f32> {
     if tile == 0u {
         return vec4<f32>(0.0);
     }
-    let p = slot_texel(brick_slot(tree, tile, lvl, params.block), atlas_bricks(tree, lvl)) + (c & vec3<u32>(1u));
+    let block = select(dir_block(tree, params.block), 0u, lvl == 0u);
+    let p = brick_texel(atlas_shape(tree, lvl), brick_index(tree, tile, lvl), block) + (c & vec3<u32>(1u));
     if (lvl & 1u) == 0u {
         return from_depth(textureLoad(even_atlas, p, 0));
     }

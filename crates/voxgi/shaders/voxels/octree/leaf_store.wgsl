@@ -33,7 +33,7 @@ fn store_leaf_radiance(i: u32, v: vec4<f32>) {
         if tile == 0u {
             continue;
         }
-        let p = slot_texel(tile - leaf_tree.base_v, leaf_tree.even_bricks) + border_local(o, s);
+        let p = brick_texel(leaf_tree.leaf_atlas, tile - leaf_tree.base_v, 0u) + border_local(o, s);
         textureStore(leaf_atlas_out, p, d);
     }
 }

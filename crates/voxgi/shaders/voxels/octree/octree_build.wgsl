@@ -5,12 +5,17 @@
 //   dilate   each CONTENT node marks its seven negative neighbours NEEDED (their bricks hold
 //            its voxels as their positive border)
 //   mark     remember where this depth's tiles start in their class
-//   allocate each marked node takes a tile of eight children (and so a brick)
+//   count    per workgroup of 64 nodes, how many are marked
+//   scan     one workgroup: the counts' exclusive prefix sum
+//   allocate each marked node takes a tile of eight children (and so a brick), numbered by
+//            its rank among the depth's marked nodes
 //   finish   the new tiles' range and the dispatch size over their nodes
-//   init     the new nodes: no children, their negative neighbours, a cleared brick
-// then at depth D (the finest voxels): flag, one leaf slot per occupied voxel, integer sums of
-// the fragments per slot (deterministic), and the averages. Allocation order varies from run
-// to run; what is allocated, and every value, does not.
+//   init     the new nodes: no children, their negative neighbours, a cleared brick, and
+//            (down to GRID_DEPTH) their entry in the top grid
+// then at depth D (the finest voxels): flag, count and scan, one leaf slot per occupied voxel
+// (by rank), integer sums of the fragments per slot, and the averages. Ranks instead of an
+// atomic counter make the layout itself deterministic, not only the values: the atlases'
+// filtering rounds by a texel's position, so the same scene gives the same image every run.
 //
 // Every pool counts what it was asked for past its capacity; a node whose tile did not fit
 // stays a leaf without children (its geometry is missing until the pools grow and the next
@@ -29,12 +34,17 @@ struct Level {
 @group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
 // The header (counters, voxels/octree/tree.wgsl), then the nodes.
 @group(0) @binding(3) var<storage, read_write> nodes: array<atomic<u32>>;
-// Per tile: its parent node.
-@group(0) @binding(4) var<storage, read_write> tile_parent: array<u32>;
+// Per tile, TILE_WORDS u32: its parent node and the parent's packed coordinate.
+@group(0) @binding(4) var<storage, read_write> tiles: array<u32>;
 @group(0) @binding(5) var<storage, read_write> slots: array<atomic<u32>>;
 @group(0) @binding(6) var even_out: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(7) var odd_out: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(8) var<uniform> level: Level;
+// Per workgroup of `count`: its marked nodes, then (after `scan`) the marked nodes before it.
+@group(0) @binding(9) var<storage, read_write> block_sums: array<u32>;
+// The top grid (voxels/octree/tree.wgsl): per depth down to GRID_DEPTH, the node at each
+// position, 0 where none.
+@group(0) @binding(10) var<storage, read_write> grid: array<u32>;
 // Indirect dispatch sizes: [0..3] over fragments, [3..6] over leaf slots, from [6] per depth
 // t over the nodes of depth t. Only the one-thread kernels bind them.
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
@@ -86,6 +96,11 @@ fn node_of_depth(i: u32, t: u32) -> u32 {
     return atomicLoad(&nodes[RANGES + 2u * t]) * 8u + i;
 }
 
+// Node n's coordinate at its depth: its tile's parent's, doubled, plus its octant.
+fn node_coord(n: u32) -> vec3<u32> {
+    return 2u * unpack_coord(tiles[(n / 8u) * TILE_WORDS + 1u]) + octant_offset(n % 8u);
+}
+
 fn class_capacity(c: u32) -> u32 {
     return class_end(tree, c) - class_base(tree, c);
 }
@@ -105,6 +120,10 @@ fn begin() {
     for (var i = 0u; i < 8u * NODE_STRIDE; i++) {
         atomicStore(&nodes[NODE_HEADER + i], 0u);
     }
+    // The root tile's "parent" sits at the origin, so the root's coordinate is 0.
+    tiles[0] = 0u;
+    tiles[1] = 0u;
+    grid[0] = 0u;
     // The level above the root's brick (one voxel, level D): the first tile of its class,
     // reserved here, is its brick, and node TOP_NODE of the root tile points to it.
     let top_class = brick_class(tree.depth);
@@ -165,21 +184,96 @@ fn mark() {
     atomicStore(&nodes[4], atomicLoad(&nodes[1u + c]));
 }
 
+var<workgroup> ranks: array<u32, 64>;
+
+// Inclusive prefix sum of `v` over the workgroup (every thread must call it).
+fn workgroup_scan(lid: u32, v: u32) -> u32 {
+    ranks[lid] = v;
+    workgroupBarrier();
+    for (var d = 1u; d < 64u; d *= 2u) {
+        var x = 0u;
+        if lid >= d {
+            x = ranks[lid - d];
+        }
+        workgroupBarrier();
+        ranks[lid] += x;
+        workgroupBarrier();
+    }
+    return ranks[lid];
+}
+
+fn block_index(wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return wid.x + wid.y * nwg.x;
+}
+
+// Whether node n (of the dispatch's depth) takes a tile (depth < D) or a leaf slot (depth D).
+fn marked(n: u32) -> bool {
+    if n == NONE {
+        return false;
+    }
+    let c = child(n);
+    return select(c >= NEEDED, c == CONTENT, level.t == tree.depth);
+}
+
 @compute @workgroup_size(64)
-fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let n = node_of_depth(flat(gid, nwg), level.t);
-    if n == NONE || child(n) < NEEDED {
+    let total = workgroup_scan(lid, u32(marked(n)));
+    if lid == 63u {
+        block_sums[block_index(wid, nwg)] = total;
+    }
+}
+
+// One workgroup: the exclusive prefix sum of the counts of the depth's blocks, in chunks of 64.
+var<workgroup> scan_blocks: u32;
+
+@compute @workgroup_size(64)
+fn scan(@builtin(local_invocation_index) lid: u32) {
+    if lid == 0u {
+        scan_blocks = (atomicLoad(&nodes[RANGES + 2u * level.t + 1u]) * 8u + 63u) / 64u;
+    }
+    let blocks = workgroupUniformLoad(&scan_blocks);
+    var offset = 0u;
+    for (var base = 0u; base < blocks; base += 64u) {
+        let i = base + lid;
+        var v = 0u;
+        if i < blocks {
+            v = block_sums[i];
+        }
+        let inclusive = workgroup_scan(lid, v);
+        if i < blocks {
+            block_sums[i] = offset + inclusive - v;
+        }
+        offset += ranks[63];
+        workgroupBarrier();
+    }
+}
+
+// The rank of node n among the marked nodes of its depth (every thread must call it).
+fn rank(n: u32, lid: u32, wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    let m = u32(marked(n));
+    return block_sums[block_index(wid, nwg)] + workgroup_scan(lid, m) - m;
+}
+
+@compute @workgroup_size(64)
+fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), level.t);
+    let r = rank(n, lid, wid, nwg);
+    if !marked(n) {
         return;
     }
     let c = brick_class(tree.depth - 1u - level.t);
-    let k = atomicAdd(&nodes[1u + c], 1u);
+    // Counted past the capacity, so the host sees how many tiles the class needs.
+    atomicMax(&nodes[1u + c], atomicLoad(&nodes[4]) + r + 1u);
+    let k = atomicLoad(&nodes[4]) + r;
     if k >= class_capacity(c) {
         atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
         return;
     }
     let tile = class_base(tree, c) + k;
     atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], tile);
-    tile_parent[tile] = n;
+    tiles[tile * TILE_WORDS] = n;
+    tiles[tile * TILE_WORDS + 1u] = pack_coord(node_coord(n));
 }
 
 @compute @workgroup_size(1)
@@ -197,9 +291,10 @@ fn finish() {
 // Clears the texels of brick `tile` (holding `lvl`) that octant thread `o` owns: every eighth.
 fn clear_brick(tile: u32, lvl: u32, o: u32) {
     let dirs = select(1u, tree.dirs, lvl > 0u);
-    let bricks = atlas_bricks(tree, lvl);
+    let shape = atlas_shape(tree, lvl);
+    let b = brick_index(tree, tile, lvl);
     for (var d = 0u; d < dirs; d++) {
-        let base = slot_texel(brick_slot(tree, tile, lvl, d), bricks);
+        let base = brick_texel(shape, b, d);
         for (var k = o; k < 27u; k += 8u) {
             let p = base + vec3<u32>(k % 3u, (k / 3u) % 3u, k / 9u);
             if (lvl & 1u) == 0u {
@@ -222,7 +317,10 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let tile = n / 8u;
     let o = n % 8u;
     atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
-    let parent = tile_parent[tile];
+    let parent = tiles[tile * TILE_WORDS];
+    if u <= grid_depth(tree) {
+        grid[grid_index(node_coord(n), u)] = n;
+    }
     for (var a = 0u; a < 3u; a++) {
         var nb = 0u;
         if u < tree.depth {
@@ -243,20 +341,22 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     clear_brick(tile, tree.depth - u, o);
 }
 
-// Depth D: one leaf slot per occupied finest voxel.
+// Depth D: one leaf slot per occupied finest voxel, by rank.
 @compute @workgroup_size(64)
-fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let n = node_of_depth(flat(gid, nwg), tree.depth);
-    if n == NONE || child(n) != CONTENT {
+    let s = rank(n, lid, wid, nwg);
+    if !marked(n) {
         return;
     }
-    let s = atomicAdd(&nodes[0], 1u);
+    atomicMax(&nodes[0], s + 1u);
     if s >= tree.slots {
         atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
         return;
     }
     atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], s + 1u);
-    atomicStore(&slots[s * SLOT_STRIDE + 1u], tile_parent[n / 8u] | ((n % 8u) << 29u));
+    atomicStore(&slots[s * SLOT_STRIDE], pack_coord(node_coord(n)));
+    atomicStore(&slots[s * SLOT_STRIDE + 1u], tiles[(n / 8u) * TILE_WORDS] | ((n % 8u) << 29u));
     for (var k = 0u; k < ACCUM_STRIDE; k++) {
         atomicStore(&slots[s * SLOT_STRIDE + SLOT_ACCUM + k], 0u);
     }
@@ -278,8 +378,6 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         return;
     }
     let base = (v - 1u) * SLOT_STRIDE;
-    // Every fragment of the voxel has its coordinate.
-    atomicStore(&slots[base], f.coord);
     let sums = fragment_sums(f);
     for (var k = 0u; k < FRAGMENT_SUMS; k++) {
         atomicAdd(&slots[base + SLOT_ACCUM + k], sums[k]);

@@ -15,7 +15,8 @@ struct Level {
 
 @group(0) @binding(0) var<uniform> tree: Octree;
 @group(0) @binding(1) var<storage, read> nodes: array<u32>;
-@group(0) @binding(2) var<storage, read> tile_parent: array<u32>;
+// Per tile, TILE_WORDS u32: its parent node first.
+@group(0) @binding(2) var<storage, read> tiles: array<u32>;
 // Level k - 1's atlas (read) and level k's (written).
 @group(0) @binding(3) var src: texture_3d<f32>;
 @group(0) @binding(4) var dst: texture_storage_3d<rgba16float, write>;
@@ -50,7 +51,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let tile = c / 8u;
     let o = c % 8u;
     let k = tree.depth - u;
-    let m = tile_parent[tile];
+    let m = tiles[tile * TILE_WORDS];
     let x = neighbour(m, 0u);
     let y = neighbour(m, 1u);
     let xy = neighbour(x, 1u);
@@ -64,12 +65,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         targets[s] = t;
     }
     let dirs = select(1u, tree.dirs, tree.anisotropic != 0u);
-    let dst_bricks = atlas_bricks(tree, k);
+    let dst_shape = atlas_shape(tree, k);
     for (var d = 0u; d < dirs; d++) {
         let stored = filtered(below, k, d);
         for (var s = 0u; s < 8u; s++) {
             if targets[s] != 0u {
-                let p = slot_texel(brick_slot(tree, targets[s], k, d), dst_bricks) + border_local(o, s);
+                let p = brick_texel(dst_shape, brick_index(tree, targets[s], k), dir_block(tree, d)) + border_local(o, s);
                 textureStore(dst, p, stored);
             }
         }
@@ -79,7 +80,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 // The value at level k, direction block d, of the node whose children's brick is `below`
 // (level k - 1): the dense volume's filter over its eight voxels, as stored optical depth.
 fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
-    let base = slot_texel(brick_slot(tree, below, k - 1u, d), atlas_bricks(tree, k - 1u));
+    // Level 0 is isotropic: every direction filters its one block.
+    let block = select(dir_block(tree, d), 0u, k == 1u);
+    let base = brick_texel(atlas_shape(tree, k - 1u), brick_index(tree, below, k - 1u), block);
     var value = vec4<f32>(0.0);
     if tree.anisotropic == 0u {
         for (var j = 0u; j < 8u; j++) {
@@ -115,6 +118,6 @@ fn top() {
     let k = tree.depth;
     let dirs = select(1u, tree.dirs, tree.anisotropic != 0u);
     for (var d = 0u; d < dirs; d++) {
-        textureStore(dst, slot_texel(brick_slot(tree, top, k, d), atlas_bricks(tree, k)), filtered(below, k, d));
+        textureStore(dst, brick_texel(atlas_shape(tree, k), brick_index(tree, top, k), dir_block(tree, d)), filtered(below, k, d));
     }
 }

@@ -2,7 +2,7 @@
 // it; the test `every_structure_defines_the_voxel_contract` checks the signatures).
 //
 // A sample at level-of-detail lod blends the two levels around it (quadrilinear): for each,
-// one descent from the root to the node whose brick holds the level's voxel under the sample,
+// one descent from the top grid to the node whose brick holds the level's voxel under the sample,
 // then trilinear fetches inside that brick (voxels/octree/tree.wgsl has the layout). Both
 // descents run in one loop without branches; a missing child parks a descent on node 1 (an
 // unused node of the root tile whose child pointer stays 0), which reads as empty. Levels
@@ -19,6 +19,8 @@
 @group(1) @binding(2) var even_atlas: texture_3d<f32>;
 @group(1) @binding(3) var odd_atlas: texture_3d<f32>;
 @group(1) @binding(4) var voxel_sampler: sampler;
+// The top grid (voxels/octree/tree.wgsl): where descents start.
+@group(1) @binding(5) var<storage, read> tree_grid: array<u32>;
 
 const WIDE_SAMPLE: f32 = 2.0;
 
@@ -64,32 +66,41 @@ fn tree_child(n: u32) -> u32 {
     return tree_nodes[NODE_HEADER + n * NODE_STRIDE];
 }
 
+// The top grid's node at coordinate c of depth t; node 1 (empty) where there is none (depth 0
+// is the root, node 0).
+fn grid_node(c: vec3<u32>, t: u32) -> u32 {
+    let n = tree_grid[grid_index(c, t)];
+    return select(n, 1u, n == 0u && t > 0u);
+}
+
 // One step of a descent: the child of `node` in octant `o`, or node 1 (empty) when it has none.
 fn descend_step(node: u32, o: u32) -> u32 {
     let tile = tree_child(node);
     return select(tile * 8u + o, 1u, tile == 0u);
 }
 
-// Level `lvl` of the brick of `tile` in `atlas` (the level's), at brick-local texel position
-// `local`, along `dir`.
-fn fetch_level(atlas: texture_3d<f32>, tile: u32, lvl: u32, local: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
-    let even = (lvl & 1u) == 0u;
-    let bricks = atlas_bricks(tree, lvl);
-    let texel = select(tree.odd_texel.xyz, tree.even_texel.xyz, even);
+// Level `lvl` of the brick of `tile` in `atlas` (the level's; `shape`, its region), at
+// brick-local texel position `local`, along `dir`: three fetches weighted by the squared
+// direction cosines (two with SAMPLE_AXES = 2, one in isotropic mode). Level 0 is isotropic:
+// its three fetches read the same texel (cheaper on CPU drivers than a branch around them).
+fn fetch_level(atlas: texture_3d<f32>, shape: AtlasShape, tile: u32, lvl: u32, local: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
     // A tile of 0 (no brick) reads some texel and is masked below.
-    let t = max(tile, class_base(tree, brick_class(lvl)));
+    let b = brick_index(tree, max(tile, class_base(tree, brick_class(lvl))), lvl);
+    let origin = vec3<f32>(brick_texel(shape, b, 0u)) + local;
+    let inv = shape.inv_size.xyz;
     var v: vec4<f32>;
     if ISOTROPIC_ONLY {
-        let uvw = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, 0u), bricks)) + local) * texel;
-        v = textureSampleLevel(atlas, voxel_sampler, uvw, 0.0);
+        v = textureSampleLevel(atlas, voxel_sampler, origin * inv, 0.0);
     } else {
-        let bx = select(1u, 0u, dir.x >= 0.0);
-        let by = select(3u, 2u, dir.y >= 0.0);
-        let bz = select(5u, 4u, dir.z >= 0.0);
+        // An isotropic octree's one block serves every axis, as level 0's does.
+        let block = select(0.0, f32(shape.block), tree.dirs > 1u && lvl > 0u);
+        let bx = select(1.0, 0.0, dir.x >= 0.0);
+        let by = select(3.0, 2.0, dir.y >= 0.0);
+        let bz = select(5.0, 4.0, dir.z >= 0.0);
         let w = dir * dir;
-        let ux = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, bx), bricks)) + local) * texel;
-        let uy = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, by), bricks)) + local) * texel;
-        let uz = (vec3<f32>(slot_texel(brick_slot(tree, t, lvl, bz), bricks)) + local) * texel;
+        let ux = (origin + vec3<f32>(0.0, 0.0, bx * block)) * inv;
+        let uy = (origin + vec3<f32>(0.0, 0.0, by * block)) * inv;
+        let uz = (origin + vec3<f32>(0.0, 0.0, bz * block)) * inv;
         if SAMPLE_AXES == 2u {
             // The two axes of largest weight, renormalised (as the dense volume's).
             let drop_x = w.x <= w.y && w.x <= w.z;
@@ -111,6 +122,14 @@ fn fetch_level(atlas: texture_3d<f32>, tile: u32, lvl: u32, local: vec3<f32>, di
     return select(vec4<f32>(0.0), v, tile != 0u);
 }
 
+// The even atlas's region for level `lvl` (even): the leaf region for 0, else the even one.
+fn even_region(lvl: u32) -> AtlasShape {
+    let leaf = lvl == 0u;
+    let l = tree.leaf_atlas;
+    let e = tree.even_atlas;
+    return AtlasShape(select(e.shift, l.shift, leaf), select(e.block, l.block, leaf), select(e.z0, l.z0, leaf), e.inv_size);
+}
+
 // Optical depth at lod, blended between the levels floor(lod) and floor(lod) + 1.
 fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let lo = min(u32(lod), tree.depth - 1u);
@@ -122,14 +141,20 @@ fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let qb = clamp(uvw * rb - 0.5, vec3<f32>(0.0), vec3<f32>(rb - 1.0));
     let na = vec3<u32>(qa) >> vec3<u32>(1u);
     let nb = vec3<u32>(qb) >> vec3<u32>(1u);
-    // The node holding level lo's voxels is at depth da; level lo + 1's one above it (above
-    // the root: TOP_NODE, whose brick is level D).
+    // The node holding level lo's voxels is at depth da; level lo + 1's at depth da - 1 (above
+    // the root: TOP_NODE, whose brick is level D). Both start from the top grid, at depth at
+    // most g, and descend the rest of the way together (b needs one step less, or none).
     let da = tree.depth - 1u - lo;
-    var a = 0u;
-    var b = select(0u, TOP_NODE, da == 0u);
-    for (var i = 0u; i < da; i++) {
-        a = descend_step(a, octant_of(na, da - 1u - i));
-        b = select(b, descend_step(b, octant_of(nb, (da - 2u - i) & 31u)), i + 1u < da);
+    let db = max(da, 1u) - 1u;
+    let g = grid_depth(tree);
+    let sa = min(da, g);
+    let sb = min(db, g);
+    var a = grid_node(na >> vec3<u32>(da - sa), sa);
+    var b = select(grid_node(nb >> vec3<u32>(db - sb), sb), TOP_NODE, da == 0u);
+    let steps_b = db - sb;
+    for (var i = 0u; i < da - sa; i++) {
+        a = descend_step(a, octant_of(na, da - sa - 1u - i));
+        b = select(b, descend_step(b, octant_of(nb, (steps_b - 1u - i) & 31u)), i < steps_b);
     }
     let la = qa - 2.0 * vec3<f32>(na) + 0.5;
     let lb = qb - 2.0 * vec3<f32>(nb) + 0.5;
@@ -137,7 +162,8 @@ fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let tb = tree_child(b);
     // One of the two levels is even: read it from the even atlas and the other from the odd.
     let a_even = (lo & 1u) == 0u;
-    let se = fetch_level(even_atlas, select(tb, ta, a_even), select(lo + 1u, lo, a_even), select(lb, la, a_even), dir);
-    let so = fetch_level(odd_atlas, select(ta, tb, a_even), select(lo, lo + 1u, a_even), select(la, lb, a_even), dir);
+    let le = select(lo + 1u, lo, a_even);
+    let se = fetch_level(even_atlas, even_region(le), select(tb, ta, a_even), le, select(lb, la, a_even), dir);
+    let so = fetch_level(odd_atlas, tree.odd_atlas, select(ta, tb, a_even), select(lo, lo + 1u, a_even), select(la, lb, a_even), dir);
     return mix(select(so, se, a_even), select(se, so, a_even), f);
 }

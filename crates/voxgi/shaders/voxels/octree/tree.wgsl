@@ -19,15 +19,28 @@
 // build's `dilate`).
 //
 // Nodes at depth D are the finest voxels themselves: their child pointer is 1 + their leaf
-// slot. Tiles are numbered per class so that a brick's place in its atlas is its tile's index
-// in the class:
-//   class V: tiles at depth D (leaf voxels); their parents' bricks hold level 0 (isotropic),
-//            in the even atlas at slots [0, cap_v);
-//   class E: tiles whose parents' bricks hold an even level k > 0: even atlas, `dirs` slots
-//            each after the V slots;
-//   class O: odd levels: odd atlas, `dirs` slots each.
-// Levels alternate between the two atlases so that filtering level k + 1 from level k reads
-// one texture and writes the other.
+// slot. Tiles are numbered per class, and a brick's place in its atlas is its tile's index in
+// the class:
+//   class V: tiles at depth D (leaf voxels); their parents' bricks hold level 0 (isotropic):
+//            the leaf region of the even atlas;
+//   class E: tiles whose parents' bricks hold an even level k > 0: the even region of the even
+//            atlas;
+//   class O: odd levels: the odd atlas.
+// A region holds its bricks in rows and layers of powers of two (addressing by shifts: CPU
+// drivers have no vector integer division), and its direction blocks one after another along
+// z. Levels alternate between the even and the odd atlas, so filtering level k + 1 from level
+// k reads one texture and writes the other, and a sample's two levels are one fetch from each
+// texture without a branch.
+
+// Where a region of an atlas keeps its bricks: log2 of the bricks per row and per layer, the
+// texels of one direction block along z, the region's first texel along z, and 1 / the atlas
+// size in texels.
+struct AtlasShape {
+    shift: vec2<u32>,
+    block: u32,
+    z0: u32,
+    inv_size: vec4<f32>,
+}
 
 struct Octree {
     // World position of the volume's minimum corner.
@@ -40,7 +53,7 @@ struct Octree {
     depth: u32,
     // 1: six directional values per voxel above the finest level, 0: one.
     anisotropic: u32,
-    // Atlas slots per brick above level 0: 6 or 1.
+    // Direction blocks of the atlases above level 0: 6 or 1.
     dirs: u32,
     // First tile of classes V, E and O, and the end of the pool.
     base_v: u32,
@@ -50,13 +63,11 @@ struct Octree {
     // Leaf slots the pool holds.
     slots: u32,
     _pad0: u32,
-    // Bricks per row and per layer of the even and odd atlases.
-    even_bricks: vec2<u32>,
-    odd_bricks: vec2<u32>,
-    _pad1: vec2<u32>,
-    // 1 / (atlas size in texels), even and odd.
-    even_texel: vec4<f32>,
-    odd_texel: vec4<f32>,
+    _pad1: u32,
+    _pad2: u32,
+    leaf_atlas: AtlasShape,
+    even_atlas: AtlasShape,
+    odd_atlas: AtlasShape,
 }
 
 // The node buffer starts with a header of counters, so that every pass reaching the nodes
@@ -71,6 +82,25 @@ const NODE_STRIDE: u32 = 4u;
 // the whole volume as one voxel (the dense volume's top mip), filtered from the root's brick.
 // (Node 1 stays empty: descents that lose their way park there.)
 const TOP_NODE: u32 = 2u;
+// u32 per tile in the tile buffer: the parent node, and the parent's packed coordinate.
+const TILE_WORDS: u32 = 2u;
+
+// The top grid: for each depth t up to grid_depth (at most GRID_DEPTH), the node at every
+// position of that depth (2^t per side, x fastest), 0 where there is none; depths one after
+// the other. Sampling starts its descents there instead of at the root, so a descent takes at
+// most depth - 1 - GRID_DEPTH steps (none up to 128³).
+const GRID_DEPTH: u32 = 6u;
+
+fn grid_depth(t: Octree) -> u32 {
+    return min(t.depth - 1u, GRID_DEPTH);
+}
+
+fn grid_index(c: vec3<u32>, t: u32) -> u32 {
+    // Entries of the depths above t: (8^t - 1) / 7.
+    let above = ((1u << (3u * t)) - 1u) / 7u;
+    let side = 1u << t;
+    return above + c.x + side * (c.y + side * c.z);
+}
 // A node's child field while the build flags it: geometry lies in it (CONTENT) or in one of
 // its positive neighbours (NEEDED). Allocation replaces both by a tile index.
 const CONTENT: u32 = 0xffffffffu;
@@ -108,25 +138,34 @@ fn class_end(tree: Octree, cls: u32) -> u32 {
     return select(select(tree.tiles, tree.base_o, cls == 1u), tree.base_e, cls == 0u);
 }
 
-// The atlas slot of direction block `dir` of the brick of tile `tile`, which holds `level`.
-fn brick_slot(tree: Octree, tile: u32, level: u32, dir: u32) -> u32 {
+// The index of the brick of `tile` (which holds `level`) in that level's atlas.
+fn brick_index(tree: Octree, tile: u32, level: u32) -> u32 {
+    return tile - class_base(tree, brick_class(level));
+}
+
+// The atlas direction block of direction `dir` (0..6: +X, -X, +Y, -Y, +Z, -Z): 0 when the
+// octree is isotropic.
+fn dir_block(tree: Octree, dir: u32) -> u32 {
+    return select(0u, dir, tree.dirs > 1u);
+}
+
+// First texel of direction block `block` of brick `b` in an atlas of shape `a`.
+fn brick_texel(a: AtlasShape, b: u32, block: u32) -> vec3<u32> {
+    let x = b & ((1u << a.shift.x) - 1u);
+    let y = (b >> a.shift.x) & ((1u << a.shift.y) - 1u);
+    let z = b >> (a.shift.x + a.shift.y);
+    return 3u * vec3<u32>(x, y, z) + vec3<u32>(0u, 0u, a.z0 + block * a.block);
+}
+
+// The atlas region of `level`: the leaf region for level 0, else the even or the odd one.
+fn atlas_shape(tree: Octree, level: u32) -> AtlasShape {
     if level == 0u {
-        return tile - tree.base_v;
+        return tree.leaf_atlas;
     }
-    let d = select(0u, dir, tree.dirs > 1u);
     if (level & 1u) == 0u {
-        return (tree.base_e - tree.base_v) + (tile - tree.base_e) * tree.dirs + d;
+        return tree.even_atlas;
     }
-    return (tile - tree.base_o) * tree.dirs + d;
-}
-
-// First texel of a slot in an atlas of `bricks` bricks per row and per layer.
-fn slot_texel(slot: u32, bricks: vec2<u32>) -> vec3<u32> {
-    return 3u * vec3<u32>(slot % bricks.x, (slot / bricks.x) % bricks.y, slot / (bricks.x * bricks.y));
-}
-
-fn atlas_bricks(tree: Octree, level: u32) -> vec2<u32> {
-    return select(tree.odd_bricks, tree.even_bricks, (level & 1u) == 0u);
+    return tree.odd_atlas;
 }
 
 // A value of voxel octant `o` of a node m's brick also lies in the positive border of the bricks

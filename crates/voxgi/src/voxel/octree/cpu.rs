@@ -66,14 +66,14 @@ pub fn walk(nodes: &[u32], layout: &GpuOctree) -> Vec<NodeSet> {
     out
 }
 
-/// The octree as voxels/octree/sample.wgsl reads it: its layout, node words and both atlases
-/// (stored optical depth per texel, one level each).
+/// The octree as voxels/octree/sample.wgsl reads it: its layout, node words and both
+/// atlases (stored optical depth per texel, one level each).
 pub struct OctreeSampler<'a> {
     /// The octree uniform.
     pub layout: GpuOctree,
     /// The node buffer, header included.
     pub nodes: &'a [u32],
-    /// The even atlas (level 0 bricks and the even levels).
+    /// The even atlas (level 0 and levels 2, 4, …).
     pub even: &'a Texture3d,
     /// The odd atlas.
     pub odd: &'a Texture3d,
@@ -105,38 +105,23 @@ impl OctreeSampler<'_> {
         self.child(node)
     }
 
-    fn slot(&self, tile: u32, lvl: u32, dir: u32) -> u32 {
-        let l = &self.layout;
-        let d = if l.dirs > 1 { dir } else { 0 };
-        if lvl == 0 {
-            tile - l.base_v
-        } else if lvl.is_multiple_of(2) {
-            (l.base_e - l.base_v) + (tile - l.base_e) * l.dirs + d
-        } else {
-            (tile - l.base_o) * l.dirs + d
-        }
-    }
-
     /// Level `lvl` at uvw along the directional block `dir` (0..6), trilinear inside one brick.
     fn level(&self, uvw: Vec3, lvl: u32, dir: u32) -> Vec4 {
-        let r = (self.layout.resolution >> lvl) as f32;
+        let l = &self.layout;
+        let r = (l.resolution >> lvl) as f32;
         let q = (uvw * r - 0.5).clamp(Vec3::ZERO, Vec3::splat(r - 1.0));
         let v = q.as_uvec3();
         let tile = self.brick(v, lvl);
         if tile == 0 {
             return Vec4::ZERO;
         }
-        let (atlas, bricks) = if lvl.is_multiple_of(2) {
-            (self.even, self.layout.even_bricks)
-        } else {
-            (self.odd, self.layout.odd_bricks)
+        let (atlas, shape, base) = match lvl {
+            0 => (self.even, &l.leaf_atlas, l.base_v),
+            _ if lvl.is_multiple_of(2) => (self.even, &l.even_atlas, l.base_e),
+            _ => (self.odd, &l.odd_atlas, l.base_o),
         };
-        let s = self.slot(tile, lvl, dir);
-        let origin = 3 * UVec3::new(
-            s % bricks[0],
-            (s / bricks[0]) % bricks[1],
-            s / (bricks[0] * bricks[1]),
-        );
+        let block = if lvl == 0 || l.dirs == 1 { 0 } else { dir };
+        let origin = UVec3::from_array(shape.brick_texel(tile - base, block));
         let local = q - 2.0 * (v >> 1u32).as_vec3() + 0.5;
         let size = atlas.levels[0].1.as_vec3();
         atlas.sample((origin.as_vec3() + local) / size, 0.0)

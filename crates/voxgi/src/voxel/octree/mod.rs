@@ -37,6 +37,10 @@ pub const SLOT_WORDS: u64 = 17;
 pub const SLOT_BYTES: u64 = SLOT_WORDS * 4 + 32;
 /// Words of counters before the nodes in the node buffer (`NODE_HEADER` in tree.wgsl).
 const NODE_HEADER: u64 = 32;
+/// u32 per tile in the tile buffer (`TILE_WORDS` in tree.wgsl).
+const TILE_WORDS: u64 = 2;
+/// Deepest depth of the top grid (`GRID_DEPTH` in tree.wgsl).
+const GRID_DEPTH: u32 = 6;
 /// Stride of the per-depth uniforms (the minimum dynamic-offset alignment).
 const LEVEL_STRIDE: u64 = 256;
 /// Texels per brick side.
@@ -69,17 +73,78 @@ pub struct GpuOctree {
     /// Leaf slots.
     pub slots: u32,
     /// Padding; zero.
-    pub _pad0: u32,
-    /// Bricks per row and per layer of the even atlas.
-    pub even_bricks: [u32; 2],
-    /// Bricks per row and per layer of the odd atlas.
-    pub odd_bricks: [u32; 2],
-    /// Padding; zero.
-    pub _pad1: [u32; 2],
-    /// 1 / (even atlas size in texels); w unused.
-    pub even_texel: [f32; 4],
-    /// 1 / (odd atlas size in texels); w unused.
-    pub odd_texel: [f32; 4],
+    pub _pad: [u32; 3],
+    /// The even atlas's region of level 0.
+    pub leaf_atlas: GpuAtlasShape,
+    /// The even atlas's region of levels 2, 4, …
+    pub even_atlas: GpuAtlasShape,
+    /// The odd atlas (levels 1, 3, …).
+    pub odd_atlas: GpuAtlasShape,
+}
+
+/// Mirrors `AtlasShape` in shaders/voxels/octree/tree.wgsl: where a region of an atlas keeps
+/// its bricks.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuAtlasShape {
+    /// log2 of the bricks per row and per layer.
+    pub shift: [u32; 2],
+    /// Texels of one direction block along z.
+    pub block: u32,
+    /// The region's first texel along z.
+    pub z0: u32,
+    /// 1 / the atlas size in texels; w unused.
+    pub inv_size: [f32; 4],
+}
+
+impl GpuAtlasShape {
+    /// The regions of one atlas texture within `max_dim` texels a side, each `(bricks, blocks)`
+    /// (bricks in `blocks` direction blocks), one after another along z: rows and layers of a
+    /// power of two bricks, the texture as close to a cube as that allows.
+    pub fn regions<const N: usize>(regions: [(u64, u32); N], max_dim: u32) -> Option<[Self; N]> {
+        let total: u64 = regions.iter().map(|(b, k)| b.max(&1) * *k as u64).sum();
+        let max_shift = (max_dim / BRICK).max(1).ilog2();
+        let side = (total as f64).cbrt().ceil() as u64;
+        let shift = side.next_power_of_two().ilog2().min(max_shift);
+        let per_layer = 1u64 << (2 * shift);
+        let mut z0 = 0u64;
+        let mut out = [(0u64, 0u64); N];
+        for (o, (bricks, blocks)) in out.iter_mut().zip(regions) {
+            let block = bricks.max(1).div_ceil(per_layer) * BRICK as u64;
+            *o = (z0, block);
+            z0 += block * blocks as u64;
+        }
+        if z0 > max_dim as u64 {
+            return None;
+        }
+        let width = (BRICK << shift) as f32;
+        let inv_size = [1.0 / width, 1.0 / width, 1.0 / z0 as f32, 0.0];
+        Some(out.map(|(z0, block)| GpuAtlasShape {
+            shift: [shift, shift],
+            block: block as u32,
+            z0: z0 as u32,
+            inv_size,
+        }))
+    }
+
+    /// The atlas texture's size in texels.
+    pub fn size(&self) -> [u32; 3] {
+        [
+            (1.0 / self.inv_size[0]).round() as u32,
+            (1.0 / self.inv_size[1]).round() as u32,
+            (1.0 / self.inv_size[2]).round() as u32,
+        ]
+    }
+
+    /// First texel of direction block `block` of brick `b` (`brick_texel` in tree.wgsl).
+    pub fn brick_texel(&self, b: u32, block: u32) -> [u32; 3] {
+        let [sx, sy] = self.shift;
+        [
+            3 * (b & ((1 << sx) - 1)),
+            3 * ((b >> sx) & ((1 << sy) - 1)),
+            3 * (b >> (sx + sy)) + self.z0 + block * self.block,
+        ]
+    }
 }
 
 /// How many of each pool an octree holds: leaf slots, and tiles of the three classes (leaf
@@ -131,16 +196,6 @@ impl OctreePools {
     }
 }
 
-/// Bricks per row, per layer and layers of an atlas of `slots` bricks, within `max_dim` texels.
-fn atlas_shape(slots: u64, max_dim: u32) -> Option<[u32; 3]> {
-    let per_side = (max_dim / BRICK).max(1) as u64;
-    let slots = slots.max(1);
-    let row = (slots as f64).cbrt().ceil() as u64;
-    let row = row.clamp(1, per_side);
-    let layers = slots.div_ceil(row * row);
-    (layers <= per_side).then_some([row as u32, row as u32, layers as u32])
-}
-
 /// The octree's pipelines (octree_build, octree_filter, debug): made once per renderer and
 /// shared by every octree it makes (one is remade whenever its pools grow).
 pub struct OctreePipelines {
@@ -158,6 +213,8 @@ struct BuildPipelines {
     flag: wgpu::ComputePipeline,
     dilate: wgpu::ComputePipeline,
     mark: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+    scan: wgpu::ComputePipeline,
     allocate: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     init: wgpu::ComputePipeline,
@@ -183,6 +240,8 @@ impl OctreePipelines {
                 layout::storage_texture_3d(6, ATLAS_FORMAT),
                 layout::storage_texture_3d(7, ATLAS_FORMAT),
                 layout::uniform(8, c, true),
+                layout::storage(9, c, false),
+                layout::storage(10, c, false),
             ],
         });
         let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -215,6 +274,8 @@ impl OctreePipelines {
             flag: b("flag", false),
             dilate: b("dilate", false),
             mark: b("mark", false),
+            count: b("count", false),
+            scan: b("scan", false),
             allocate: b("allocate", false),
             finish: b("finish", true),
             init: b("init", false),
@@ -281,8 +342,12 @@ pub struct OctreeVolume {
     /// counted past the capacity; then per depth the range of its tiles), then `NODE_WORDS`
     /// u32 per node, eight nodes per tile.
     pub nodes: wgpu::Buffer,
-    /// Per tile: its parent node.
-    pub tile_parent: wgpu::Buffer,
+    /// Per tile, `TILE_WORDS` u32: its parent node and the parent's packed coordinate.
+    pub tiles: wgpu::Buffer,
+    /// The build's per-workgroup counts and their prefix sums (deterministic allocation).
+    block_sums: wgpu::Buffer,
+    /// The top grid: per depth down to the grid's, the node at every position.
+    pub top_grid: wgpu::Buffer,
     /// Per leaf slot, `SLOT_WORDS` u32.
     pub slots: wgpu::Buffer,
     /// Per leaf: direct radiance and opacity (vec4 f32).
@@ -294,14 +359,15 @@ pub struct OctreeVolume {
     pub args: wgpu::Buffer,
     /// Per depth: the depth, at `LEVEL_STRIDE` bytes (dynamic uniform offsets).
     levels: wgpu::Buffer,
-    /// Bricks of level 0 and of the even levels above it.
+    /// Bricks of level 0 and of the even levels above it (two regions).
     pub even_atlas: wgpu::Texture,
     /// Bricks of the odd levels.
     pub odd_atlas: wgpu::Texture,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
     leaf_store: wgpu::BindGroup,
-    /// Filter bind groups: [0] writes the even atlas (reads the odd), [1] writes the odd.
+    /// Filter bind groups: [0] writes the even atlas (reads the odd), [1] the odd (reads the
+    /// even).
     filter: [wgpu::BindGroup; 2],
     pipelines: Arc<OctreePipelines>,
 }
@@ -317,13 +383,14 @@ fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer
     })
 }
 
-fn atlas(device: &wgpu::Device, label: &str, shape: [u32; 3]) -> wgpu::Texture {
+fn atlas(device: &wgpu::Device, label: &str, shape: &GpuAtlasShape) -> wgpu::Texture {
+    let [width, height, depth] = shape.size();
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d {
-            width: shape[0] * BRICK,
-            height: shape[1] * BRICK,
-            depth_or_array_layers: shape[2] * BRICK,
+            width,
+            height,
+            depth_or_array_layers: depth,
         },
         mip_level_count: 1,
         sample_count: 1,
@@ -371,26 +438,23 @@ impl OctreeVolume {
         };
         too_big("nodes", tiles * 8 * NODE_WORDS * 4)?;
         too_big("leaf slots", pools.slots as u64 * SLOT_WORDS * 4)?;
-        let even_slots = pools.leaf_tiles as u64 + dirs as u64 * pools.even_tiles as u64;
-        let odd_slots = dirs as u64 * pools.odd_tiles as u64;
         let max_dim = limits.max_texture_dimension_3d;
-        let shape = |slots: u64| {
-            atlas_shape(slots, max_dim).ok_or_else(|| {
-                crate::Error::Setting(format!(
-                    "the octree needs {slots} bricks, more than a {max_dim}³ atlas holds; \
-                     lower the voxel resolution"
-                ))
-            })
+        let too_many = |bricks: u64| {
+            crate::Error::Setting(format!(
+                "the octree needs {bricks} bricks, more than a {max_dim}³ atlas holds; lower \
+                 the voxel resolution"
+            ))
         };
-        let (even_shape, odd_shape) = (shape(even_slots)?, shape(odd_slots)?);
-        let texel = |s: [u32; 3]| {
+        let [leaf_shape, even_shape] = GpuAtlasShape::regions(
             [
-                1.0 / (s[0] * BRICK) as f32,
-                1.0 / (s[1] * BRICK) as f32,
-                1.0 / (s[2] * BRICK) as f32,
-                0.0,
-            ]
-        };
+                (pools.leaf_tiles as u64, 1),
+                (pools.even_tiles as u64, dirs),
+            ],
+            max_dim,
+        )
+        .ok_or_else(|| too_many(pools.leaf_tiles as u64 + pools.even_tiles as u64))?;
+        let [odd_shape] = GpuAtlasShape::regions([(pools.odd_tiles as u64, dirs)], max_dim)
+            .ok_or_else(|| too_many(pools.odd_tiles as u64))?;
         let layout = GpuOctree {
             origin: grid.origin.to_array(),
             resolution: grid.resolution,
@@ -403,12 +467,10 @@ impl OctreeVolume {
             base_o: base_o as u32,
             tiles: tiles as u32,
             slots: pools.slots,
-            _pad0: 0,
-            even_bricks: [even_shape[0], even_shape[1]],
-            odd_bricks: [odd_shape[0], odd_shape[1]],
-            _pad1: [0; 2],
-            even_texel: texel(even_shape),
-            odd_texel: texel(odd_shape),
+            _pad: [0; 3],
+            leaf_atlas: leaf_shape,
+            even_atlas: even_shape,
+            odd_atlas: odd_shape,
         };
         let tree = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("octree"),
@@ -431,7 +493,12 @@ impl OctreeVolume {
             "octree nodes",
             (NODE_HEADER + tiles * 8 * NODE_WORDS) * 4,
         );
-        let tile_parent = storage_buffer(device, "octree tile parents", tiles * 4);
+        let tile_buf = storage_buffer(device, "octree tiles", tiles * TILE_WORDS * 4);
+        // A depth has at most eight nodes per tile of the pool: a count per 64 of them.
+        let block_sums = storage_buffer(device, "octree block sums", (tiles / 8 + 2) * 4);
+        let g = (depth - 1).min(GRID_DEPTH);
+        let grid_words = ((1u64 << (3 * (g + 1))) - 1) / 7;
+        let top_grid = storage_buffer(device, "octree top grid", grid_words * 4);
         let slot_buf = storage_buffer(device, "octree leaf slots", slots * SLOT_WORDS * 4);
         let leaf_direct = storage_buffer(device, "octree direct light", slots * 16);
         let leaf_next = storage_buffer(device, "octree bounce light", slots * 16);
@@ -443,8 +510,8 @@ impl OctreeVolume {
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let even_atlas = atlas(device, "octree even atlas", even_shape);
-        let odd_atlas = atlas(device, "octree odd atlas", odd_shape);
+        let even_atlas = atlas(device, "octree even atlas", &even_shape);
+        let odd_atlas = atlas(device, "octree odd atlas", &odd_shape);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("octree bricks"),
@@ -461,6 +528,7 @@ impl OctreeVolume {
                 wgpu::BindingResource::TextureView(&view(&even_atlas)),
                 wgpu::BindingResource::TextureView(&view(&odd_atlas)),
                 wgpu::BindingResource::Sampler(&sampler),
+                top_grid.as_entire_binding(),
             ]),
         });
         let leaves = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -491,7 +559,7 @@ impl OctreeVolume {
                 entries: &layout::entries(vec![
                     tree.as_entire_binding(),
                     nodes.as_entire_binding(),
-                    tile_parent.as_entire_binding(),
+                    tile_buf.as_entire_binding(),
                     wgpu::BindingResource::TextureView(&view(src)),
                     wgpu::BindingResource::TextureView(&view(dst)),
                     level.clone(),
@@ -509,7 +577,9 @@ impl OctreeVolume {
             tree,
             layout,
             nodes,
-            tile_parent,
+            tiles: tile_buf,
+            block_sums,
+            top_grid,
             slots: slot_buf,
             leaf_direct,
             leaf_next,
@@ -558,6 +628,7 @@ impl OctreeVolume {
                 texture(2),
                 texture(3),
                 layout::sampler(4, c),
+                layout::storage(5, c, true),
             ],
         })
     }
@@ -596,7 +667,7 @@ impl OctreeVolume {
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
                 self.nodes.as_entire_binding(),
-                self.tile_parent.as_entire_binding(),
+                self.tiles.as_entire_binding(),
                 self.slots.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&view(&self.even_atlas)),
                 wgpu::BindingResource::TextureView(&view(&self.odd_atlas)),
@@ -605,6 +676,8 @@ impl OctreeVolume {
                     offset: 0,
                     size: wgpu::BufferSize::new(16),
                 }),
+                self.block_sums.as_entire_binding(),
+                self.top_grid.as_entire_binding(),
             ]),
         })
     }
@@ -632,6 +705,8 @@ impl OctreeVolume {
                 (&b.flag, t, Run::Indirect(0)),
                 (&b.dilate, t, over_nodes(t)),
                 (&b.mark, t, Run::One),
+                (&b.count, t, over_nodes(t)),
+                (&b.scan, t, Run::One),
                 (&b.allocate, t, over_nodes(t)),
                 (&b.finish, t, Run::Prepare),
                 (&b.init, t + 1, over_nodes(t + 1)),
@@ -639,11 +714,15 @@ impl OctreeVolume {
         }
         steps.extend([
             (&b.flag, depth, Run::Indirect(0)),
+            (&b.count, depth, over_nodes(depth)),
+            (&b.scan, depth, Run::One),
             (&b.allocate_slots, depth, over_nodes(depth)),
             (&b.accumulate, depth, Run::Indirect(0)),
             (&b.prepare_slots, depth, Run::Prepare),
             (&b.resolve, depth, Run::Indirect(12)),
         ]);
+        // Positions the previous build filled and this one may not.
+        encoder.clear_buffer(&self.top_grid, 0, None);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("octree_build"),
             timestamp_writes: timer.compute("octree_build"),
@@ -690,7 +769,13 @@ impl OctreeVolume {
             s.width as u64 * s.height as u64 * s.depth_or_array_layers as u64 * 8
         };
         vec![
-            ("octree nodes", self.nodes.size() + self.tile_parent.size()),
+            (
+                "octree nodes",
+                self.nodes.size()
+                    + self.tiles.size()
+                    + self.block_sums.size()
+                    + self.top_grid.size(),
+            ),
             (
                 "octree leaf slots",
                 self.slots.size() + self.leaf_direct.size() + self.leaf_next.size(),
@@ -814,13 +899,32 @@ mod tests {
 
     #[test]
     fn atlases_stay_within_the_texture_limit() {
-        assert_eq!(atlas_shape(1, 2048), Some([1, 1, 1]));
-        assert_eq!(atlas_shape(27, 2048), Some([3, 3, 3]));
-        // 682 bricks of 3 texels per side fit 2048; one layer more does not.
-        assert_eq!(atlas_shape(682 * 682 * 682, 2048), Some([682, 682, 682]));
-        assert_eq!(atlas_shape(682 * 682 * 682 + 1, 2048), None);
-        let [x, y, z] = atlas_shape(1_000_003, 2048).unwrap();
-        assert!(x as u64 * y as u64 * z as u64 >= 1_000_003);
+        let [one] = GpuAtlasShape::regions([(1, 6)], 2048).unwrap();
+        assert_eq!(
+            (one.shift, one.block, one.z0, one.size()),
+            ([1, 1], 3, 0, [6, 6, 18])
+        );
+        // 512 bricks of 3 texels a row fit 2048; six blocks of 113 layers do, 114 do not.
+        let [big] = GpuAtlasShape::regions([(512 * 512 * 113, 6)], 2048).unwrap();
+        assert_eq!(big.size(), [1536, 1536, 6 * 3 * 113]);
+        assert_eq!(
+            GpuAtlasShape::regions([(512 * 512 * 113 + 1, 6)], 2048),
+            None
+        );
+        for n in [27u64, 1000, 1_000_003] {
+            let [a, b] = GpuAtlasShape::regions([(n, 1), (n / 3, 6)], 2048).unwrap();
+            assert_eq!(a.size(), b.size(), "one texture");
+            let [x, y, z] = a.size();
+            // The last brick of each region, in its last block, lies inside and after the
+            // region before.
+            let ta = a.brick_texel(n as u32 - 1, 0);
+            let tb = b.brick_texel((n / 3).max(1) as u32 - 1, 5);
+            assert!(ta[2] + 3 <= b.z0, "{n}: {ta:?} reaches into {b:?}");
+            assert!(
+                ta[0] + 3 <= x && ta[1] + 3 <= y && tb[2] + 3 <= z,
+                "{n}: {tb:?}"
+            );
+        }
     }
 
     #[test]
