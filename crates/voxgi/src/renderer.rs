@@ -1064,7 +1064,9 @@ fn new_volume(
                 None => checked(device, "pipeline creation", || OctreePipelines::new(device))?,
             };
             pipelines.octree = Some(p.clone());
-            let pools = OctreePools::for_leaves(wanted);
+            let l = device.limits();
+            let pools = OctreePools::for_leaves(wanted)
+                .within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
             let v = checked(device, "voxel octree", || {
                 OctreeVolume::new(device, &p, grid, options.anisotropic, pools)
             })??;

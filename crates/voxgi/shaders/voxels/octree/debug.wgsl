@@ -39,7 +39,7 @@ const MODE_NODES: u32 = 3u;
 fn node_at(c: vec3<u32>, t: u32) -> u32 {
     var node = 0u;
     for (var i = 0u; i < t; i++) {
-        let tile = nodes[NODE_HEADER + node * NODE_STRIDE];
+        let tile = nodes[child_word(tree, node)];
         if tile == 0u {
             return 0u;
         }
@@ -51,7 +51,7 @@ fn node_at(c: vec3<u32>, t: u32) -> u32 {
 // Premultiplied value of cell c at level `lvl`.
 fn cell_value(c: vec3<u32>, lvl: u32) -> vec4<f32> {
     let n = node_at(c >> vec3<u32>(1u), tree.depth - 1u - lvl);
-    let tile = select(0u, nodes[NODE_HEADER + n * NODE_STRIDE], n != 0u || lvl == tree.depth - 1u);
+    let tile = select(0u, nodes[child_word(tree, n)], n != 0u || lvl == tree.depth - 1u);
     if tile == 0u {
         return vec4<f32>(0.0);
     }
@@ -66,13 +66,13 @@ fn cell_value(c: vec3<u32>, lvl: u32) -> vec4<f32> {
 // Whether the node of level `lvl`'s cell c (a node of depth D - lvl) has children.
 fn cell_has_children(c: vec3<u32>, lvl: u32) -> bool {
     let n = node_at(c, tree.depth - lvl);
-    return (n != 0u || lvl == tree.depth) && nodes[NODE_HEADER + n * NODE_STRIDE] != 0u;
+    return (n != 0u || lvl == tree.depth) && nodes[child_word(tree, n)] != 0u;
 }
 
 // The leaf slot of finest voxel c, or NONE.
 fn leaf_slot(c: vec3<u32>) -> u32 {
     let n = node_at(c, tree.depth);
-    let v = select(0u, nodes[NODE_HEADER + n * NODE_STRIDE], n != 0u);
+    let v = select(0u, nodes[child_word(tree, n)], n != 0u);
     return select(NONE, v - 1u, v != 0u);
 }
 

@@ -67,7 +67,7 @@ fn stored_fragments() -> u32 {
 }
 
 fn child(n: u32) -> u32 {
-    return atomicLoad(&nodes[NODE_HEADER + n * NODE_STRIDE]);
+    return atomicLoad(&nodes[child_word(tree, n)]);
 }
 
 fn neighbour(n: u32, axis: u32) -> u32 {
@@ -145,7 +145,7 @@ fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let node = descend(unpack_coord(fragments[i].coord), level.t);
     if node != NONE {
-        atomicMax(&nodes[NODE_HEADER + node * NODE_STRIDE], CONTENT);
+        atomicMax(&nodes[child_word(tree, node)], CONTENT);
     }
 }
 
@@ -173,7 +173,7 @@ fn dilate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     }
     for (var k = 0u; k < 7u; k++) {
         if around[k] != 0u {
-            atomicMax(&nodes[NODE_HEADER + around[k] * NODE_STRIDE], NEEDED);
+            atomicMax(&nodes[child_word(tree, around[k])], NEEDED);
         }
     }
 }
@@ -267,11 +267,11 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoca
     atomicMax(&nodes[1u + c], atomicLoad(&nodes[4]) + r + 1u);
     let k = atomicLoad(&nodes[4]) + r;
     if k >= class_capacity(c) {
-        atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
+        atomicStore(&nodes[child_word(tree, n)], 0u);
         return;
     }
     let tile = class_base(tree, c) + k;
-    atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], tile);
+    atomicStore(&nodes[child_word(tree, n)], tile);
     tiles[tile * TILE_WORDS] = n;
     tiles[tile * TILE_WORDS + 1u] = pack_coord(node_coord(n));
 }
@@ -316,23 +316,22 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let tile = n / 8u;
     let o = n % 8u;
-    atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
+    atomicStore(&nodes[child_word(tree, n)], 0u);
     let parent = tiles[tile * TILE_WORDS];
     if u <= grid_depth(tree) {
         grid[grid_index(node_coord(n), u)] = n;
     }
-    for (var a = 0u; a < 3u; a++) {
+    // Leaf voxels keep no neighbours.
+    for (var a = 0u; a < 3u * u32(u < tree.depth); a++) {
         var nb = 0u;
-        if u < tree.depth {
-            if ((o >> a) & 1u) == 1u {
-                nb = tile * 8u + (o ^ (1u << a));
-            } else {
-                let pn = neighbour(parent, a);
-                if pn != 0u {
-                    let pt = child(pn);
-                    if pt != 0u {
-                        nb = pt * 8u + (o | (1u << a));
-                    }
+        if ((o >> a) & 1u) == 1u {
+            nb = tile * 8u + (o ^ (1u << a));
+        } else {
+            let pn = neighbour(parent, a);
+            if pn != 0u {
+                let pt = child(pn);
+                if pt != 0u {
+                    nb = pt * 8u + (o | (1u << a));
                 }
             }
         }
@@ -351,10 +350,10 @@ fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_
     }
     atomicMax(&nodes[0], s + 1u);
     if s >= tree.slots {
-        atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], 0u);
+        atomicStore(&nodes[child_word(tree, n)], 0u);
         return;
     }
-    atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE], s + 1u);
+    atomicStore(&nodes[child_word(tree, n)], s + 1u);
     atomicStore(&slots[s * SLOT_STRIDE], pack_coord(node_coord(n)));
     atomicStore(&slots[s * SLOT_STRIDE + 1u], tiles[(n / 8u) * TILE_WORDS] | ((n % 8u) << 29u));
     for (var k = 0u; k < ACCUM_STRIDE; k++) {

@@ -19,8 +19,9 @@
 // build's `dilate`).
 //
 // Nodes at depth D are the finest voxels themselves: their child pointer is 1 + their leaf
-// slot. Tiles are numbered per class, and a brick's place in its atlas is its tile's index in
-// the class:
+// slot, and they keep nothing else (one u32 each, after the other nodes' records: see
+// `child_word`). Tiles are numbered per class (E, then O, then V, after the root tile), and a
+// brick's place in its atlas is its tile's index in the class:
 //   class V: tiles at depth D (leaf voxels); their parents' bricks hold level 0 (isotropic):
 //            the leaf region of the even atlas;
 //   class E: tiles whose parents' bricks hold an even level k > 0: the even region of the even
@@ -55,7 +56,7 @@ struct Octree {
     anisotropic: u32,
     // Direction blocks of the atlases above level 0: 6 or 1.
     dirs: u32,
-    // First tile of classes V, E and O, and the end of the pool.
+    // First tile of classes V, E and O (in the pool's order E, O, V), and the end of the pool.
     base_v: u32,
     base_e: u32,
     base_o: u32,
@@ -135,7 +136,14 @@ fn class_base(tree: Octree, cls: u32) -> u32 {
 }
 
 fn class_end(tree: Octree, cls: u32) -> u32 {
-    return select(select(tree.tiles, tree.base_o, cls == 1u), tree.base_e, cls == 0u);
+    return select(select(tree.base_v, tree.base_o, cls == 1u), tree.tiles, cls == 0u);
+}
+
+// The word of node n's child pointer in the node buffer: a four-word record for the nodes of
+// the root tile and of classes E and O, one word for a leaf voxel (class V).
+fn child_word(tree: Octree, n: u32) -> u32 {
+    let leaves = 8u * tree.base_v;
+    return select(NODE_HEADER + n * NODE_STRIDE, NODE_HEADER + leaves * NODE_STRIDE + (n - leaves), n >= leaves);
 }
 
 // The index of the brick of `tile` (which holds `level`) in that level's atlas.

@@ -33,11 +33,22 @@ pub fn subdivided(occupied: &BTreeSet<[u32; 3]>, depth: u32) -> Vec<NodeSet> {
     out
 }
 
+/// The word of node n's child pointer (`child_word` in tree.wgsl).
+pub fn child_word(layout: &GpuOctree, n: u32) -> usize {
+    let leaves = 8 * layout.base_v as usize;
+    let (header, stride) = (super::NODE_HEADER as usize, super::NODE_WORDS as usize);
+    let n = n as usize;
+    if n >= leaves {
+        header + leaves * stride + (n - leaves)
+    } else {
+        header + n * stride
+    }
+}
+
 /// The nodes with children at each depth of a GPU node buffer (`OctreeVolume::nodes` read back
 /// as u32), found by walking it from the root: the GPU side of `subdivided`.
 pub fn walk(nodes: &[u32], layout: &GpuOctree) -> Vec<NodeSet> {
-    let header = super::NODE_HEADER as usize;
-    let child = |n: u32| nodes[header + n as usize * super::NODE_WORDS as usize];
+    let child = |n: u32| nodes[child_word(layout, n)];
     let depth = layout.depth;
     let mut out = vec![NodeSet::new(); depth as usize + 1];
     let mut level = vec![(0u32, [0u32; 3])];
@@ -81,7 +92,7 @@ pub struct OctreeSampler<'a> {
 
 impl OctreeSampler<'_> {
     fn child(&self, n: u32) -> u32 {
-        self.nodes[super::NODE_HEADER as usize + n as usize * super::NODE_WORDS as usize]
+        self.nodes[child_word(&self.layout, n)]
     }
 
     /// The tile of the brick holding level `lvl` at level voxel `v`, or 0.
@@ -191,11 +202,17 @@ mod tests {
         // Depth 1 (a 2³ grid): the root (tile 0, node 0) has children in tile 1; of those,
         // node 8 + 5 (octant (1, 0, 1)) is an occupied voxel (slot 0, stored as 1).
         let header = super::super::NODE_HEADER as usize;
-        let mut nodes = vec![0u32; header + 16 * 4];
+        let mut nodes = vec![0u32; header + 8 * 4 + 8];
         nodes[header] = 1;
-        nodes[header + 13 * 4] = 1;
+        nodes[header + 8 * 4 + 5] = 1;
+        // No tiles of classes E and O: tile 1 is the first of class V, whose nodes keep one
+        // word each after the root tile's records.
         let layout = GpuOctree {
             depth: 1,
+            base_e: 1,
+            base_o: 1,
+            base_v: 1,
+            tiles: 2,
             ..bytemuck::Zeroable::zeroed()
         };
         let w = walk(&nodes, &layout);

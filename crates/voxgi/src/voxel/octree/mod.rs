@@ -29,7 +29,8 @@ use wgpu::util::DeviceExt;
 
 /// Format of both atlases: optical depth (L sigma, sigma), as the dense volume's radiance.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// u32 per node: child pointer and the -x, -y, -z neighbours (`NODE_STRIDE`).
+/// u32 per node above the leaves: child pointer and the -x, -y, -z neighbours (`NODE_STRIDE`;
+/// a leaf voxel keeps its child word only).
 pub const NODE_WORDS: u64 = 4;
 /// u32 per leaf slot (`SLOT_STRIDE` in tree.wgsl): what the leaf is, and the build's sums.
 pub const SLOT_WORDS: u64 = 17;
@@ -173,6 +174,25 @@ impl OctreePools {
             even_tiles: c(leaves / 16),
             odd_tiles: c(leaves / 8),
         }
+    }
+
+    /// These pools, shrunk where a buffer would exceed `max_binding` bytes: a first guess
+    /// must not fail where the scene itself would fit (growth then reports a real excess).
+    pub fn within(self, max_binding: u64) -> Self {
+        let mut p = self;
+        p.slots = p
+            .slots
+            .min((max_binding / (SLOT_WORDS * 4)).min(u32::MAX as u64) as u32);
+        let node_bytes = |p: &OctreePools| {
+            let interior = 1 + p.even_tiles as u64 + p.odd_tiles as u64;
+            (NODE_HEADER + 8 * interior * NODE_WORDS + 8 * p.leaf_tiles as u64) * 4
+        };
+        while node_bytes(&p) > max_binding && p.leaf_tiles > 64 {
+            p.leaf_tiles /= 2;
+            p.even_tiles = (p.even_tiles / 2).max(64);
+            p.odd_tiles = (p.odd_tiles / 2).max(64);
+        }
+        p
     }
 
     /// The pools that hold what a build counted (`OctreeVolume::pool_counter`'s first four
@@ -340,7 +360,7 @@ pub struct OctreeVolume {
     pub layout: GpuOctree,
     /// A header of `NODE_HEADER` counters ([0] leaf slots, [1..4] tiles of each class, all
     /// counted past the capacity; then per depth the range of its tiles), then `NODE_WORDS`
-    /// u32 per node, eight nodes per tile.
+    /// u32 per node of the root tile and classes E and O, then one per leaf voxel (class V).
     pub nodes: wgpu::Buffer,
     /// Per tile, `TILE_WORDS` u32: its parent node and the parent's packed coordinate.
     pub tiles: wgpu::Buffer,
@@ -415,10 +435,13 @@ impl OctreeVolume {
     ) -> crate::Result<Self> {
         let depth = grid.resolution.ilog2();
         let dirs: u32 = if anisotropic { 6 } else { 1 };
-        let base_v = 1u64;
-        let base_e = base_v + pools.leaf_tiles as u64;
+        // Tile 0 is the root's; then classes E, O and V (`child_word` in tree.wgsl).
+        let base_e = 1u64;
         let base_o = base_e + pools.even_tiles as u64;
-        let tiles = base_o + pools.odd_tiles as u64;
+        let base_v = base_o + pools.odd_tiles as u64;
+        let tiles = base_v + pools.leaf_tiles as u64;
+        // Four words per node above the leaves, one per leaf voxel.
+        let node_words = NODE_HEADER + 8 * base_v * NODE_WORDS + 8 * pools.leaf_tiles as u64;
         let limits = device.limits();
         let too_big = |what: &str, bytes: u64| -> crate::Result<()> {
             if bytes
@@ -436,7 +459,7 @@ impl OctreeVolume {
             }
             Ok(())
         };
-        too_big("nodes", tiles * 8 * NODE_WORDS * 4)?;
+        too_big("nodes", node_words * 4)?;
         too_big("leaf slots", pools.slots as u64 * SLOT_WORDS * 4)?;
         let max_dim = limits.max_texture_dimension_3d;
         let too_many = |bricks: u64| {
@@ -488,11 +511,7 @@ impl OctreeVolume {
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let slots = pools.slots as u64;
-        let nodes = storage_buffer(
-            device,
-            "octree nodes",
-            (NODE_HEADER + tiles * 8 * NODE_WORDS) * 4,
-        );
+        let nodes = storage_buffer(device, "octree nodes", node_words * 4);
         let tile_buf = storage_buffer(device, "octree tiles", tiles * TILE_WORDS * 4);
         // A depth has at most eight nodes per tile of the pool: a count per 64 of them.
         let block_sums = storage_buffer(device, "octree block sums", (tiles / 8 + 2) * 4);
