@@ -2,7 +2,7 @@
 // cell of that level per step), looking cells up by descending the tree, and writes the first
 // hit into the HDR target:
 //   mode 0 (albedo):   the first cell of opacity > 0.5; the albedo of the first occupied leaf
-//                      the ray crosses inside it (failing that, grey),
+//                      the ray crosses inside it (failing that, the cell's mean),
 //   mode 1 (opacity):  the hit cell's opacity as grey,
 //   mode 2 (radiance): the hit cell's radiance, un-premultiplied,
 //   mode 3 (nodes):    the first node of the level's depth that has children (at level 0: an
@@ -111,7 +111,21 @@ fn albedo_under(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, cell: vec3<i32>, s
             break;
         }
     }
-    return vec3<f32>(0.5);
+    // The ray crossed only empty leaves (the cell is opaque as a whole): the mean albedo of
+    // the cell's occupied leaves, on a lattice of at most 8^3 samples (as the dense view).
+    let stride = max(scale / 8, 1);
+    var sum = vec4<f32>(0.0);
+    for (var z = 0; z < scale; z += stride) {
+        for (var y = 0; y < scale; y += stride) {
+            for (var x = 0; x < scale; x += stride) {
+                let s = leaf_slot(vec3<u32>(lo + vec3<i32>(x, y, z)));
+                if s != NONE {
+                    sum += vec4<f32>(unpack4x8unorm(slots[s * SLOT_STRIDE + 2u]).rgb, 1.0);
+                }
+            }
+        }
+    }
+    return sum.rgb / max(sum.w, 1.0);
 }
 
 // A colour per level, so the levels of the nodes view tell apart.
