@@ -59,6 +59,13 @@ pub struct PanelActions {
 /// The panel's creation-time options section: widgets over the draft.
 pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -> PanelActions {
     let mut actions = PanelActions::default();
+    egui::ComboBox::from_label("voxel structure")
+        .selected_text(draft.voxels.name())
+        .show_ui(ui, |ui| {
+            for k in voxgi::VoxelKind::ALL {
+                ui.selectable_value(&mut draft.voxels, k, k.name());
+            }
+        });
     egui::ComboBox::from_label("voxels per side")
         .selected_text(draft.voxel_resolution.to_string())
         .show_ui(ui, |ui| {

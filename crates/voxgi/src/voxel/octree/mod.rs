@@ -195,13 +195,32 @@ impl OctreePools {
         p
     }
 
-    /// The pools that hold what a build counted (`OctreeVolume::pool_counter`'s first four
-    /// words), or None when these already do. A pool that overflowed hides what the levels
+    /// Bytes these pools take on the GPU (bricks with six directions above level 0).
+    pub fn bytes(&self) -> u64 {
+        let brick = 27 * 8;
+        self.slots as u64 * SLOT_BYTES
+            + self.leaf_tiles as u64 * (brick + 8 * 4 + 8)
+            + (self.even_tiles as u64 + self.odd_tiles as u64) * (6 * brick + 8 * 16 + 8)
+    }
+
+    /// The pools to make after a build that counted `counted` (`OctreeVolume::pool_counter`'s
+    /// first four words), or None to keep these. A pool that overflowed hides what the levels
     /// below it would have needed, so every pool grows at least by half once one overflows.
-    pub fn grown_for(&self, counted: &[u32]) -> Option<Self> {
+    /// Pools more than twice what the build needed (the first guess comes from an upper bound
+    /// on the fragments) shrink to the counts and an eighth: the octree's point is its memory.
+    pub fn resized_for(&self, counted: &[u32]) -> Option<Self> {
         let have = [self.slots, self.leaf_tiles, self.even_tiles, self.odd_tiles];
         if counted.iter().zip(have).all(|(&n, h)| n <= h) {
-            return None;
+            let need = |n: u32| n.saturating_add(n / 8).max(64);
+            let fit = OctreePools {
+                slots: need(counted[0]),
+                leaf_tiles: need(counted[1]),
+                even_tiles: need(counted[2]),
+                odd_tiles: need(counted[3]),
+            };
+            // Below a few MiB a shrink is not worth a rebuild.
+            let oversized = self.bytes() > 2 * fit.bytes() && self.bytes() > 8 << 20;
+            return oversized.then_some(fit);
         }
         let grow = |n: u32, h: u32| -> u32 {
             let half = h.saturating_add(h / 2);
@@ -864,11 +883,11 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
-        self.pools.grown_for(counted).is_some()
+        self.pools.resized_for(counted).is_some()
     }
 
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {
-        let Some(pools) = self.pools.grown_for(counted) else {
+        let Some(pools) = self.pools.resized_for(counted) else {
             return Ok(());
         };
         let grown = crate::gpu::checked(device, "octree pools", || {
@@ -954,11 +973,24 @@ mod tests {
             even_tiles: 10,
             odd_tiles: 10,
         };
-        assert_eq!(p.grown_for(&[1000, 100, 10, 10]), None);
-        let g = p.grown_for(&[5000, 100, 10, 11]).unwrap();
+        assert_eq!(p.resized_for(&[1000, 100, 10, 10]), None);
+        let g = p.resized_for(&[5000, 100, 10, 11]).unwrap();
         assert_eq!(
             (g.slots, g.leaf_tiles, g.even_tiles, g.odd_tiles),
             (5000, 150, 64, 64)
         );
+    }
+
+    #[test]
+    fn pools_far_larger_than_needed_shrink_to_the_counts() {
+        let big = OctreePools::for_leaves(4_000_000);
+        let counted = [400_000, 150_000, 6_000, 25_000];
+        let fit = big.resized_for(&counted).expect("a tenth of the pools is used");
+        assert_eq!(
+            (fit.slots, fit.leaf_tiles, fit.even_tiles, fit.odd_tiles),
+            (450_000, 168_750, 6_750, 28_125)
+        );
+        // Sized so, the next build keeps them.
+        assert_eq!(fit.resized_for(&counted), None);
     }
 }
