@@ -26,7 +26,8 @@ fn triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
         }
         let m = &scene.meshes[inst.mesh];
         for t in m.indices.chunks_exact(3) {
-            out.push(t.map(|i| inst.transform.transform_point3(m.positions[i as usize])));
+            let p = |i: u32| inst.transform.transform_point3(m.positions[i as usize]);
+            out.push([p(t[0]), p(t[1]), p(t[2])]);
         }
     }
     out
@@ -55,7 +56,7 @@ fn voxel_centred(occ: &BTreeSet<[u32; 3]>, p: Vec3) -> f32 {
 /// 0 elsewhere (the sampler clamps p - 0.5 to the grid as a clamp-to-edge sampler would).
 fn voxgi_bricks(occ: &BTreeSet<[u32; 3]>, nodes: &BTreeSet<[u32; 3]>, res: u32, p: Vec3) -> f32 {
     let q = (p - 0.5).clamp(Vec3::ZERO, Vec3::splat(res as f32 - 1.0));
-    let n = q.floor().as_uvec3() >> 1;
+    let n: voxgi::scene::glam::UVec3 = q.floor().as_uvec3() >> 1u32;
     if !nodes.contains(&[n.x, n.y, n.z]) {
         return 0.0;
     }
@@ -63,10 +64,12 @@ fn voxgi_bricks(occ: &BTreeSet<[u32; 3]>, nodes: &BTreeSet<[u32; 3]>, res: u32, 
 }
 
 /// Vertex-centred bricks: values on voxel corners (each the mean of the eight voxels around
-/// it), trilinear inside a node of two voxels, and only where the node holds geometry.
-fn vertex_centred(occ: &BTreeSet<[u32; 3]>, nodes: &BTreeSet<[u32; 3]>, p: Vec3) -> f32 {
+/// it: the fragments lie on the voxel grid), trilinear inside a node of two voxels, and only
+/// where the node holds geometry (`nodes`; None: as if every node had a brick).
+fn vertex_centred(occ: &BTreeSet<[u32; 3]>, nodes: Option<&BTreeSet<[u32; 3]>>, p: Vec3) -> f32 {
     let cell = (p / 2.0).floor().as_ivec3();
-    if cell.min_element() < 0 || !nodes.contains(&[cell.x as u32, cell.y as u32, cell.z as u32]) {
+    let has = |n: &BTreeSet<[u32; 3]>| n.contains(&[cell.x as u32, cell.y as u32, cell.z as u32]);
+    if cell.min_element() < 0 || nodes.is_some_and(|n| !has(n)) {
         return 0.0;
     }
     let corner = |c: IVec3| -> f32 {
@@ -126,7 +129,7 @@ fn report(name: &str, scene: &Scene, res: u32) {
         (seed >> 8) as f32 / (1u32 << 24) as f32
     };
     let leaves = &content[depth as usize - 1];
-    let (mut err_ours, mut err_vc, mut n) = (0.0f64, 0.0f64, 0u32);
+    let (mut err_ours, mut err_vc, mut err_blur, mut n) = (0.0f64, 0.0f64, 0.0f64, 0u32);
     let mut worst_vc = 0.0f32;
     for _ in 0..20000 {
         let v = voxels[(rnd() * voxels.len() as f32) as usize % voxels.len()];
@@ -135,7 +138,8 @@ fn report(name: &str, scene: &Scene, res: u32) {
             - 1.5;
         let dense = voxel_centred(&occ, p);
         let ob = voxgi_bricks(&occ, &ours[depth as usize - 1], res, p);
-        let vc = vertex_centred(&occ, leaves, p);
+        let vc = vertex_centred(&occ, Some(leaves), p);
+        err_blur += (vertex_centred(&occ, None, p) - dense).abs() as f64;
         err_ours += (ob - dense).abs() as f64;
         err_vc += (vc - dense).abs() as f64;
         worst_vc = worst_vc.max((vc - dense).abs());
@@ -145,17 +149,24 @@ fn report(name: &str, scene: &Scene, res: u32) {
     println!(
         "{name} {res}³: {} occupied voxels\n  voxel-centred 2³ + border: {} bricks, {:.1} MiB bricks + {:.1} MiB nodes; \
          opacity error against the dense volume {:.4} (mean)\n  vertex-centred 3³:         {} bricks, {:.1} MiB bricks + {:.1} MiB nodes; \
-         opacity error against the dense volume {:.4} (mean), {:.3} (worst)",
+         opacity error against the dense volume {:.4} (mean), {:.3} (worst); with a brick in every node {:.4}",
         occ.len(),
-        ours[..depth as usize].iter().map(|s| s.len()).sum::<usize>(),
+        ours[..depth as usize]
+            .iter()
+            .map(|s| s.len())
+            .sum::<usize>(),
         mib(ob),
         mib(on),
         err_ours / n as f64,
-        content[..depth as usize].iter().map(|s| s.len()).sum::<usize>(),
+        content[..depth as usize]
+            .iter()
+            .map(|s| s.len())
+            .sum::<usize>(),
         mib(vb),
         mib(vn),
         err_vc / n as f64,
         worst_vc,
+        err_blur / n as f64,
     );
 }
 
@@ -164,7 +175,8 @@ fn main() {
     let mut scenes: Vec<(String, Scene)> = Vec::new();
     if args.is_empty() {
         scenes.push(("Cornell box".into(), builtin::cornell_box()));
-        let sponza = std::path::Path::new("../shared/scenes/sponza_dabrovic_geometry_only/sponza.obj");
+        let sponza =
+            std::path::Path::new("../shared/scenes/sponza_dabrovic_geometry_only/sponza.obj");
         match io::load(sponza) {
             Ok(s) => scenes.push(("Sponza".into(), s)),
             Err(e) => eprintln!("Sponza skipped: {e}"),

@@ -985,7 +985,9 @@ mod tests {
     fn pools_far_larger_than_needed_shrink_to_the_counts() {
         let big = OctreePools::for_leaves(4_000_000);
         let counted = [400_000, 150_000, 6_000, 25_000];
-        let fit = big.resized_for(&counted).expect("a tenth of the pools is used");
+        let fit = big
+            .resized_for(&counted)
+            .expect("a tenth of the pools is used");
         assert_eq!(
             (fit.slots, fit.leaf_tiles, fit.even_tiles, fit.odd_tiles),
             (450_000, 168_750, 6_750, 28_125)
