@@ -111,8 +111,8 @@ fn report(name: &str, scene: &Scene, res: u32) {
     let bytes = |sets: &[BTreeSet<[u32; 3]>]| -> (u64, u64) {
         let mut bricks = 0u64;
         let mut nodes = 0u64;
-        for t in 0..depth as usize {
-            let n = sets[t].len() as u64;
+        for (t, set) in sets.iter().enumerate().take(depth as usize) {
+            let n = set.len() as u64;
             let dirs = if t == depth as usize - 1 { 1 } else { 6 };
             bricks += n * 27 * 8 * dirs;
             nodes += n * 8 * if t == depth as usize - 1 { 4 } else { 16 };
