@@ -138,6 +138,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let extent = f32(vol.resolution);
     var out = frame.background.rgb;
     let span = ray_box(o, inv_d, vec3<f32>(0.0), vec3<f32>(extent));
+    let inside = all(o > vec3<f32>(0.0)) && all(o < vec3<f32>(extent));
     if span.x < span.y {
         // Coarse DDA in level units.
         let s = f32(scale);
@@ -156,7 +157,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var i = 0; i < 3 * res + 3; i++) {
             let v = cell_value(c);
             let t_exit = min(t_max.x, min(t_max.y, t_max.z));
-            if params.mode == MODE_NODES && v.a > 0.0 {
+            // The cell the camera stands in is skipped: from inside, it would fill the view.
+            if params.mode == MODE_NODES && v.a > 0.0 && !(i == 0 && inside) {
                 let f = fract(oc + d * t_enter);
                 let e = min(f, 1.0 - f);
                 var m = vec2<f32>(e.y, e.z);

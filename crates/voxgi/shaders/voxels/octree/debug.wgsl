@@ -160,6 +160,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let extent = f32(tree.resolution);
     var out = frame.background.rgb;
     let span = ray_box(o, inv_d, vec3<f32>(0.0), vec3<f32>(extent));
+    let inside = all(o > vec3<f32>(0.0)) && all(o < vec3<f32>(extent));
     if span.x < span.y {
         let s = f32(scale);
         let oc = o / s;
@@ -176,7 +177,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var i = 0; i < 3 * res + 3; i++) {
             let cu = vec3<u32>(c);
             if params.mode == MODE_NODES {
-                if cell_has_children(cu, lvl) {
+                // The cell the camera stands in is skipped: from inside, it would fill the view.
+                if cell_has_children(cu, lvl) && !(i == 0 && inside) {
                     // Where on the entered face the ray hit: darken near the cell's edges.
                     let f = fract(oc + d * t_enter);
                     let e = min(f, 1.0 - f);
