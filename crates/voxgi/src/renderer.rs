@@ -48,12 +48,13 @@ use wgpu::util::DeviceExt;
 
 /// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
 /// camera), in the order they run; every other pass is the screen's.
-pub const VOXEL_PASSES: [&str; 9] = [
+pub const VOXEL_PASSES: [&str; 10] = [
     "shadow",
     "voxelize",
     "dense_build",
     "dense_update",
     "octree_build",
+    "octree_update",
     "inject",
     "filter",
     "octree_filter",
@@ -1068,7 +1069,7 @@ fn new_volume(
             let pools = OctreePools::for_leaves(wanted)
                 .within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
             let v = checked(device, "voxel octree", || {
-                OctreeVolume::new(device, &p, grid, options.anisotropic, pools)
+                OctreeVolume::new(device, &p, grid, options.anisotropic, pools, facts.dynamic)
             })??;
             Ok(Voxels::Octree(v))
         }

@@ -18,9 +18,9 @@ fn leaf_count() -> u32 {
     return min(leaf_nodes[0], leaf_tree.slots);
 }
 
-// Every build and every update hands out all slots anew (OctreeVolume::record_update).
+// An update hands out the slots after the static build's anew (octree_update.wgsl).
 fn leaf_is_new(i: u32) -> bool {
-    return true;
+    return i >= leaf_nodes[STATIC_SLOTS];
 }
 
 fn leaf_coord(i: u32) -> vec3<u32> {

@@ -39,15 +39,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     // Nodes of depth u = t + 1, whose values are level k = D - u.
     let u = level.t + 1u;
     let i = gid.x + gid.y * nwg.x * 64u;
-    if i >= nodes[RANGES + 2u * u + 1u] * 8u {
+    // The static build's nodes of depth u, then the last update's.
+    let s_count = nodes[RANGES + 2u * u + 1u] * 8u;
+    if i >= s_count + nodes[DYN_RANGES + 2u * u + 1u] * 8u {
         return;
     }
-    let c = nodes[RANGES + 2u * u] * 8u + i;
+    let c = select(nodes[DYN_RANGES + 2u * u] * 8u + (i - s_count), nodes[RANGES + 2u * u] * 8u + i, i < s_count);
+    // No brick below: c and its positive neighbours are empty, and so is its value, which is
+    // written all the same (an update may have taken c's children away).
     let below = child(c);
-    if below == 0u {
-        // No brick below: c and its positive neighbours are empty, and so is its value.
-        return;
-    }
     let tile = c / 8u;
     let o = c % 8u;
     let k = tree.depth - u;
@@ -67,7 +67,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let dirs = select(1u, tree.dirs, tree.anisotropic != 0u);
     let dst_shape = atlas_shape(tree, k);
     for (var d = 0u; d < dirs; d++) {
-        let stored = filtered(below, k, d);
+        let stored = select(vec4<f32>(0.0), filtered(below, k, d), below != 0u);
         for (var s = 0u; s < 8u; s++) {
             if targets[s] != 0u {
                 let p = brick_texel(dst_shape, brick_index(tree, targets[s], k), dir_block(tree, d)) + border_local(o, s);

@@ -75,9 +75,16 @@ struct Octree {
 // reaches them too (one storage binding fewer: inject's stage holds the minimum eight): [0]
 // leaf slots, [1..4] tiles of classes V, E and O (all counted past the capacity: the host
 // reads these four back to grow the pools), [4] where the tiles of the depth being allocated
-// start in their class; from [RANGES], per depth t, the first tile and the number of tiles.
-const NODE_HEADER: u32 = 32u;
+// start in their class, [STATIC_SLOTS] the static build's slots, [FIRST_FRAGMENT] the first
+// fragment the running build or update reads, [UPDATING] 1 during an update; from [RANGES],
+// per depth t, the first tile and the number of tiles of the static build, from
+// [DYN_RANGES] those of the last update (after the static ones in each class).
+const NODE_HEADER: u32 = 64u;
+const STATIC_SLOTS: u32 = 5u;
+const FIRST_FRAGMENT: u32 = 6u;
+const UPDATING: u32 = 7u;
 const RANGES: u32 = 8u;
+const DYN_RANGES: u32 = 32u;
 const NODE_STRIDE: u32 = 4u;
 // Node 2 of the root tile stands above the root: its child pointer names the brick of level D,
 // the whole volume as one voxel (the dense volume's top mip), filtered from the root's brick.

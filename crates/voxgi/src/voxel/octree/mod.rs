@@ -37,7 +37,12 @@ pub const SLOT_WORDS: u64 = 17;
 /// Bytes per leaf slot across the slot, direct-light and bounce buffers.
 pub const SLOT_BYTES: u64 = SLOT_WORDS * 4 + 32;
 /// Words of counters before the nodes in the node buffer (`NODE_HEADER` in tree.wgsl).
-const NODE_HEADER: u64 = 32;
+const NODE_HEADER: u64 = 64;
+/// Dispatch sizes (u32): fragments, leaves, the nodes of each depth, the new nodes of each
+/// depth, the last update's leaves (`ARGS_NEW`, `ARGS_CLEAR` in octree_update.wgsl).
+const ARGS_WORDS: u64 = 75;
+const ARGS_NEW: u64 = 39;
+const ARGS_CLEAR: u64 = 72;
 /// u32 per tile in the tile buffer (`TILE_WORDS` in tree.wgsl).
 const TILE_WORDS: u64 = 2;
 /// Deepest depth of the top grid (`GRID_DEPTH` in tree.wgsl).
@@ -242,9 +247,30 @@ pub struct OctreePipelines {
     args_layout: wgpu::BindGroupLayout,
     filter_layout: wgpu::BindGroupLayout,
     build: BuildPipelines,
+    update: UpdatePipelines,
     filter: wgpu::ComputePipeline,
     filter_top: wgpu::ComputePipeline,
     debug: DebugPass,
+}
+
+/// octree_update's entry points (shaders/voxels/octree/octree_update.wgsl).
+struct UpdatePipelines {
+    begin_clear: wgpu::ComputePipeline,
+    clear_leaves: wgpu::ComputePipeline,
+    clear_nodes: wgpu::ComputePipeline,
+    begin_update: wgpu::ComputePipeline,
+    flag: wgpu::ComputePipeline,
+    mark: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+    scan: wgpu::ComputePipeline,
+    allocate: wgpu::ComputePipeline,
+    finish_update: wgpu::ComputePipeline,
+    init: wgpu::ComputePipeline,
+    repair: wgpu::ComputePipeline,
+    allocate_slots: wgpu::ComputePipeline,
+    accumulate: wgpu::ComputePipeline,
+    prepare_slots: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
 }
 
 struct BuildPipelines {
@@ -261,6 +287,7 @@ struct BuildPipelines {
     accumulate: wgpu::ComputePipeline,
     prepare_slots: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
+    seal: wgpu::ComputePipeline,
 }
 
 impl OctreePipelines {
@@ -297,17 +324,18 @@ impl OctreePipelines {
             bind_group_layouts: &[Some(&build_layout), Some(&args_layout)],
             immediate_size: 0,
         });
-        let m = shader::module_for(device, "voxels/octree/octree_build.wgsl", "octree");
-        let b = |entry: &str, args: bool| {
+        let pipe = |m: &wgpu::ShaderModule, label: &str, entry: &str, args: bool| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("octree_build"),
+                label: Some(label),
                 layout: Some(if args { &with_args } else { &plain }),
-                module: &m,
+                module: m,
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
             })
         };
+        let m = shader::module_for(device, "voxels/octree/octree_build.wgsl", "octree");
+        let b = |entry: &str, args: bool| pipe(&m, "octree_build", entry, args);
         let build = BuildPipelines {
             begin: b("begin", true),
             flag: b("flag", false),
@@ -322,6 +350,27 @@ impl OctreePipelines {
             accumulate: b("accumulate", false),
             prepare_slots: b("prepare_slots", true),
             resolve: b("resolve", false),
+            seal: b("seal", false),
+        };
+        let m = shader::module_for(device, "voxels/octree/octree_update.wgsl", "octree");
+        let u = |entry: &str, args: bool| pipe(&m, "octree_update", entry, args);
+        let update = UpdatePipelines {
+            begin_clear: u("begin_clear", true),
+            clear_leaves: u("clear_leaves", false),
+            clear_nodes: u("clear_nodes", false),
+            begin_update: u("begin_update", true),
+            flag: u("flag", false),
+            mark: u("mark", false),
+            count: u("count", false),
+            scan: u("scan", false),
+            allocate: u("allocate", false),
+            finish_update: u("finish_update", true),
+            init: u("init", false),
+            repair: u("repair", false),
+            allocate_slots: u("allocate_slots", false),
+            accumulate: u("accumulate", false),
+            prepare_slots: u("prepare_slots", true),
+            resolve: u("resolve", false),
         };
         let filter_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("octree_filter"),
@@ -358,6 +407,7 @@ impl OctreePipelines {
             args_layout,
             filter_layout,
             build,
+            update,
             filter,
             filter_top,
             debug: DebugPass::new(device),
@@ -408,6 +458,9 @@ pub struct OctreeVolume {
     /// Filter bind groups: [0] writes the even atlas (reads the odd), [1] the odd (reads the
     /// even).
     filter: [wgpu::BindGroup; 2],
+    /// The static build's nodes, tiles, leaves and top grid, which every update starts from;
+    /// None for a scene without dynamic instances.
+    snapshot: Option<[wgpu::Buffer; 4]>,
     pipelines: Arc<OctreePipelines>,
 }
 
@@ -451,6 +504,7 @@ impl OctreeVolume {
         grid: Grid,
         anisotropic: bool,
         pools: OctreePools,
+        dynamic: bool,
     ) -> crate::Result<Self> {
         let depth = grid.resolution.ilog2();
         let dirs: u32 = if anisotropic { 6 } else { 1 };
@@ -542,7 +596,7 @@ impl OctreeVolume {
         let leaf_next = storage_buffer(device, "octree bounce light", slots * 16);
         let args = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("octree dispatch sizes"),
-            size: (6 + 3 * 11) * 4,
+            size: ARGS_WORDS * 4,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::INDIRECT
                 | wgpu::BufferUsages::COPY_SRC,
@@ -608,6 +662,10 @@ impl OctreeVolume {
             filter_group(&odd_atlas, &even_atlas),
             filter_group(&even_atlas, &odd_atlas),
         ];
+        let snapshot = dynamic.then(|| {
+            [&nodes, &tile_buf, &slot_buf, &top_grid]
+                .map(|b| storage_buffer(device, "octree static snapshot", b.size()))
+        });
         Ok(OctreeVolume {
             grid,
             anisotropic,
@@ -629,6 +687,7 @@ impl OctreeVolume {
             leaves,
             leaf_store,
             filter,
+            snapshot,
             pipelines: pipelines.clone(),
         })
     }
@@ -758,25 +817,115 @@ impl OctreeVolume {
             (&b.accumulate, depth, Run::Indirect(0)),
             (&b.prepare_slots, depth, Run::Prepare),
             (&b.resolve, depth, Run::Indirect(12)),
+            (&b.seal, depth, Run::One),
         ]);
         // Positions the previous build filled and this one may not.
         encoder.clear_buffer(&self.top_grid, 0, None);
+        self.run_steps(encoder, "octree_build", &bind, &args, &steps, timer);
+        if let Some(snapshot) = &self.snapshot {
+            for (live, copy) in self.snapshotted().iter().zip(snapshot) {
+                encoder.copy_buffer_to_buffer(live, 0, copy, 0, live.size());
+            }
+        }
+    }
+
+    /// The buffers an update starts from the static build's copy of.
+    fn snapshotted(&self) -> [&wgpu::Buffer; 4] {
+        [&self.nodes, &self.tiles, &self.slots, &self.top_grid]
+    }
+
+    /// Records `steps` in one compute pass timed as `label`: each dispatch reads what the one
+    /// before wrote (dispatch sizes, counters, nodes).
+    fn run_steps(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &'static str,
+        bind: &wgpu::BindGroup,
+        args: &wgpu::BindGroup,
+        steps: &[(&wgpu::ComputePipeline, u32, Run)],
+        timer: &mut GpuTimer,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("octree_build"),
-            timestamp_writes: timer.compute("octree_build"),
+            label: Some(label),
+            timestamp_writes: timer.compute(label),
         });
         for (pipeline, t, run) in steps {
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind, &[(t as u64 * LEVEL_STRIDE) as u32]);
+            pass.set_bind_group(0, bind, &[(*t as u64 * LEVEL_STRIDE) as u32]);
             match run {
                 Run::Prepare => {
-                    pass.set_bind_group(1, &args, &[]);
+                    pass.set_bind_group(1, args, &[]);
                     pass.dispatch_workgroups(1, 1, 1);
                 }
                 Run::One => pass.dispatch_workgroups(1, 1, 1),
-                Run::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.args, offset),
+                Run::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.args, *offset),
             }
         }
+    }
+
+    /// Records an update by the dynamic fragments (those after the static build's): the last
+    /// update's texels in the static bricks are zeroed, the static build's nodes, tiles, leaves
+    /// and top grid come back from their copy, and the dynamic fragments are merged in depth by
+    /// depth (octree_update.wgsl). Without a copy (a scene with no dynamic instances) it is a
+    /// build.
+    fn update(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        let Some(snapshot) = &self.snapshot else {
+            self.build(device, encoder, fragments, timer);
+            return;
+        };
+        let bind = self.build_bind_group(device, fragments);
+        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("octree_update args"),
+            layout: &self.pipelines.args_layout,
+            entries: &layout::entries(vec![self.args.as_entire_binding()]),
+        });
+        let u = &self.pipelines.update;
+        let depth = self.depth();
+        let over_nodes = |t: u32| Run::Indirect((6 + 3 * t as u64) * 4);
+        let over_new = |t: u32| Run::Indirect((ARGS_NEW + 3 * t as u64) * 4);
+        let mut clear: Vec<(&wgpu::ComputePipeline, u32, Run)> = vec![
+            (&u.begin_clear, 0, Run::Prepare),
+            (&u.clear_leaves, 0, Run::Indirect(ARGS_CLEAR * 4)),
+        ];
+        for t in 1..depth {
+            clear.push((&u.clear_nodes, t, over_new(t)));
+        }
+        self.run_steps(encoder, "octree_update", &bind, &args, &clear, timer);
+        for (live, copy) in self.snapshotted().iter().zip(snapshot) {
+            encoder.copy_buffer_to_buffer(copy, 0, live, 0, live.size());
+        }
+        let mut steps: Vec<(&wgpu::ComputePipeline, u32, Run)> =
+            vec![(&u.begin_update, 0, Run::Prepare)];
+        for t in 0..depth {
+            steps.extend([
+                (&u.flag, t, Run::Indirect(0)),
+                (&u.mark, t, Run::One),
+                (&u.count, t, over_nodes(t)),
+                (&u.scan, t, Run::One),
+                (&u.allocate, t, over_nodes(t)),
+                (&u.finish_update, t, Run::Prepare),
+                (&u.init, t + 1, over_new(t + 1)),
+            ]);
+            if t + 1 < depth {
+                steps.push((&u.repair, t + 1, over_new(t + 1)));
+            }
+        }
+        steps.extend([
+            (&u.flag, depth, Run::Indirect(0)),
+            (&u.count, depth, over_nodes(depth)),
+            (&u.scan, depth, Run::One),
+            (&u.allocate_slots, depth, over_nodes(depth)),
+            (&u.accumulate, depth, Run::Indirect(0)),
+            (&u.prepare_slots, depth, Run::Prepare),
+            (&u.resolve, depth, Run::Indirect(12)),
+        ]);
+        self.run_steps(encoder, "octree_update", &bind, &args, &steps, timer);
     }
 
     /// Records the filtering of every level above the leaves, finest first: one dispatch per
@@ -818,6 +967,10 @@ impl OctreeVolume {
                 "octree leaf slots",
                 self.slots.size() + self.leaf_direct.size() + self.leaf_next.size(),
             ),
+            (
+                "octree static copy (dynamic scenes)",
+                self.snapshot.iter().flatten().map(|b| b.size()).sum(),
+            ),
             ("octree even atlas", texels(&self.even_atlas)),
             ("octree odd atlas", texels(&self.odd_atlas)),
         ]
@@ -853,8 +1006,6 @@ impl VoxelStructure for OctreeVolume {
         self.build(device, encoder, fragments, timer);
     }
 
-    /// Rebuilds from the static and dynamic fragments together: correct (it equals a fresh
-    /// build of both), but it costs a full build per update; every leaf is new afterwards.
     fn record_update(
         &self,
         device: &wgpu::Device,
@@ -862,7 +1013,7 @@ impl VoxelStructure for OctreeVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        self.build(device, encoder, fragments, timer);
+        self.update(device, encoder, fragments, timer);
     }
 
     fn record_filter(
@@ -891,7 +1042,14 @@ impl VoxelStructure for OctreeVolume {
             return Ok(());
         };
         let grown = crate::gpu::checked(device, "octree pools", || {
-            OctreeVolume::new(device, &self.pipelines, self.grid, self.anisotropic, pools)
+            OctreeVolume::new(
+                device,
+                &self.pipelines,
+                self.grid,
+                self.anisotropic,
+                pools,
+                self.snapshot.is_some(),
+            )
         })??;
         *self = grown;
         Ok(())

@@ -1,0 +1,352 @@
+// The octree's build resources and helpers, shared by octree_build (the static geometry, from
+// scratch) and octree_update (the dynamic geometry, on top of the static build), and the
+// steps both run: mark, count, scan, allocate, init, allocate_slots, accumulate, resolve.
+
+//!include shared/fragment.wgsl
+//!include voxels/tree.wgsl
+
+struct Level {
+    // The depth this dispatch works on.
+    t: u32,
+}
+
+@group(0) @binding(0) var<uniform> tree: Octree;
+@group(0) @binding(1) var<storage, read> fragments: array<Fragment>;
+@group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
+// The header (counters, voxels/octree/tree.wgsl), then the nodes.
+@group(0) @binding(3) var<storage, read_write> nodes: array<atomic<u32>>;
+// Per tile, TILE_WORDS u32: its parent node and the parent's packed coordinate.
+@group(0) @binding(4) var<storage, read_write> tiles: array<u32>;
+@group(0) @binding(5) var<storage, read_write> slots: array<atomic<u32>>;
+@group(0) @binding(6) var even_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(7) var odd_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(8) var<uniform> level: Level;
+// Per workgroup of `count`: its marked nodes, then (after `scan`) the marked nodes before it.
+@group(0) @binding(9) var<storage, read_write> block_sums: array<u32>;
+// The top grid (voxels/octree/tree.wgsl): per depth down to GRID_DEPTH, the node at each
+// position, 0 where none.
+@group(0) @binding(10) var<storage, read_write> grid: array<u32>;
+// Indirect dispatch sizes: [0..3] over fragments, [3..6] over leaf slots, from [6] per depth
+// t over the nodes of depth t. Only the one-thread kernels bind them.
+@group(1) @binding(0) var<storage, read_write> args: array<u32>;
+
+const WG: u32 = 64u;
+
+fn flat(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WG;
+}
+
+fn write_args(offset: u32, count: u32) {
+    let groups = (count + WG - 1u) / WG;
+    args[offset] = max(min(groups, 65535u), 1u);
+    args[offset + 1u] = max((groups + 65534u) / 65535u, 1u);
+    args[offset + 2u] = 1u;
+}
+
+fn stored_fragments() -> u32 {
+    return min(fragment_count[0], arrayLength(&fragments));
+}
+
+fn child(n: u32) -> u32 {
+    return atomicLoad(&nodes[child_word(tree, n)]);
+}
+
+fn neighbour(n: u32, axis: u32) -> u32 {
+    return atomicLoad(&nodes[NODE_HEADER + n * NODE_STRIDE + 1u + axis]);
+}
+
+// The node of depth t (whose children are allocated down to it) that holds finest voxel c, or
+// NONE where a pool overflowed above it.
+fn descend(c: vec3<u32>, t: u32) -> u32 {
+    var node = 0u;
+    for (var i = 0u; i < t; i++) {
+        let tile = child(node);
+        if tile == 0u || tile >= NEEDED {
+            return NONE;
+        }
+        node = tile * 8u + octant_of(c, tree.depth - 1u - i);
+    }
+    return node;
+}
+
+// Nodes of depth t: the static build's tiles, then the last update's.
+fn nodes_at(t: u32) -> u32 {
+    return (atomicLoad(&nodes[RANGES + 2u * t + 1u]) + atomicLoad(&nodes[DYN_RANGES + 2u * t + 1u])) * 8u;
+}
+
+// Node `i` of depth t (threads over the depth's static tiles, then its dynamic ones, eight
+// nodes each), or NONE.
+fn node_of_depth(i: u32, t: u32) -> u32 {
+    let s = atomicLoad(&nodes[RANGES + 2u * t + 1u]) * 8u;
+    if i < s {
+        return atomicLoad(&nodes[RANGES + 2u * t]) * 8u + i;
+    }
+    if i - s >= atomicLoad(&nodes[DYN_RANGES + 2u * t + 1u]) * 8u {
+        return NONE;
+    }
+    return atomicLoad(&nodes[DYN_RANGES + 2u * t]) * 8u + (i - s);
+}
+
+// Node `i` of the tiles of depth t the running build or update has just made: the static range
+// in a build, the dynamic one in an update (header word UPDATING).
+fn node_of_new(i: u32, t: u32) -> u32 {
+    let r = select(RANGES, DYN_RANGES, atomicLoad(&nodes[UPDATING]) != 0u);
+    if i >= atomicLoad(&nodes[r + 2u * t + 1u]) * 8u {
+        return NONE;
+    }
+    return atomicLoad(&nodes[r + 2u * t]) * 8u + i;
+}
+
+// Node n's coordinate at its depth: its tile's parent's, doubled, plus its octant.
+fn node_coord(n: u32) -> vec3<u32> {
+    return 2u * unpack_coord(tiles[(n / 8u) * TILE_WORDS + 1u]) + octant_offset(n % 8u);
+}
+
+fn class_capacity(c: u32) -> u32 {
+    return class_end(tree, c) - class_base(tree, c);
+}
+
+@compute @workgroup_size(1)
+fn mark() {
+    let c = brick_class(tree.depth - 1u - level.t);
+    atomicStore(&nodes[4], atomicLoad(&nodes[1u + c]));
+}
+
+var<workgroup> ranks: array<u32, 64>;
+
+// Inclusive prefix sum of `v` over the workgroup (every thread must call it).
+fn workgroup_scan(lid: u32, v: u32) -> u32 {
+    ranks[lid] = v;
+    workgroupBarrier();
+    for (var d = 1u; d < 64u; d *= 2u) {
+        var x = 0u;
+        if lid >= d {
+            x = ranks[lid - d];
+        }
+        workgroupBarrier();
+        ranks[lid] += x;
+        workgroupBarrier();
+    }
+    return ranks[lid];
+}
+
+fn block_index(wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return wid.x + wid.y * nwg.x;
+}
+
+// Whether node n (of the dispatch's depth) takes a tile (depth < D) or a leaf slot (depth D).
+fn marked(n: u32) -> bool {
+    if n == NONE {
+        return false;
+    }
+    let c = child(n);
+    return select(c >= NEEDED, c == CONTENT, level.t == tree.depth);
+}
+
+@compute @workgroup_size(64)
+fn count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), level.t);
+    let total = workgroup_scan(lid, u32(marked(n)));
+    if lid == 63u {
+        block_sums[block_index(wid, nwg)] = total;
+    }
+}
+
+// One workgroup: the exclusive prefix sum of the counts of the depth's blocks, in chunks of 64.
+var<workgroup> scan_blocks: u32;
+
+@compute @workgroup_size(64)
+fn scan(@builtin(local_invocation_index) lid: u32) {
+    if lid == 0u {
+        scan_blocks = (nodes_at(level.t) + 63u) / 64u;
+    }
+    let blocks = workgroupUniformLoad(&scan_blocks);
+    var offset = 0u;
+    for (var base = 0u; base < blocks; base += 64u) {
+        let i = base + lid;
+        var v = 0u;
+        if i < blocks {
+            v = block_sums[i];
+        }
+        let inclusive = workgroup_scan(lid, v);
+        if i < blocks {
+            block_sums[i] = offset + inclusive - v;
+        }
+        offset += ranks[63];
+        workgroupBarrier();
+    }
+}
+
+// The rank of node n among the marked nodes of its depth (every thread must call it).
+fn rank(n: u32, lid: u32, wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    let m = u32(marked(n));
+    return block_sums[block_index(wid, nwg)] + workgroup_scan(lid, m) - m;
+}
+
+@compute @workgroup_size(64)
+fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), level.t);
+    let r = rank(n, lid, wid, nwg);
+    if !marked(n) {
+        return;
+    }
+    let c = brick_class(tree.depth - 1u - level.t);
+    // Counted past the capacity, so the host sees how many tiles the class needs.
+    atomicMax(&nodes[1u + c], atomicLoad(&nodes[4]) + r + 1u);
+    let k = atomicLoad(&nodes[4]) + r;
+    if k >= class_capacity(c) {
+        atomicStore(&nodes[child_word(tree, n)], 0u);
+        return;
+    }
+    let tile = class_base(tree, c) + k;
+    atomicStore(&nodes[child_word(tree, n)], tile);
+    tiles[tile * TILE_WORDS] = n;
+    tiles[tile * TILE_WORDS + 1u] = pack_coord(node_coord(n));
+}
+
+// Clears the texels of brick `tile` (holding `lvl`) that octant thread `o` owns: every eighth.
+fn clear_brick(tile: u32, lvl: u32, o: u32) {
+    let dirs = select(1u, tree.dirs, lvl > 0u);
+    let shape = atlas_shape(tree, lvl);
+    let b = brick_index(tree, tile, lvl);
+    for (var d = 0u; d < dirs; d++) {
+        let base = brick_texel(shape, b, d);
+        for (var k = o; k < 27u; k += 8u) {
+            let p = base + vec3<u32>(k % 3u, (k / 3u) % 3u, k / 9u);
+            if (lvl & 1u) == 0u {
+                textureStore(even_out, p, vec4<f32>(0.0));
+            } else {
+                textureStore(odd_out, p, vec4<f32>(0.0));
+            }
+        }
+    }
+}
+
+// The nodes of depth level.t, just allocated.
+@compute @workgroup_size(64)
+fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let u = level.t;
+    let n = node_of_new(flat(gid, nwg), u);
+    if n == NONE {
+        return;
+    }
+    let tile = n / 8u;
+    let o = n % 8u;
+    atomicStore(&nodes[child_word(tree, n)], 0u);
+    let parent = tiles[tile * TILE_WORDS];
+    if u <= grid_depth(tree) {
+        grid[grid_index(node_coord(n), u)] = n;
+    }
+    // Leaf voxels keep no neighbours.
+    for (var a = 0u; a < 3u * u32(u < tree.depth); a++) {
+        var nb = 0u;
+        if ((o >> a) & 1u) == 1u {
+            nb = tile * 8u + (o ^ (1u << a));
+        } else {
+            let pn = neighbour(parent, a);
+            if pn != 0u {
+                let pt = child(pn);
+                if pt != 0u {
+                    nb = pt * 8u + (o | (1u << a));
+                }
+            }
+        }
+        atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE + 1u + a], nb);
+    }
+    clear_brick(tile, tree.depth - u, o);
+}
+
+// Depth D: one leaf slot per newly occupied finest voxel, by rank.
+@compute @workgroup_size(64)
+fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let n = node_of_depth(flat(gid, nwg), tree.depth);
+    // An update's slots follow the static build's (STATIC_SLOTS is 0 during a build).
+    let s = atomicLoad(&nodes[STATIC_SLOTS]) + rank(n, lid, wid, nwg);
+    if !marked(n) {
+        return;
+    }
+    atomicMax(&nodes[0], s + 1u);
+    if s >= tree.slots {
+        atomicStore(&nodes[child_word(tree, n)], 0u);
+        return;
+    }
+    atomicStore(&nodes[child_word(tree, n)], s + 1u);
+    atomicStore(&slots[s * SLOT_STRIDE], pack_coord(node_coord(n)));
+    atomicStore(&slots[s * SLOT_STRIDE + 1u], tiles[(n / 8u) * TILE_WORDS] | ((n % 8u) << 29u));
+    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+        atomicStore(&slots[s * SLOT_STRIDE + SLOT_ACCUM + k], 0u);
+    }
+}
+
+@compute @workgroup_size(64)
+fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    // A build's fragments from 0, an update's from the static ones on (FIRST_FRAGMENT).
+    let i = atomicLoad(&nodes[FIRST_FRAGMENT]) + flat(gid, nwg);
+    if i >= stored_fragments() {
+        return;
+    }
+    let f = fragments[i];
+    let node = descend(unpack_coord(f.coord), tree.depth);
+    if node == NONE {
+        return;
+    }
+    let v = child(node);
+    if v == 0u || v >= NEEDED {
+        return;
+    }
+    let base = (v - 1u) * SLOT_STRIDE;
+    let sums = fragment_sums(f);
+    for (var k = 0u; k < FRAGMENT_SUMS; k++) {
+        atomicAdd(&slots[base + SLOT_ACCUM + k], sums[k]);
+    }
+    atomicMax(&slots[base + SLOT_ACCUM + FRAGMENT_SUMS], fragment_coverage(f));
+}
+
+@compute @workgroup_size(1)
+fn prepare_slots() {
+    write_args(3u, min(atomicLoad(&nodes[0]), tree.slots));
+}
+
+@compute @workgroup_size(64)
+fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = flat(gid, nwg);
+    if s >= min(atomicLoad(&nodes[0]), tree.slots) {
+        return;
+    }
+    let base = s * SLOT_STRIDE;
+    var sum = array<u32, 10>();
+    for (var k = 0u; k < FRAGMENT_SUMS; k++) {
+        sum[k] = atomicLoad(&slots[base + SLOT_ACCUM + k]);
+    }
+    let a = resolve_sums(sum, atomicLoad(&slots[base + SLOT_ACCUM + FRAGMENT_SUMS]));
+    atomicStore(&slots[base + 2u], pack4x8unorm(a.albedo));
+    atomicStore(&slots[base + 3u], pack4x8snorm(a.normal));
+    atomicStore(&slots[base + 4u], pack2x16float(a.emission.rg));
+    atomicStore(&slots[base + 5u], pack2x16float(vec2<f32>(a.emission.b, 0.0)));
+}
+
+// Writes `v` (stored optical depth) as the value of octant `o` of node m's brick, holding level
+// `lvl`, direction block `block`: into m's brick and the positive borders of the bricks of m's
+// negative neighbours that hold it (as the filter and the leaf store do).
+fn store_value(m: u32, o: u32, lvl: u32, block: u32, v: vec4<f32>) {
+    let x = neighbour(m, 0u);
+    let y = neighbour(m, 1u);
+    let xy = neighbour(x, 1u);
+    let around = array<u32, 8>(m, x, y, xy, neighbour(m, 2u), neighbour(x, 2u), neighbour(y, 2u), neighbour(xy, 2u));
+    let shape = atlas_shape(tree, lvl);
+    for (var s = 0u; s < 8u; s++) {
+        if !border_holds(o, s) || (s != 0u && around[s] == 0u) {
+            continue;
+        }
+        let tile = child(around[s]);
+        if tile == 0u || tile >= NEEDED {
+            continue;
+        }
+        let p = brick_texel(shape, brick_index(tree, tile, lvl), block) + border_local(o, s);
+        if (lvl & 1u) == 0u {
+            textureStore(even_out, p, v);
+        } else {
+            textureStore(odd_out, p, v);
+        }
+    }
+}

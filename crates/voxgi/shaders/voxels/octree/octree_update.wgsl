@@ -1,0 +1,178 @@
+// octree_update: the dynamic geometry's fragments (those after the static build's) merged into
+// the static octree, so that it equals a build of static and dynamic fragments together (the
+// seeds' scheme: dynamic nodes, bricks and leaves go after the static ones in every pool, and
+// an update starts by dropping the last one's). In the order the host runs them:
+//   begin_clear, clear_leaves, clear_nodes
+//            zero the texels the last update's leaves and nodes wrote into the static bricks
+//            (their own bricks go with them); the host then copies the static build's nodes,
+//            tiles, leaves and top grid back over the last update's
+//   begin_update
+//            the ranges and dispatch sizes of this update
+// then per depth t as octree_build, but from the dynamic fragments only:
+//   flag     each fragment's node and its seven negative neighbours, where they have no
+//            children yet, are marked (a static node that has children keeps them)
+//   mark, count, scan, allocate, finish_update, init
+//            the marked nodes, static or dynamic, take tiles after the static ones
+//   repair   a static node whose negative neighbour is one of the new nodes points to it
+// and at depth D: the new voxels take slots after the static ones, the fragments' sums are
+// added (into a static leaf's, when they share its voxel), and every leaf is resolved.
+
+//!include voxels/build_shared.wgsl
+
+const ARGS_NEW: u32 = 39u;
+const ARGS_CLEAR: u32 = 72u;
+
+@compute @workgroup_size(1)
+fn begin_clear() {
+    let slots_now = min(atomicLoad(&nodes[0]), tree.slots);
+    let static_slots = atomicLoad(&nodes[STATIC_SLOTS]);
+    write_args(ARGS_CLEAR, select(0u, slots_now - static_slots, slots_now > static_slots));
+    for (var t = 1u; t < tree.depth; t++) {
+        write_args(ARGS_NEW + 3u * t, atomicLoad(&nodes[DYN_RANGES + 2u * t + 1u]) * 8u);
+    }
+}
+
+// The last update's leaves: each zeroes its texel in its parent's level-0 brick and in the
+// borders of the neighbours' bricks (the parent may be static).
+@compute @workgroup_size(64)
+fn clear_leaves(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = atomicLoad(&nodes[STATIC_SLOTS]) + flat(gid, nwg);
+    if s >= min(atomicLoad(&nodes[0]), tree.slots) {
+        return;
+    }
+    let info = atomicLoad(&slots[s * SLOT_STRIDE + 1u]);
+    store_value(info & 0x1fffffffu, info >> 29u, 0u, 0u, vec4<f32>(0.0));
+}
+
+// The last update's nodes of depth level.t: each zeroes its value, every direction, in its
+// parent's brick and the borders it pushed into the neighbours' (static ones among them).
+@compute @workgroup_size(64)
+fn clear_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let u = level.t;
+    let i = flat(gid, nwg);
+    if i >= atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]) * 8u {
+        return;
+    }
+    let c = atomicLoad(&nodes[DYN_RANGES + 2u * u]) * 8u + i;
+    let m = tiles[(c / 8u) * TILE_WORDS];
+    let k = tree.depth - u;
+    for (var d = 0u; d < tree.dirs; d++) {
+        store_value(m, c % 8u, k, d, vec4<f32>(0.0));
+    }
+}
+
+@compute @workgroup_size(1)
+fn begin_update() {
+    for (var t = 0u; t <= tree.depth; t++) {
+        atomicStore(&nodes[DYN_RANGES + 2u * t], 0u);
+        atomicStore(&nodes[DYN_RANGES + 2u * t + 1u], 0u);
+    }
+    atomicStore(&nodes[UPDATING], 1u);
+    let first = atomicLoad(&nodes[FIRST_FRAGMENT]);
+    let frags = stored_fragments();
+    write_args(0u, select(0u, frags - first, frags > first));
+    write_args(6u, nodes_at(0u));
+}
+
+// Marks node n for children where it has none (a node with children, or marked already,
+// stays as it is). The weak exchange may fail spuriously: retry while the node is unmarked.
+fn mark_node(n: u32, value: u32) {
+    for (var r = 0u; r < 64u; r++) {
+        let x = atomicCompareExchangeWeak(&nodes[child_word(tree, n)], 0u, value);
+        if x.exchanged || x.old_value != 0u {
+            return;
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = atomicLoad(&nodes[FIRST_FRAGMENT]) + flat(gid, nwg);
+    if i >= stored_fragments() {
+        return;
+    }
+    let t = level.t;
+    let n = descend(unpack_coord(fragments[i].coord), t);
+    if n == NONE {
+        return;
+    }
+    if t == tree.depth {
+        // A voxel a static leaf holds already keeps its slot (the sums are added to it).
+        mark_node(n, CONTENT);
+        return;
+    }
+    // The node and its seven negative neighbours (their bricks hold its voxels as a border),
+    // as octree_build's flag and dilate do.
+    let x = neighbour(n, 0u);
+    let y = neighbour(n, 1u);
+    let z = neighbour(n, 2u);
+    var around = array<u32, 8>(n, x, y, z, 0u, 0u, 0u, 0u);
+    if x != 0u {
+        around[4] = neighbour(x, 1u);
+        around[5] = neighbour(x, 2u);
+    }
+    if y != 0u {
+        around[6] = neighbour(y, 2u);
+    }
+    if around[4] != 0u {
+        around[7] = neighbour(around[4], 2u);
+    }
+    for (var k = 0u; k < 8u; k++) {
+        if k == 0u || around[k] != 0u {
+            mark_node(around[k], NEEDED);
+        }
+    }
+}
+
+@compute @workgroup_size(1)
+fn finish_update() {
+    let c = brick_class(tree.depth - 1u - level.t);
+    let start = atomicLoad(&nodes[4]);
+    let end = min(atomicLoad(&nodes[1u + c]), class_capacity(c));
+    let count = select(0u, end - start, end > start);
+    let u = level.t + 1u;
+    atomicStore(&nodes[DYN_RANGES + 2u * u], class_base(tree, c) + start);
+    atomicStore(&nodes[DYN_RANGES + 2u * u + 1u], count);
+    write_args(6u + 3u * u, nodes_at(u));
+    write_args(ARGS_NEW + 3u * u, count * 8u);
+}
+
+// The node at coordinate c of depth t, or NONE.
+fn node_at(c: vec3<u32>, t: u32) -> u32 {
+    var node = 0u;
+    for (var i = 0u; i < t; i++) {
+        let tile = child(node);
+        if tile == 0u || tile >= NEEDED {
+            return NONE;
+        }
+        node = tile * 8u + octant_of(c, t - 1u - i);
+    }
+    return node;
+}
+
+// The new nodes of depth level.t: a static node on their positive side along an axis points
+// back at them (its -axis neighbour was none, or another update's).
+@compute @workgroup_size(64)
+fn repair(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let u = level.t;
+    let n = node_of_new(flat(gid, nwg), u);
+    if n == NONE {
+        return;
+    }
+    let c = node_coord(n);
+    let side = 1u << u;
+    let dyn_start = atomicLoad(&nodes[DYN_RANGES + 2u * u]);
+    let dyn_end = dyn_start + atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]);
+    for (var a = 0u; a < 3u; a++) {
+        // Where n comes first in its tile along the axis, the next node is its sibling (new too).
+        if (((n % 8u) >> a) & 1u) == 0u || c[a] + 1u >= side {
+            continue;
+        }
+        var p = c;
+        p[a] += 1u;
+        let m = node_at(p, u);
+        if m != NONE && (m / 8u < dyn_start || m / 8u >= dyn_end) {
+            atomicStore(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a], n);
+        }
+    }
+}
