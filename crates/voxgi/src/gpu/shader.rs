@@ -21,6 +21,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/lights.wgsl",
     "shared/volume.wgsl",
     "shared/fragment.wgsl",
+    "shared/voxel_debug.wgsl",
     "voxels/dense/sample.wgsl",
     "voxels/dense/leaves.wgsl",
     "voxels/dense/leaf_store.wgsl",

@@ -15,6 +15,7 @@
 
 //!include shared/scene.wgsl
 //!include shared/volume.wgsl
+//!include shared/voxel_debug.wgsl
 
 struct DebugParams {
     // 0 albedo, 1 opacity, 2 radiance.
@@ -40,28 +41,12 @@ const MODE_OPACITY: u32 = 1u;
 const MODE_RADIANCE: u32 = 2u;
 const MODE_NODES: u32 = 3u;
 
-// A colour per level (the octree's debug view uses the same).
-fn level_colour(lvl: u32) -> vec3<f32> {
-    let h = f32(lvl) * 0.618034;
-    let k = fract(vec3<f32>(h, h + 0.333333, h + 0.666667)) * 6.283185;
-    return 0.55 + 0.4 * cos(k);
-}
-
 fn cell_value(c: vec3<i32>) -> vec4<f32> {
     if params.level == 0u {
         return from_depth(textureLoad(radiance0, c, 0));
     }
     let n = i32(vol.resolution) >> params.level;
     return from_depth(textureLoad(chain, c + vec3<i32>(0, 0, n * i32(params.block)), i32(params.level) - 1));
-}
-
-// Ray / box [lo, hi] entry and exit distances (t_enter > t_exit: miss).
-fn ray_box(o: vec3<f32>, inv_d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
-    let t0 = (lo - o) * inv_d;
-    let t1 = (hi - o) * inv_d;
-    let tmin = min(t0, t1);
-    let tmax = max(t0, t1);
-    return vec2<f32>(max(max(tmin.x, tmin.y), max(tmin.z, 0.0)), min(tmax.x, min(tmax.y, tmax.z)));
 }
 
 // Finest albedo under the coarse cell `cell` (of `scale` finest voxels per side) that the ray
@@ -159,16 +144,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             let t_exit = min(t_max.x, min(t_max.y, t_max.z));
             // The cell the camera stands in is skipped: from inside, it would fill the view.
             if params.mode == MODE_NODES && v.a > 0.0 && !(i == 0 && inside) {
-                let f = fract(oc + d * t_enter);
-                let e = min(f, 1.0 - f);
-                var m = vec2<f32>(e.y, e.z);
-                if axis == 1u {
-                    m = vec2<f32>(e.x, e.z);
-                } else if axis == 2u {
-                    m = vec2<f32>(e.x, e.y);
-                }
-                let shade = array<f32, 3>(0.8, 1.0, 0.6)[axis];
-                out = level_colour(params.level) * shade * select(1.0, 0.35, min(m.x, m.y) < 0.06);
+                out = node_colour(params.level, oc + d * t_enter, axis);
                 break;
             }
             if params.mode != MODE_NODES && v.a > 0.5 {

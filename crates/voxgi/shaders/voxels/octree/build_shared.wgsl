@@ -350,3 +350,16 @@ fn store_value(m: u32, o: u32, lvl: u32, block: u32, v: vec4<f32>) {
         }
     }
 }
+
+// After allocate at depth level.t: the new tiles (of depth t + 1) as the range at `ranges`
+// (RANGES in a build, DYN_RANGES in an update); returns how many.
+fn record_new_tiles(ranges: u32) -> u32 {
+    let c = brick_class(tree.depth - 1u - level.t);
+    let start = atomicLoad(&nodes[4]);
+    let end = min(atomicLoad(&nodes[1u + c]), class_capacity(c));
+    let count = select(0u, end - start, end > start);
+    let u = level.t + 1u;
+    atomicStore(&nodes[ranges + 2u * u], class_base(tree, c) + start);
+    atomicStore(&nodes[ranges + 2u * u + 1u], count);
+    return count;
+}

@@ -11,6 +11,7 @@
 
 //!include shared/scene.wgsl
 //!include shared/volume.wgsl
+//!include shared/voxel_debug.wgsl
 //!include voxels/tree.wgsl
 
 struct DebugParams {
@@ -76,14 +77,6 @@ fn leaf_slot(c: vec3<u32>) -> u32 {
     return select(NONE, v - 1u, v != 0u);
 }
 
-fn ray_box(o: vec3<f32>, inv_d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
-    let t0 = (lo - o) * inv_d;
-    let t1 = (hi - o) * inv_d;
-    let tmin = min(t0, t1);
-    let tmax = max(t0, t1);
-    return vec2<f32>(max(max(tmin.x, tmin.y), max(tmin.z, 0.0)), min(tmax.x, min(tmax.y, tmax.z)));
-}
-
 // Albedo of the first occupied leaf the ray (finest-voxel units) crosses inside the cell
 // `cell` of `scale` finest voxels per side, entered at t0.
 fn albedo_under(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, cell: vec3<i32>, scale: i32, t0: f32) -> vec3<f32> {
@@ -126,13 +119,6 @@ fn albedo_under(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, cell: vec3<i32>, s
         }
     }
     return sum.rgb / max(sum.w, 1.0);
-}
-
-// A colour per level, so the levels of the nodes view tell apart.
-fn level_colour(lvl: u32) -> vec3<f32> {
-    let h = f32(lvl) * 0.618034;
-    let k = fract(vec3<f32>(h, h + 0.333333, h + 0.666667)) * 6.283185;
-    return 0.55 + 0.4 * cos(k);
 }
 
 @compute @workgroup_size(8, 8)
@@ -179,18 +165,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             if params.mode == MODE_NODES {
                 // The cell the camera stands in is skipped: from inside, it would fill the view.
                 if cell_has_children(cu, lvl) && !(i == 0 && inside) {
-                    // Where on the entered face the ray hit: darken near the cell's edges.
-                    let f = fract(oc + d * t_enter);
-                    let e = min(f, 1.0 - f);
-                    var m = vec2<f32>(e.y, e.z);
-                    if axis == 1u {
-                        m = vec2<f32>(e.x, e.z);
-                    } else if axis == 2u {
-                        m = vec2<f32>(e.x, e.y);
-                    }
-                    let shade = array<f32, 3>(0.8, 1.0, 0.6)[axis];
-                    let line = select(1.0, 0.35, min(m.x, m.y) < 0.06);
-                    out = level_colour(lvl) * shade * line;
+                    out = node_colour(lvl, oc + d * t_enter, axis);
                     break;
                 }
             } else {

@@ -107,14 +107,8 @@ fn dilate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
 
 @compute @workgroup_size(1)
 fn finish() {
-    let c = brick_class(tree.depth - 1u - level.t);
-    let start = atomicLoad(&nodes[4]);
-    let end = min(atomicLoad(&nodes[1u + c]), class_capacity(c));
-    let count = select(0u, end - start, end > start);
-    let u = level.t + 1u;
-    atomicStore(&nodes[RANGES + 2u * u], class_base(tree, c) + start);
-    atomicStore(&nodes[RANGES + 2u * u + 1u], count);
-    write_args(6u + 3u * u, count * 8u);
+    let count = record_new_tiles(RANGES);
+    write_args(6u + 3u * (level.t + 1u), count * 8u);
 }
 
 

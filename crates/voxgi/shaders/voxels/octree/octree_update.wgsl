@@ -126,13 +126,8 @@ fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 
 @compute @workgroup_size(1)
 fn finish_update() {
-    let c = brick_class(tree.depth - 1u - level.t);
-    let start = atomicLoad(&nodes[4]);
-    let end = min(atomicLoad(&nodes[1u + c]), class_capacity(c));
-    let count = select(0u, end - start, end > start);
+    let count = record_new_tiles(DYN_RANGES);
     let u = level.t + 1u;
-    atomicStore(&nodes[DYN_RANGES + 2u * u], class_base(tree, c) + start);
-    atomicStore(&nodes[DYN_RANGES + 2u * u + 1u], count);
     write_args(6u + 3u * u, nodes_at(u));
     write_args(ARGS_NEW + 3u * u, count * 8u);
 }
