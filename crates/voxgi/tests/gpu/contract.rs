@@ -517,3 +517,77 @@ fn octree_sample_voxels_matches_its_cpu_twin() {
     octree_probe_matches_cpu(true);
     octree_probe_matches_cpu(false);
 }
+
+/// Interpolation is continuous across brick borders: at every level, pairs of samples a
+/// hair's breadth either side of the planes where a fetch passes from one brick to the next
+/// (level-k voxel coordinate 2m + 0.5 along x, y or z) agree, in the lit Cornell box at 32³.
+/// A brick whose border was not filled from its neighbour reads a step there (up to the
+/// opacity of a wall, ~1).
+#[test]
+fn octree_interpolation_is_continuous_across_bricks() {
+    let options = RendererOptions {
+        voxels: VoxelKind::Octree,
+        voxel_resolution: 32,
+        ..measuring()
+    };
+    let mut r = renderer(&builtin::cornell_box(), &options);
+    let params = FrameParams::new(r.default_camera().clone());
+    frame(&mut r, &params, 8, 8);
+    let grid = r.volume().get().grid();
+    let mut seed = 0x1234_5678_u32;
+    let mut rnd = move || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let mut probes = Vec::new();
+    let eps = 1e-4;
+    for level in 0..4u32 {
+        let size = (1u32 << level) as f32;
+        let cells = grid.resolution >> level;
+        for _ in 0..96 {
+            let axis = (rnd() * 3.0) as usize % 3;
+            let dir = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::Y);
+            // In level-k voxels: a brick border plane along `axis`, anywhere across the others.
+            let m = 1 + (rnd() * (cells / 2 - 1) as f32) as u32;
+            let mut q = Vec3::new(rnd(), rnd(), rnd()) * cells as f32;
+            for side in [-eps, eps] {
+                q[axis] = 2.0 * m as f32 + 0.5 + side;
+                let p = grid.origin + q * size * grid.voxel_size;
+                probes.push([
+                    p.x,
+                    p.y,
+                    p.z,
+                    size * grid.voxel_size,
+                    dir.x,
+                    dir.y,
+                    dir.z,
+                    0.0,
+                ]);
+            }
+        }
+    }
+    let got = run_probes(&r, &probes);
+    let (mut worst, mut seen) = (0.0f32, 0);
+    for (pair, q) in got.chunks_exact(2).zip(probes.chunks_exact(2)) {
+        let jump = (pair[0] - pair[1]).abs().max_element();
+        worst = worst.max(jump);
+        if pair[0].w > 0.01 {
+            seen += 1;
+        }
+        // Either side lies 2e-4 level voxels apart: opacity changes by at most a step of 1
+        // per voxel times that, plus the filtering weights' 8-bit rounding (5e-3).
+        assert!(
+            jump <= 6e-3,
+            "a step of {jump} across a brick border at {:?} (diameter {}): {} vs {}",
+            &q[0][0..3],
+            q[0][3],
+            pair[0],
+            pair[1]
+        );
+    }
+    eprintln!(
+        "brick borders: largest step {worst:.2e}, {seen} of {} pairs see voxels",
+        got.len() / 2
+    );
+    assert!(seen > got.len() / 8, "only {seen} pairs see voxels");
+}
