@@ -97,6 +97,62 @@ fn node_of_new(i: u32, t: u32) -> u32 {
     return atomicLoad(&nodes[r + 2u * t]) * 8u + i;
 }
 
+// The node at coordinate c of depth t, or NONE.
+fn node_at(c: vec3<u32>, t: u32) -> u32 {
+    var node = 0u;
+    for (var i = 0u; i < t; i++) {
+        let tile = child(node);
+        if tile == 0u || tile >= NEEDED {
+            return NONE;
+        }
+        node = tile * 8u + octant_of(c, t - 1u - i);
+    }
+    return node;
+}
+
+struct Box {
+    lo: vec3<u32>,
+    size: vec3<u32>,
+}
+
+// In an update, the box at depth t of the nodes its fragments can mark: their own and, above
+// the leaves, their negative neighbours. Empty when the update has no fragments.
+fn update_box(t: u32) -> Box {
+    let lo = vec3<u32>(atomicLoad(&nodes[BOX]), atomicLoad(&nodes[BOX + 1u]), atomicLoad(&nodes[BOX + 2u]));
+    let hi = vec3<u32>(atomicLoad(&nodes[BOX + 3u]), atomicLoad(&nodes[BOX + 4u]), atomicLoad(&nodes[BOX + 5u]));
+    if any(lo > hi) {
+        return Box(vec3<u32>(0u), vec3<u32>(0u));
+    }
+    let shift = vec3<u32>(tree.depth - t);
+    let margin = vec3<u32>(select(1u, 0u, t == tree.depth));
+    let l = (lo >> shift) - min(lo >> shift, margin);
+    return Box(l, (hi >> shift) - l + 1u);
+}
+
+// Threads of the dispatches over the nodes of depth t: every node in a build; in an update, a
+// thread per position of its box (so the update's cost follows what moved, not the static
+// octree, and its ranks follow the positions: the same layout every run).
+fn threads_at(t: u32) -> u32 {
+    if atomicLoad(&nodes[UPDATING]) == 0u {
+        return nodes_at(t);
+    }
+    let b = update_box(t);
+    return b.size.x * b.size.y * b.size.z;
+}
+
+// The node thread `i` of such a dispatch takes, or NONE.
+fn node_for_thread(i: u32, t: u32) -> u32 {
+    if atomicLoad(&nodes[UPDATING]) == 0u {
+        return node_of_depth(i, t);
+    }
+    let b = update_box(t);
+    if i >= b.size.x * b.size.y * b.size.z {
+        return NONE;
+    }
+    let p = b.lo + vec3<u32>(i % b.size.x, (i / b.size.x) % b.size.y, i / (b.size.x * b.size.y));
+    return node_at(p, t);
+}
+
 // Node n's coordinate at its depth: its tile's parent's, doubled, plus its octant.
 fn node_coord(n: u32) -> vec3<u32> {
     return 2u * unpack_coord(tiles[(n / 8u) * TILE_WORDS + 1u]) + octant_offset(n % 8u);
@@ -145,7 +201,7 @@ fn marked(n: u32) -> bool {
 
 @compute @workgroup_size(64)
 fn count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let n = node_of_depth(flat(gid, nwg), level.t);
+    let n = node_for_thread(flat(gid, nwg), level.t);
     let total = workgroup_scan(lid, u32(marked(n)));
     if lid == 63u {
         block_sums[block_index(wid, nwg)] = total;
@@ -158,7 +214,7 @@ var<workgroup> scan_blocks: u32;
 @compute @workgroup_size(64)
 fn scan(@builtin(local_invocation_index) lid: u32) {
     if lid == 0u {
-        scan_blocks = (nodes_at(level.t) + 63u) / 64u;
+        scan_blocks = (threads_at(level.t) + 63u) / 64u;
     }
     let blocks = workgroupUniformLoad(&scan_blocks);
     var offset = 0u;
@@ -185,7 +241,7 @@ fn rank(n: u32, lid: u32, wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 
 @compute @workgroup_size(64)
 fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let n = node_of_depth(flat(gid, nwg), level.t);
+    let n = node_for_thread(flat(gid, nwg), level.t);
     let r = rank(n, lid, wid, nwg);
     if !marked(n) {
         return;
@@ -259,7 +315,7 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 // Depth D: one leaf slot per newly occupied finest voxel, by rank.
 @compute @workgroup_size(64)
 fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let n = node_of_depth(flat(gid, nwg), tree.depth);
+    let n = node_for_thread(flat(gid, nwg), tree.depth);
     // An update's slots follow the static build's (STATIC_SLOTS is 0 during a build).
     let s = atomicLoad(&nodes[STATIC_SLOTS]) + rank(n, lid, wid, nwg);
     if !marked(n) {
@@ -309,7 +365,14 @@ fn prepare_slots() {
 
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = flat(gid, nwg);
+    // A build resolves every slot; an update the slots of its box's voxels (the new ones, and
+    // the static ones its fragments may have added to).
+    var s = flat(gid, nwg);
+    if atomicLoad(&nodes[UPDATING]) != 0u {
+        let n = node_for_thread(s, tree.depth);
+        let v = select(0u, child(n), n != NONE);
+        s = select(NONE, v - 1u, v != 0u && v < NEEDED);
+    }
     if s >= min(atomicLoad(&nodes[0]), tree.slots) {
         return;
     }

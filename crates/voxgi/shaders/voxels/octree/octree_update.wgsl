@@ -6,16 +6,17 @@
 //            zero the texels the last update's leaves and nodes wrote into the static bricks
 //            (their own bricks go with them); the host then copies the static build's nodes,
 //            tiles, leaves and top grid back over the last update's
-//   begin_update
-//            the ranges and dispatch sizes of this update
+//   begin_update, bounds
+//            the ranges and dispatch sizes of this update, and the box of its fragments
 // then per depth t as octree_build, but from the dynamic fragments only:
 //   flag     each fragment's node and its seven negative neighbours, where they have no
 //            children yet, are marked (a static node that has children keeps them)
-//   mark, count, scan, allocate, finish_update, init
-//            the marked nodes, static or dynamic, take tiles after the static ones
+//   mark, prepare_depth, count, scan, allocate, finish_update, init
+//            the marked nodes, static or dynamic, take tiles after the static ones, ranked by
+//            their position in the box (the marks lie in it), so the cost follows what moved
 //   repair   a static node whose negative neighbour is one of the new nodes points to it
 // and at depth D: the new voxels take slots after the static ones, the fragments' sums are
-// added (into a static leaf's, when they share its voxel), and every leaf is resolved.
+// added (into a static leaf's, when they share its voxel), and the box's leaves are resolved.
 
 //!include voxels/build_shared.wgsl
 
@@ -68,10 +69,33 @@ fn begin_update() {
         atomicStore(&nodes[DYN_RANGES + 2u * t + 1u], 0u);
     }
     atomicStore(&nodes[UPDATING], 1u);
+    for (var a = 0u; a < 3u; a++) {
+        atomicStore(&nodes[BOX + a], 0xffffffffu);
+        atomicStore(&nodes[BOX + 3u + a], 0u);
+    }
     let first = atomicLoad(&nodes[FIRST_FRAGMENT]);
     let frags = stored_fragments();
     write_args(0u, select(0u, frags - first, frags > first));
-    write_args(6u, nodes_at(0u));
+}
+
+// The box of the update's fragments.
+@compute @workgroup_size(64)
+fn bounds(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = atomicLoad(&nodes[FIRST_FRAGMENT]) + flat(gid, nwg);
+    if i >= stored_fragments() {
+        return;
+    }
+    let c = unpack_coord(fragments[i].coord);
+    for (var a = 0u; a < 3u; a++) {
+        atomicMin(&nodes[BOX + a], c[a]);
+        atomicMax(&nodes[BOX + 3u + a], c[a]);
+    }
+}
+
+// The dispatch size over the positions of depth level.t's box.
+@compute @workgroup_size(1)
+fn prepare_depth() {
+    write_args(6u + 3u * level.t, threads_at(level.t));
 }
 
 // Marks node n for children where it has none (a node with children, or marked already,
@@ -128,21 +152,7 @@ fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 fn finish_update() {
     let count = record_new_tiles(DYN_RANGES);
     let u = level.t + 1u;
-    write_args(6u + 3u * u, nodes_at(u));
     write_args(ARGS_NEW + 3u * u, count * 8u);
-}
-
-// The node at coordinate c of depth t, or NONE.
-fn node_at(c: vec3<u32>, t: u32) -> u32 {
-    var node = 0u;
-    for (var i = 0u; i < t; i++) {
-        let tile = child(node);
-        if tile == 0u || tile >= NEEDED {
-            return NONE;
-        }
-        node = tile * 8u + octant_of(c, t - 1u - i);
-    }
-    return node;
 }
 
 // The new nodes of depth level.t: a static node on their positive side along an axis points
@@ -169,5 +179,14 @@ fn repair(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
         if m != NONE && (m / 8u < dyn_start || m / 8u >= dyn_end) {
             atomicStore(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a], n);
         }
+    }
+}
+
+// The end of an update: the dispatch sizes over every node of each depth, static and dynamic,
+// for the filter (the update's own were over its box).
+@compute @workgroup_size(1)
+fn end_update() {
+    for (var t = 0u; t <= tree.depth; t++) {
+        write_args(6u + 3u * t, nodes_at(t));
     }
 }

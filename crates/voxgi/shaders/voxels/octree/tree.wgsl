@@ -78,13 +78,17 @@ struct Octree {
 // start in their class, [STATIC_SLOTS] the static build's slots, [FIRST_FRAGMENT] the first
 // fragment the running build or update reads, [UPDATING] 1 during an update; from [RANGES],
 // per depth t, the first tile and the number of tiles of the static build, from
-// [DYN_RANGES] those of the last update (after the static ones in each class).
+// [DYN_RANGES] those of the last update (after the static ones in each class); from [BOX] the
+// box of the update's fragments.
 const NODE_HEADER: u32 = 64u;
 const STATIC_SLOTS: u32 = 5u;
 const FIRST_FRAGMENT: u32 = 6u;
 const UPDATING: u32 = 7u;
 const RANGES: u32 = 8u;
 const DYN_RANGES: u32 = 32u;
+// [BOX..BOX + 3] and [BOX + 3..BOX + 6]: the smallest and largest finest-voxel coordinates of
+// an update's fragments (octree_update.wgsl's `bounds`).
+const BOX: u32 = 54u;
 const NODE_STRIDE: u32 = 4u;
 // Node 2 of the root tile stands above the root: its child pointer names the brick of level D,
 // the whole volume as one voxel (the dense volume's top mip), filtered from the root's brick.

@@ -259,6 +259,9 @@ struct UpdatePipelines {
     clear_leaves: wgpu::ComputePipeline,
     clear_nodes: wgpu::ComputePipeline,
     begin_update: wgpu::ComputePipeline,
+    bounds: wgpu::ComputePipeline,
+    prepare_depth: wgpu::ComputePipeline,
+    end_update: wgpu::ComputePipeline,
     flag: wgpu::ComputePipeline,
     mark: wgpu::ComputePipeline,
     count: wgpu::ComputePipeline,
@@ -359,6 +362,9 @@ impl OctreePipelines {
             clear_leaves: u("clear_leaves", false),
             clear_nodes: u("clear_nodes", false),
             begin_update: u("begin_update", true),
+            bounds: u("bounds", false),
+            prepare_depth: u("prepare_depth", true),
+            end_update: u("end_update", true),
             flag: u("flag", false),
             mark: u("mark", false),
             count: u("count", false),
@@ -900,12 +906,15 @@ impl OctreeVolume {
         for (live, copy) in self.snapshotted().iter().zip(snapshot) {
             encoder.copy_buffer_to_buffer(copy, 0, live, 0, live.size());
         }
-        let mut steps: Vec<(&wgpu::ComputePipeline, u32, Run)> =
-            vec![(&u.begin_update, 0, Run::Prepare)];
+        let mut steps: Vec<(&wgpu::ComputePipeline, u32, Run)> = vec![
+            (&u.begin_update, 0, Run::Prepare),
+            (&u.bounds, 0, Run::Indirect(0)),
+        ];
         for t in 0..depth {
             steps.extend([
                 (&u.flag, t, Run::Indirect(0)),
                 (&u.mark, t, Run::One),
+                (&u.prepare_depth, t, Run::Prepare),
                 (&u.count, t, over_nodes(t)),
                 (&u.scan, t, Run::One),
                 (&u.allocate, t, over_nodes(t)),
@@ -918,12 +927,15 @@ impl OctreeVolume {
         }
         steps.extend([
             (&u.flag, depth, Run::Indirect(0)),
+            (&u.prepare_depth, depth, Run::Prepare),
             (&u.count, depth, over_nodes(depth)),
             (&u.scan, depth, Run::One),
             (&u.allocate_slots, depth, over_nodes(depth)),
             (&u.accumulate, depth, Run::Indirect(0)),
             (&u.prepare_slots, depth, Run::Prepare),
-            (&u.resolve, depth, Run::Indirect(12)),
+            // Over the box's voxels (prepare_depth's size), not every slot.
+            (&u.resolve, depth, over_nodes(depth)),
+            (&u.end_update, depth, Run::Prepare),
         ]);
         self.run_steps(encoder, "octree_update", &bind, &args, &steps, timer);
     }
