@@ -492,9 +492,16 @@ fn lag(
 /// whole series' (docs/QUALITY.md has the measured values; the bounds allow a frame more).
 #[test]
 fn progressive_bounces_and_update_intervals_catch_up_after_a_change() {
+    for voxels in voxgi::VoxelKind::ALL {
+        catch_up_after_a_change(voxels);
+    }
+}
+
+fn catch_up_after_a_change(voxels: voxgi::VoxelKind) {
     let mut scene = builtin::cornell_box();
     let light = scene.lights.len() - 1;
     let base = RendererOptions {
+        voxels,
         voxel_resolution: 32,
         shadow_map_size: 256,
         ..RendererOptions::default()
@@ -529,12 +536,12 @@ fn progressive_bounces_and_update_intervals_catch_up_after_a_change() {
             want = frame(&mut fresh, &p, 32, 32);
         }
         let (frames, errors) = lag(&mut r, &p, &want, 40);
-        eprintln!("{what}: within 1 % after {frames} frames; errors {errors:.4?}");
+        eprintln!("{what} ({voxels:?}): within 1 % after {frames} frames; errors {errors:.4?}");
         results.push((what, frames));
     }
     scene.lights[light] = moved;
     // Progressive: each frame adds a bounce on top of the old light, which is close already.
-    assert!(results[0].1 <= 6, "{:?}", results[0]);
+    assert!(results[0].1 <= 6, "{voxels:?}: {:?}", results[0]);
     // Every 4th frame: the indirect light waits for the next update, at most 4 frames away.
-    assert!(results[1].1 <= 4, "{:?}", results[1]);
+    assert!(results[1].1 <= 4, "{voxels:?}: {:?}", results[1]);
 }
