@@ -363,6 +363,7 @@ impl Scene {
             if pc.colors.len() != n
                 || !ok_len(pc.normals.len())
                 || !ok_len(pc.radii.len())
+                || !ok_len(pc.regions.len())
                 || !ok_len(pc.emission.len())
             {
                 return bad(format!(

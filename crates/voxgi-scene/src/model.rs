@@ -227,6 +227,9 @@ pub struct PointCloud {
     pub normals: Vec<Vec3>,
     /// Radius of each sample's disc in metres, empty when the file has none.
     pub radii: Vec<f32>,
+    /// Edge of each sample's cubic region of influence in the voxels (seed 004 §4.3.4), in
+    /// local units; empty until `pointcloud::estimate_regions` fills it.
+    pub regions: Vec<f32>,
     /// Emitted radiance per point, empty when the points do not emit.
     pub emission: Vec<[f32; 3]>,
     pub transform: Mat4,

@@ -4,8 +4,8 @@
 //! empty, so values from the file win. Neighbour queries use a `kiddo` immutable k-d tree (which,
 //! unlike its mutable tree, copes with many identical points) and run on all cores.
 
-use crate::PointCloud;
-use glam::{DVec3, Vec3};
+use crate::{PointCloud, Scene};
+use glam::{DVec3, Mat4, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
 
@@ -139,6 +139,35 @@ pub fn estimate_radii(pc: &mut PointCloud, k: usize) {
     });
 }
 
+/// Fills the edge of each point's cubic region of influence where the cloud has none (seed 004
+/// §4.3.4): from the file's disc radius when it has one (the square of the disc's area,
+/// `sqrt(π) r`), else the Chebyshev (maximum-norm) distance to the nearest other point, which
+/// fills the space between points without overlaps. The Chebyshev nearest point is looked for
+/// among the `k` Euclidean nearest (it is within √3 of the Euclidean nearest distance, so a
+/// few are enough); points at the same position do not count as neighbours. A point without
+/// neighbours gets 0, which the voxels read as "one voxel". Call before `estimate_radii`,
+/// so that only radii from the file are used.
+pub fn estimate_regions(pc: &mut PointCloud, k: usize) {
+    if !pc.regions.is_empty() || pc.positions.is_empty() {
+        return;
+    }
+    if pc.radii.len() == pc.positions.len() {
+        let s = std::f32::consts::PI.sqrt();
+        pc.regions = pc.radii.iter().map(|&r| (s * r).max(0.0)).collect();
+        return;
+    }
+    let positions = &pc.positions;
+    pc.regions = for_each_neighbourhood(positions, k.max(1), |i, nb| {
+        let p = positions[i];
+        let d = nb
+            .iter()
+            .map(|&j| (positions[j as usize] - p).abs().max_element())
+            .filter(|&d| d > 0.0)
+            .fold(f32::INFINITY, f32::min);
+        if d.is_finite() { d } else { 0.0 }
+    });
+}
+
 /// How far the surface around each point strays from flat: the largest `|dot(q - p, n)|` and
 /// `|dot(q - p, n_q)|` over the `k` nearest neighbours `q` (normal `n_q`) of a point `p` with
 /// normal `n`, then the largest of those over
@@ -169,6 +198,152 @@ pub fn surface_spread(pc: &PointCloud, k: usize) -> Vec<f32> {
     for_each_neighbourhood(positions, k, |_, nb| {
         nb.iter().map(|&j| raw[j as usize]).fold(0.0f32, f32::max)
     })
+}
+
+/// A scene's mesh surfaces as points, as a scanner would see them: every instance becomes a
+/// point cloud with a point wherever a lattice of `spacing` metres, laid in each triangle's
+/// dominant-axis plane, falls inside the triangle (so axis-aligned surfaces get a regular
+/// square grid, and slanted ones up to √3 times sparser). Each point takes its triangle's
+/// normal (oriented like the mesh's shading normals), its material's base colour (textures are
+/// not read) and emission. Area lights' emitters stay meshes: they are lights, not geometry.
+/// Lights, cameras and materials are kept. For comparing points with the meshes they sample.
+pub fn sample_surfaces(scene: &Scene, spacing: f32) -> Scene {
+    let mut out = scene.clone();
+    out.instances.retain(|i| i.light.is_some());
+    out.animations.clear();
+    let spacing = spacing.max(1e-6) as f64;
+    for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
+        let mesh = &scene.meshes[inst.mesh];
+        let material = &scene.materials[mesh.material];
+        let normal_matrix = inst.transform.inverse().transpose();
+        let mut pc = PointCloud {
+            name: format!("{} (points)", inst.name),
+            transform: Mat4::IDENTITY,
+            ..Default::default()
+        };
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| {
+                inst.transform
+                    .transform_point3(mesh.positions[i as usize])
+                    .as_dvec3()
+            });
+            let mut n = (b - a).cross(c - a);
+            if n.length_squared() < 1e-30 {
+                continue;
+            }
+            n = n.normalize();
+            let shading: Vec3 = [t[0], t[1], t[2]]
+                .iter()
+                .filter_map(|&i| mesh.normals.get(i as usize))
+                .map(|&s| normal_matrix.transform_vector3(s))
+                .sum();
+            if n.dot(shading.as_dvec3()) < 0.0 {
+                n = -n;
+            }
+            let w = n.abs().max_position();
+            let (u, v) = ((w + 1) % 3, (w + 2) % 3);
+            let lo = a.min(b).min(c);
+            let hi = a.max(b).max(c);
+            // Offsets that differ per axis keep lattice points off the diagonal a quad's two
+            // triangles share, where both or neither might take them.
+            let (du, dv) = (0.5, 0.5 + 0.123_456_7);
+            let i0 = (lo[u] / spacing - du).ceil() as i64;
+            let i1 = (hi[u] / spacing - du).floor() as i64;
+            let j0 = (lo[v] / spacing - dv).ceil() as i64;
+            let j1 = (hi[v] / spacing - dv).floor() as i64;
+            // Edge functions in the (u, v) plane, signed so the inside is positive.
+            let edge = |p: DVec3, q: DVec3, x: f64, y: f64| {
+                (q[u] - p[u]) * (y - p[v]) - (q[v] - p[v]) * (x - p[u])
+            };
+            let sign = edge(a, b, c[u], c[v]).signum();
+            for i in i0..=i1 {
+                for j in j0..=j1 {
+                    let (x, y) = ((i as f64 + du) * spacing, (j as f64 + dv) * spacing);
+                    if sign * edge(a, b, x, y) < 0.0
+                        || sign * edge(b, c, x, y) < 0.0
+                        || sign * edge(c, a, x, y) < 0.0
+                    {
+                        continue;
+                    }
+                    let mut p = DVec3::ZERO;
+                    p[u] = x;
+                    p[v] = y;
+                    p[w] = a[w] - (n[u] * (x - a[u]) + n[v] * (y - a[v])) / n[w];
+                    pc.positions.push(p.as_vec3());
+                    pc.normals.push(n.as_vec3());
+                    let [r, g, bl, _] = material.base_color;
+                    pc.colors.push([r, g, bl]);
+                    pc.emission.push(material.emissive);
+                }
+            }
+        }
+        if pc.emission.iter().all(|e| *e == [0.0; 3]) {
+            pc.emission.clear();
+        }
+        if !pc.positions.is_empty() {
+            out.point_clouds.push(pc);
+        }
+    }
+    out
+}
+
+/// The world-space area of the triangles `sample_surfaces` samples, m².
+pub fn surface_area(scene: &Scene) -> f64 {
+    let mut area = 0.0;
+    for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
+        let mesh = &scene.meshes[inst.mesh];
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| {
+                inst.transform
+                    .transform_point3(mesh.positions[i as usize])
+                    .as_dvec3()
+            });
+            area += 0.5 * (b - a).cross(c - a).length();
+        }
+    }
+    area
+}
+
+/// A scene's meshes as point clouds of their vertices (a scan that kept a mesh's vertices, as
+/// the Stanford models' PLY files do): each instance becomes a cloud of its vertices in world
+/// space with the mesh's normals, its material's base colour and emission. Area lights'
+/// emitters stay meshes; lights, cameras and materials are kept.
+pub fn mesh_vertices(scene: &Scene) -> Scene {
+    let mut out = scene.clone();
+    out.instances.retain(|i| i.light.is_some());
+    out.animations.clear();
+    for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
+        let mesh = &scene.meshes[inst.mesh];
+        let material = &scene.materials[mesh.material];
+        let normal_matrix = inst.transform.inverse().transpose();
+        let n = mesh.positions.len();
+        let [r, g, b, _] = material.base_color;
+        let pc = PointCloud {
+            name: format!("{} (vertices)", inst.name),
+            positions: mesh
+                .positions
+                .iter()
+                .map(|&p| inst.transform.transform_point3(p))
+                .collect(),
+            normals: mesh
+                .normals
+                .iter()
+                .map(|&v| normal_matrix.transform_vector3(v).normalize_or_zero())
+                .collect(),
+            colors: vec![[r, g, b]; n],
+            emission: if material.emissive == [0.0; 3] {
+                Vec::new()
+            } else {
+                vec![material.emissive; n]
+            },
+            transform: Mat4::IDENTITY,
+            ..Default::default()
+        };
+        if n > 0 {
+            out.point_clouds.push(pc);
+        }
+    }
+    out
 }
 
 /// Eigen-decomposition of a symmetric 3×3 matrix by cyclic Jacobi rotations (robust for

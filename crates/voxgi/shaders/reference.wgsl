@@ -45,7 +45,8 @@ struct Node {
     count: u32,
 }
 
-// A world-space triangle.
+// A world-space triangle, or a point-cloud sample's disc (kind PRIM_DISC: p0 its centre, p1
+// its unit normal, p2.x its radius).
 struct Tri {
     p0: vec3<f32>,
     material: u32,
@@ -53,10 +54,13 @@ struct Tri {
     // The area light this triangle shows, or NO_INDEX.
     light: u32,
     p2: vec3<f32>,
-    _pad: u32,
+    kind: u32,
 }
 
-// Its shading attributes: vertex normals with the UVs packed in the w components.
+const PRIM_DISC: u32 = 1u;
+
+// Its shading attributes: vertex normals with the UVs packed in the w components. A disc's:
+// n0 its normal, n1 its albedo, n2 its emitted radiance.
 struct TriShading {
     n0: vec4<f32>,
     n1: vec4<f32>,
@@ -126,9 +130,27 @@ fn tri_uv(i: u32, b: vec2<f32>) -> vec2<f32> {
     return uv0 * (1.0 - b.x - b.y) + uv1 * b.x + uv2 * b.y;
 }
 
+// A disc, both sides: t (or -1).
+fn intersect_disc(tri: Tri, o: vec3<f32>, d: vec3<f32>, tmax: f32) -> vec3<f32> {
+    let n = tri.p1;
+    let dn = dot(d, n);
+    if abs(dn) < 1e-12 {
+        return vec3<f32>(-1.0, 0.0, 0.0);
+    }
+    let t = dot(tri.p0 - o, n) / dn;
+    let q = o + d * t - tri.p0;
+    if t <= 0.0 || t >= tmax || dot(q, q) > tri.p2.x * tri.p2.x {
+        return vec3<f32>(-1.0, 0.0, 0.0);
+    }
+    return vec3<f32>(t, 0.0, 0.0);
+}
+
 // Möller-Trumbore, both sides. Returns t (or -1) and the barycentrics of p1, p2.
 fn intersect_tri(i: u32, o: vec3<f32>, d: vec3<f32>, tmax: f32) -> vec3<f32> {
     let tri = tris[i];
+    if tri.kind == PRIM_DISC {
+        return intersect_disc(tri, o, d, tmax);
+    }
     let e1 = tri.p1 - tri.p0;
     let e2 = tri.p2 - tri.p0;
     let pv = cross(d, e2);
@@ -358,6 +380,12 @@ struct SurfaceHit {
 fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
     let tri = tris[h.tri];
     let sh = shading[h.tri];
+    if tri.kind == PRIM_DISC {
+        // A point: matte, as the rasterizer's surfels (metallic 0, roughness 1, specular 0.5).
+        let ng = select(-tri.p1, tri.p1, dot(tri.p1, d) < 0.0);
+        let s = Surface(sh.n1.xyz, 0.0, 1.0, 0.5);
+        return SurfaceHit(o + d * h.t, ng, ng, s, sh.n2.xyz, NO_INDEX);
+    }
     let w = vec3<f32>(1.0 - h.b.x - h.b.y, h.b.x, h.b.y);
     var ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
     var n = normalize(sh.n0.xyz * w.x + sh.n1.xyz * w.y + sh.n2.xyz * w.z);

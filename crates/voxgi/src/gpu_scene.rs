@@ -138,6 +138,48 @@ pub fn encode_octahedral(n: Vec3) -> u32 {
     snorm(x) | (snorm(y) << 16)
 }
 
+/// The unit normal `encode_octahedral` encoded, as `point_normal` in shaders/shared/surfel.wgsl
+/// decodes it; zero for `POINT_NO_NORMAL`.
+pub fn decode_octahedral(v: u32) -> Vec3 {
+    if v == POINT_NO_NORMAL {
+        return Vec3::ZERO;
+    }
+    let snorm = |b: u32| ((b as u16 as i16) as f32 / 32767.0).max(-1.0);
+    let (x, y) = (snorm(v & 0xffff), snorm(v >> 16));
+    let mut n = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+    let t = (-n.z).max(0.0);
+    n.x += if n.x >= 0.0 { -t } else { t };
+    n.y += if n.y >= 0.0 { -t } else { t };
+    n.normalize_or_zero()
+}
+
+impl GpuPoint {
+    /// The disc's unit normal (zero when it has none).
+    pub fn normal(&self) -> Vec3 {
+        decode_octahedral(self.normal)
+    }
+
+    /// Linear albedo.
+    pub fn albedo(&self) -> [f32; 3] {
+        let h = |b: u32| half::f16::from_bits(b as u16).to_f32();
+        [
+            h(self.albedo_rg),
+            h(self.albedo_rg >> 16),
+            h(self.albedo_b_emission_r),
+        ]
+    }
+
+    /// Emitted radiance, W/(m² sr).
+    pub fn emission(&self) -> [f32; 3] {
+        let h = |b: u32| half::f16::from_bits(b as u16).to_f32();
+        [
+            h(self.albedo_b_emission_r >> 16),
+            h(self.emission_gb),
+            h(self.emission_gb >> 16),
+        ]
+    }
+}
+
 /// IEEE half-precision bits of `v` (round to nearest even), clamped to the finite range; NaN and
 /// negative values become 0 (albedo and radiance are never negative).
 pub fn half_bits(v: f32) -> u16 {
@@ -269,6 +311,9 @@ pub struct GpuScene {
     /// tangent plane, in metres (`pointcloud::surface_spread`); shadow maps push the surfel
     /// that far away from the light so noisy scans do not shadow themselves.
     pub point_spread: wgpu::Buffer,
+    /// One f32 per point (splat pass only): the edge of its cubic region of influence in the
+    /// voxels, in metres (`pointcloud::estimate_regions`; 0 for a point alone).
+    pub point_regions: wgpu::Buffer,
     /// Number of points in `points`.
     pub point_count: u32,
     /// Every material texture as one layer of a square RGBA8 sRGB 2D array with a full mip
@@ -447,7 +492,11 @@ impl GpuScene {
             })
             .collect();
         let lights = gpu_lights(scene);
-        let (points, spread) = gpu_points(scene);
+        let GpuPoints {
+            points,
+            spread,
+            regions,
+        } = gpu_points(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
             let mut data = bytes.to_vec();
@@ -491,6 +540,7 @@ impl GpuScene {
             lights: storage("lights", bytemuck::cast_slice(&lights), 96),
             points: storage("points", bytemuck::cast_slice(&points), 32),
             point_spread: storage("point spread", bytemuck::cast_slice(&spread), 4),
+            point_regions: storage("point regions", bytemuck::cast_slice(&regions), 4),
             point_count: points.len() as u32,
             texture_view: textures.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -544,6 +594,7 @@ impl GpuScene {
             ("lights", self.lights.size()),
             ("points", self.points.size()),
             ("point spread", self.point_spread.size()),
+            ("point regions", self.point_regions.size()),
             ("textures", tex),
         ]
     }
@@ -552,11 +603,11 @@ impl GpuScene {
 /// Surfels of every point cloud in world space: positions by the cloud's transform, normals by
 /// its inverse transpose, radii by its mean scale. Attributes a cloud lacks get defaults here
 /// (no normal: the disc faces the viewer; radius 0: not drawn; grey albedo; no emission); the
-/// renderer estimates normals and radii before uploading. The second result is each point's
-/// world-space surface spread (see `GpuScene::point_spread`).
-pub fn gpu_points(scene: &Scene) -> (Vec<GpuPoint>, Vec<f32>) {
+/// renderer estimates normals, radii and regions before uploading.
+pub fn gpu_points(scene: &Scene) -> GpuPoints {
     let mut out = Vec::with_capacity(scene.point_count());
     let mut spread_out = Vec::with_capacity(scene.point_count());
+    let mut regions = Vec::with_capacity(scene.point_count());
     for pc in &scene.point_clouds {
         if pc.positions.is_empty() {
             continue;
@@ -588,6 +639,8 @@ pub fn gpu_points(scene: &Scene) -> (Vec<GpuPoint>, Vec<f32>) {
             });
             let r = pc.radii.get(i).map_or(0.0, |&r| r * scale);
             let r = if r.is_finite() { r.max(0.0) } else { 0.0 };
+            let e = pc.regions.get(i).map_or(0.0, |&e| e * scale);
+            regions.push(if e.is_finite() { e.max(0.0) } else { 0.0 });
             out.push(GpuPoint::new(
                 m.transform_point3(p),
                 r,
@@ -597,7 +650,21 @@ pub fn gpu_points(scene: &Scene) -> (Vec<GpuPoint>, Vec<f32>) {
             ));
         }
     }
-    (out, spread_out)
+    GpuPoints {
+        points: out,
+        spread: spread_out,
+        regions,
+    }
+}
+
+/// The point clouds as the GPU takes them, one entry per point in each.
+pub struct GpuPoints {
+    /// The surfels.
+    pub points: Vec<GpuPoint>,
+    /// World-space surface spread (see `GpuScene::point_spread`).
+    pub spread: Vec<f32>,
+    /// World-space edge of the region of influence (see `GpuScene::point_regions`).
+    pub regions: Vec<f32>,
 }
 
 /// All material textures go into one RGBA8 sRGB 2D array at a common power-of-two size, so that

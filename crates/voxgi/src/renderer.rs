@@ -18,6 +18,7 @@
 //! for everything, and no frame waits for the GPU.
 
 use crate::brdf::BrdfTables;
+use crate::fragments::splat::SplatPass;
 use crate::fragments::voxelize::VoxelizePass;
 use crate::fragments::{self, FragmentEstimate, Fragments, TriangleTable, triangle_table};
 use crate::gpu::feedback::CounterReadback;
@@ -48,9 +49,10 @@ use wgpu::util::DeviceExt;
 
 /// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
 /// camera), in the order they run; every other pass is the screen's.
-pub const VOXEL_PASSES: [&str; 10] = [
+pub const VOXEL_PASSES: [&str; 11] = [
     "shadow",
     "voxelize",
+    "splat",
     "dense_build",
     "dense_update",
     "octree_build",
@@ -65,6 +67,7 @@ pub const VOXEL_PASSES: [&str; 10] = [
 struct Passes {
     shadow: ShadowPass,
     voxelize: VoxelizePass,
+    splat: SplatPass,
     inject: InjectPass,
     bounce: BouncePass,
     gbuffer: GbufferPass,
@@ -83,9 +86,20 @@ pub struct VoxelCounts {
     pub occupied: u64,
 }
 
-/// Fills in normals (k = 16) and disc radii (k = 8) of point clouds that lack them. Normals face
-/// the cloud's local origin when that lies outside the cloud's bounds (scanners put the sensor
-/// there), else the default camera.
+/// `estimate_point_attributes` when a point cloud lacks any, on a copy of the scene. The
+/// renderer and the path tracer both call it, so both see the same points.
+pub(crate) fn complete_point_attributes(scene: &mut std::borrow::Cow<'_, Scene>) {
+    if scene.point_clouds.iter().any(|pc| {
+        !pc.positions.is_empty()
+            && (pc.normals.is_empty() || pc.radii.is_empty() || pc.regions.is_empty())
+    }) {
+        estimate_point_attributes(scene.to_mut());
+    }
+}
+
+/// Fills in normals (k = 16), regions of influence and disc radii (k = 8) of point clouds that
+/// lack them. Normals face the cloud's local origin when that lies outside the cloud's bounds
+/// (scanners put the sensor there), else the default camera.
 fn estimate_point_attributes(scene: &mut Scene) {
     let camera = scene
         .cameras
@@ -94,7 +108,9 @@ fn estimate_point_attributes(scene: &mut Scene) {
         .unwrap_or_else(|| scene.default_camera())
         .position;
     for pc in &mut scene.point_clouds {
-        if pc.positions.is_empty() || (!pc.normals.is_empty() && !pc.radii.is_empty()) {
+        if pc.positions.is_empty()
+            || (!pc.normals.is_empty() && !pc.radii.is_empty() && !pc.regions.is_empty())
+        {
             continue;
         }
         let start = std::time::Instant::now();
@@ -109,12 +125,18 @@ fn estimate_point_attributes(scene: &mut Scene) {
         } else {
             camera
         };
-        let what = match (pc.normals.is_empty(), pc.radii.is_empty()) {
-            (true, true) => "normals and radii",
-            (true, false) => "normals",
-            _ => "radii",
-        };
+        let what: Vec<&str> = [
+            (pc.normals.is_empty(), "normals"),
+            (pc.radii.is_empty(), "radii"),
+            (pc.regions.is_empty(), "regions of influence"),
+        ]
+        .into_iter()
+        .filter_map(|(missing, name)| missing.then_some(name))
+        .collect();
+        let what = what.join(", ");
         pointcloud::estimate_normals(pc, 16, viewpoint);
+        // Regions first: they take the file's radii, not estimated ones.
+        pointcloud::estimate_regions(pc, 8);
         pointcloud::estimate_radii(pc, 8);
         log::info!(
             "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
@@ -249,13 +271,7 @@ impl Renderer {
             return Err(Error::EmptyScene);
         }
         let mut scene = lit_scene(scene, options.default_light);
-        if scene
-            .point_clouds
-            .iter()
-            .any(|pc| !pc.positions.is_empty() && (pc.normals.is_empty() || pc.radii.is_empty()))
-        {
-            estimate_point_attributes(scene.to_mut());
-        }
+        complete_point_attributes(&mut scene);
         let scene = scene.as_ref();
         let mut gpu_scene = checked(device, "scene upload", || {
             GpuScene::new(device, queue, scene, options)
@@ -291,6 +307,7 @@ impl Renderer {
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             voxelize: VoxelizePass::new(device),
+            splat: SplatPass::new(device),
             inject: InjectPass::new(
                 device,
                 options.voxels,
@@ -703,6 +720,9 @@ impl Renderer {
                 &self.fragments,
                 timer,
             );
+            // Point clouds are static: the renderer places them once.
+            p.splat
+                .record(&self.device, encoder, &self.scene, &self.fragments, timer);
             self.fragments.record_mark(encoder);
             self.volume
                 .get()

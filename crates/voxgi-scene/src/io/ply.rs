@@ -10,7 +10,9 @@
 //!
 //! Read: `vertex` element with `x y z` (float or double), optional `nx ny nz`, optional colour
 //! `red green blue` or `diffuse_red ...` (integer types are sRGB-encoded and scaled by the type's
-//! maximum, floats are linear in [0, 1]), optional `radius`; `face` element with a
+//! maximum, floats are linear in [0, 1]), optional `radius`, optional emitted radiance
+//! `emission_red emission_green emission_blue` (or `emission_r ...`; linear W/(m² sr), any
+//! numeric type; point clouds only, a mesh takes its emission from its material); `face` element with a
 //! `vertex_indices` or `vertex_index` list (polygons become triangle fans). Other elements and
 //! properties are parsed and skipped. With faces the result is a mesh, without a point cloud.
 
@@ -321,6 +323,7 @@ struct VertexLayout {
     pos: [Option<usize>; 3],
     normal: [Option<usize>; 3],
     color: [Option<usize>; 3],
+    emission: [Option<usize>; 3],
     radius: Option<usize>,
 }
 
@@ -385,6 +388,9 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
                 slot(&mut layout.color, 2);
                 color_ty[2] = p.ty;
             }
+            "emission_red" | "emission_r" => slot(&mut layout.emission, 0),
+            "emission_green" | "emission_g" => slot(&mut layout.emission, 1),
+            "emission_blue" | "emission_b" => slot(&mut layout.emission, 2),
             "radius" => layout.radius = Some(i),
             _ => {}
         }
@@ -394,12 +400,19 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
     };
     let has_normals = layout.normal.iter().all(Option::is_some);
     let has_colors = layout.color.iter().all(Option::is_some);
+    let has_emission = layout.emission.iter().all(Option::is_some);
+    if !has_emission && layout.emission.iter().any(Option::is_some) {
+        return Err("vertex element has some but not all of the emission_red, \
+                    emission_green, emission_blue properties"
+            .into());
+    }
 
     let nv = h.elements[vertex_el].count;
     let mut positions = Vec::with_capacity(nv);
     let mut normals = Vec::with_capacity(if has_normals { nv } else { 0 });
     let mut colors = Vec::with_capacity(if has_colors { nv } else { 0 });
     let mut radii = Vec::with_capacity(if layout.radius.is_some() { nv } else { 0 });
+    let mut emission = Vec::with_capacity(if has_emission { nv } else { 0 });
     let mut indices: Vec<u32> = Vec::new();
     let mut face_count = 0usize;
     let mut skipped_faces = 0usize;
@@ -496,6 +509,15 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
                 if let Some(k) = layout.radius {
                     radii.push(values[k] as f32);
                 }
+                if has_emission {
+                    let e = [0, 1, 2].map(|k| get(layout.emission[k]) as f32);
+                    if e.iter().any(|v| !v.is_finite() || *v < 0.0) {
+                        return Err(format!(
+                            "vertex {r}: emission {e:?} is not a finite radiance >= 0"
+                        ));
+                    }
+                    emission.push(e);
+                }
             } else if face_prop.is_some() {
                 if list.len() < 3 {
                     skipped_faces += 1;
@@ -574,7 +596,8 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
             },
             normals,
             radii,
-            emission: Vec::new(),
+            regions: Vec::new(),
+            emission,
             transform: Mat4::IDENTITY,
             dynamic: false,
         });

@@ -151,6 +151,16 @@ struct Include {
     #[serde(default)]
     dynamic: bool,
     material: Option<MaterialOverride>,
+    points: Option<AsPoints>,
+}
+
+/// An include's meshes as point clouds: `"vertices"` (the meshes' vertices) or a number (the
+/// surfaces sampled on a lattice of that many metres, `pointcloud::sample_surfaces`).
+#[derive(Deserialize, Debug, Clone)]
+#[serde(untagged)]
+enum AsPoints {
+    Spacing(f32),
+    Named(String),
 }
 
 #[derive(Deserialize, Debug, Clone, Copy)]
@@ -307,6 +317,29 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         if let Some(o) = &inc.material {
             apply_override(&mut sub, o).map_err(|r| err(format!("{what}: {r}")))?;
         }
+        match &inc.points {
+            None => {}
+            Some(AsPoints::Named(n)) if n == "vertices" => {
+                sub = crate::pointcloud::mesh_vertices(&sub);
+            }
+            Some(AsPoints::Spacing(h)) if h.is_finite() && *h > 0.0 => {
+                // Each point of the lattice stands for at least h² of surface.
+                let count = crate::pointcloud::surface_area(&sub) / (*h as f64 * *h as f64);
+                if count > crate::limits::MAX_ELEMENTS as f64 {
+                    return Err(err(format!(
+                        "{what}: `points = {h}` would sample about {count:.0} points, more than \
+                         the {} a cloud may hold",
+                        crate::limits::MAX_ELEMENTS
+                    )));
+                }
+                sub = crate::pointcloud::sample_surfaces(&sub, *h);
+            }
+            Some(p) => {
+                return Err(err(format!(
+                    "{what}: `points` must be \"vertices\" or a spacing in metres > 0, not {p:?}"
+                )));
+            }
+        }
         let scale = match inc.scale {
             None => Vec3::ONE,
             Some(Scale::Uniform(s)) => Vec3::splat(s),
@@ -400,6 +433,14 @@ fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Resul
     ] {
         if v.is_some_and(|v| !(0.0..=1.0).contains(&v)) {
             return Err(format!("material {k} must be in [0, 1]"));
+        }
+    }
+    for pc in &mut scene.point_clouds {
+        if let Some(c) = o.base_color {
+            pc.colors.fill(c);
+        }
+        if let Some(e) = o.emissive {
+            pc.emission = vec![e; pc.positions.len()];
         }
     }
     for m in &mut scene.materials {

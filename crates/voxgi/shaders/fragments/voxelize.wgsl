@@ -35,6 +35,7 @@ fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emissio
             pack4x8unorm(vec4<f32>(albedo, coverage)),
             pack2x16snorm(oct_encode(n)),
             pack_rgb9e5(emission),
+            WEIGHT_ONE,
         );
     }
 }

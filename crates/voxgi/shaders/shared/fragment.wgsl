@@ -1,6 +1,6 @@
 // Voxel fragments: the one interface between geometry (meshes, points) and voxel structures.
-// 16 bytes: voxel coordinates, albedo + opacity, normal, emission. A structure is built from
-// these and nothing else. The fragment buffer's length is its capacity: a pass that makes
+// 20 bytes: voxel coordinates, albedo + coverage, normal, emission, weight. A structure is
+// built from these and nothing else. The fragment buffer's length is its capacity: a pass that makes
 // fragments counts every one in `fragment_count[0]` and stores those that fit.
 
 // Where the finest voxels lie: the grid every structure shares. Twin: `GpuFragmentGrid` in
@@ -12,7 +12,8 @@ struct FragmentGrid {
     resolution: u32,
     // World size of a voxel.
     voxel_size: f32,
-    _pad0: u32,
+    // 1 / voxel_size, rounded once on the host (shaders multiply, so their CPU twins agree).
+    inv_voxel_size: f32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -26,7 +27,21 @@ struct Fragment {
     normal: u32,
     // Emitted radiance as RGB9E5.
     emission: u32,
+    // Bits 0-30: the fragment's share of its voxel's surface, in 1/WEIGHT_ONE voxel faces: a
+    // mesh fragment stands for the whole surface it has in the voxel (WEIGHT_ONE), a point for
+    // the part of its area its region of influence puts in the voxel (splat.wgsl). Bit 31
+    // (DENSITY): the fragment's opacity is that share (points, seed 004 §4.3.4), not its
+    // coverage (meshes).
+    weight: u32,
 }
+
+const WEIGHT_ONE: u32 = 4096u;
+const DENSITY: u32 = 0x80000000u;
+// The surface share at which a voxel of points is opaque: half a voxel face. A surface that
+// crosses a voxel's grid plane splits its points between the two voxels beside it, and one of
+// them holds at least half: so every ray across a point-sampled surface meets an opaque voxel,
+// as it meets one of the voxels a mesh's conservative voxelization fills.
+const DENSITY_OPAQUE: f32 = 0.5;
 
 fn pack_coord(c: vec3<u32>) -> u32 {
     return c.x | (c.y << 10u) | (c.z << 20u);
@@ -76,29 +91,39 @@ fn unpack_rgb9e5(v: u32) -> vec3<f32> {
     return vec3<f32>(f32(v & 511u), f32((v >> 9u) & 511u), f32((v >> 18u) & 511u)) * scale;
 }
 
-// A voxel's attributes are integer sums of its fragments' (so the result does not depend on
-// the order atomics add them: deterministic), then averages. FRAGMENT_SUMS u32 per voxel:
-// count, albedo rgb (8-bit units), normal xyz (snorm16 units, two's complement), emission
-// rgb (1/EMISSION_SCALE units); the coverage (how much of the voxel a fragment's solid fills,
-// 8-bit units) is kept as a maximum beside them.
-const FRAGMENT_SUMS: u32 = 10u;
-const EMISSION_SCALE: f32 = 4096.0;
+// A voxel's attributes are weighted integer sums of its fragments' (so the result does not
+// depend on the order atomics add them: deterministic), then averages. FRAGMENT_SUMS u32 per
+// voxel: weight, weight x albedo rgb (8-bit units), weight x normal xyz (1/NORMAL_UNITS units,
+// two's complement), weight x emission rgb (1/EMISSION_SCALE units), then the weight of the
+// density fragments (points); the coverage (how much of the voxel a mesh fragment's solid
+// fills, 8-bit units) is kept as a maximum beside them. The units bound what a voxel holds
+// before a sum wraps: 1024 mesh fragments (the normal sums, i32), and emission x fragments
+// below 16384 W/(m² sr); points weigh a fraction of a mesh fragment each.
+const FRAGMENT_SUMS: u32 = 11u;
+const NORMAL_UNITS: f32 = 512.0;
+const EMISSION_SCALE: f32 = 64.0;
 
-fn fragment_sums(f: Fragment) -> array<u32, 10> {
+fn fragment_weight(f: Fragment) -> u32 {
+    return f.weight & ~DENSITY;
+}
+
+fn fragment_sums(f: Fragment) -> array<u32, 11> {
+    let w = fragment_weight(f);
     let albedo = unpack4x8unorm(f.albedo);
-    let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * 32767.0));
-    let e = vec3<u32>(round(unpack_rgb9e5(f.emission) * EMISSION_SCALE));
-    return array<u32, 10>(
-        1u,
-        u32(round(albedo.r * 255.0)),
-        u32(round(albedo.g * 255.0)),
-        u32(round(albedo.b * 255.0)),
+    let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * NORMAL_UNITS)) * i32(w);
+    let e = vec3<u32>(round(unpack_rgb9e5(f.emission) * EMISSION_SCALE)) * w;
+    return array<u32, 11>(
+        w,
+        u32(round(albedo.r * 255.0)) * w,
+        u32(round(albedo.g * 255.0)) * w,
+        u32(round(albedo.b * 255.0)) * w,
         bitcast<u32>(n.x),
         bitcast<u32>(n.y),
         bitcast<u32>(n.z),
         e.r,
         e.g,
         e.b,
+        select(0u, w, (f.weight & DENSITY) != 0u),
     );
 }
 
@@ -107,29 +132,33 @@ fn fragment_coverage(f: Fragment) -> u32 {
 }
 
 // What a voxel's sums resolve to: albedo (rgb) and opacity, mean normal (xyz) and how well the
-// fragments' normals agree (w: 1 one orientation, ~0 opposite faces), emitted radiance.
+// fragments' normals agree (w, the length of their mean: 1 one orientation, ~0 opposite faces;
+// Toksvig's measure of the normal distribution's spread), emitted radiance.
 struct VoxelAttributes {
     albedo: vec4<f32>,
     normal: vec4<f32>,
     emission: vec3<f32>,
 }
 
-fn resolve_sums(sum: array<u32, 10>, coverage: u32) -> VoxelAttributes {
-    let count = f32(max(sum[0], 1u));
-    let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * count);
+fn resolve_sums(sum: array<u32, 11>, coverage: u32) -> VoxelAttributes {
+    let weight = f32(max(sum[0], 1u));
+    let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * weight);
     let nsum = vec3<f32>(
         f32(bitcast<i32>(sum[4])),
         f32(bitcast<i32>(sum[5])),
         f32(bitcast<i32>(sum[6])),
-    ) / (32767.0 * count);
-    let e = vec3<f32>(f32(sum[7]), f32(sum[8]), f32(sum[9])) / (EMISSION_SCALE * count);
-    let len = length(nsum);
+    ) / (NORMAL_UNITS * weight);
+    let e = vec3<f32>(f32(sum[7]), f32(sum[8]), f32(sum[9])) / (EMISSION_SCALE * weight);
+    let len = min(length(nsum), 1.0);
     // A voxel static geometry touches blocks all rays through it: opacity 1 (conservative).
     // Dynamic geometry fills the voxels its surface crosses by how much of them lies inside
     // it (voxelize.wgsl), so it moves through the grid smoothly instead of a voxel at a time.
+    // Points make a voxel as opaque as the surface they put in it (DENSITY_OPAQUE).
+    let density = f32(sum[10]) / (DENSITY_OPAQUE * f32(WEIGHT_ONE));
+    let opacity = max(f32(coverage) / 255.0, min(density, 1.0));
     return VoxelAttributes(
-        vec4<f32>(albedo, f32(coverage) / 255.0),
-        vec4<f32>(select(vec3<f32>(0.0), nsum / len, len > 1e-4), len),
+        vec4<f32>(albedo, opacity),
+        vec4<f32>(select(vec3<f32>(0.0), nsum / length(nsum), len > 1e-4), len),
         e,
     );
 }

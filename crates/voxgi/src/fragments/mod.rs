@@ -4,6 +4,7 @@
 //! its capacity; the count runs past it when a build overflowed, and the renderer grows the
 //! buffer a frame later.
 
+pub mod splat;
 pub mod voxelize;
 
 use crate::gpu_scene::GpuScene;
@@ -13,7 +14,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 /// Bytes per fragment (`Fragment` in shaders/shared/fragment.wgsl).
-pub const FRAGMENT_BYTES: u64 = 16;
+pub const FRAGMENT_BYTES: u64 = 20;
 
 /// Mirrors `FragmentGrid` in shaders/shared/fragment.wgsl.
 #[repr(C)]
@@ -25,8 +26,10 @@ pub struct GpuFragmentGrid {
     pub resolution: u32,
     /// Edge length of a voxel, metres.
     pub voxel_size: f32,
+    /// `1 / voxel_size`.
+    pub inv_voxel_size: f32,
     /// Padding to the WGSL struct's 32 bytes; zero.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// The fragment buffer of one grid, and its count.
@@ -53,7 +56,8 @@ impl Fragments {
             origin: grid.origin.to_array(),
             resolution: grid.resolution,
             voxel_size: grid.voxel_size,
-            _pad: [0; 3],
+            inv_voxel_size: 1.0 / grid.voxel_size,
+            _pad: [0; 2],
         };
         let storage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_DST
@@ -116,9 +120,12 @@ pub fn capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
     crate::gpu::pool_capacity(device, wanted, FRAGMENT_BYTES, "voxel fragments")
 }
 
-/// An upper bound on the fragments a scene makes on a grid: per triangle, the columns its
-/// dominant-axis projection can touch times the three voxels a column can hold. Kept as sums
-/// over the triangles in metres, so it can be evaluated for any grid without the scene.
+/// How many fragments a scene makes on a grid, to size the first fragment buffer (a short one
+/// grows a frame later): per triangle, an upper bound, the columns its
+/// dominant-axis projection can touch times the three voxels a column can hold; per point, the
+/// voxels its region of influence overlaps on average ((1 + e)³ for an edge of e voxels, at
+/// most 8). Kept as sums over the triangles and points in metres, so it can be evaluated for
+/// any grid without the scene.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FragmentEstimate {
     /// Sum of the triangles' dominant-axis projected areas, m².
@@ -126,6 +133,9 @@ pub struct FragmentEstimate {
     /// Sum of their perimeters, m.
     perimeter: f64,
     triangles: u64,
+    points: u64,
+    /// Sums of the points' region edges, their squares and cubes (m, m², m³).
+    edges: [f64; 3],
 }
 
 impl FragmentEstimate {
@@ -147,14 +157,32 @@ impl FragmentEstimate {
                 e.triangles += k as u64;
             }
         }
+        for pc in &scene.point_clouds {
+            let scale = pc.transform.determinant().abs().cbrt() as f64;
+            e.points += pc.positions.len() as u64;
+            for &r in &pc.regions {
+                let r = r as f64 * scale;
+                if r.is_finite() {
+                    e.edges[0] += r;
+                    e.edges[1] += r * r;
+                    e.edges[2] += r * r * r;
+                }
+            }
+        }
         e
     }
 
     /// The bound on `grid`.
     pub fn at(&self, grid: &Grid) -> u64 {
         let inv = 1.0 / grid.voxel_size as f64;
-        (3.0 * (self.area * inv * inv + self.perimeter * inv + 2.0 * self.triangles as f64)).ceil()
-            as u64
+        let triangles =
+            3.0 * (self.area * inv * inv + self.perimeter * inv + 2.0 * self.triangles as f64);
+        // Regions wider than a voxel are clipped to one, so the sum can overshoot: cap it.
+        let [e1, e2, e3] = self.edges;
+        let points =
+            (self.points as f64 + 3.0 * e1 * inv + 3.0 * e2 * inv * inv + e3 * inv * inv * inv)
+                .min(8.0 * self.points as f64);
+        (triangles + points).ceil() as u64
     }
 }
 

@@ -41,6 +41,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "lighting/shadow.wgsl",
     "screen/gbuffer.wgsl",
     "fragments/voxelize.wgsl",
+    "fragments/splat.wgsl",
     "voxels/dense/build_shared.wgsl",
     "voxels/dense/dense_build.wgsl",
     "voxels/dense/dense_update.wgsl",

@@ -1,8 +1,9 @@
 //! The ground truth: a GPU path tracer over the same scene, materials and lights as the
 //! rasterizer, and an ambient-occlusion reference.
 //!
-//! All mesh instances are flattened into world-space triangles, a BVH is built on the CPU
-//! (obvhs' PLOC builder) and flattened into a node array the compute shader
+//! All mesh instances are flattened into world-space triangles and all point clouds into the
+//! oriented discs the rasterizer draws for them, a BVH is built on the CPU (obvhs' PLOC
+//! builder) and flattened into a node array the compute shader
 //! (`shaders/reference.wgsl`) walks with a stack. Samples accumulate in an f32 buffer, a batch
 //! per submit, so long renders report progress and never hold the GPU for long.
 
@@ -128,7 +129,9 @@ pub struct GpuNode {
     pub count: u32,
 }
 
-/// Mirrors `Tri` in shaders/reference.wgsl.
+/// Mirrors `Tri` in shaders/reference.wgsl: a triangle, or a point's disc (`kind`
+/// `PRIM_DISC`: `p0` its centre, `p1` its unit normal, `p2.x` its radius; its albedo and
+/// emission in `GpuTriShading::n1` and `n2`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuTri {
@@ -142,9 +145,14 @@ pub struct GpuTri {
     pub light: u32,
     /// Third vertex, world space, metres.
     pub p2: [f32; 3],
-    /// Padding to a multiple of 16 bytes; zero.
-    pub _pad: u32,
+    /// `PRIM_TRIANGLE` or `PRIM_DISC`.
+    pub kind: u32,
 }
+
+/// `GpuTri::kind` of a triangle.
+pub const PRIM_TRIANGLE: u32 = 0;
+/// `GpuTri::kind` of a point's disc.
+pub const PRIM_DISC: u32 = 1;
 
 /// Mirrors `TriShading` in shaders/reference.wgsl.
 #[repr(C)]
@@ -218,7 +226,7 @@ pub fn flatten(scene: &Scene) -> FlatScene {
                 p1: p[1].to_array(),
                 light,
                 p2: p[2].to_array(),
-                _pad: 0,
+                kind: PRIM_TRIANGLE,
             });
             shading.push(GpuTriShading {
                 n0: n[0].extend(uv[0].x).to_array(),
@@ -228,17 +236,54 @@ pub fn flatten(scene: &Scene) -> FlatScene {
             });
         }
     }
+    // The discs the rasterizer draws: the same points, normals, radii and colours.
+    let mut faceless = 0usize;
+    for p in crate::gpu_scene::gpu_points(scene).points {
+        let n = p.normal();
+        if n == Vec3::ZERO || p.radius.is_nan() || p.radius <= 0.0 {
+            // Not drawn (radius 0) or drawn facing the viewer, which a ray cannot know.
+            faceless += 1;
+            continue;
+        }
+        tris.push(GpuTri {
+            p0: p.position,
+            material: 0,
+            p1: n.to_array(),
+            light: NO_INDEX,
+            p2: [p.radius, 0.0, 0.0],
+            kind: PRIM_DISC,
+        });
+        let [r, g, b] = p.albedo();
+        let [er, eg, eb] = p.emission();
+        shading.push(GpuTriShading {
+            n0: [n.x, n.y, n.z, 0.0],
+            n1: [r, g, b, 0.0],
+            n2: [er, eg, eb, 0.0],
+            uv: [0.0; 4],
+        });
+    }
+    if faceless > 0 {
+        log::warn!("reference: {faceless} points without a normal or a radius are left out");
+    }
     let v = |a: [f32; 3]| glam_obvhs::Vec3A::from_array(a);
-    let prims: Vec<obvhs::triangle::Triangle> = tris
+    let bounds: Vec<obvhs::aabb::Aabb> = tris
         .iter()
-        .map(|t| obvhs::triangle::Triangle {
-            v0: v(t.p0),
-            v1: v(t.p1),
-            v2: v(t.p2),
+        .map(|t| {
+            if t.kind == PRIM_DISC {
+                // A disc of radius r and unit normal n spans r sqrt(1 - n_i²) along axis i.
+                let (c, n) = (Vec3::from(t.p0), Vec3::from(t.p1));
+                let e = (Vec3::ONE - n * n).max(Vec3::ZERO).map(f32::sqrt) * t.p2[0];
+                obvhs::aabb::Aabb::new(v((c - e).to_array()), v((c + e).to_array()))
+            } else {
+                let mut b = obvhs::aabb::Aabb::new(v(t.p0), v(t.p0));
+                b.extend(v(t.p1));
+                b.extend(v(t.p2));
+                b
+            }
         })
         .collect();
-    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
-        &prims,
+    let bvh = obvhs::bvh2::builder::build_bvh2(
+        &bounds,
         obvhs::BvhBuildParams::medium_build(),
         &mut std::time::Duration::default(),
     );
@@ -291,10 +336,11 @@ impl PathTracer {
     ) -> Result<Self> {
         options.validate()?;
         scene.validate()?;
-        if scene.triangle_count() == 0 {
+        if scene.triangle_count() == 0 && scene.point_count() == 0 {
             return Err(Error::EmptyScene);
         }
-        let scene = lit_scene(scene, options.default_light);
+        let mut scene = lit_scene(scene, options.default_light);
+        crate::renderer::complete_point_attributes(&mut scene);
         let scene = scene.as_ref();
         let device = device.clone();
         let queue = queue.clone();

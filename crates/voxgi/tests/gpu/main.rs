@@ -11,6 +11,7 @@ mod embed;
 mod errors;
 mod golden;
 mod options;
+mod point_gi;
 mod points;
 mod reference;
 mod shaders;

@@ -36,6 +36,7 @@ fn grid(normals: bool, radii: bool) -> PointCloud {
         } else {
             vec![]
         },
+        regions: vec![],
         emission: vec![],
         transform: Mat4::IDENTITY,
         dynamic: false,

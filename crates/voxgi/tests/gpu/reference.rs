@@ -24,7 +24,7 @@ fn trace(
     trace_with(scene, options, &clamped(cam), w, h, opts)
 }
 
-fn trace_with(
+pub(crate) fn trace_with(
     scene: &Scene,
     options: &RendererOptions,
     params: &FrameParams,
@@ -37,7 +37,7 @@ fn trace_with(
         .expect("reference render")
 }
 
-fn opts(spp: u32, bounces: Bounces) -> ReferenceOptions {
+pub(crate) fn opts(spp: u32, bounces: Bounces) -> ReferenceOptions {
     ReferenceOptions {
         spp,
         bounces,
@@ -380,7 +380,7 @@ fn reference_area_light_is_counted_once() {
 }
 
 /// Mean radiance of a pixel rectangle (all channels).
-fn region(out: &RenderOutput, x0: u32, y0: u32, x1: u32, y1: u32) -> f32 {
+pub(crate) fn region(out: &RenderOutput, x0: u32, y0: u32, x1: u32, y1: u32) -> f32 {
     let mut s = 0.0;
     for y in y0..y1 {
         for x in x0..x1 {

@@ -36,12 +36,12 @@
 // one dispatch).
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
 
-const ACCUM_STRIDE: u32 = 11u;
-const ACCUM_SUMS: u32 = 10u;
-const ACCUM_COVERAGE: u32 = 10u;
-const DYN_STRIDE: u32 = 13u;
-const DYN_FLAG: u32 = 11u;
-const DYN_LIST: u32 = 12u;
+const ACCUM_STRIDE: u32 = 12u;
+const ACCUM_SUMS: u32 = FRAGMENT_SUMS;
+const ACCUM_COVERAGE: u32 = FRAGMENT_SUMS;
+const DYN_STRIDE: u32 = 14u;
+const DYN_FLAG: u32 = 12u;
+const DYN_LIST: u32 = 13u;
 
 // Entry `i` of the touched list.
 fn touched(i: u32) -> u32 {
@@ -94,7 +94,7 @@ fn add_fragment(s: u32, f: Fragment, dynamic: bool) {
 // finest level's albedo/opacity, normal and emission.
 fn resolve_slot(s: u32, dynamic: bool) {
     let base = s * ACCUM_STRIDE;
-    var sum = array<u32, 10>();
+    var sum = array<u32, FRAGMENT_SUMS>();
     for (var k = 0u; k < ACCUM_SUMS; k++) {
         sum[k] = atomicLoad(&accum[base + k]);
         if dynamic {

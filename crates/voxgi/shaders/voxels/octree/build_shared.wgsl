@@ -377,7 +377,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let base = s * SLOT_STRIDE;
-    var sum = array<u32, 10>();
+    var sum = array<u32, FRAGMENT_SUMS>();
     for (var k = 0u; k < FRAGMENT_SUMS; k++) {
         sum[k] = atomicLoad(&slots[base + SLOT_ACCUM + k]);
     }

@@ -120,9 +120,9 @@ const NEEDED: u32 = 0xfffffffeu;
 const NONE: u32 = 0xffffffffu;
 // Per leaf slot, u32: packed coordinate, parent node | octant << 29, albedo (rgba8unorm),
 // normal (rgba8snorm), emission (2 x f16), then ACCUM_STRIDE sums of the build.
-const SLOT_STRIDE: u32 = 17u;
+const SLOT_STRIDE: u32 = 18u;
 const SLOT_ACCUM: u32 = 6u;
-const ACCUM_STRIDE: u32 = 11u;
+const ACCUM_STRIDE: u32 = 12u;
 
 fn octant_of(c: vec3<u32>, shift: u32) -> u32 {
     let b = (c >> vec3<u32>(shift)) & vec3<u32>(1u);

@@ -1,0 +1,94 @@
+//! splat: every point-cloud sample into voxel fragments through its region of influence (seed
+//! 004 §4.3.4). It writes the fragments and their count, nothing else.
+
+use crate::fragments::Fragments;
+use crate::gpu::layout;
+use crate::gpu::timer::GpuTimer;
+use crate::gpu_scene::GpuScene;
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// Mirrors `SplatParams` in shaders/fragments/splat.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSplatParams {
+    /// Points to splat.
+    pub count: u32,
+    /// Padding to 16 bytes; zero.
+    pub _pad: [u32; 3],
+}
+
+/// The splat compute pass (shaders/fragments/splat.wgsl): its pipeline and bind group layout.
+pub struct SplatPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl SplatPass {
+    /// Compiles the pipeline and creates its bind group layout.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("splat"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::storage(1, c, true),
+                layout::storage(2, c, true),
+                layout::storage(3, c, false),
+                layout::storage(4, c, false),
+                layout::uniform(5, c, false),
+            ],
+        });
+        let pipeline = crate::gpu::shader::grouped_pipeline(
+            device,
+            "splat",
+            "fragments/splat.wgsl",
+            &[Some(&layout)],
+            &[],
+        );
+        SplatPass { pipeline, layout }
+    }
+
+    /// Records the pass over every point of `scene`, one thread per point, appending to
+    /// `fragments` and its count (after `voxelize`, into the same build). Timed as "splat".
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("splat"),
+            timestamp_writes: timer.compute("splat"),
+        });
+        if scene.point_count == 0 {
+            return;
+        }
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("splat params"),
+            contents: bytemuck::bytes_of(&GpuSplatParams {
+                count: scene.point_count,
+                _pad: [0; 3],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                fragments.grid_uniform.as_entire_binding(),
+                scene.points.as_entire_binding(),
+                scene.point_regions.as_entire_binding(),
+                fragments.buffer.as_entire_binding(),
+                fragments.count.as_entire_binding(),
+                params.as_entire_binding(),
+            ]),
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        let (x, y) = layout::groups_2d(scene.point_count, 64);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}

@@ -1,0 +1,329 @@
+//! Point clouds as GI geometry: the splat pass against its CPU twin, and the invariants of
+//! vct.rs on point-sampled versions of the same scenes (`pointcloud::sample_surfaces`), for
+//! every voxel structure: points must block, reflect and emit light as the surfaces they
+//! sample do.
+
+use crate::common::*;
+use crate::reference::{opts, region, trace_with};
+use crate::vct::{FURNACE_CASES, ao_beside_a_wall, furnace_series, mean, on, vct, wall_mesh};
+use voxgi::compare::{Image, compare};
+use voxgi::gpu::readback::read_buffer_copy;
+use voxgi::scene::glam::{Mat4, Vec3};
+use voxgi::scene::{Camera, Material, PointCloud, Scene, builtin, pointcloud};
+use voxgi::voxel::{Grid, cpu};
+use voxgi::{RendererOptions, ViewMode, VoxelKind};
+
+/// The voxel size of `scene` at `res`³ (the grid the renderer will lay around it).
+fn voxel_size(scene: &Scene, res: u32) -> f32 {
+    let b = scene.bounds();
+    Grid::around(b.min, b.max, res).voxel_size
+}
+
+/// `scene`'s surfaces as points `per_voxel` to a voxel edge at `res`³, on the same grid: two
+/// more points mark the corners of the meshes' bounds (the lattice stops short of them), so the
+/// renderer lays the grid it lays for the meshes and the two are compared voxel for voxel.
+fn as_points(scene: &Scene, res: u32, per_voxel: f32) -> Scene {
+    let mut points = pointcloud::sample_surfaces(scene, voxel_size(scene, res) / per_voxel);
+    let b = scene.bounds();
+    points.point_clouds.push(PointCloud {
+        name: "bounds".into(),
+        positions: vec![b.min, b.max],
+        colors: vec![[0.5; 3]; 2],
+        normals: vec![Vec3::Y; 2],
+        transform: Mat4::IDENTITY,
+        ..Default::default()
+    });
+    assert_eq!(points.bounds().min, b.min);
+    assert_eq!(points.bounds().max, b.max);
+    points
+}
+
+/// Deterministic numbers in [0, 1) (xorshift).
+fn rng(seed: u64) -> impl FnMut() -> f32 {
+    let mut s = seed.max(1);
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+#[test]
+fn splat_matches_its_cpu_twin() {
+    // Random points in a unit cube with regions from a hundredth of a voxel to three voxels,
+    // some with none (0: a point alone); every region's fragments as the CPU makes them. The
+    // normals are the six axes, which the GPU decodes exactly from their octahedral encoding,
+    // so both shift the regions behind the points alike.
+    let res = 32;
+    let mut r = rng(11);
+    let n = 3000;
+    let mut pc = PointCloud {
+        name: "random".into(),
+        transform: Mat4::IDENTITY,
+        ..Default::default()
+    };
+    for i in 0..n {
+        pc.positions
+            .push(Vec3::new(r(), r(), r()) * 0.98 + Vec3::splat(0.01));
+        pc.colors.push([0.5; 3]);
+        let axis = [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+        ];
+        pc.normals.push(axis[i % 6]);
+        pc.radii.push(0.01);
+        let voxel = 1.0 / 30.0;
+        pc.regions.push(if i % 10 == 0 {
+            0.0
+        } else {
+            voxel * 0.01 * 300f32.powf(r())
+        });
+    }
+    // Corners of the cube, so the bounds are exactly the unit cube whatever the random points.
+    for c in 0..8 {
+        pc.positions.push(Vec3::new(
+            (c & 1) as f32,
+            ((c >> 1) & 1) as f32,
+            (c >> 2) as f32,
+        ));
+        pc.colors.push([0.5; 3]);
+        pc.normals.push(Vec3::Y);
+        pc.radii.push(0.01);
+        pc.regions.push(0.02);
+    }
+    let scene = Scene {
+        point_clouds: vec![pc.clone()],
+        ..Default::default()
+    };
+    let options = RendererOptions {
+        voxel_resolution: res,
+        bounces: 0,
+        ..RendererOptions::default()
+    };
+    let mut renderer = renderer(&scene, &options);
+    let params = voxgi::FrameParams::new(renderer.default_camera().clone());
+    frame(&mut renderer, &params, 8, 8);
+    let (device, queue) = (&ctx().device, &ctx().queue);
+    let f = renderer.fragments();
+    let grid = f.grid;
+    let count = read_buffer_copy(device, queue, &f.count).expect("count");
+    let count = bytemuck::cast_slice::<u8, u32>(&count)[0] as usize;
+    let bytes = read_buffer_copy(device, queue, &f.buffer).expect("fragments");
+    let words: &[u32] = bytemuck::cast_slice(&bytes);
+    assert!(count * 5 <= words.len(), "the fragment buffer overflowed");
+    let mut gpu: Vec<([u32; 3], u32)> = words
+        .chunks_exact(5)
+        .take(count)
+        .map(|w| {
+            assert_ne!(w[4] & 0x8000_0000, 0, "a point fragment without DENSITY");
+            let c = w[0];
+            (
+                [c & 1023, (c >> 10) & 1023, (c >> 20) & 1023],
+                w[4] & 0x7fff_ffff,
+            )
+        })
+        .collect();
+    let mut want: Vec<([u32; 3], u32)> = pc
+        .positions
+        .iter()
+        .zip(&pc.regions)
+        .zip(&pc.normals)
+        .enumerate()
+        .flat_map(|(i, ((&p, &e), &n))| cpu::splat(&grid, i as u32, p, n, e))
+        .filter(|f| f.weight > 0)
+        .map(|f| (f.cell, f.weight))
+        .collect();
+    gpu.sort_unstable();
+    want.sort_unstable();
+    eprintln!(
+        "splat: {} fragments on the GPU, {} on the CPU",
+        gpu.len(),
+        want.len()
+    );
+    assert!(want.len() > n, "too few fragments to test: {}", want.len());
+    // Exact: both take the same integer steps from positions computed alike.
+    assert_eq!(gpu.len(), want.len(), "fragment counts differ");
+    let differ = gpu.iter().zip(&want).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "{differ} fragments differ from the CPU twin");
+}
+
+#[test]
+fn points_of_an_open_plane_have_ao_one() {
+    let scene = as_points(&plane_scene(0.5), 64, 2.0);
+    let cam = Camera::look_at(Vec3::new(0.0, 4.0, 0.01), Vec3::ZERO, 40.0);
+    for kind in VoxelKind::ALL {
+        let mut s = on(kind, vct(ViewMode::Ao, 64, 0));
+        s.options.ao_radius = Some(3.0);
+        let out = render(&scene, s, &cam, 32, 32);
+        let ao = mean(&out, 8, 8, 24, 24, 0);
+        eprintln!("open plane of points: AO ({kind:?}) {ao}");
+        // The mesh plane's tolerance (vct.rs): its voxels, opaque or split between two
+        // layers, must not occlude the samples above them.
+        assert!(
+            ao > 0.98,
+            "AO of an unoccluded plane of points ({kind:?}): {ao}"
+        );
+    }
+}
+
+#[test]
+fn points_beside_a_wall_have_the_meshes_ao() {
+    let mut scene = plane_scene(0.5);
+    scene.add_mesh(
+        wall_mesh(0.0, 10.0, 10.0),
+        Material::diffuse("wall", [0.5; 3]),
+        Mat4::IDENTITY,
+    );
+    let scene = as_points(&scene, 64, 2.0);
+    let cam = Camera::look_at(Vec3::new(-1.0, 3.0, 0.01), Vec3::new(-0.4, 0.0, 0.0), 30.0);
+    for kind in VoxelKind::ALL {
+        // The closed form and the mesh's tolerance (vct.rs).
+        ao_beside_a_wall(&scene, &cam, kind);
+    }
+}
+
+#[test]
+fn a_box_of_points_passes_the_furnace() {
+    // The glowing white box with its walls as points that emit and reflect.
+    let scene = as_points(&builtin::closed_box(0.5, 1.0), 64, 2.0);
+    for kind in VoxelKind::ALL {
+        furnace_series(&scene, kind, &FURNACE_CASES);
+    }
+}
+
+/// Room B's indirect radiance over room A's, in the two rooms with a wall one voxel thick.
+fn thin_wall_leak(scene: &Scene, kind: VoxelKind, res: u32) -> f32 {
+    let cam_a = Camera::look_at(Vec3::new(-0.9, 0.5, 0.9), Vec3::new(-0.1, 0.3, 0.1), 70.0);
+    let cam_b = Camera::look_at(Vec3::new(0.9, 0.5, 0.9), Vec3::new(0.1, 0.3, 0.1), 70.0);
+    let s = on(kind, vct(ViewMode::Indirect, res, 2));
+    let a = render(scene, s.clone(), &cam_a, 32, 32).mean_radiance()[0];
+    let b = render(scene, s, &cam_b, 32, 32).mean_radiance()[0];
+    assert!(a > 0.0, "no indirect light in room A");
+    b / a
+}
+
+#[test]
+fn a_wall_of_points_leaks_as_little_as_the_mesh_wall() {
+    let res = 64;
+    let scene = builtin::two_rooms(voxel_size(&builtin::two_rooms(0.01), res));
+    let points = as_points(&scene, res, 2.0);
+    for kind in VoxelKind::ALL {
+        let mesh = thin_wall_leak(&scene, kind, res);
+        let pts = thin_wall_leak(&points, kind, res);
+        eprintln!(
+            "thin wall ({kind:?}): room B gets {:.3} % of room A's indirect light through the \
+             mesh wall, {:.3} % through the wall of points",
+            mesh * 100.0,
+            pts * 100.0
+        );
+        // The issue's bound: within one percentage point of the mesh wall.
+        assert!(
+            pts < mesh + 0.01,
+            "{kind:?}: {:.3} % through points against {:.3} % through the mesh",
+            pts * 100.0,
+            mesh * 100.0
+        );
+    }
+}
+
+/// The Cornell box's regions away from the emitter (reference.rs): back wall, floor, the two
+/// walls, ceiling.
+/// A pixel rectangle: x0, y0, x1, y1.
+type Rect = (u32, u32, u32, u32);
+
+const CORNELL_REGIONS: [(&str, Rect); 5] = [
+    ("back wall", (25, 20, 40, 35)),
+    ("floor", (20, 56, 44, 62)),
+    ("red wall", (2, 20, 8, 40)),
+    ("green wall", (56, 20, 62, 40)),
+    ("ceiling", (10, 1, 54, 4)),
+];
+
+#[test]
+fn cornell_box_of_points_agrees_with_the_path_tracer() {
+    let mesh = builtin::cornell_box();
+    let res = 64;
+    let points = as_points(&mesh, res, 2.0);
+    let cam = mesh.cameras[0].clone();
+    let (w, h) = (64, 64);
+    let settings = RendererOptions {
+        voxel_resolution: res,
+        ..RendererOptions::default()
+    };
+    let aces = voxgi::FrameParams::new(cam.clone());
+    let spp = opts(128, voxgi::Bounces::Exactly(2));
+    let pt_mesh = trace_with(&mesh, &settings, &aces, w, h, spp);
+    let pt_points = trace_with(&points, &settings, &aces, w, h, spp);
+    // The path tracer's discs against its triangles: the same box.
+    for (name, r) in CORNELL_REGIONS {
+        let (a, b) = (
+            region(&pt_mesh, r.0, r.1, r.2, r.3),
+            region(&pt_points, r.0, r.1, r.2, r.3),
+        );
+        eprintln!(
+            "{name}: path-traced mesh {a:.4}, path-traced points {b:.4}, ratio {:.3}",
+            b / a
+        );
+        // Measured 0.98, 0.91, 1.07, 1.11 and 1.25 (the ceiling: 44 x 3 pixels of bounced
+        // light, the noisiest region at 128 spp). The discs are the same surfaces, but for their
+        // overlapping edges at corners and the blocks' seams; a tracer that missed the discs
+        // would lose the walls and their bleeding entirely.
+        let tolerance = if name == "ceiling" { 0.4 } else { 0.15 };
+        assert!(
+            (b / a - 1.0).abs() < tolerance,
+            "{name}: discs {b} against triangles {a}"
+        );
+    }
+    for kind in VoxelKind::ALL {
+        let settings = RendererOptions {
+            voxels: kind,
+            ..settings.clone()
+        };
+        let vct = render_with(&points, &settings, &aces, w, h);
+        let vct_mesh = render_with(&mesh, &settings, &aces, w, h);
+        let c = compare(
+            &Image::from_ldr_rgba8(w, h, &pt_points.ldr),
+            &Image::from_ldr_rgba8(w, h, &vct.ldr),
+        )
+        .unwrap();
+        let cm = compare(
+            &Image::from_ldr_rgba8(w, h, &pt_mesh.ldr),
+            &Image::from_ldr_rgba8(w, h, &vct_mesh.ldr),
+        )
+        .unwrap();
+        eprintln!(
+            "Cornell box of points ({kind:?}, {res}³): mean FLIP {:.3} against the path-traced \
+             points (the mesh: {:.3})",
+            c.flip_mean, cm.flip_mean
+        );
+        for (name, r) in CORNELL_REGIONS {
+            let (a, b) = (
+                region(&pt_points, r.0, r.1, r.2, r.3),
+                region(&vct, r.0, r.1, r.2, r.3),
+            );
+            let (am, bm) = (
+                region(&pt_mesh, r.0, r.1, r.2, r.3),
+                region(&vct_mesh, r.0, r.1, r.2, r.3),
+            );
+            eprintln!(
+                "{name} ({kind:?}): cone-traced points / path-traced points {:.3}, mesh {:.3}",
+                b / a,
+                bm / am
+            );
+            // Measured (both structures): back wall 1.10, floor 0.82, red wall 1.06, green
+            // wall 1.03, ceiling 0.96. The floor's front is darker mostly in the direct light:
+            // the surfels' shadow of the short block reaches further than the discs' in the path
+            // tracer (the direct view's floor is 0.72 of the mesh's). 0.25 bounds that; a wall
+            // of points that did not reflect, or leaked, moves a region by half.
+            assert!((b / a - 1.0).abs() < 0.25, "{kind:?}, {name}: {b} vs {a}");
+        }
+        // Measured 0.200 (the mesh against its own path tracing: 0.159); 0.24 leaves room for
+        // other drivers.
+        assert!(c.flip_mean < 0.24, "{kind:?}: mean FLIP {}", c.flip_mean);
+    }
+}
