@@ -87,6 +87,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             continue;
         }
         let volume = o.x * o.y * o.z;
+        let surface = dot(vec3<f32>(cell) + 0.5 - p, n_in);
         let up = select(0u, 1u, hash(i * 8u + k) % den < volume % den);
         let weight = volume / den + up;
         if weight == 0u {
@@ -99,7 +100,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
                 albedo_packed,
                 normal,
                 emission,
-                weight | DENSITY,
+                pack_weight(weight, surface, true),
             );
         }
     }

@@ -27,7 +27,8 @@
 // Static geometry fills every voxel it touches (a wall stays opaque whatever its thickness).
 override DYNAMIC_COVERAGE: bool = false;
 
-fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emission: vec3<f32>) {
+// `surface`: how far the voxel's centre lies in front of the triangle's plane (voxels).
+fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emission: vec3<f32>, surface: f32) {
     let slot = atomicAdd(&fragment_count[0], 1u);
     if slot < arrayLength(&fragments) {
         fragments[slot] = Fragment(
@@ -35,7 +36,7 @@ fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emissio
             pack4x8unorm(vec4<f32>(albedo, coverage)),
             pack2x16snorm(oct_encode(n)),
             pack_rgb9e5(emission),
-            WEIGHT_ONE,
+            pack_weight(WEIGHT_ONE, surface, false),
         );
     }
 }
@@ -190,18 +191,21 @@ fn main(
             }
             // Voxels bounce light diffusely: metals' diffuse albedo is zero.
             let diffuse = albedo.rgb * (1.0 - m.metallic);
+            let surface = dot(center - a, n);
             if !DYNAMIC_COVERAGE {
-                emit(cell, diffuse, 1.0, n, emission);
+                emit(cell, diffuse, 1.0, n, emission, surface);
                 continue;
             }
             // The share of the voxel behind the plane (the normal points out of the solid):
             // exact for axis-aligned planes, linear in the plane's offset for the others.
             let behind = clamp(0.5 - dot(center - a, n) / (abs(n.x) + abs(n.y) + abs(n.z)), 0.0, 1.0);
-            emit(cell, diffuse, behind, n, emission);
+            emit(cell, diffuse, behind, n, emission, surface);
             var inner = cell;
             inner[w] -= select(-1, 1, n[w] > 0.0);
             if inner[w] >= 0 && inner[w] < res {
-                emit(inner, diffuse, 1.0, n, emission);
+                // Inside the solid: no surface of its own, so shaded at its centre (a surface
+                // distance of 0 puts the shading point inside, where the light does not reach).
+                emit(inner, diffuse, 1.0, n, emission, 0.0);
             }
         }
     }

@@ -32,14 +32,15 @@ struct InjectParams {
 // on, and only their direct light is renewed.
 override STORE_RADIANCE: bool = true;
 
-// Where leaf `i` is shaded for `light`: at the front of the voxel (its centre may lie up to
-// half a diagonal behind the surface, where the shadow map would see the surface itself as an
-// occluder); for a two-sided voxel, a voxel towards the light.
+// Where leaf `i` is shaded for `light`: three quarters of a voxel in front of the surface its
+// fragments lie on (the centre may lie up to half a diagonal behind a mesh's surface and a
+// voxel behind a point's, where the shadow map would see the surface itself as an occluder);
+// for a two-sided voxel, a voxel towards the light.
 fn shading_point(i: u32, light: Light) -> vec3<f32> {
     let nw = leaf_normal(i);
     let center = leaf_center(i);
     if nw.w > 0.3 {
-        return center + normalize(nw.xyz) * leaf_size() * 0.75;
+        return center + normalize(nw.xyz) * leaf_size() * (0.75 - leaf_surface(i));
     }
     return center + to_light(light, center) * leaf_size();
 }

@@ -27,12 +27,27 @@ struct Fragment {
     normal: u32,
     // Emitted radiance as RGB9E5.
     emission: u32,
-    // Bits 0-30: the fragment's share of its voxel's surface, in 1/WEIGHT_ONE voxel faces: a
+    // Bits 0-15: the fragment's share of its voxel's surface, in 1/WEIGHT_ONE voxel faces: a
     // mesh fragment stands for the whole surface it has in the voxel (WEIGHT_ONE), a point for
-    // the part of its area its region of influence puts in the voxel (splat.wgsl). Bit 31
-    // (DENSITY): the fragment's opacity is that share (points, seed 004 §4.3.4), not its
-    // coverage (meshes).
+    // the part of its area its region of influence puts in the voxel (splat.wgsl). Bits 16-23:
+    // how far the voxel's centre lies in front of the surface along the normal, in
+    // 1/SURFACE_UNITS voxels (two's complement; negative: behind). Bit 31 (DENSITY): the
+    // fragment's opacity is its share (points, seed 004 §4.3.4), not its coverage (meshes).
     weight: u32,
+}
+
+const SURFACE_UNITS: f32 = 64.0;
+
+// The fragment's `weight` word: share `w` (at most WEIGHT_ONE), the centre's signed distance
+// `d` from the surface (voxels, clamped to +-2), DENSITY when `density`.
+fn pack_weight(w: u32, d: f32, density: bool) -> u32 {
+    let q = u32(i32(round(clamp(d, -2.0, 1.98) * SURFACE_UNITS))) & 0xffu;
+    return min(w, 0xffffu) | (q << 16u) | select(0u, DENSITY, density);
+}
+
+// The centre's signed distance from the surface, in SURFACE_UNITS (sign-extended).
+fn fragment_surface(f: Fragment) -> i32 {
+    return (i32(f.weight << 8u)) >> 24u;
 }
 
 const WEIGHT_ONE: u32 = 4096u;
@@ -94,25 +109,26 @@ fn unpack_rgb9e5(v: u32) -> vec3<f32> {
 // A voxel's attributes are weighted integer sums of its fragments' (so the result does not
 // depend on the order atomics add them: deterministic), then averages. FRAGMENT_SUMS u32 per
 // voxel: weight, weight x albedo rgb (8-bit units), weight x normal xyz (1/NORMAL_UNITS units,
-// two's complement), weight x emission rgb (1/EMISSION_SCALE units), then the weight of the
-// density fragments (points); the coverage (how much of the voxel a mesh fragment's solid
+// two's complement), weight x emission rgb (1/EMISSION_SCALE units), the weight of the
+// density fragments (points), weight x the centre's distance from the surface (SURFACE_UNITS,
+// two's complement); the coverage (how much of the voxel a mesh fragment's solid
 // fills, 8-bit units) is kept as a maximum beside them. The units bound what a voxel holds
 // before a sum wraps: 1024 mesh fragments (the normal sums, i32), and emission x fragments
 // below 16384 W/(m² sr); points weigh a fraction of a mesh fragment each.
-const FRAGMENT_SUMS: u32 = 11u;
+const FRAGMENT_SUMS: u32 = 12u;
 const NORMAL_UNITS: f32 = 512.0;
 const EMISSION_SCALE: f32 = 64.0;
 
 fn fragment_weight(f: Fragment) -> u32 {
-    return f.weight & ~DENSITY;
+    return f.weight & 0xffffu;
 }
 
-fn fragment_sums(f: Fragment) -> array<u32, 11> {
+fn fragment_sums(f: Fragment) -> array<u32, 12> {
     let w = fragment_weight(f);
     let albedo = unpack4x8unorm(f.albedo);
     let n = vec3<i32>(round(oct_decode(unpack2x16snorm(f.normal)) * NORMAL_UNITS)) * i32(w);
     let e = vec3<u32>(round(unpack_rgb9e5(f.emission) * EMISSION_SCALE)) * w;
-    return array<u32, 11>(
+    return array<u32, 12>(
         w,
         u32(round(albedo.r * 255.0)) * w,
         u32(round(albedo.g * 255.0)) * w,
@@ -124,6 +140,7 @@ fn fragment_sums(f: Fragment) -> array<u32, 11> {
         e.g,
         e.b,
         select(0u, w, (f.weight & DENSITY) != 0u),
+        bitcast<u32>(fragment_surface(f) * i32(w)),
     );
 }
 
@@ -133,14 +150,16 @@ fn fragment_coverage(f: Fragment) -> u32 {
 
 // What a voxel's sums resolve to: albedo (rgb) and opacity, mean normal (xyz) and how well the
 // fragments' normals agree (w, the length of their mean: 1 one orientation, ~0 opposite faces;
-// Toksvig's measure of the normal distribution's spread), emitted radiance.
+// Toksvig's measure of the normal distribution's spread), emitted radiance, and how far the
+// centre lies in front of the surface along the normal (voxels; negative: behind).
 struct VoxelAttributes {
     albedo: vec4<f32>,
     normal: vec4<f32>,
     emission: vec3<f32>,
+    surface: f32,
 }
 
-fn resolve_sums(sum: array<u32, 11>, coverage: u32) -> VoxelAttributes {
+fn resolve_sums(sum: array<u32, 12>, coverage: u32) -> VoxelAttributes {
     let weight = f32(max(sum[0], 1u));
     let albedo = vec3<f32>(f32(sum[1]), f32(sum[2]), f32(sum[3])) / (255.0 * weight);
     let nsum = vec3<f32>(
@@ -160,5 +179,6 @@ fn resolve_sums(sum: array<u32, 11>, coverage: u32) -> VoxelAttributes {
         vec4<f32>(albedo, opacity),
         vec4<f32>(select(vec3<f32>(0.0), nsum / length(nsum), len > 1e-4), len),
         e,
+        f32(bitcast<i32>(sum[11])) / (SURFACE_UNITS * weight),
     );
 }

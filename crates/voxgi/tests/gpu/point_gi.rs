@@ -124,7 +124,7 @@ fn splat_matches_its_cpu_twin() {
             let c = w[0];
             (
                 [c & 1023, (c >> 10) & 1023, (c >> 20) & 1023],
-                w[4] & 0x7fff_ffff,
+                w[4] & 0xffff,
             )
         })
         .collect();

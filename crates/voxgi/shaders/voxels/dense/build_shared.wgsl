@@ -36,12 +36,12 @@
 // one dispatch).
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
 
-const ACCUM_STRIDE: u32 = 12u;
+const ACCUM_STRIDE: u32 = 13u;
 const ACCUM_SUMS: u32 = FRAGMENT_SUMS;
 const ACCUM_COVERAGE: u32 = FRAGMENT_SUMS;
-const DYN_STRIDE: u32 = 14u;
-const DYN_FLAG: u32 = 12u;
-const DYN_LIST: u32 = 13u;
+const DYN_STRIDE: u32 = 15u;
+const DYN_FLAG: u32 = 13u;
+const DYN_LIST: u32 = 14u;
 
 // Entry `i` of the touched list.
 fn touched(i: u32) -> u32 {
@@ -110,7 +110,8 @@ fn resolve_slot(s: u32, dynamic: bool) {
     let c = voxel_coord(slot_voxel[s], vol.resolution);
     textureStore(albedo_out, c, a.albedo);
     textureStore(normal_out, c, a.normal);
-    textureStore(emission_out, c, vec4<f32>(a.emission, 1.0));
+    // Alpha: where the surface lies (leaves.wgsl's leaf_surface).
+    textureStore(emission_out, c, vec4<f32>(a.emission, a.surface));
 }
 
 // Empties voxel `c` of the finest level.

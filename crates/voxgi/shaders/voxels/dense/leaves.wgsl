@@ -8,6 +8,8 @@
 //   fn leaf_center(i) -> vec3<f32>                its centre, metres
 //   fn leaf_size() -> f32                         its edge, metres
 //   fn leaf_albedo(i) / leaf_normal(i) / leaf_emission(i)   what the build resolved
+//   fn leaf_surface(i) -> f32                     how far its centre lies in front of its
+//                                                 surface along the normal, voxels
 //   leaf_direct[i], leaf_next[i]                  per-leaf light: direct (inject) and bounced
 //
 // and voxels/<kind>/leaf_store.wgsl's store_leaf_radiance(i, premultiplied). All at
@@ -61,4 +63,8 @@ fn leaf_normal(i: u32) -> vec4<f32> {
 
 fn leaf_emission(i: u32) -> vec3<f32> {
     return textureLoad(leaf_emission_tex, leaf_coord(i), 0).rgb;
+}
+
+fn leaf_surface(i: u32) -> f32 {
+    return textureLoad(leaf_emission_tex, leaf_coord(i), 0).a;
 }

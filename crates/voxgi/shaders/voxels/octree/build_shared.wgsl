@@ -385,7 +385,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     atomicStore(&slots[base + 2u], pack4x8unorm(a.albedo));
     atomicStore(&slots[base + 3u], pack4x8snorm(a.normal));
     atomicStore(&slots[base + 4u], pack2x16float(a.emission.rg));
-    atomicStore(&slots[base + 5u], pack2x16float(vec2<f32>(a.emission.b, 0.0)));
+    atomicStore(&slots[base + 5u], pack2x16float(vec2<f32>(a.emission.b, a.surface)));
 }
 
 // Writes `v` (stored optical depth) as the value of octant `o` of node m's brick, holding level

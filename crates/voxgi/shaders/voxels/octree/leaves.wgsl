@@ -48,3 +48,7 @@ fn leaf_emission(i: u32) -> vec3<f32> {
     let b = unpack2x16float(leaf_slots[i * SLOT_STRIDE + 5u]);
     return vec3<f32>(rg, b.x);
 }
+
+fn leaf_surface(i: u32) -> f32 {
+    return unpack2x16float(leaf_slots[i * SLOT_STRIDE + 5u]).y;
+}

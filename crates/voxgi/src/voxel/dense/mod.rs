@@ -35,9 +35,9 @@ pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Snorm;
 /// Format of the finest level's emission: rgb emitted radiance, W/(m² sr).
 pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// u32 sums per slot (`ACCUM_STRIDE` in build_shared.wgsl).
-const ACCUM_STRIDE: u64 = 12;
+const ACCUM_STRIDE: u64 = 13;
 /// u32 per slot of the dynamic part (`DYN_STRIDE` in build_shared.wgsl).
-const DYN_STRIDE: u64 = 14;
+const DYN_STRIDE: u64 = 15;
 /// Bytes of the largest per-slot buffer (the dynamic part).
 pub const SLOT_BYTES: u64 = DYN_STRIDE * 4;
 /// Directions of the anisotropic chains, in the order of `filter.wgsl`.

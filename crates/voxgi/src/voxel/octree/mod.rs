@@ -33,7 +33,7 @@ pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// a leaf voxel keeps its child word only).
 pub const NODE_WORDS: u64 = 4;
 /// u32 per leaf slot (`SLOT_STRIDE` in tree.wgsl): what the leaf is, and the build's sums.
-pub const SLOT_WORDS: u64 = 18;
+pub const SLOT_WORDS: u64 = 19;
 /// Bytes per leaf slot across the slot, direct-light and bounce buffers.
 pub const SLOT_BYTES: u64 = SLOT_WORDS * 4 + 32;
 /// Words of counters before the nodes in the node buffer (`NODE_HEADER` in tree.wgsl).
