@@ -11,6 +11,8 @@
 @group(0) @binding(4) var textures: texture_2d_array<f32>;
 @group(0) @binding(5) var texture_sampler: sampler;
 @group(0) @binding(6) var<storage, read> points: array<Point>;
+// Per point: how far its neighbours stray from its tangent plane, metres (scan noise).
+@group(0) @binding(7) var<storage, read> point_spread: array<f32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -89,8 +91,16 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
         n = -n;
     }
     let corner = surfel_corner(vi);
+    // A surfel is drawn at the front of its neighbourhood's spread, along its own normal: the
+    // voxels hold the neighbourhood's surface, so cones and shadow lookups leaving a noisy
+    // scan's surfel that lay behind it started inside it (blotches of occlusion all over the
+    // office scan's walls). Along the normal as the file or the estimate has it, not as turned
+    // to the camera: the back faces of thin things move back, behind their front faces. Clean
+    // surfaces have no spread and stay where they are.
+    var q = p;
+    q.position += point_normal(p) * point_spread[vi / 6u];
     var out: PointOut;
-    out.clip = frame.view_proj * vec4<f32>(surfel_world(p, n, corner), 1.0);
+    out.clip = frame.view_proj * vec4<f32>(surfel_world(q, n, corner), 1.0);
     out.disc = corner;
     out.normal = n;
     out.albedo = point_albedo(p);

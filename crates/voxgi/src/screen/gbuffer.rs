@@ -43,6 +43,7 @@ impl GbufferPass {
                 ),
                 layout::sampler(5, wgpu::ShaderStages::FRAGMENT),
                 layout::storage(6, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(7, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let module = shader::module(device, "screen/gbuffer.wgsl");
@@ -116,6 +117,7 @@ impl GbufferPass {
                 wgpu::BindingResource::TextureView(&scene.texture_view),
                 wgpu::BindingResource::Sampler(&scene.sampler),
                 scene.points.as_entire_binding(),
+                scene.point_spread.as_entire_binding(),
             ]),
         });
         let clear = |view| {

@@ -21,7 +21,9 @@ fn voxel_size(scene: &Scene, res: u32) -> f32 {
 
 /// `scene`'s surfaces as points `per_voxel` to a voxel edge at `res`³, on the same grid: two
 /// more points mark the corners of the meshes' bounds (the lattice stops short of them), so the
-/// renderer lays the grid it lays for the meshes and the two are compared voxel for voxel.
+/// renderer lays the grid it lays for the meshes and the two are compared voxel for voxel. Their
+/// discs and regions are a tenth of a millimetre (two lone points would get discs as wide as
+/// the distance between them).
 fn as_points(scene: &Scene, res: u32, per_voxel: f32) -> Scene {
     let mut points = pointcloud::sample_surfaces(scene, voxel_size(scene, res) / per_voxel);
     let b = scene.bounds();
@@ -30,6 +32,7 @@ fn as_points(scene: &Scene, res: u32, per_voxel: f32) -> Scene {
         positions: vec![b.min, b.max],
         colors: vec![[0.5; 3]; 2],
         normals: vec![Vec3::Y; 2],
+        radii: vec![1e-4; 2],
         transform: Mat4::IDENTITY,
         ..Default::default()
     });
@@ -269,11 +272,11 @@ fn cornell_box_of_points_agrees_with_the_path_tracer() {
             "{name}: path-traced mesh {a:.4}, path-traced points {b:.4}, ratio {:.3}",
             b / a
         );
-        // Measured 0.98, 0.91, 1.07, 1.11 and 1.25 (the ceiling: 44 x 3 pixels of bounced
-        // light, the noisiest region at 128 spp). The discs are the same surfaces, but for their
-        // overlapping edges at corners and the blocks' seams; a tracer that missed the discs
-        // would lose the walls and their bleeding entirely.
-        let tolerance = if name == "ceiling" { 0.4 } else { 0.15 };
+        // Measured 1.004, 0.977, 1.045, 1.080 and 1.092 (the ceiling: 44 x 3 pixels of
+        // bounced light, the noisiest region at 128 spp). The discs are the same surfaces but
+        // for their overlapping edges at corners; a tracer that missed the discs would lose the
+        // walls and their bleeding entirely.
+        let tolerance = 0.12;
         assert!(
             (b / a - 1.0).abs() < tolerance,
             "{name}: discs {b} against triangles {a}"
@@ -315,15 +318,18 @@ fn cornell_box_of_points_agrees_with_the_path_tracer() {
                 b / a,
                 bm / am
             );
-            // Measured (both structures): back wall 1.10, floor 0.82, red wall 1.06, green
-            // wall 1.03, ceiling 0.96. The floor's front is darker mostly in the direct light:
-            // the surfels' shadow of the short block reaches further than the discs' in the path
-            // tracer (the direct view's floor is 0.72 of the mesh's). 0.25 bounds that; a wall
-            // of points that did not reflect, or leaked, moves a region by half.
-            assert!((b / a - 1.0).abs() < 0.25, "{kind:?}, {name}: {b} vs {a}");
+            // Measured (both structures): back wall 1.06, floor 1.02, red wall 1.09, green wall
+            // 1.06, ceiling 1.35; the mesh against its own path tracing 1.06, 1.03, 1.05, 1.05
+            // and 1.40 (the ceiling's known error, reference.rs). The mesh's bounds: 10 %, and
+            // 50 % for the ceiling.
+            let tolerance = if name == "ceiling" { 0.5 } else { 0.10 };
+            assert!(
+                (b / a - 1.0).abs() < tolerance,
+                "{kind:?}, {name}: {b} vs {a}"
+            );
         }
-        // Measured 0.200 (the mesh against its own path tracing: 0.159); 0.24 leaves room for
+        // Measured 0.185 (the mesh against its own path tracing: 0.159); 0.21 leaves room for
         // other drivers.
-        assert!(c.flip_mean < 0.24, "{kind:?}: mean FLIP {}", c.flip_mean);
+        assert!(c.flip_mean < 0.21, "{kind:?}: mean FLIP {}", c.flip_mean);
     }
 }
