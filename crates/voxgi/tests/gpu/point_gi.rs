@@ -333,3 +333,100 @@ fn cornell_box_of_points_agrees_with_the_path_tracer() {
         assert!(c.flip_mean < 0.21, "{kind:?}: mean FLIP {}", c.flip_mean);
     }
 }
+
+/// `../shared/scenes/<rel>`, or None (the test says it skips) when it is not there.
+fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/scenes")
+        .join(rel);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipped: ../shared/scenes/{rel} is not present");
+        None
+    }
+}
+
+#[test]
+fn the_bunnys_vertices_bounce_light_as_its_mesh_does() {
+    // The Stanford bunny on a floor under a spot light, once as its mesh and once as the
+    // point cloud of the same file's vertices (their normals the mesh's): the same bounds, so
+    // the same grid. The indirect light on the floor around it and on the bunny itself.
+    let Some(path) = shared_scene("stanford_bunny/bun_zipper.ply") else {
+        return;
+    };
+    let bunny = voxgi::scene::io::load(&path).expect("bunny");
+    // A 3 m floor: the voxels (128³) are 2.4 cm, the bunny 30 of them across.
+    let mut mesh = Scene::default();
+    mesh.add_mesh(
+        quad_mesh("floor", Vec3::ZERO, 3.0),
+        Material::diffuse("floor", [0.5; 3]),
+        Mat4::IDENTITY,
+    );
+    mesh.append(
+        bunny,
+        Mat4::from_scale(Vec3::splat(5.0)) * Mat4::from_translation(Vec3::new(0.0, -0.033, 0.0)),
+        false,
+    );
+    mesh.lights.push(voxgi::scene::Light {
+        name: "key".into(),
+        kind: voxgi::scene::LightKind::Spot {
+            inner_angle: 20f32.to_radians(),
+            outer_angle: 30f32.to_radians(),
+        },
+        color: [1.0; 3],
+        intensity: 12.0,
+        position: Vec3::new(1.2, 1.8, 1.0),
+        direction: (Vec3::new(0.0, 0.3, 0.0) - Vec3::new(1.2, 1.8, 1.0)).normalize(),
+        range: None,
+        cast_shadows: true,
+    });
+    let points = pointcloud::mesh_vertices(&mesh);
+    // The floor stays a mesh in both.
+    let mut points_scene = mesh.clone();
+    points_scene.instances.truncate(1);
+    points_scene.point_clouds = points
+        .point_clouds
+        .into_iter()
+        .filter(|pc| pc.positions.len() > 4)
+        .collect();
+    assert_eq!(points_scene.point_clouds.len(), 1);
+    let cam = Camera::look_at(Vec3::new(-0.3, 0.6, 1.9), Vec3::new(-0.1, 0.35, 0.0), 40.0);
+    let (w, h) = (96, 64);
+    for kind in VoxelKind::ALL {
+        let s = on(kind, vct(ViewMode::Indirect, 128, 2));
+        let a = render(&mesh, s.clone(), &cam, w, h);
+        let b = render(&points_scene, s, &cam, w, h);
+        let c = compare(
+            &Image::from_hdr_rgba(w, h, &a.hdr),
+            &Image::from_hdr_rgba(w, h, &b.hdr),
+        )
+        .unwrap();
+        eprintln!("bunny ({kind:?}): indirect light, points against mesh: {c:?}");
+        if std::env::var_os("VOXGI_TEST_IMAGES").is_some() {
+            a.save(std::path::Path::new("/tmp/bunny_mesh_ind.png"))
+                .unwrap();
+            b.save(std::path::Path::new("/tmp/bunny_points_ind.png"))
+                .unwrap();
+        }
+        // Measured 0.108 (HDR-FLIP, both structures): the two differ where the vertices' discs
+        // leave the silhouette ragged and where regions round the surface differently; a
+        // points bunny that bounced or occluded nothing would differ by its whole shading.
+        assert!(c.flip_mean < 0.13, "{kind:?}: HDR-FLIP {}", c.flip_mean);
+        let regions = [
+            ("whole", (0, 0, w, h)),
+            ("floor", (0, 52, w, h)),
+            ("bunny", (30, 14, 62, 44)),
+        ];
+        for (name, r) in regions {
+            let (ra, rb) = (
+                region(&a, r.0, r.1, r.2, r.3),
+                region(&b, r.0, r.1, r.2, r.3),
+            );
+            eprintln!(
+                "{name} ({kind:?}): mesh {ra:.4}, points {rb:.4}, ratio {:.3}",
+                rb / ra
+            );
+        }
+    }
+}
