@@ -70,9 +70,20 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             ctx.info.name
         );
     }
+    // The CPU's share of a point cloud, timed apart: its attributes, then the upload (which
+    // includes each point's surface spread).
+    let points = (scene.point_count() > 0).then(|| {
+        eprintln!(
+            "bench: estimating the attributes of {} points …",
+            scene.point_count()
+        );
+        voxgi::prepare_points(&mut scene)
+    });
+    let upload = std::time::Instant::now();
     let mut renderer = ctx
         .renderer(&scene, &settings)
         .with_context(|| label.clone())?;
+    let upload = upload.elapsed().as_secs_f64() * 1e3;
     renderer.enable_timing(true);
     let (w, h) = args.size;
     let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
@@ -213,6 +224,18 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         println!("  {name:<36} {:>10.2} MiB", *bytes as f64 / 1048576.0);
     }
     println!("voxels: {fragments} fragments, {occupied} occupied voxels");
+    println!("scene upload (CPU and GPU): {upload:.0} ms");
+    if let Some(p) = &points {
+        println!(
+            "points: {} estimated; normals {:.0} ms, regions {:.0} ms, radii {:.0} ms (CPU, {} \
+             threads)",
+            p.points,
+            p.normals.as_secs_f64() * 1e3,
+            p.regions.as_secs_f64() * 1e3,
+            p.radii.as_secs_f64() * 1e3,
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        );
+    }
     if let Some(path) = &args.json {
         let json = serde_json::json!({
             "adapter": ctx.info.name,
@@ -246,6 +269,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "wall_ms": {"median": wmed, "p95": wp95},
             "memory_bytes": memory.iter().map(|(n, b)| serde_json::json!({"name": n, "bytes": b})).collect::<Vec<_>>(),
             "voxels": {"fragments": fragments, "occupied": occupied},
+            "upload_ms": upload,
+            "points": points.map(|p| serde_json::json!({
+                "estimated": p.points,
+                "normals_ms": p.normals.as_secs_f64() * 1e3,
+                "regions_ms": p.regions.as_secs_f64() * 1e3,
+                "radii_ms": p.radii.as_secs_f64() * 1e3,
+            })),
         });
         std::fs::write(path, serde_json::to_string_pretty(&json)? + "\n")
             .with_context(|| format!("{}", path.display()))?;

@@ -169,9 +169,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             })
             .with_context(|| label.clone())?;
         eprintln!(
-            "path tracing {w}x{h}, {} spp, {} triangles",
+            "path tracing {w}x{h}, {} spp, {} triangles and discs",
             opts.spp,
-            tracer.triangle_count()
+            tracer.primitive_count()
         );
         let t = Instant::now();
         let mut last = 0.0;

@@ -1,6 +1,8 @@
 //! Scenes that need no files: the Cornell box and the small procedural scenes that tests use.
 
-use crate::{AreaShape, Camera, Light, LightKind, Material, Mesh, Result, Scene, SceneError};
+use crate::{
+    AreaShape, Camera, Light, LightKind, Material, Mesh, PointCloud, Result, Scene, SceneError,
+};
 use glam::{Mat4, Vec3};
 
 /// Names accepted by [`by_name`], with a one-line description each.
@@ -25,6 +27,11 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "cube",
         "a 1 m white cube centred on the origin, no light: an object to include and move",
     ),
+    (
+        "point-cave",
+        "a scanned-looking cave of 1.4 million points without normals (the thesis' cave's size), \
+         two spot lights and an area light",
+    ),
 ];
 
 pub fn by_name(name: &str) -> Result<Scene> {
@@ -34,6 +41,7 @@ pub fn by_name(name: &str) -> Result<Scene> {
         "closed-box" => Ok(closed_box(0.5, 0.5)),
         "two-rooms" => Ok(two_rooms(0.01)),
         "cube" => Ok(cube([0.8; 3])),
+        "point-cave" => Ok(point_cave(POINT_CAVE_POINTS)),
         _ => Err(SceneError::UnknownBuiltin {
             name: name.into(),
             available: BUILTINS.iter().map(|b| b.0).collect::<Vec<_>>().join(", "),
@@ -450,6 +458,100 @@ pub fn two_rooms(wall: f32) -> Scene {
     });
     let mut cam = Camera::look_at(Vec3::new(-0.95, 0.6, 0.95), Vec3::new(-0.2, 0.4, 0.2), 70.0);
     cam.name = "room A".into();
+    scene.cameras.push(cam);
+    scene
+}
+
+/// Points in `point-cave`: the size of the scanned cave in seed 004 §5.1 (1.4 million).
+pub const POINT_CAVE_POINTS: usize = 1_400_000;
+
+/// A synthetic cave scan of `n` points: a winding tunnel 16 m long and about 5 m across with a
+/// flattened floor, its wall rippled by a few sinusoids, sampled uniformly at random with 2 mm
+/// of scanner noise, coloured in rock tones, without normals (the renderer estimates them, as
+/// for a raw scan). Lit by two spot lights and a rectangular area light; the camera stands at
+/// the entrance. Deterministic: the same `n` gives the same cloud.
+pub fn point_cave(n: usize) -> Scene {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut rand = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let length = 16.0f32;
+    let axis = |z: f32| Vec3::new(0.8 * (z * 0.35).sin(), 0.3 * (z * 0.5).cos(), z);
+    let radius = |theta: f32, z: f32| {
+        2.5 + 0.35 * (3.0 * theta + 0.7 * z).sin()
+            + 0.2 * (5.0 * theta - 1.3 * z).sin()
+            + 0.08 * (13.0 * theta + 2.1 * z).sin()
+    };
+    let mut pc = PointCloud {
+        name: "cave".into(),
+        transform: Mat4::IDENTITY,
+        ..Default::default()
+    };
+    pc.positions.reserve(n);
+    pc.colors.reserve(n);
+    let tau = std::f32::consts::TAU;
+    for _ in 0..n {
+        let (theta, z) = (rand() * tau, rand() * length);
+        let r = radius(theta, z) + (rand() - 0.5) * 0.004;
+        let mut p = Vec3::new(r * theta.cos(), r * theta.sin(), 0.0);
+        // A flat floor 1.6 m below the axis.
+        p.y = p.y.max(-1.6 + (rand() - 0.5) * 0.004);
+        let p = axis(z) + Vec3::new(p.x, p.y, 0.0);
+        let shade = 0.45 + 0.15 * (2.3 * theta + 0.9 * z).sin() + 0.1 * rand();
+        pc.positions.push(p);
+        pc.colors.push([shade * 0.95, shade * 0.8, shade * 0.62]);
+    }
+    let mut scene = Scene {
+        name: "point-cave".into(),
+        point_clouds: vec![pc],
+        ..Default::default()
+    };
+    let spot = |name: &str, position: Vec3, target: Vec3, color: [f32; 3]| Light {
+        name: name.into(),
+        kind: LightKind::Spot {
+            inner_angle: 18f32.to_radians(),
+            outer_angle: 28f32.to_radians(),
+        },
+        color,
+        intensity: 60.0,
+        position,
+        direction: (target - position).normalize(),
+        range: None,
+        cast_shadows: true,
+    };
+    scene.lights.push(spot(
+        "spot left",
+        axis(1.0) + Vec3::new(-1.0, 0.5, 0.0),
+        axis(7.0) + Vec3::new(1.5, -1.2, 0.0),
+        [1.0, 0.85, 0.7],
+    ));
+    scene.lights.push(spot(
+        "spot right",
+        axis(9.0) + Vec3::new(1.0, 0.8, 0.0),
+        axis(13.0) + Vec3::new(-1.8, 0.0, 0.0),
+        [0.75, 0.85, 1.0],
+    ));
+    scene.add_area_light(Light {
+        name: "lamp".into(),
+        kind: LightKind::Area {
+            shape: AreaShape::Rect {
+                u: Vec3::new(0.3, 0.0, 0.0),
+                v: Vec3::new(0.0, 0.0, 0.6),
+            },
+        },
+        color: [1.0, 0.9, 0.7],
+        intensity: 12.0,
+        position: axis(5.0) + Vec3::new(0.0, 1.7, 0.0),
+        direction: Vec3::NEG_Y,
+        range: None,
+        cast_shadows: true,
+    });
+    let eye = axis(-1.0) + Vec3::new(0.0, 0.2, 0.0);
+    let mut cam = Camera::look_at(eye, axis(6.0) + Vec3::new(0.0, -0.4, 0.0), 60.0);
+    cam.name = "entrance".into();
     scene.cameras.push(cam);
     scene
 }

@@ -895,3 +895,142 @@ fn bad_animations_are_errors_naming_the_file_and_the_animation() {
         );
     }
 }
+
+#[test]
+fn ply_point_emission_and_scene_file_points() {
+    let dir = tmp("points");
+    // A cloud with emitted radiance per point, read as written (linear, any numeric type).
+    let p = write(
+        &dir,
+        "glow.ply",
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n\
+         property float emission_red\nproperty float emission_green\nproperty uchar emission_blue\nend_header\n\
+         0 0 0 1.5 0.25 2\n1 0 0 0 0 0\n",
+    );
+    let s = io::load(&p).unwrap();
+    assert_eq!(s.point_clouds[0].emission, vec![[1.5, 0.25, 2.0], [0.0; 3]]);
+    // Some but not all of the three, or a negative radiance: errors naming the problem.
+    let partial = write(
+        &dir,
+        "partial.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+         property float emission_red\nend_header\n0 0 0 1\n",
+    );
+    let e = io::load(&partial).unwrap_err().to_string();
+    assert!(e.contains("partial.ply") && e.contains("emission"), "{e}");
+    let negative = write(
+        &dir,
+        "negative.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+         property float emission_r\nproperty float emission_g\nproperty float emission_b\nend_header\n0 0 0 1 -1 0\n",
+    );
+    let e = io::load(&negative).unwrap_err().to_string();
+    assert!(e.contains("vertex 0") && e.contains("emission"), "{e}");
+
+    // A scene file includes a mesh as its vertices and as a lattice of points; an emissive
+    // override reaches the points.
+    let quad = write(
+        &dir,
+        "quad.ply",
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n1 0 1\n0 0 1\n4 0 3 2 1\n",
+    );
+    let scene = write(
+        &dir,
+        "points.toml",
+        format!(
+            "[[include]]\nfile = '{}'\npoints = 'vertices'\nmaterial = {{ base_color = [0.2, 0.4, 0.6], emissive = [3.0, 2.0, 1.0] }}\n\
+             [[include]]\nfile = '{}'\npoints = 0.1\ntranslate = [0.0, 1.0, 0.0]\n",
+            quad.display(),
+            quad.display()
+        ),
+    );
+    let s = io::load(&scene).unwrap();
+    assert!(s.instances.is_empty(), "the meshes became points");
+    assert_eq!(s.point_clouds.len(), 2);
+    let v = &s.point_clouds[0];
+    assert_eq!(v.positions.len(), 4);
+    assert_eq!(v.colors, vec![[0.2, 0.4, 0.6]; 4]);
+    assert_eq!(v.emission, vec![[3.0, 2.0, 1.0]; 4]);
+    assert!(v.normals.iter().all(|n| close(*n, Vec3::Y)));
+    // A 1 m square on a 0.1 m lattice: 10 x 10 points, at height 1 after the include's move.
+    let l = &s.point_clouds[1];
+    assert_eq!(l.positions.len(), 100);
+    assert!(
+        l.positions
+            .iter()
+            .all(|&p| (l.transform.transform_point3(p).y - 1.0).abs() < 1e-6)
+    );
+    // Bad values name the key.
+    for (value, what) in [
+        ("'edges'", "points"),
+        ("-1.0", "points"),
+        ("1e-9", "points"),
+    ] {
+        let bad = write(
+            &dir,
+            "bad_points.toml",
+            format!(
+                "[[include]]\nfile = '{}'\npoints = {value}\n",
+                quad.display()
+            ),
+        );
+        let e = io::load(&bad).unwrap_err().to_string();
+        assert!(e.contains(what), "points = {value}: {e}");
+    }
+}
+
+#[test]
+fn sampled_surfaces_lie_on_a_lattice_with_the_meshes_attributes() {
+    // The Cornell box's floor is 0.5496-0.5528 m by 0.5592 m: on a 1 cm lattice about 55 x 56
+    // points, every one on the floor's plane with its normal and colour.
+    let s = builtin::cornell_box();
+    let p = pointcloud::sample_surfaces(&s, 0.01);
+    let floor = p
+        .point_clouds
+        .iter()
+        .find(|c| c.name.starts_with("floor"))
+        .expect("floor points");
+    assert!(
+        (3000..=3130).contains(&floor.positions.len()),
+        "{} floor points",
+        floor.positions.len()
+    );
+    assert!(floor.positions.iter().all(|q| q.y.abs() < 1e-6));
+    assert!(floor.normals.iter().all(|n| close(*n, Vec3::Y)));
+    // The area light's emitter stays a mesh; everything else became points.
+    assert_eq!(p.instances.len(), 1);
+    assert!(p.instances[0].light.is_some());
+    assert_eq!(p.point_clouds.len(), s.instances.len() - 1);
+    // The points' share of the box's area: each stands for at least spacing² of surface.
+    let area = pointcloud::surface_area(&s);
+    let n: usize = p.point_clouds.iter().map(|c| c.positions.len()).sum();
+    assert!(
+        n as f64 <= area / (0.01 * 0.01) * 1.05,
+        "{n} points on {area} m²"
+    );
+}
+
+#[test]
+fn the_point_cave_is_a_deterministic_tunnel() {
+    let a = builtin::point_cave(20_000);
+    let b = builtin::point_cave(20_000);
+    let (pa, pb) = (&a.point_clouds[0], &b.point_clouds[0]);
+    assert_eq!(pa.positions, pb.positions, "the same cloud every time");
+    assert_eq!(pa.positions.len(), 20_000);
+    assert!(pa.normals.is_empty(), "a raw scan: normals are estimated");
+    // Every point on the wall of a tunnel about 2.5 m in radius (the ripples reach 0.63 m, the
+    // floor cuts it 1.6 m below the axis) between z = 0 and 16.
+    for p in &pa.positions {
+        assert!((0.0..=16.0).contains(&p.z), "{p}");
+        let axis = Vec2::new(0.8 * (p.z * 0.35).sin(), 0.3 * (p.z * 0.5).cos());
+        let r = (Vec2::new(p.x, p.y) - axis).length();
+        assert!((1.5..=3.2).contains(&r), "{p}: {r} m from the axis");
+    }
+    assert_eq!(a.lights.len(), 3);
+    assert_eq!(
+        builtin::by_name("point-cave").unwrap().point_count(),
+        builtin::POINT_CAVE_POINTS
+    );
+}

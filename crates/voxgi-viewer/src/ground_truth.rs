@@ -181,10 +181,6 @@ impl GroundTruth {
                 t.version = u64::MAX;
             }
         }
-        if let Some(why) = Self::unsupported(scene) {
-            self.error = Some(why.into());
-            return;
-        }
         let current = self.traced.as_ref().is_some_and(|t| t.version == version);
         let failed_here = self.error.is_some();
         if current || self.building.is_some() || failed_here {
@@ -262,14 +258,6 @@ impl GroundTruth {
     /// Whether a path tracer is being built.
     pub fn building(&self) -> bool {
         self.building.is_some()
-    }
-
-    /// Why the path tracer cannot show this scene, if it cannot.
-    fn unsupported(scene: &Scene) -> Option<&'static str> {
-        (scene.triangle_count() == 0).then_some(
-            "the path tracer traces triangles, and this scene has none (a point cloud is cone \
-             traced only)",
-        )
     }
 
     /// What the path tracer is doing, for the window: building, or how many samples it has.

@@ -64,7 +64,7 @@ pub use options::{
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use renderer::{Renderer, VOXEL_PASSES, VoxelCounts};
+pub use renderer::{PointPreparation, Renderer, VOXEL_PASSES, VoxelCounts, prepare_points};
 pub use scene_state::swept_bounds;
 pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
 pub use targets::{FrameTargets, Target};

@@ -93,14 +93,29 @@ pub(crate) fn complete_point_attributes(scene: &mut std::borrow::Cow<'_, Scene>)
         !pc.positions.is_empty()
             && (pc.normals.is_empty() || pc.radii.is_empty() || pc.regions.is_empty())
     }) {
-        estimate_point_attributes(scene.to_mut());
+        prepare_points(scene.to_mut());
     }
 }
 
+/// How long `prepare_points` took for each attribute, summed over the clouds.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PointPreparation {
+    /// Points whose attributes were estimated.
+    pub points: usize,
+    /// Normal estimation (PCA over 16 neighbours).
+    pub normals: std::time::Duration,
+    /// Regions of influence (8 neighbours).
+    pub regions: std::time::Duration,
+    /// Disc radii (8 neighbours).
+    pub radii: std::time::Duration,
+}
+
 /// Fills in normals (k = 16), regions of influence and disc radii (k = 8) of point clouds that
-/// lack them. Normals face the cloud's local origin when that lies outside the cloud's bounds
-/// (scanners put the sensor there), else the default camera.
-fn estimate_point_attributes(scene: &mut Scene) {
+/// lack them, as `Renderer::new` does (call it first to time it, or to keep the result for
+/// several renderers). Normals face the cloud's local origin when that lies outside the
+/// cloud's bounds (scanners put the sensor there), else the default camera.
+pub fn prepare_points(scene: &mut Scene) -> PointPreparation {
+    let mut timing = PointPreparation::default();
     let camera = scene
         .cameras
         .first()
@@ -134,10 +149,17 @@ fn estimate_point_attributes(scene: &mut Scene) {
         .filter_map(|(missing, name)| missing.then_some(name))
         .collect();
         let what = what.join(", ");
+        timing.points += pc.positions.len();
+        let t = std::time::Instant::now();
         pointcloud::estimate_normals(pc, 16, viewpoint);
+        timing.normals += t.elapsed();
         // Regions first: they take the file's radii, not estimated ones.
+        let t = std::time::Instant::now();
         pointcloud::estimate_regions(pc, 8);
+        timing.regions += t.elapsed();
+        let t = std::time::Instant::now();
         pointcloud::estimate_radii(pc, 8);
+        timing.radii += t.elapsed();
         log::info!(
             "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
             pc.name,
@@ -150,6 +172,7 @@ fn estimate_point_attributes(scene: &mut Scene) {
             }
         );
     }
+    timing
 }
 
 /// A scene uploaded to the GPU, ready to render from any camera into the caller's targets.

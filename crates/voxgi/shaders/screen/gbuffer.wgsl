@@ -95,10 +95,12 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
     // voxels hold the neighbourhood's surface, so cones and shadow lookups leaving a noisy
     // scan's surfel that lay behind it started inside it (blotches of occlusion all over the
     // office scan's walls). Along the normal as the file or the estimate has it, not as turned
-    // to the camera: the back faces of thin things move back, behind their front faces. Clean
-    // surfaces have no spread and stay where they are.
+    // to the camera: the back faces of thin things move back, behind their front faces. At
+    // most a radius: on a finely curved clean surface (the dragon's scales) the spread measures
+    // curvature, not noise, and a full push swelled the model and opened gaps between discs.
+    // Flat clean surfaces have no spread and stay where they are.
     var q = p;
-    q.position += point_normal(p) * point_spread[vi / 6u];
+    q.position += point_normal(p) * min(point_spread[vi / 6u], p.radius);
     var out: PointOut;
     out.clip = frame.view_proj * vec4<f32>(surfel_world(q, n, corner), 1.0);
     out.disc = corner;

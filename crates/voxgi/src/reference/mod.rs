@@ -180,7 +180,7 @@ pub struct PathTracer {
     light_count: u32,
     center: Vec3,
     radius: f32,
-    triangles: usize,
+    primitives: usize,
     nodes: wgpu::Buffer,
     tris: wgpu::Buffer,
     shading: wgpu::Buffer,
@@ -190,17 +190,18 @@ pub struct PathTracer {
     timer: GpuTimer,
 }
 
-/// World-space triangles in BVH order, and the flattened BVH over them.
+/// World-space triangles and discs in BVH order, and the flattened BVH over them.
 pub struct FlatScene {
     /// The flattened BVH; node 0 is the root.
     pub nodes: Vec<GpuNode>,
-    /// The triangles, in the order the leaves index them.
+    /// The triangles and discs, in the order the leaves index them.
     pub tris: Vec<GpuTri>,
     /// Shading attributes of `tris`, in the same order.
     pub shading: Vec<GpuTriShading>,
 }
 
-/// Flattens every mesh instance into world-space triangles and builds their BVH.
+/// Flattens every mesh instance into world-space triangles and every point into the disc the
+/// rasterizer draws for it, and builds their BVH.
 pub fn flatten(scene: &Scene) -> FlatScene {
     let mut tris = Vec::new();
     let mut shading = Vec::new();
@@ -354,7 +355,7 @@ impl PathTracer {
             )));
         }
         log::info!(
-            "reference: {} triangles, BVH of {} nodes, depth {depth}",
+            "reference: {} triangles and discs, BVH of {} nodes, depth {depth}",
             flat.tris.len(),
             flat.nodes.len()
         );
@@ -422,7 +423,7 @@ impl PathTracer {
             scene: gpu_scene,
             center,
             radius,
-            triangles: flat.tris.len(),
+            primitives: flat.tris.len(),
             nodes: buffers.0,
             tris: buffers.1,
             shading: buffers.2,
@@ -472,9 +473,9 @@ impl PathTracer {
         Ok(())
     }
 
-    /// Number of world-space triangles traced.
-    pub fn triangle_count(&self) -> usize {
-        self.triangles
+    /// Number of primitives traced: world-space triangles and points' discs.
+    pub fn primitive_count(&self) -> usize {
+        self.primitives
     }
 
     /// Renders `opts.spp` samples per pixel, calling `progress(done, total)` after each batch.
