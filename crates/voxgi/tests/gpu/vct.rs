@@ -55,12 +55,16 @@ pub(crate) fn wall_mesh(x: f32, height: f32, depth: f32) -> Mesh {
 
 #[test]
 fn ao_of_an_open_plane_is_one() {
-    let scene = plane_scene(0.5);
+    ao_of_an_open_plane(&plane_scene(0.5));
+}
+
+/// The AO of `plane_scene` (or a version of it) seen from above, for every structure.
+pub(crate) fn ao_of_an_open_plane(scene: &Scene) {
     let cam = Camera::look_at(Vec3::new(0.0, 4.0, 0.01), Vec3::ZERO, 40.0);
     for kind in VoxelKind::ALL {
         let mut s = on(kind, vct(ViewMode::Ao, 64, 0));
         s.options.ao_radius = Some(3.0);
-        let out = render(&scene, s, &cam, 32, 32);
+        let out = render(scene, s, &cam, 32, 32);
         let ao = mean(&out, 8, 8, 24, 24, 0);
         eprintln!("open plane AO ({kind:?}) {ao}");
         // Measured 1.000 at 64³ (both structures): samples stay far enough above their own
