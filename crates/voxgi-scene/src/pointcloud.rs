@@ -4,7 +4,7 @@
 //! empty, so values from the file win. Neighbour queries use a `kiddo` immutable k-d tree (which,
 //! unlike its mutable tree, copes with many identical points) and run on all cores.
 
-use crate::{PointCloud, Scene};
+use crate::{Instance, PointCloud, Scene};
 use glam::{DVec3, Mat4, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
@@ -221,11 +221,9 @@ pub fn surface_spread(pc: &PointCloud, k: usize) -> Vec<f32> {
 /// not read) and emission. Area lights' emitters stay meshes: they are lights, not geometry.
 /// Lights, cameras and materials are kept. For comparing points with the meshes they sample.
 pub fn sample_surfaces(scene: &Scene, spacing: f32) -> Scene {
-    let mut out = scene.clone();
-    out.instances.retain(|i| i.light.is_some());
-    out.animations.clear();
+    let mut out = without_geometry(scene);
     let spacing = spacing.max(1e-6) as f64;
-    for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
+    for inst in geometry(scene) {
         let mesh = &scene.meshes[inst.mesh];
         let material = &scene.materials[mesh.material];
         let normal_matrix = inst.transform.inverse().transpose();
@@ -234,12 +232,11 @@ pub fn sample_surfaces(scene: &Scene, spacing: f32) -> Scene {
             transform: Mat4::IDENTITY,
             ..Default::default()
         };
-        for t in mesh.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| {
-                inst.transform
-                    .transform_point3(mesh.positions[i as usize])
-                    .as_dvec3()
-            });
+        for (t, [a, b, c]) in mesh
+            .indices
+            .chunks_exact(3)
+            .zip(world_triangles(scene, inst))
+        {
             let mut n = (b - a).cross(c - a);
             if n.length_squared() < 1e-30 {
                 continue;
@@ -302,19 +299,10 @@ pub fn sample_surfaces(scene: &Scene, spacing: f32) -> Scene {
 
 /// The world-space area of the triangles `sample_surfaces` samples, m².
 pub fn surface_area(scene: &Scene) -> f64 {
-    let mut area = 0.0;
-    for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
-        let mesh = &scene.meshes[inst.mesh];
-        for t in mesh.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| {
-                inst.transform
-                    .transform_point3(mesh.positions[i as usize])
-                    .as_dvec3()
-            });
-            area += 0.5 * (b - a).cross(c - a).length();
-        }
-    }
-    area
+    geometry(scene)
+        .flat_map(|inst| world_triangles(scene, inst))
+        .map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length())
+        .sum()
 }
 
 /// A scene's meshes as point clouds of their vertices (a scan that kept a mesh's vertices, as
@@ -322,10 +310,8 @@ pub fn surface_area(scene: &Scene) -> f64 {
 /// space with the mesh's normals, its material's base colour and emission. Area lights'
 /// emitters stay meshes; lights, cameras and materials are kept.
 pub fn mesh_vertices(scene: &Scene) -> Scene {
-    let mut out = scene.clone();
-    out.instances.retain(|i| i.light.is_some());
-    out.animations.clear();
-    for inst in scene.instances.iter().filter(|i| i.light.is_none()) {
+    let mut out = without_geometry(scene);
+    for inst in geometry(scene) {
         let mesh = &scene.meshes[inst.mesh];
         let material = &scene.materials[mesh.material];
         let normal_matrix = inst.transform.inverse().transpose();
@@ -357,6 +343,36 @@ pub fn mesh_vertices(scene: &Scene) -> Scene {
         }
     }
     out
+}
+
+/// The instances `sample_surfaces` and `mesh_vertices` turn into points: all but area lights'
+/// emitters.
+fn geometry(scene: &Scene) -> impl Iterator<Item = &Instance> {
+    scene.instances.iter().filter(|i| i.light.is_none())
+}
+
+/// `scene` without the instances `geometry` lists (and without animations, which name
+/// instances by index): what the points are added to.
+fn without_geometry(scene: &Scene) -> Scene {
+    let mut out = scene.clone();
+    out.instances.retain(|i| i.light.is_some());
+    out.animations.clear();
+    out
+}
+
+/// The world-space corners of `inst`'s triangles, in f64.
+fn world_triangles<'a>(
+    scene: &'a Scene,
+    inst: &'a Instance,
+) -> impl Iterator<Item = [DVec3; 3]> + 'a {
+    let mesh = &scene.meshes[inst.mesh];
+    mesh.indices.chunks_exact(3).map(move |t| {
+        [t[0], t[1], t[2]].map(|i| {
+            inst.transform
+                .transform_point3(mesh.positions[i as usize])
+                .as_dvec3()
+        })
+    })
 }
 
 /// Eigen-decomposition of a symmetric 3×3 matrix by cyclic Jacobi rotations (robust for

@@ -161,23 +161,26 @@ impl GpuPoint {
 
     /// Linear albedo.
     pub fn albedo(&self) -> [f32; 3] {
-        let h = |b: u32| half::f16::from_bits(b as u16).to_f32();
         [
-            h(self.albedo_rg),
-            h(self.albedo_rg >> 16),
-            h(self.albedo_b_emission_r),
+            low_half(self.albedo_rg),
+            low_half(self.albedo_rg >> 16),
+            low_half(self.albedo_b_emission_r),
         ]
     }
 
     /// Emitted radiance, W/(m² sr).
     pub fn emission(&self) -> [f32; 3] {
-        let h = |b: u32| half::f16::from_bits(b as u16).to_f32();
         [
-            h(self.albedo_b_emission_r >> 16),
-            h(self.emission_gb),
-            h(self.emission_gb >> 16),
+            low_half(self.albedo_b_emission_r >> 16),
+            low_half(self.emission_gb),
+            low_half(self.emission_gb >> 16),
         ]
     }
+}
+
+/// The f16 in the low half of `bits`, as f32.
+fn low_half(bits: u32) -> f32 {
+    half::f16::from_bits(bits as u16).to_f32()
 }
 
 /// IEEE half-precision bits of `v` (round to nearest even), clamped to the finite range; NaN and
@@ -492,11 +495,8 @@ impl GpuScene {
             })
             .collect();
         let lights = gpu_lights(scene);
-        let GpuPoints {
-            points,
-            spread,
-            regions,
-        } = gpu_points(scene);
+        let GpuPoints { points, regions } = gpu_points(scene);
+        let spread = point_spread(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
             let mut data = bytes.to_vec();
@@ -601,17 +601,14 @@ impl GpuScene {
 }
 
 /// Surfels of every point cloud in world space: positions by the cloud's transform, normals by
-/// its inverse transpose, radii by its mean scale. Attributes a cloud lacks get defaults here
-/// (no normal: the disc faces the viewer; radius 0: not drawn; grey albedo; no emission); the
-/// renderer estimates normals, radii and regions before uploading.
+/// its inverse transpose, radii and regions by its mean scale. Attributes a cloud lacks get
+/// defaults here (no normal: the disc faces the viewer; radius 0: not drawn; region 0: one
+/// voxel; grey albedo; no emission); the renderer estimates normals, radii and regions before
+/// uploading.
 pub fn gpu_points(scene: &Scene) -> GpuPoints {
-    let mut out = Vec::with_capacity(scene.point_count());
-    let mut spread_out = Vec::with_capacity(scene.point_count());
+    let mut points = Vec::with_capacity(scene.point_count());
     let mut regions = Vec::with_capacity(scene.point_count());
     for pc in &scene.point_clouds {
-        if pc.positions.is_empty() {
-            continue;
-        }
         let m = pc.transform;
         let normal_matrix = m.inverse().transpose();
         let normal_matrix = if normal_matrix.is_finite() {
@@ -619,9 +616,42 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
         } else {
             Mat4::IDENTITY
         };
-        // Mean scale: the cube root of the volume scale (|det| of the linear part).
-        let scale = m.determinant().abs().cbrt();
-        let scale = if scale.is_finite() { scale } else { 1.0 };
+        let scale = cloud_scale(pc);
+        for (i, &p) in pc.positions.iter().enumerate() {
+            let n = pc.normals.get(i).map_or(Vec3::ZERO, |&n| {
+                normal_matrix.transform_vector3(n).normalize_or_zero()
+            });
+            let length = |v: Option<&f32>| v.map_or(0.0, |&v| finite_or_zero(v * scale).max(0.0));
+            regions.push(length(pc.regions.get(i)));
+            points.push(GpuPoint::new(
+                m.transform_point3(p),
+                length(pc.radii.get(i)),
+                n,
+                pc.colors.get(i).copied().unwrap_or([0.8; 3]),
+                pc.emission.get(i).copied().unwrap_or([0.0; 3]),
+            ));
+        }
+    }
+    GpuPoints { points, regions }
+}
+
+/// The point clouds as the GPU takes them, one entry per point in each.
+pub struct GpuPoints {
+    /// The surfels.
+    pub points: Vec<GpuPoint>,
+    /// World-space edge of the region of influence (see `GpuScene::point_regions`).
+    pub regions: Vec<f32>,
+}
+
+/// Each point's world-space surface spread (see `GpuScene::point_spread`), in `gpu_points`'
+/// order: a k-nearest-neighbour search per cloud, so only the rasterizer's upload pays for it.
+pub fn point_spread(scene: &Scene) -> Vec<f32> {
+    let mut out = Vec::with_capacity(scene.point_count());
+    for pc in scene
+        .point_clouds
+        .iter()
+        .filter(|pc| !pc.positions.is_empty())
+    {
         let start = std::time::Instant::now();
         // 24 neighbours (then dilated over 24 more) span a few point spacings each way.
         let spread = pointcloud::surface_spread(pc, 24);
@@ -631,40 +661,24 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
             pc.positions.len(),
             start.elapsed().as_secs_f64()
         );
-        for (i, &p) in pc.positions.iter().enumerate() {
-            let s = spread.get(i).map_or(0.0, |&s| s * scale);
-            spread_out.push(if s.is_finite() { s } else { 0.0 });
-            let n = pc.normals.get(i).map_or(Vec3::ZERO, |&n| {
-                normal_matrix.transform_vector3(n).normalize_or_zero()
-            });
-            let r = pc.radii.get(i).map_or(0.0, |&r| r * scale);
-            let r = if r.is_finite() { r.max(0.0) } else { 0.0 };
-            let e = pc.regions.get(i).map_or(0.0, |&e| e * scale);
-            regions.push(if e.is_finite() { e.max(0.0) } else { 0.0 });
-            out.push(GpuPoint::new(
-                m.transform_point3(p),
-                r,
-                n,
-                pc.colors.get(i).copied().unwrap_or([0.8; 3]),
-                pc.emission.get(i).copied().unwrap_or([0.0; 3]),
-            ));
-        }
+        let scale = cloud_scale(pc);
+        out.extend(
+            (0..pc.positions.len())
+                .map(|i| spread.get(i).map_or(0.0, |&s| finite_or_zero(s * scale))),
+        );
     }
-    GpuPoints {
-        points: out,
-        spread: spread_out,
-        regions,
-    }
+    out
 }
 
-/// The point clouds as the GPU takes them, one entry per point in each.
-pub struct GpuPoints {
-    /// The surfels.
-    pub points: Vec<GpuPoint>,
-    /// World-space surface spread (see `GpuScene::point_spread`).
-    pub spread: Vec<f32>,
-    /// World-space edge of the region of influence (see `GpuScene::point_regions`).
-    pub regions: Vec<f32>,
+/// A cloud's mean scale: the cube root of its transform's volume scale (|det| of the linear
+/// part), 1 when that is not finite.
+fn cloud_scale(pc: &voxgi_scene::PointCloud) -> f32 {
+    let scale = pc.transform.determinant().abs().cbrt();
+    if scale.is_finite() { scale } else { 1.0 }
+}
+
+fn finite_or_zero(v: f32) -> f32 {
+    if v.is_finite() { v } else { 0.0 }
 }
 
 /// All material textures go into one RGBA8 sRGB 2D array at a common power-of-two size, so that

@@ -21,20 +21,12 @@
 
 @group(0) @binding(0) var<uniform> grid: FragmentGrid;
 @group(0) @binding(1) var<storage, read> points: array<Point>;
-// Per point: the edge of its region of influence, metres (0: a point alone, one voxel).
+// Per point: the edge of its region of influence, metres (0: a point alone, one voxel). Its
+// length is the point count (the host runs the pass only when there are points).
 @group(0) @binding(2) var<storage, read> regions: array<f32>;
 @group(0) @binding(3) var<storage, read_write> fragments: array<Fragment>;
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
 @group(0) @binding(4) var<storage, read_write> fragment_count: array<atomic<u32>>;
-
-struct SplatParams {
-    // Points in `points` (the buffers are padded when empty).
-    count: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-@group(0) @binding(5) var<uniform> params: SplatParams;
 
 const SUB: u32 = 1024u;
 
@@ -52,7 +44,7 @@ fn flat(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat(gid, nwg);
-    if i >= params.count {
+    if i >= arrayLength(&regions) {
         return;
     }
     let pt = points[i];

@@ -5,18 +5,6 @@ use crate::fragments::Fragments;
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
-
-/// Mirrors `SplatParams` in shaders/fragments/splat.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuSplatParams {
-    /// Points to splat.
-    pub count: u32,
-    /// Padding to 16 bytes; zero.
-    pub _pad: [u32; 3],
-}
 
 /// The splat compute pass (shaders/fragments/splat.wgsl): its pipeline and bind group layout.
 pub struct SplatPass {
@@ -36,7 +24,6 @@ impl SplatPass {
                 layout::storage(2, c, true),
                 layout::storage(3, c, false),
                 layout::storage(4, c, false),
-                layout::uniform(5, c, false),
             ],
         });
         let pipeline = crate::gpu::shader::grouped_pipeline(
@@ -66,14 +53,6 @@ impl SplatPass {
         if scene.point_count == 0 {
             return;
         }
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("splat params"),
-            contents: bytemuck::bytes_of(&GpuSplatParams {
-                count: scene.point_count,
-                _pad: [0; 3],
-            }),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat"),
             layout: &self.layout,
@@ -83,7 +62,6 @@ impl SplatPass {
                 scene.point_regions.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
-                params.as_entire_binding(),
             ]),
         });
         pass.set_pipeline(&self.pipeline);
