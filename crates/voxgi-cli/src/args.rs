@@ -50,6 +50,10 @@ pub struct SettingsArgs {
     /// Diffuse cone set: 6x60, 7x45 or 9x45. Default 6x60.
     #[arg(long, value_name = "SET", value_parser = lib(voxgi::parse_cones))]
     pub cones: Option<voxgi::ConeSet>,
+    /// Diffuse indirect light per pixel: cones (a cone bundle per pixel) or leaves (the
+    /// thesis' fast shading: the leaves' stored irradiance, interpolated). Default cones.
+    #[arg(long, value_parser = names(voxgi::IndirectShading::ALL.map(voxgi::IndirectShading::name)))]
+    pub indirect: Option<String>,
     /// One radiance value per voxel above the finest level instead of six directional ones.
     #[arg(long)]
     pub isotropic: bool,
@@ -119,6 +123,9 @@ impl SettingsArgs {
         set!(o.voxel_resolution, self.voxel_resolution);
         set!(o.bounces, self.bounces);
         set!(o.cones, self.cones);
+        if let Some(i) = &self.indirect {
+            o.indirect = voxgi::IndirectShading::parse(i)?;
+        }
         if self.isotropic {
             o.anisotropic = false;
         }

@@ -132,6 +132,43 @@ impl ViewMode {
     }
 }
 
+/// How each pixel gets its diffuse indirect light and ambient occlusion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum IndirectShading {
+    /// A bundle of diffuse cones traced from every pixel (the per-pixel gather of Crassin et
+    /// al.): sharp contact occlusion, costs cones per pixel every frame.
+    #[default]
+    Cones,
+    /// The thesis' fast shading (Salm, §4.6): the last voxel bounce keeps every leaf's
+    /// irradiance and occlusion, and each pixel interpolates those of the leaves around it
+    /// (weighted by how well their normals agree with its own). No per-pixel diffuse cones:
+    /// the frame's cost no longer grows with the cone count, the voxel update costs one more
+    /// bounce, and light leaks along edges where a leaf holds two surfaces
+    /// (docs/QUALITY.md). Glossy cones are still traced per pixel.
+    Leaves,
+}
+
+impl IndirectShading {
+    /// Both, in the order of their names.
+    pub const ALL: [IndirectShading; 2] = [IndirectShading::Cones, IndirectShading::Leaves];
+
+    /// The name scene files and the CLI use.
+    pub fn name(self) -> &'static str {
+        match self {
+            IndirectShading::Cones => "cones",
+            IndirectShading::Leaves => "leaves",
+        }
+    }
+
+    /// A shading by name.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| Error::Setting(format!("indirect shading '{s}' is not cones or leaves")))
+    }
+}
+
 /// `RendererOptions::bounces` value for "until converged": voxel bounces are repeated until the
 /// energy left (the largest albedo to the power of the bounce count) is below 0.1 %.
 pub const UNLIMITED_BOUNCES: u32 = u32::MAX;
@@ -163,9 +200,13 @@ pub struct RendererOptions {
     pub gather_axes: u32,
     /// Diffuse cone set. Default: six cones of 60°.
     pub cones: ConeSet,
-    /// Indirect bounces: 0 (direct light only) to 8, or `UNLIMITED_BOUNCES`. The last bounce is
-    /// the per-pixel gather; the others run in voxel space. Default 2.
+    /// Indirect bounces: 0 (direct light only) to 8, or `UNLIMITED_BOUNCES`. With cones the last
+    /// bounce is the per-pixel gather and the others run in voxel space; with leaves all run in
+    /// voxel space. Default 2.
     pub bounces: u32,
+    /// Where pixels get diffuse indirect light: cones per pixel (default) or the leaves'
+    /// stored irradiance.
+    pub indirect: IndirectShading,
     /// Ambient occlusion radius in metres; `None`: a quarter of the volume's extent.
     pub ao_radius: Option<f32>,
     /// Ambient occlusion falloff lambda in 1/(1 + lambda r), per metre (>= 0). Default 0:
@@ -213,6 +254,7 @@ impl Default for RendererOptions {
             gather_axes: 3,
             cones: ConeSet::Six60,
             bounces: 2,
+            indirect: IndirectShading::Cones,
             ao_radius: None,
             ao_lambda: 0.0,
             step_factor: 0.5,

@@ -1,8 +1,12 @@
 //! The renderer: uploads a scene once, then records frames into the caller's encoder by calling
 //! the passes in one fixed order from `Renderer::render`:
 //!
-//! shadow → voxelize → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
+//! shadow → voxelize → splat → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
 //!        → gbuffer → gather → upsample → composite → [debug] → tonemap
+//!
+//! With the fast shading (`IndirectShading::Leaves`) one more bounce runs, which keeps every
+//! leaf's irradiance and is neither stored nor filtered, and the gather reads those instead of
+//! tracing diffuse cones.
 //!
 //! `debug` runs only for the voxel views (`ViewMode::is_voxel`) and replaces the composite's
 //! output with the ray-marched volume. `tonemap` writes the caller's target.
@@ -26,10 +30,12 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
 use crate::gpu_scene::{GpuFrame, GpuScene, bounding_sphere, check_light, gpu_light};
 use crate::lighting::atlas::{self as shadow, ShadowAtlas, ViewDirt};
-use crate::lighting::bounce::BouncePass;
+use crate::lighting::bounce::{BouncePass, BounceSteps};
 use crate::lighting::inject::InjectPass;
 use crate::lighting::shadow::ShadowPass;
-use crate::options::{FrameParams, RendererOptions, UNLIMITED_BOUNCES, validate_size};
+use crate::options::{
+    FrameParams, IndirectShading, RendererOptions, UNLIMITED_BOUNCES, validate_size,
+};
 use crate::scene_state::SceneState;
 use crate::screen::composite::CompositePass;
 use crate::screen::gather::{self, GatherPass};
@@ -337,7 +343,7 @@ impl Renderer {
                 gpu_scene.light_count,
                 atlas.views.len(),
             ),
-            bounce: BouncePass::new(device, options.voxels, options.anisotropic),
+            bounce: BouncePass::new(device, options.voxels, options.anisotropic, leaves(options)),
             gbuffer: GbufferPass::new(device),
             gather: GatherPass::new(device, options, facts.glossy),
             upsample: UpsamplePass::new(device),
@@ -351,7 +357,7 @@ impl Renderer {
             ))
         })??;
         let brdf_tables = BrdfTables::new(device, queue);
-        let voxel_bounces = voxel_bounce_count(facts.max_albedo, options.bounces);
+        let voxel_bounces = voxel_bounce_count(facts.max_albedo, options);
         let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("cones"),
             contents: bytemuck::bytes_of(&cone_uniforms(options, &grid)),
@@ -430,7 +436,8 @@ impl Renderer {
             || old.ao_radius != new.ao_radius
             || old.ao_lambda != new.ao_lambda
             || old.origin_offset != new.origin_offset
-            || old.bounces != new.bounces;
+            || old.bounces != new.bounces
+            || old.indirect != new.indirect;
         let grid = grid(&self.facts, new);
         // Build everything first, so a failure leaves the renderer as it was.
         let atlas_new = if atlas {
@@ -463,14 +470,15 @@ impl Renderer {
         } else {
             None
         };
-        let gather = volume || old.gather_axes != new.gather_axes;
+        let indirect = old.indirect != new.indirect;
+        let gather = volume || old.gather_axes != new.gather_axes || indirect;
         let views = self.atlas.views.len();
         let (gather_new, bounce_new, composite_new, inject_new) =
             checked(device, "pipeline creation", || {
                 (
                     gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
-                    (kind || old.anisotropic != new.anisotropic)
-                        .then(|| BouncePass::new(device, new.voxels, new.anisotropic)),
+                    (kind || old.anisotropic != new.anisotropic || indirect)
+                        .then(|| BouncePass::new(device, new.voxels, new.anisotropic, leaves(new))),
                     (old.cone_shadows != new.cone_shadows)
                         .then(|| composite_pass(device, &self.scene, &self.facts, new)),
                     kind.then(|| {
@@ -506,7 +514,7 @@ impl Renderer {
                 0,
                 bytemuck::bytes_of(&cone_uniforms(new, &grid)),
             );
-            self.voxel_bounces = voxel_bounce_count(self.facts.max_albedo, new.bounces);
+            self.voxel_bounces = voxel_bounce_count(self.facts.max_albedo, new);
         }
         // The gather's resolution needs no work here: the next frame makes targets to match.
         let progressive = old.progressive != new.progressive;
@@ -817,18 +825,45 @@ impl Renderer {
                 self.volume
                     .get()
                     .record_filter(&self.device, encoder, timer);
-                for _ in 0..self.voxel_bounces {
-                    p.bounce
-                        .record(&self.device, encoder, self.volume.get(), &self.cones, timer);
-                    self.volume
-                        .get()
-                        .record_filter(&self.device, encoder, timer);
+                let n = self.voxel_bounces;
+                for i in 0..n {
+                    // With leaves the last bounce's light is what the pixels read: it keeps
+                    // the irradiance and need not be stored or filtered (the glossy cones
+                    // then see the same light as with cones).
+                    let last = leaves(&self.options) && i + 1 == n;
+                    let steps = BounceSteps {
+                        irradiance: last,
+                        store: !last,
+                    };
+                    p.bounce.record(
+                        &self.device,
+                        encoder,
+                        self.volume.get(),
+                        &self.cones,
+                        steps,
+                        timer,
+                    );
+                    if steps.store {
+                        self.volume
+                            .get()
+                            .record_filter(&self.device, encoder, timer);
+                    }
                 }
             }
         }
         if progressive && self.progressive_left > 0 {
-            p.bounce
-                .record(&self.device, encoder, self.volume.get(), &self.cones, timer);
+            let steps = BounceSteps {
+                irradiance: leaves(&self.options),
+                store: true,
+            };
+            p.bounce.record(
+                &self.device,
+                encoder,
+                self.volume.get(),
+                &self.cones,
+                steps,
+                timer,
+            );
             self.volume
                 .get()
                 .record_filter(&self.device, encoder, timer);
@@ -1184,17 +1219,28 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
     Ok(())
 }
 
-/// Voxel-space bounces for a total of `bounces` indirect bounces (the gather adds one).
-fn voxel_bounce_count(max_albedo: f32, bounces: u32) -> u32 {
+/// Whether the pixels read the leaves' irradiance (the fast shading).
+fn leaves(options: &RendererOptions) -> bool {
+    options.indirect == IndirectShading::Leaves
+}
+
+/// Voxel-space bounces for a total of `options.bounces` indirect bounces: with cones the
+/// per-pixel gather adds one; with leaves every bounce runs in voxel space, and at least one
+/// runs (with no indirect light, for the occlusion it keeps).
+fn voxel_bounce_count(max_albedo: f32, options: &RendererOptions) -> u32 {
+    let in_voxels = |cones: u32| {
+        if leaves(options) { cones + 1 } else { cones }
+    };
+    let bounces = options.bounces;
     if bounces != UNLIMITED_BOUNCES {
-        return bounces.saturating_sub(1);
+        return in_voxels(bounces.saturating_sub(1));
     }
     // Until the energy left, max albedo^k, is below 0.1 %.
     let rho = max_albedo.clamp(0.0, 0.99);
     if rho <= 0.0 {
-        return 0;
+        return in_voxels(0);
     }
-    ((1e-3f32.ln() / rho.ln()).ceil() as u32).clamp(1, 64)
+    in_voxels(((1e-3f32.ln() / rho.ln()).ceil() as u32).clamp(1, 64))
 }
 
 /// The cone uniforms from the options and the volume.

@@ -2,7 +2,8 @@
 //! an application) shares one parser and one list of keys.
 
 use crate::options::{
-    FrameParams, MAX_BOUNCES, RendererOptions, Tonemap, UNLIMITED_BOUNCES, ViewMode,
+    FrameParams, IndirectShading, MAX_BOUNCES, RendererOptions, Tonemap, UNLIMITED_BOUNCES,
+    ViewMode,
 };
 use crate::voxel::dense::DIRECTIONS;
 use crate::voxel::{ConeSet, VoxelKind};
@@ -31,6 +32,8 @@ pub struct SceneSettings {
     pub gather_axes: Option<u32>,
     /// `RendererOptions::cones`: "6x60", "7x45" or "9x45".
     pub cones: Option<String>,
+    /// `RendererOptions::indirect`: "cones" or "leaves".
+    pub indirect: Option<String>,
     /// `RendererOptions::bounces`: a number, "direct" (0) or "unlimited".
     pub bounces: Option<BouncesValue>,
     /// `RendererOptions::ao_radius`, metres.
@@ -119,6 +122,9 @@ impl SceneSettings {
         set!(o.gather_axes, self.gather_axes);
         if let Some(c) = &self.cones {
             o.cones = parse_cones(c)?;
+        }
+        if let Some(i) = &self.indirect {
+            o.indirect = IndirectShading::parse(i)?;
         }
         if let Some(b) = &self.bounces {
             o.bounces = match b {

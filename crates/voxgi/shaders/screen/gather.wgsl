@@ -1,15 +1,18 @@
 // gather: per pixel (or per 2x2 block at half resolution), indirect light from the voxels:
-// diffuse cones (irradiance and ambient occlusion) and one glossy cone along the specular
-// lobe's dominant direction whose aperture follows the roughness; with cone shadows, the visibility of the
-// first area lights by one cone each.
+// diffuse cones (irradiance and ambient occlusion), or with LEAVES the irradiance and occlusion
+// the last bounce kept in the leaves around the pixel (shared/leaf_irradiance.wgsl), and one
+// glossy cone along the specular lobe's dominant direction whose aperture follows the
+// roughness; with cone shadows, the visibility of the first area lights by one cone each.
 
 //!include shared/globals.wgsl
 //!include shared/brdf.wgsl
 //!include shared/cone.wgsl
 //!include shared/interleave.wgsl
+//!include shared/leaf_irradiance.wgsl
 
 // Group 0: the frame's globals (shared/globals.wgsl).
-// Group 1: the voxel structure (voxels/<kind>/sample.wgsl). Group 2, the pass's own:
+// Group 1: the voxel structure (voxels/<kind>/sample.wgsl); group 3 its irradiance lookup
+// (voxels/<kind>/irradiance.wgsl). Group 2, the pass's own:
 @group(2) @binding(0) var gb_albedo: texture_2d<f32>;
 @group(2) @binding(1) var gb_normal: texture_2d<f32>;
 @group(2) @binding(2) var gb_emission: texture_2d<f32>;
@@ -66,6 +69,8 @@ fn world_position(px: vec2<u32>, depth: f32) -> vec3<f32> {
 // False when no surface in the scene has a specular lobe: the glossy cone's code is then
 // compiled out (CPU drivers run an untaken branch's code; it cost 6 % of this pass).
 override GLOSSY: bool = true;
+// The fast shading: diffuse light and occlusion from the leaves' records, no diffuse cones.
+override LEAVES: bool = false;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -95,7 +100,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let angle = (f32(bayer4(gid.xy)) + 0.5) / 16.0 * period;
     // Even and odd Bayer ranks trace the two halves of the ring: each half then meets eight
     // rotations spread over the whole period.
-    let g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO, cone_half(gid.xy));
+    var g: Gathered;
+    if LEAVES {
+        g = leaf_gather(p, n);
+    } else {
+        g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO, cone_half(gid.xy));
+    }
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);
     if GLOSSY && cones.indirect != 0u && max(f0.r, max(f0.g, f0.b)) > 0.0 {

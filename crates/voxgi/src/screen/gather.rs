@@ -1,11 +1,13 @@
-//! gather: per-pixel indirect light from the voxels (diffuse cones with AO, glossy cone) and,
-//! with `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
-//! Bind groups: 0 the frame's globals, 1 the voxel structure's sampling group, 2 its own.
+//! gather: per-pixel indirect light from the voxels (diffuse cones with AO, or with
+//! `IndirectShading::Leaves` the leaves' interpolated irradiance; glossy cone) and, with
+//! `cone_shadows`, the visibility of area lights by a cone, at full or half resolution.
+//! Bind groups: 0 the frame's globals, 1 the voxel structure's sampling group, 2 its own, 3 the
+//! structure's irradiance lookup.
 
 use crate::gpu::layout;
 use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::options::RendererOptions;
+use crate::options::{IndirectShading, RendererOptions};
 use crate::targets::FrameTargets;
 use crate::voxel::VoxelStructure;
 use voxgi_scene::Scene;
@@ -53,15 +55,27 @@ impl GatherPass {
         });
         let kind = settings.voxels;
         let [iso, axes] = kind.sampling_constants(settings.anisotropic, settings.gather_axes);
-        let constants = [iso, axes, ("GLOSSY", f64::from(u8::from(glossy)))];
+        let leaves = settings.indirect == IndirectShading::Leaves;
+        let constants = [
+            iso,
+            axes,
+            ("GLOSSY", f64::from(u8::from(glossy))),
+            ("LEAVES", f64::from(u8::from(leaves))),
+        ];
         let voxels = kind.sampling_layout(device);
+        let irradiance = kind.irradiance_layout(device);
         GatherPass {
             pipeline: voxel_pipeline(
                 device,
                 "gather",
                 "screen/gather.wgsl",
                 kind.name(),
-                &[Some(&globals), Some(&voxels), Some(&layout)],
+                &[
+                    Some(&globals),
+                    Some(&voxels),
+                    Some(&layout),
+                    Some(&irradiance),
+                ],
                 &constants,
             ),
             layout,
@@ -100,6 +114,7 @@ impl GatherPass {
         pass.set_bind_group(0, globals, &[]);
         pass.set_bind_group(1, voxels.sampling(), &[]);
         pass.set_bind_group(2, &own, &[]);
+        pass.set_bind_group(3, voxels.irradiance(), &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
 }

@@ -87,6 +87,12 @@ pub trait VoxelStructure {
     fn leaves(&self) -> &wgpu::BindGroup;
     /// The leaves' radiance for writing (`voxels/<kind>/leaf_store.wgsl`), `@group(3)`.
     fn leaf_store(&self) -> &wgpu::BindGroup;
+    /// Per leaf slot, what the last bounce kept for the fast shading (`IndirectShading::Leaves`):
+    /// a `vec4<u32>` record of irradiance, occlusion and normal (shaders/lighting/bounce.wgsl).
+    fn leaf_irradiance(&self) -> &wgpu::Buffer;
+    /// The bind group of `voxels/<kind>/irradiance.wgsl`, `@group(3)` of the gather: the
+    /// record of the leaf at a voxel coordinate.
+    fn irradiance(&self) -> &wgpu::BindGroup;
     /// An indirect dispatch of one 64-wide workgroup per 64 leaves (2D past 65535 groups:
     /// threads index leaves as `gid.x + gid.y * num_workgroups.x * 64`).
     fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64);
@@ -157,6 +163,14 @@ impl VoxelKind {
         match self {
             VoxelKind::Dense => dense::DenseVolume::leaf_store_layout(device),
             VoxelKind::Octree => octree::OctreeVolume::leaf_store_layout(device),
+        }
+    }
+
+    /// The layout of @group(3) of the gather, the structure's irradiance lookup.
+    pub fn irradiance_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        match self {
+            VoxelKind::Dense => dense::DenseVolume::irradiance_layout(device),
+            VoxelKind::Octree => octree::OctreeVolume::irradiance_layout(device),
         }
     }
 

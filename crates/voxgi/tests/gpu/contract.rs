@@ -31,6 +31,7 @@ fn type_name(m: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
         (K::Float, 4) => "f32",
         (K::Bool, _) => "bool",
         (K::Uint, 4) => "u32",
+        (K::Sint, 4) => "i32",
         _ => "?",
     };
     match &m.types[ty].inner {
@@ -158,6 +159,35 @@ fn every_structure_defines_the_leaf_contract() {
                 );
             }
         }
+    }
+}
+
+/// The irradiance lookup of the fast shading (shared/leaf_irradiance.wgsl): names and
+/// signatures, and its own resources at group 3 (the sampling group's at 1).
+#[test]
+fn every_structure_defines_the_irradiance_lookup() {
+    for kind in shader::STRUCTURES {
+        let src = shader::compose_for(&format!("voxels/{kind}/irradiance.wgsl"), kind);
+        let m = parse(&src);
+        validate(&m);
+        check_functions(
+            &m,
+            kind,
+            &[
+                ("irradiance_grid", &["vec3<f32>"], "vec3<f32>"),
+                ("leaf_irradiance_at", &["vec3<i32>"], "vec4<u32>"),
+            ],
+        );
+        let own: Vec<_> = m
+            .global_variables
+            .iter()
+            .filter_map(|(_, g)| g.binding.as_ref().map(|b| (g.name.clone(), b.group)))
+            .filter(|(_, group)| *group != 1)
+            .collect();
+        assert!(
+            own.iter().all(|(_, group)| *group == 3) && !own.is_empty(),
+            "{kind}: the lookup's own resources must be in group 3: {own:?}"
+        );
     }
 }
 

@@ -9,6 +9,7 @@ mod contract;
 mod dynamic;
 mod embed;
 mod errors;
+mod fast_shading;
 mod golden;
 mod options;
 mod point_gi;

@@ -217,9 +217,9 @@ fn a_wall_of_points_leaks_as_little_as_the_mesh_wall() {
 /// The Cornell box's regions away from the emitter (reference.rs): back wall, floor, the two
 /// walls, ceiling.
 /// A pixel rectangle: x0, y0, x1, y1.
-type Rect = (u32, u32, u32, u32);
+pub(crate) type Rect = (u32, u32, u32, u32);
 
-const CORNELL_REGIONS: [(&str, Rect); 5] = [
+pub(crate) const CORNELL_REGIONS: [(&str, Rect); 5] = [
     ("back wall", (25, 20, 40, 35)),
     ("floor", (20, 56, 44, 62)),
     ("red wall", (2, 20, 8, 40)),

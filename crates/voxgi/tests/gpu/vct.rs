@@ -5,7 +5,7 @@ use crate::common::*;
 use voxgi::scene::builtin;
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Material, Mesh, Scene};
-use voxgi::{RendererOptions, ViewMode, VoxelKind};
+use voxgi::{IndirectShading, RendererOptions, ViewMode, VoxelKind};
 
 pub(crate) fn vct(view: ViewMode, res: u32, bounces: u32) -> Setup {
     Setup {
@@ -19,9 +19,28 @@ pub(crate) fn vct(view: ViewMode, res: u32, bounces: u32) -> Setup {
     }
 }
 
-/// `vct` on voxel structure `kind`.
-pub(crate) fn on(kind: VoxelKind, mut s: Setup) -> Setup {
-    s.options.voxels = kind;
+/// A voxel structure and how pixels read its indirect light: what the shared invariant checks
+/// run on (a `VoxelKind` alone means per-pixel cones).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Variant {
+    pub kind: VoxelKind,
+    pub indirect: IndirectShading,
+}
+
+impl From<VoxelKind> for Variant {
+    fn from(kind: VoxelKind) -> Self {
+        Variant {
+            kind,
+            indirect: IndirectShading::Cones,
+        }
+    }
+}
+
+/// `vct` on voxel structure `kind` (with its indirect shading).
+pub(crate) fn on(kind: impl Into<Variant>, mut s: Setup) -> Setup {
+    let v = kind.into();
+    s.options.voxels = v.kind;
+    s.options.indirect = v.indirect;
     s
 }
 
@@ -60,8 +79,15 @@ fn ao_of_an_open_plane_is_one() {
 
 /// The AO of `plane_scene` (or a version of it) seen from above, for every structure.
 pub(crate) fn ao_of_an_open_plane(scene: &Scene) {
-    let cam = Camera::look_at(Vec3::new(0.0, 4.0, 0.01), Vec3::ZERO, 40.0);
     for kind in VoxelKind::ALL {
+        ao_of_an_open_plane_on(scene, kind.into());
+    }
+}
+
+/// `ao_of_an_open_plane` on one variant.
+pub(crate) fn ao_of_an_open_plane_on(scene: &Scene, kind: Variant) {
+    let cam = Camera::look_at(Vec3::new(0.0, 4.0, 0.01), Vec3::ZERO, 40.0);
+    {
         let mut s = on(kind, vct(ViewMode::Ao, 64, 0));
         s.options.ao_radius = Some(3.0);
         let out = render(scene, s, &cam, 32, 32);
@@ -90,7 +116,8 @@ fn ao_beside_a_wall_matches_the_closed_form() {
     }
 }
 
-pub(crate) fn ao_beside_a_wall(scene: &Scene, cam: &Camera, kind: VoxelKind) {
+pub(crate) fn ao_beside_a_wall(scene: &Scene, cam: &Camera, kind: impl Into<Variant>) -> f32 {
+    let kind = kind.into();
     let mut s = on(kind, vct(ViewMode::Ao, 64, 0));
     let radius = 4.0;
     s.options.ao_radius = Some(radius);
@@ -145,10 +172,11 @@ pub(crate) fn ao_beside_a_wall(scene: &Scene, cam: &Camera, kind: VoxelKind) {
         worst.1,
         worst.3
     );
+    worst.0
 }
 
 /// The mean of the white furnace's image (`builtin::closed_box(0.5, 1.0)` or a version of it).
-fn furnace(scene: &Scene, kind: VoxelKind, bounces: u32) -> f32 {
+fn furnace(scene: &Scene, kind: Variant, bounces: u32) -> f32 {
     let cam = scene.cameras[0].clone();
     let out = render(
         scene,
@@ -176,7 +204,8 @@ pub(crate) const FURNACE_CASES: [(u32, f32, f32); 4] = [
     (voxgi::UNLIMITED_BOUNCES, 2.0, 0.03),
 ];
 
-pub(crate) fn furnace_series(scene: &Scene, kind: VoxelKind, cases: &[(u32, f32, f32)]) {
+pub(crate) fn furnace_series(scene: &Scene, kind: impl Into<Variant>, cases: &[(u32, f32, f32)]) {
+    let kind = kind.into();
     let got: Vec<f32> = cases.iter().map(|c| furnace(scene, kind, c.0)).collect();
     for (c, g) in cases.iter().zip(&got) {
         eprintln!(
@@ -222,7 +251,7 @@ fn thin_wall_leaks_less_than_one_percent() {
 
 /// Room B's indirect radiance over room A's (two bounces), in `builtin::two_rooms` or a
 /// version of it.
-pub(crate) fn thin_wall_leak(scene: &Scene, kind: VoxelKind, res: u32) -> f32 {
+pub(crate) fn thin_wall_leak(scene: &Scene, kind: impl Into<Variant>, res: u32) -> f32 {
     let cam_a = Camera::look_at(Vec3::new(-0.9, 0.5, 0.9), Vec3::new(-0.1, 0.3, 0.1), 70.0);
     let cam_b = Camera::look_at(Vec3::new(0.9, 0.5, 0.9), Vec3::new(0.1, 0.3, 0.1), 70.0);
     let s = on(kind, vct(ViewMode::Indirect, res, 2));

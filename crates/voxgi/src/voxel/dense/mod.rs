@@ -74,6 +74,8 @@ pub struct DenseVolume {
     pub slot_direct: wgpu::Buffer,
     /// Per slot: the last bounce's outgoing radiance and opacity (vec4 f32).
     pub slot_next: wgpu::Buffer,
+    /// Per slot: the irradiance record for the fast shading (`VoxelStructure::leaf_irradiance`).
+    pub slot_irradiance: wgpu::Buffer,
     /// Indirect dispatch sizes: [0..3] over slots, [3..6] over fragments, [6..9] over the
     /// touched slots.
     pub args: wgpu::Buffer,
@@ -93,6 +95,7 @@ pub struct DenseVolume {
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
     leaf_store: wgpu::BindGroup,
+    irradiance: wgpu::BindGroup,
     pipelines: Arc<DensePipelines>,
 }
 
@@ -345,6 +348,16 @@ impl DenseVolume {
         let dyn_slots = if dynamic { slots } else { 1 };
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
+        let slot_irradiance = storage_buffer(device, "voxel leaf irradiance", slots * 16, no);
+        let occupancy = storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no);
+        let irradiance = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel irradiance"),
+            layout: &Self::irradiance_layout(device),
+            entries: &layout::entries(vec![
+                occupancy.as_entire_binding(),
+                slot_irradiance.as_entire_binding(),
+            ]),
+        });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let leaves = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel leaves"),
@@ -371,13 +384,14 @@ impl DenseVolume {
             volume,
             slot_capacity: slots as u32,
             counters,
-            occupancy: storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no),
+            occupancy,
             slot_voxel,
             accum: storage_buffer(device, "voxel sums", slots * ACCUM_STRIDE * 4, no),
             dyn_accum: storage_buffer(device, "voxel dynamic sums", dyn_slots * DYN_STRIDE * 4, no),
             dynamic,
             slot_direct,
             slot_next,
+            slot_irradiance,
             args: storage_buffer(
                 device,
                 "voxel dispatch sizes",
@@ -392,6 +406,7 @@ impl DenseVolume {
             sampling,
             leaves,
             leaf_store,
+            irradiance,
             pipelines: pipelines.clone(),
         }
     }
@@ -411,7 +426,8 @@ impl DenseVolume {
                 self.slot_voxel.size()
                     + self.accum.size()
                     + self.slot_direct.size()
-                    + self.slot_next.size(),
+                    + self.slot_next.size()
+                    + self.slot_irradiance.size(),
             ),
             ("voxel dynamic sums", self.dyn_accum.size()),
             ("voxel albedo", texture_bytes(res, 4, 1)),
@@ -478,6 +494,16 @@ impl DenseVolume {
                 layout::storage(6, c, false),
                 layout::storage(7, c, false),
             ],
+        })
+    }
+
+    /// The layout of @group(3) of the gather, twin of voxels/dense/irradiance.wgsl: the
+    /// occupancy (voxel to slot) and the slots' irradiance records.
+    pub fn irradiance_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let c = wgpu::ShaderStages::COMPUTE;
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel irradiance"),
+            entries: &[layout::storage(0, c, true), layout::storage(1, c, true)],
         })
     }
 
@@ -706,6 +732,14 @@ impl VoxelStructure for DenseVolume {
 
     fn leaf_store(&self) -> &wgpu::BindGroup {
         &self.leaf_store
+    }
+
+    fn leaf_irradiance(&self) -> &wgpu::Buffer {
+        &self.slot_irradiance
+    }
+
+    fn irradiance(&self) -> &wgpu::BindGroup {
+        &self.irradiance
     }
 
     fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64) {

@@ -449,6 +449,8 @@ pub struct OctreeVolume {
     pub leaf_direct: wgpu::Buffer,
     /// Per leaf: the last bounce's radiance and opacity (vec4 f32).
     pub leaf_next: wgpu::Buffer,
+    /// Per slot: the irradiance record for the fast shading (`VoxelStructure::leaf_irradiance`).
+    pub leaf_irradiance: wgpu::Buffer,
     /// Indirect dispatch sizes: [0..3] over fragments, [3..6] over leaves, then per depth over
     /// its nodes.
     pub args: wgpu::Buffer,
@@ -461,6 +463,7 @@ pub struct OctreeVolume {
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
     leaf_store: wgpu::BindGroup,
+    irradiance: wgpu::BindGroup,
     /// Filter bind groups: [0] writes the even atlas (reads the odd), [1] the odd (reads the
     /// even).
     filter: [wgpu::BindGroup; 2],
@@ -600,6 +603,7 @@ impl OctreeVolume {
         let slot_buf = storage_buffer(device, "octree leaf slots", slots * SLOT_WORDS * 4);
         let leaf_direct = storage_buffer(device, "octree direct light", slots * 16);
         let leaf_next = storage_buffer(device, "octree bounce light", slots * 16);
+        let leaf_irradiance = storage_buffer(device, "octree leaf irradiance", slots * 16);
         let args = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("octree dispatch sizes"),
             size: ARGS_WORDS * 4,
@@ -645,6 +649,11 @@ impl OctreeVolume {
             layout: &Self::leaf_store_layout(device),
             entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&view(&even_atlas))]),
         });
+        let irradiance = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel irradiance"),
+            layout: &Self::irradiance_layout(device),
+            entries: &layout::entries(vec![leaf_irradiance.as_entire_binding()]),
+        });
         let level = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
             buffer: &levels,
             offset: 0,
@@ -685,6 +694,7 @@ impl OctreeVolume {
             slots: slot_buf,
             leaf_direct,
             leaf_next,
+            leaf_irradiance,
             args,
             levels,
             even_atlas,
@@ -692,6 +702,7 @@ impl OctreeVolume {
             sampling,
             leaves,
             leaf_store,
+            irradiance,
             filter,
             snapshot,
             pipelines: pipelines.clone(),
@@ -748,6 +759,15 @@ impl OctreeVolume {
                 layout::storage(3, c, false),
                 layout::storage(4, c, true),
             ],
+        })
+    }
+
+    /// The layout of @group(3) of the gather, twin of voxels/octree/irradiance.wgsl: the
+    /// slots' irradiance records (the voxel's slot comes from a descent of the tree).
+    pub fn irradiance_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel irradiance"),
+            entries: &[layout::storage(0, wgpu::ShaderStages::COMPUTE, true)],
         })
     }
 
@@ -977,7 +997,10 @@ impl OctreeVolume {
             ),
             (
                 "octree leaf slots",
-                self.slots.size() + self.leaf_direct.size() + self.leaf_next.size(),
+                self.slots.size()
+                    + self.leaf_direct.size()
+                    + self.leaf_next.size()
+                    + self.leaf_irradiance.size(),
             ),
             (
                 "octree static copy (dynamic scenes)",
@@ -1081,6 +1104,14 @@ impl VoxelStructure for OctreeVolume {
 
     fn leaf_store(&self) -> &wgpu::BindGroup {
         &self.leaf_store
+    }
+
+    fn leaf_irradiance(&self) -> &wgpu::Buffer {
+        &self.leaf_irradiance
+    }
+
+    fn irradiance(&self) -> &wgpu::BindGroup {
+        &self.irradiance
     }
 
     fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64) {

@@ -1,0 +1,25 @@
+// A leaf's irradiance record for the fast shading (`IndirectShading::Leaves`): what the last
+// bounce kept of its diffuse gather, as four u32: irradiance rgb and occlusion as four f16,
+// the leaf's normal and how well its fragments' normals agree as snorm8, and 1 (a record
+// exists; an empty one is all zero).
+
+fn pack_irradiance(e: vec3<f32>, ao: f32, normal: vec4<f32>) -> vec4<u32> {
+    return vec4<u32>(pack2x16float(e.rg), pack2x16float(vec2<f32>(e.b, ao)), pack4x8snorm(normal), 1u);
+}
+
+// Irradiance (rgb) and ambient occlusion (a).
+fn record_light(r: vec4<u32>) -> vec4<f32> {
+    return vec4<f32>(unpack2x16float(r.x), unpack2x16float(r.y));
+}
+
+fn record_normal(r: vec4<u32>) -> vec4<f32> {
+    return unpack4x8snorm(r.z);
+}
+
+// The rotation of leaf c's cone bundle, as a fraction of the bundle's period: one of sixteen,
+// each once in every 4x4 window of any axis-aligned plane ((x + y, y + z) mod 4 is one-to-one
+// on each), the layout shared/leaf_irradiance.wgsl's window averages.
+fn leaf_rotation(c: vec3<u32>) -> f32 {
+    let rank = 4u * ((c.x + c.y) & 3u) + ((c.y + c.z) & 3u);
+    return (f32(rank) + 0.5) / 16.0;
+}
