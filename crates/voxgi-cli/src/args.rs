@@ -34,6 +34,10 @@ pub struct SettingsArgs {
     /// voxel with opacity > 0.5. Default final.
     #[arg(long, value_parser = names(ViewMode::ALL.map(ViewMode::name)))]
     pub view: Option<String>,
+    /// Shadow filter of point, spot and directional lights: pcf, or vsm-esm (the thesis'
+    /// prefiltered variance and exponential maps, the smaller visibility). Default pcf.
+    #[arg(long, value_parser = names(voxgi::ShadowFilter::ALL.map(voxgi::ShadowFilter::name)))]
+    pub shadow_filter: Option<String>,
     /// Shadow map resolution per view, in texels. Default 1024.
     #[arg(long, value_name = "N")]
     pub shadow_map_size: Option<u32>,
@@ -117,6 +121,9 @@ impl SettingsArgs {
             f.view = ViewMode::parse(v)?;
         }
         set!(o.shadow_map_size, self.shadow_map_size);
+        if let Some(f) = &self.shadow_filter {
+            o.shadow_filter = voxgi::ShadowFilter::parse(f)?;
+        }
         if let Some(v) = &self.voxels {
             o.voxels = voxgi::VoxelKind::parse(v)?;
         }

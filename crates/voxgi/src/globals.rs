@@ -28,9 +28,10 @@ pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             layout::storage(2, v, true),
             layout::storage(3, v, true),
             texture(4, false, wgpu::TextureViewDimension::D2Array),
-            texture(5, true, wgpu::TextureViewDimension::D2),
-            texture(6, false, wgpu::TextureViewDimension::D2),
-            layout::sampler(7, v),
+            texture(5, false, wgpu::TextureViewDimension::D2Array),
+            texture(6, true, wgpu::TextureViewDimension::D2),
+            texture(7, false, wgpu::TextureViewDimension::D2),
+            layout::sampler(8, v),
         ],
     })
 }

@@ -58,8 +58,8 @@ pub mod voxel;
 pub use error::{Error, Result};
 pub use gpu::requirements::{check_device, minimum_limits, required_features, required_limits};
 pub use options::{
-    FrameParams, IndirectShading, MAX_BOUNCES, MAX_IMAGE_SIZE, RendererOptions, Tonemap,
-    UNLIMITED_BOUNCES, ViewMode, validate_size,
+    FrameParams, IndirectShading, MAX_BOUNCES, MAX_IMAGE_SIZE, RendererOptions, ShadowFilter,
+    Tonemap, UNLIMITED_BOUNCES, ViewMode, validate_size,
 };
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]

@@ -169,6 +169,42 @@ impl IndirectShading {
     }
 }
 
+/// How shadow maps are filtered for point, spot and directional lights (area lights use PCSS
+/// or cone shadows whatever this says).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShadowFilter {
+    /// Percentage-closer filtering: twelve comparisons in a disc of `FrameParams::shadow_softness`
+    /// texels against the receiver plane.
+    #[default]
+    Pcf,
+    /// The thesis' shadows (Salm, §2.3 and §4.2): variance and exponential shadow maps
+    /// prefiltered with a 5x5-texel disc, one lookup each, the smaller of the two visibilities.
+    /// Soft-edged, one lookup per pixel instead of twelve, more GPU memory (16 bytes per map
+    /// texel); light leaks where occluders and receivers meet (docs/QUALITY.md).
+    VsmEsm,
+}
+
+impl ShadowFilter {
+    /// Both, in the order of their names.
+    pub const ALL: [ShadowFilter; 2] = [ShadowFilter::Pcf, ShadowFilter::VsmEsm];
+
+    /// The name scene files and the CLI use.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowFilter::Pcf => "pcf",
+            ShadowFilter::VsmEsm => "vsm-esm",
+        }
+    }
+
+    /// A filter by name.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| Error::Setting(format!("shadow filter '{s}' is not pcf or vsm-esm")))
+    }
+}
+
 /// `RendererOptions::bounces` value for "until converged": voxel bounces are repeated until the
 /// energy left (the largest albedo to the power of the bounce count) is below 0.1 %.
 pub const UNLIMITED_BOUNCES: u32 = u32::MAX;
@@ -181,6 +217,8 @@ pub const MAX_BOUNCES: u32 = 8;
 pub struct RendererOptions {
     /// Width and height of each shadow map in texels (64..=8192). Default 1024.
     pub shadow_map_size: u32,
+    /// How the shadow maps of point, spot and directional lights are filtered. Default PCF.
+    pub shadow_filter: ShadowFilter,
     /// Largest material texture size; bigger textures are downsampled (1..=8192). Default 1024.
     pub max_texture_size: u32,
     /// Add a sun when the scene has no light and nothing emissive, instead of rendering black.
@@ -246,6 +284,7 @@ impl Default for RendererOptions {
     fn default() -> Self {
         RendererOptions {
             shadow_map_size: 1024,
+            shadow_filter: ShadowFilter::Pcf,
             max_texture_size: 1024,
             default_light: true,
             voxels: VoxelKind::Dense,

@@ -1,7 +1,7 @@
 //! The renderer: uploads a scene once, then records frames into the caller's encoder by calling
 //! the passes in one fixed order from `Renderer::render`:
 //!
-//! shadow → voxelize → splat → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
+//! shadow → [moments] → voxelize → splat → dense_build → inject → filter → (bounce → filter) × (bounces − 1)
 //!        → gbuffer → gather → upsample → composite → [debug] → tonemap
 //!
 //! With the fast shading (`IndirectShading::Leaves`) one more bounce runs, which keeps every
@@ -32,9 +32,10 @@ use crate::gpu_scene::{GpuFrame, GpuScene, bounding_sphere, check_light, gpu_lig
 use crate::lighting::atlas::{self as shadow, ShadowAtlas, ViewDirt};
 use crate::lighting::bounce::{BouncePass, BounceSteps};
 use crate::lighting::inject::InjectPass;
+use crate::lighting::moments::MomentsPass;
 use crate::lighting::shadow::ShadowPass;
 use crate::options::{
-    FrameParams, IndirectShading, RendererOptions, UNLIMITED_BOUNCES, validate_size,
+    FrameParams, IndirectShading, RendererOptions, ShadowFilter, UNLIMITED_BOUNCES, validate_size,
 };
 use crate::scene_state::SceneState;
 use crate::screen::composite::CompositePass;
@@ -55,8 +56,9 @@ use wgpu::util::DeviceExt;
 
 /// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
 /// camera), in the order they run; every other pass is the screen's.
-pub const VOXEL_PASSES: [&str; 11] = [
+pub const VOXEL_PASSES: [&str; 12] = [
     "shadow",
+    "moments",
     "voxelize",
     "splat",
     "dense_build",
@@ -72,6 +74,7 @@ pub const VOXEL_PASSES: [&str; 11] = [
 /// Every pass, by name.
 struct Passes {
     shadow: ShadowPass,
+    moments: MomentsPass,
     voxelize: VoxelizePass,
     splat: SplatPass,
     inject: InjectPass,
@@ -335,6 +338,7 @@ impl Renderer {
         let volume = new_volume(device, &mut structure_pipelines, &facts, options, grid)?;
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
+            moments: MomentsPass::new(device),
             voxelize: VoxelizePass::new(device),
             splat: SplatPass::new(device),
             inject: InjectPass::new(
@@ -342,6 +346,7 @@ impl Renderer {
                 options.voxels,
                 gpu_scene.light_count,
                 atlas.views.len(),
+                options.shadow_filter,
             ),
             bounce: BouncePass::new(device, options.voxels, options.anisotropic, leaves(options)),
             gbuffer: GbufferPass::new(device),
@@ -427,6 +432,7 @@ impl Renderer {
             || old.anisotropic != new.anisotropic;
         let atlas = old.shadow_map_size != new.shadow_map_size
             || old.cone_shadows != new.cone_shadows
+            || old.shadow_filter != new.shadow_filter
             || shadow::atlas_resolution(old, &self.scene.gpu_lights)
                 != shadow::atlas_resolution(new, &self.scene.gpu_lights);
         let cones = volume
@@ -471,6 +477,7 @@ impl Renderer {
             None
         };
         let indirect = old.indirect != new.indirect;
+        let filter = old.shadow_filter != new.shadow_filter;
         let gather = volume || old.gather_axes != new.gather_axes || indirect;
         let views = self.atlas.views.len();
         let (gather_new, bounce_new, composite_new, inject_new) =
@@ -479,10 +486,16 @@ impl Renderer {
                     gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
                     (kind || old.anisotropic != new.anisotropic || indirect)
                         .then(|| BouncePass::new(device, new.voxels, new.anisotropic, leaves(new))),
-                    (old.cone_shadows != new.cone_shadows)
+                    (old.cone_shadows != new.cone_shadows || filter)
                         .then(|| composite_pass(device, &self.scene, &self.facts, new)),
-                    kind.then(|| {
-                        InjectPass::new(device, new.voxels, self.scene.light_count, views)
+                    (kind || filter).then(|| {
+                        InjectPass::new(
+                            device,
+                            new.voxels,
+                            self.scene.light_count,
+                            views,
+                            new.shadow_filter,
+                        )
                     }),
                 )
             })?;
@@ -720,6 +733,15 @@ impl Renderer {
                 &views,
                 &mut self.timer,
             );
+            if self.options.shadow_filter == ShadowFilter::VsmEsm {
+                self.passes.moments.record(
+                    &self.device,
+                    encoder,
+                    &self.atlas,
+                    &views,
+                    &mut self.timer,
+                );
+            }
         }
         self.pending.views = vec![ViewDirt::Clean; self.atlas.views.len()];
     }
@@ -1170,7 +1192,8 @@ fn plan_atlas(
         let (views, owners) =
             shadow::plan_views(&mut scene.gpu_lights, &facts.casts, center, radius, res);
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
-        ShadowAtlas::new(device, views, owners, res)
+        let moments = options.shadow_filter == ShadowFilter::VsmEsm;
+        ShadowAtlas::new(device, views, owners, res, moments)
     })
 }
 
@@ -1184,6 +1207,7 @@ fn composite_pass(
         device,
         shadow::composite_reads_shadow_maps(&scene.gpu_lights, options.cone_shadows),
         facts.glossy,
+        options.shadow_filter,
     )
 }
 

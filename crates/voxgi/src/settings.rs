@@ -2,8 +2,8 @@
 //! an application) shares one parser and one list of keys.
 
 use crate::options::{
-    FrameParams, IndirectShading, MAX_BOUNCES, RendererOptions, Tonemap, UNLIMITED_BOUNCES,
-    ViewMode,
+    FrameParams, IndirectShading, MAX_BOUNCES, RendererOptions, ShadowFilter, Tonemap,
+    UNLIMITED_BOUNCES, ViewMode,
 };
 use crate::voxel::dense::DIRECTIONS;
 use crate::voxel::{ConeSet, VoxelKind};
@@ -32,6 +32,8 @@ pub struct SceneSettings {
     pub gather_axes: Option<u32>,
     /// `RendererOptions::cones`: "6x60", "7x45" or "9x45".
     pub cones: Option<String>,
+    /// `RendererOptions::shadow_filter`: "pcf" or "vsm-esm".
+    pub shadow_filter: Option<String>,
     /// `RendererOptions::indirect`: "cones" or "leaves".
     pub indirect: Option<String>,
     /// `RendererOptions::bounces`: a number, "direct" (0) or "unlimited".
@@ -125,6 +127,9 @@ impl SceneSettings {
         }
         if let Some(i) = &self.indirect {
             o.indirect = IndirectShading::parse(i)?;
+        }
+        if let Some(f) = &self.shadow_filter {
+            o.shadow_filter = ShadowFilter::parse(f)?;
         }
         if let Some(b) = &self.bounces {
             o.bounces = match b {

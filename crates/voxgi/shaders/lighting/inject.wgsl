@@ -23,9 +23,10 @@ struct InjectParams {
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var<storage, read> shadow_views: array<ShadowView>;
 @group(0) @binding(3) var shadow_maps: texture_2d_array<f32>;
+@group(0) @binding(4) var shadow_moments: texture_2d_array<f32>;
 // Per shadow view: the rectangle of texels (x, y from xy inclusive to zw exclusive) that
 // changed since the last injection (empty when none did).
-@group(0) @binding(4) var<storage, read> view_dirt: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> view_dirt: array<vec4<f32>>;
 // Group 2: the structure's leaves, group 3: their radiance (voxels/<kind>/leaf_store.wgsl).
 
 // false for progressive bounces: the leaves keep last frame's radiance for the bounce to build
@@ -110,7 +111,7 @@ fn leaf_inputs_changed(i: u32) -> bool {
 // The leaves `mark` found changed: [0] how many, then their indices. `main` recomputes only
 // these, so unchanged leaves cost a test and not the whole lighting code's run (on CPU drivers
 // a SIMD group pays for every branch any of its lanes takes).
-@group(0) @binding(5) var<storage, read_write> todo: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> todo: array<atomic<u32>>;
 // Group 1, `prepare` only: `main`'s indirect dispatch size.
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
 

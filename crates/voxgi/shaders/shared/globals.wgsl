@@ -9,9 +9,11 @@
 @group(0) @binding(2) var<storage, read> lights: array<Light>;
 @group(0) @binding(3) var<storage, read> shadow_views: array<ShadowView>;
 @group(0) @binding(4) var shadow_maps: texture_2d_array<f32>;
+// The maps' prefiltered moments (lighting/moments.wgsl), with the VSM/ESM shadow filter.
+@group(0) @binding(5) var shadow_moments: texture_2d_array<f32>;
 // The specular lobe's directional albedo: (a, b) over (n.v, roughness).
-@group(0) @binding(5) var specular_table: texture_2d<f32>;
+@group(0) @binding(6) var specular_table: texture_2d<f32>;
 // The LTC fit's inverse matrices, f32 (interpolated by hand: f32 need not be filterable).
-@group(0) @binding(6) var ltc_table: texture_2d<f32>;
+@group(0) @binding(7) var ltc_table: texture_2d<f32>;
 // Bilinear, clamp to edge: the BRDF tables' own sampler.
-@group(0) @binding(7) var table_sampler: sampler;
+@group(0) @binding(8) var table_sampler: sampler;

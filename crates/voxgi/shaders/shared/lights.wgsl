@@ -1,5 +1,6 @@
 // Direct light from every light type, with filtered shadows. Expects the including shader to
-// declare `lights`, `shadow_views` and `shadow_maps` (a texture_2d_array<f32> of distances).
+// declare `lights`, `shadow_views`, `shadow_maps` (a texture_2d_array<f32> of distances) and
+// `shadow_moments` (their prefiltered moments, lighting/moments.wgsl).
 
 //!include shared/scene.wgsl
 //!include shared/brdf.wgsl
@@ -122,6 +123,55 @@ fn shadow_tap(view: ShadowView, uv: vec2<f32>, rp: ReceiverPlane, bias: f32) -> 
     return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
 }
 
+// The VSM/ESM shadow filter (`ShadowFilter::VsmEsm`) for point, spot and directional lights:
+// one bilinear lookup of the prefiltered moments instead of PCF's twelve comparisons.
+override SHADOW_MOMENTS: bool = false;
+// The exponential map's sharpness over distances normalised by the view's far plane: large
+// enough that an occluder 5 % of the range in front darkens to exp(-4), small enough that
+// exp(ESM_C) stays a finite f32 (the maps store exp(ESM_C (d - 1)) <= 1).
+const ESM_C: f32 = 80.0;
+// Chebyshev's bound is cut below this and rescaled (light-bleeding reduction): where a far
+// receiver sees two occluder layers the bound stays high, which min(VSM, ESM) leaves to the
+// ESM; this trims what both let through.
+const VSM_BLEED: f32 = 0.2;
+// Smallest variance, in normalised distance squared: a flat occluder's moments have none, and
+// f32 rounding of E[d^2] - E[d]^2 must not make the bound flicker.
+const VSM_MIN_VARIANCE: f32 = 1e-7;
+// The prefilter's disc reaches this many texels from its centre (lighting/moments.wgsl).
+const MOMENT_RADIUS: f32 = 2.0;
+
+// The moments of view `view` bilinearly interpolated at uv (f32 textures need not be
+// filterable: four loads).
+fn moments_at(view: ShadowView, uv: vec2<f32>) -> vec4<f32> {
+    let st = uv * view.resolution - 0.5;
+    let i = vec2<i32>(floor(st));
+    let f = fract(st);
+    let r = i32(view.resolution);
+    let l = i32(view.layer);
+    let m00 = textureLoad(shadow_moments, clamp(i, vec2<i32>(0), vec2<i32>(r - 1)), l, 0);
+    let m10 = textureLoad(shadow_moments, clamp(i + vec2<i32>(1, 0), vec2<i32>(0), vec2<i32>(r - 1)), l, 0);
+    let m01 = textureLoad(shadow_moments, clamp(i + vec2<i32>(0, 1), vec2<i32>(0), vec2<i32>(r - 1)), l, 0);
+    let m11 = textureLoad(shadow_moments, clamp(i + vec2<i32>(1, 1), vec2<i32>(0), vec2<i32>(r - 1)), l, 0);
+    return mix(mix(m00, m10, f.x), mix(m01, m11, f.x), f.y);
+}
+
+// min(VSM, ESM) (Salm, §2.3): the variance map's Chebyshev bound leaks where occluder depths
+// vary (behind several layers), the exponential map's soft step leaks near contact; each
+// leaks where the other does not. The receiver distance is the biased one PCF compares.
+fn moments_visibility(s: ShadowSetup) -> f32 {
+    if any(s.uv < vec2<f32>(0.0)) || any(s.uv > vec2<f32>(1.0)) {
+        return 1.0;
+    }
+    let m = moments_at(s.view, s.uv);
+    let d = clamp(s.dist / s.view.far, 0.0, 1.0);
+    let variance = max(m.y - m.x * m.x, VSM_MIN_VARIANCE);
+    let dd = d - m.x;
+    let bound = clamp((variance / (variance + dd * dd) - VSM_BLEED) / (1.0 - VSM_BLEED), 0.0, 1.0);
+    let vsm = select(bound, 1.0, d <= m.x);
+    let esm = clamp(exp(-ESM_C * (d - 1.0)) * m.z, 0.0, 1.0);
+    return min(vsm, esm);
+}
+
 const PCF_TAPS: u32 = 12u;
 const PCSS_SEARCH_TAPS: u32 = 12u;
 const PCSS_TAPS: u32 = 24u;
@@ -207,6 +257,9 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
         }
         return lit / f32(PCSS_TAPS);
     }
+    if SHADOW_MOMENTS {
+        return moments_visibility(s);
+    }
     let radius = softness * s.texel_uv;
     var lit = 0.0;
     for (var i = 0u; i < PCF_TAPS; i++) {
@@ -241,6 +294,10 @@ fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: v
         }
         radius = pcss_radius(light, s, blockers);
         taps = PCSS_TAPS;
+    } else if SHADOW_MOMENTS {
+        // One bilinear lookup of moments, each the 5x5 disc around its texel.
+        let grown = dirt + vec4<f32>(-MOMENT_RADIUS, -MOMENT_RADIUS, MOMENT_RADIUS, MOMENT_RADIUS);
+        return tap_dirty(view, uv, grown);
     }
     for (var i = 0u; i < taps; i++) {
         if tap_dirty(view, uv + vogel(i, taps) * radius, dirt) {

@@ -43,6 +43,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/interleave.wgsl",
     "shared/upsample.wgsl",
     "lighting/shadow.wgsl",
+    "lighting/moments.wgsl",
     "screen/gbuffer.wgsl",
     "fragments/voxelize.wgsl",
     "fragments/splat.wgsl",

@@ -48,6 +48,9 @@ pub(crate) const SHADOW_PERSPECTIVE: u32 = 1;
 pub(crate) const UNIFORM_STRIDE: u64 = 256;
 /// Format of the atlas's distance maps: the nearest occluder's distance per texel, metres.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Format of the prefiltered moments (lighting/moments.wgsl): f32, since the variance is a
+/// difference of two close squares.
+pub const MOMENTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// The shadow views of a scene's lights and the textures they render into.
 pub struct ShadowAtlas {
@@ -61,6 +64,12 @@ pub struct ShadowAtlas {
     pub array_view: wgpu::TextureView,
     /// One view per layer, for rendering into it.
     pub(crate) layer_views: Vec<wgpu::TextureView>,
+    /// With `ShadowFilter::VsmEsm`: per map texel, the moments of its 5x5-texel disc
+    /// (`MOMENTS_FORMAT`: mean normalised distance, its square, and the exponential map), same
+    /// layers as `texture`; otherwise one texel (bound, never read).
+    pub moments: wgpu::Texture,
+    /// `moments` as a 2D-array view.
+    pub moments_view: wgpu::TextureView,
     pub(crate) depth_view: wgpu::TextureView,
     /// `views` as a storage buffer (binding 2 of `lighting_layout`).
     pub views_buffer: wgpu::Buffer,
@@ -342,14 +351,35 @@ pub fn composite_reads_shadow_maps(lights: &[GpuLight], cone_shadows: bool) -> b
 
 impl ShadowAtlas {
     /// Makes the atlas for `views` (owned by the lights in `view_light`), each map `res` texels
-    /// square, with its depth buffer and view buffers.
+    /// square, with its depth buffer and view buffers, and with `moments` the prefiltered
+    /// moments of every map.
     pub fn new(
         device: &wgpu::Device,
         views: Vec<GpuShadowView>,
         view_light: Vec<usize>,
         res: u32,
+        moments: bool,
     ) -> Self {
         let layers = views.len().max(1) as u32;
+        let (mres, mlayers) = if moments { (res, layers) } else { (1, 1) };
+        let moments = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow moments"),
+            size: wgpu::Extent3d {
+                width: mres,
+                height: mres,
+                depth_or_array_layers: mlayers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: MOMENTS_FORMAT,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let moments_view = moments.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow atlas"),
             size: wgpu::Extent3d {
@@ -416,6 +446,8 @@ impl ShadowAtlas {
             texture,
             array_view,
             layer_views,
+            moments,
+            moments_view,
             depth_view: depth.create_view(&Default::default()),
         }
     }
@@ -438,35 +470,43 @@ impl ShadowAtlas {
         self.views = views;
     }
 
-    /// Bindings 1, 2 and 3 of every shader that includes `shared/lights.wgsl`: the lights, the
-    /// shadow views and this atlas's maps.
-    pub fn lighting_layout(c: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 3] {
-        [
-            layout::storage(1, c, true),
-            layout::storage(2, c, true),
+    /// Bindings 1 to 4 of every shader that includes `shared/lights.wgsl`: the lights, the
+    /// shadow views, this atlas's maps and their moments.
+    pub fn lighting_layout(c: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 4] {
+        let array = |binding| {
             layout::texture(
-                3,
+                binding,
                 c,
                 wgpu::TextureSampleType::Float { filterable: false },
                 wgpu::TextureViewDimension::D2Array,
-            ),
+            )
+        };
+        [
+            layout::storage(1, c, true),
+            layout::storage(2, c, true),
+            array(3),
+            array(4),
         ]
     }
 
     /// The resources for `lighting_layout`, in its order.
-    pub fn lighting_resources<'a>(&'a self, scene: &'a GpuScene) -> [wgpu::BindingResource<'a>; 3] {
+    pub fn lighting_resources<'a>(&'a self, scene: &'a GpuScene) -> [wgpu::BindingResource<'a>; 4] {
         [
             scene.lights.as_entire_binding(),
             self.views_buffer.as_entire_binding(),
             wgpu::BindingResource::TextureView(&self.array_view),
+            wgpu::BindingResource::TextureView(&self.moments_view),
         ]
     }
 
     /// GPU memory of the atlas in bytes, counted as 8 bytes per texel of every layer (the R32F
-    /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound).
+    /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound),
+    /// plus the moments.
     pub fn bytes(&self) -> u64 {
-        let t = &self.texture;
-        t.width() as u64 * t.height() as u64 * t.depth_or_array_layers() as u64 * 8
+        let texels = |t: &wgpu::Texture| {
+            t.width() as u64 * t.height() as u64 * t.depth_or_array_layers() as u64
+        };
+        texels(&self.texture) * 8 + texels(&self.moments) * 16
     }
 }
 

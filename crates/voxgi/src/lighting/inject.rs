@@ -4,6 +4,7 @@ use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
 use crate::lighting::atlas::{ShadowAtlas, ViewDirt};
+use crate::options::ShadowFilter;
 use crate::voxel::{VoxelKind, VoxelStructure};
 use wgpu::util::DeviceExt;
 
@@ -41,13 +42,20 @@ struct GpuInjectParams {
 
 impl InjectPass {
     /// Compiles the pipeline for a scene of `light_count` lights with `views` shadow views
-    /// (both fixed until the pass is rebuilt).
-    pub fn new(device: &wgpu::Device, kind: VoxelKind, light_count: u32, views: usize) -> Self {
+    /// (both fixed until the pass is rebuilt), filtered by `filter`.
+    pub fn new(
+        device: &wgpu::Device,
+        kind: VoxelKind,
+        light_count: u32,
+        views: usize,
+        filter: ShadowFilter,
+    ) -> Self {
+        let moments = f64::from(u8::from(filter == ShadowFilter::VsmEsm));
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = vec![layout::uniform(0, c, false)];
         entries.extend(ShadowAtlas::lighting_layout(c));
-        entries.push(layout::storage(4, c, true));
-        entries.push(layout::storage(5, c, false));
+        entries.push(layout::storage(5, c, true));
+        entries.push(layout::storage(6, c, false));
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("inject globals"),
             entries: &entries,
@@ -71,7 +79,10 @@ impl InjectPass {
                 module: &module,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("STORE_RADIANCE", if store { 1.0 } else { 0.0 })],
+                    constants: &[
+                        ("STORE_RADIANCE", if store { 1.0 } else { 0.0 }),
+                        ("SHADOW_MOMENTS", moments),
+                    ],
                     ..Default::default()
                 },
                 cache: None,

@@ -4,6 +4,7 @@
 use crate::gpu::layout;
 use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
+use crate::options::ShadowFilter;
 use crate::targets::FrameTargets;
 
 /// Format of the HDR target the composite writes: linear radiance, RGBA f32 (read back by
@@ -21,7 +22,13 @@ impl CompositePass {
     /// (`composite_reads_shadow_maps`); without, the shader is compiled without their lookup.
     /// `specular`: whether any surface has a specular lobe (`gather::has_glossy`); without, the
     /// area lights' specular integral is compiled out.
-    pub fn new(device: &wgpu::Device, shadow_maps: bool, specular: bool) -> Self {
+    /// `filter`: the shadow filter of point, spot and directional lights.
+    pub fn new(
+        device: &wgpu::Device,
+        shadow_maps: bool,
+        specular: bool,
+        filter: ShadowFilter,
+    ) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let mut entries = FrameTargets::gbuffer_layout(0, c).to_vec();
         entries.extend([
@@ -37,6 +44,10 @@ impl CompositePass {
         let constants = [
             ("SHADOW_MAPS", f64::from(u8::from(shadow_maps))),
             ("SPECULAR", f64::from(u8::from(specular))),
+            (
+                "SHADOW_MOMENTS",
+                f64::from(u8::from(filter == ShadowFilter::VsmEsm)),
+            ),
         ];
         let globals = crate::globals::layout(device);
         let pipeline = grouped_pipeline(

@@ -16,5 +16,6 @@ mod point_gi;
 mod points;
 mod reference;
 mod shaders;
+mod shadow_filter;
 mod vct;
 mod voxels;

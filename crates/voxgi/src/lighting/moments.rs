@@ -1,0 +1,148 @@
+//! moments: prefilters the shadow maps for the VSM/ESM shadow filter (`ShadowFilter::VsmEsm`):
+//! the moments of a 5x5-texel disc around each texel of every re-rendered part of a map, into
+//! the atlas's moments texture (shaders/lighting/moments.wgsl).
+
+use crate::gpu::layout;
+use crate::gpu::shader::grouped_pipeline;
+use crate::gpu::timer::GpuTimer;
+use crate::lighting::atlas::{MOMENTS_FORMAT, ShadowAtlas, ViewDirt, behind_emitter};
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// How far the prefilter's disc reaches from its centre, in texels (`MOMENT_RADIUS` in
+/// shaders/shared/lights.wgsl).
+pub const MOMENT_RADIUS: u32 = 2;
+/// Dynamic uniform offsets must be multiples of this.
+const STRIDE: u64 = 256;
+
+/// `MomentRect` in moments.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuMomentRect {
+    min: [u32; 2],
+    max: [u32; 2],
+    layer: u32,
+    far: f32,
+    _pad: [u32; 2],
+}
+
+/// The moments compute pass: its pipeline and layout.
+pub struct MomentsPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl MomentsPass {
+    /// Compiles the pipeline.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("moments"),
+            entries: &[
+                layout::texture(
+                    0,
+                    c,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: c,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: MOMENTS_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                    },
+                    count: None,
+                },
+                layout::uniform(2, c, true),
+            ],
+        });
+        let pipeline = grouped_pipeline(
+            device,
+            "moments",
+            "lighting/moments.wgsl",
+            &[Some(&layout)],
+            &[],
+        );
+        MomentsPass { pipeline, layout }
+    }
+
+    /// Records the moments of every part of `atlas`'s maps that `views` marks re-rendered
+    /// (grown by the disc's radius: texels there average changed ones). Timed as "moments".
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        views: &[ViewDirt],
+        timer: &mut GpuTimer,
+    ) {
+        let res = atlas.texture.width();
+        let mut rects = Vec::new();
+        for (i, view) in atlas.views.iter().enumerate() {
+            let dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
+            let Some((x, y, w, h)) = dirt.scissor(res) else {
+                continue;
+            };
+            if behind_emitter(view) {
+                continue;
+            }
+            let grow = |lo: u32| lo.saturating_sub(MOMENT_RADIUS);
+            let rect = GpuMomentRect {
+                min: [grow(x), grow(y)],
+                max: [
+                    (x + w + MOMENT_RADIUS).min(res),
+                    (y + h + MOMENT_RADIUS).min(res),
+                ],
+                layer: i as u32,
+                far: view.far,
+                _pad: [0; 2],
+            };
+            rects.push(rect);
+        }
+        if rects.is_empty() {
+            return;
+        }
+        let mut bytes = vec![0u8; rects.len() * STRIDE as usize];
+        for (i, r) in rects.iter().enumerate() {
+            let o = i * STRIDE as usize;
+            bytes[o..o + size_of::<GpuMomentRect>()].copy_from_slice(bytemuck::bytes_of(r));
+        }
+        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("moments rects"),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let storage = atlas.moments.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("moments"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                wgpu::BindingResource::TextureView(&atlas.array_view),
+                wgpu::BindingResource::TextureView(&storage),
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniforms,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<GpuMomentRect>() as u64),
+                }),
+            ]),
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("moments"),
+            timestamp_writes: timer.compute("moments"),
+        });
+        pass.set_pipeline(&self.pipeline);
+        for (i, r) in rects.iter().enumerate() {
+            pass.set_bind_group(0, &bind, &[(i as u64 * STRIDE) as u32]);
+            pass.dispatch_workgroups(
+                (r.max[0] - r.min[0]).div_ceil(8),
+                (r.max[1] - r.min[1]).div_ceil(8),
+                1,
+            );
+        }
+    }
+}
