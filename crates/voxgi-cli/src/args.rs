@@ -58,6 +58,10 @@ pub struct SettingsArgs {
     /// thesis' fast shading: the leaves' stored irradiance, interpolated). Default cones.
     #[arg(long, value_parser = names(voxgi::IndirectShading::ALL.map(voxgi::IndirectShading::name)))]
     pub indirect: Option<String>,
+    /// Weigh each leaf's radiance and opacity per direction by its normals in the first
+    /// directional level (the point-cloud thesis' NDF), instead of counting leaves isotropic.
+    #[arg(long)]
+    pub ndf_mips: bool,
     /// One radiance value per voxel above the finest level instead of six directional ones.
     #[arg(long)]
     pub isotropic: bool,
@@ -136,6 +140,7 @@ impl SettingsArgs {
         if self.isotropic {
             o.anisotropic = false;
         }
+        o.ndf_mips |= self.ndf_mips;
         set!(o.gather_axes, self.gather_axes);
         o.half_resolution |= self.half_res;
         o.cone_shadows |= self.cone_shadows;

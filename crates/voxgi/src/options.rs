@@ -231,6 +231,12 @@ pub struct RendererOptions {
     pub voxel_resolution: u32,
     /// Six directional values per voxel above the finest level (true, default) or one.
     pub anisotropic: bool,
+    /// The first directional level weighs each leaf's radiance and opacity along each of the six
+    /// directions by its normal distribution (Salm, §4.4.2): fully seen face-on, half edge-on,
+    /// not at all from behind, blended towards isotropic as its fragments' normals disagree
+    /// (Toksvig's length of the mean normal). Needs `anisotropic`. Default false: leaves count
+    /// as isotropic, which is what the figures in docs/QUALITY.md were calibrated with.
+    pub ndf_mips: bool,
     /// Directional blocks each cone sample of the per-pixel gather reads in an anisotropic
     /// volume: 3, every axis by its weight (the paper's filtering), or 2, the two axes of
     /// largest weight renormalised (faster; docs/QUALITY.md has the cost in accuracy).
@@ -290,6 +296,7 @@ impl Default for RendererOptions {
             voxels: VoxelKind::Dense,
             voxel_resolution: 128,
             anisotropic: true,
+            ndf_mips: false,
             gather_axes: 3,
             cones: ConeSet::Six60,
             bounces: 2,
@@ -351,6 +358,11 @@ impl RendererOptions {
         }
         if !(self.ao_lambda.is_finite() && self.ao_lambda >= 0.0) {
             return fail(format!("AO lambda {} must be >= 0", self.ao_lambda));
+        }
+        if self.ndf_mips && !self.anisotropic {
+            return fail(
+                "ndf_mips weighs six directional values: it needs the anisotropic volume".into(),
+            );
         }
         if !(2..=3).contains(&self.gather_axes) {
             return fail(format!("gather axes {} must be 2 or 3", self.gather_axes));

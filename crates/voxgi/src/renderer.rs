@@ -47,7 +47,7 @@ use crate::targets::{FrameTargets, Target};
 use crate::view::{camera_view_proj, lit_scene};
 use crate::voxel::dense::{DensePipelines, DenseVolume, SLOT_BYTES};
 use crate::voxel::octree::{OctreePipelines, OctreePools, OctreeVolume};
-use crate::voxel::{DebugView, GpuCones, Grid, POOL_COUNTERS, VoxelKind, Voxels};
+use crate::voxel::{DebugView, Filtering, GpuCones, Grid, POOL_COUNTERS, VoxelKind, Voxels};
 use crate::{Error, Result};
 use glam::{Mat4, Vec3};
 use std::sync::Arc;
@@ -429,7 +429,8 @@ impl Renderer {
         let kind = old.voxels != new.voxels;
         let volume = kind
             || old.voxel_resolution != new.voxel_resolution
-            || old.anisotropic != new.anisotropic;
+            || old.anisotropic != new.anisotropic
+            || old.ndf_mips != new.ndf_mips;
         let atlas = old.shadow_map_size != new.shadow_map_size
             || old.cone_shadows != new.cone_shadows
             || old.shadow_filter != new.shadow_filter
@@ -1155,7 +1156,7 @@ fn new_volume(
             };
             pipelines.dense = Some(p.clone());
             let v = checked(device, "voxel volume", || {
-                DenseVolume::new(device, &p, grid, options.anisotropic, slots, facts.dynamic)
+                DenseVolume::new(device, &p, grid, filtering(options), slots, facts.dynamic)
             })?;
             Ok(Voxels::Dense(v))
         }
@@ -1169,7 +1170,7 @@ fn new_volume(
             let pools = OctreePools::for_leaves(wanted)
                 .within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
             let v = checked(device, "voxel octree", || {
-                OctreeVolume::new(device, &p, grid, options.anisotropic, pools, facts.dynamic)
+                OctreeVolume::new(device, &p, grid, filtering(options), pools, facts.dynamic)
             })??;
             Ok(Voxels::Octree(v))
         }
@@ -1241,6 +1242,14 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// How the structure filters its levels.
+fn filtering(options: &RendererOptions) -> Filtering {
+    Filtering {
+        anisotropic: options.anisotropic,
+        ndf: options.ndf_mips,
+    }
 }
 
 /// Whether the pixels read the leaves' irradiance (the fast shading).

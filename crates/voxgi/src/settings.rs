@@ -32,6 +32,8 @@ pub struct SceneSettings {
     pub gather_axes: Option<u32>,
     /// `RendererOptions::cones`: "6x60", "7x45" or "9x45".
     pub cones: Option<String>,
+    /// `RendererOptions::ndf_mips`.
+    pub ndf_mips: Option<bool>,
     /// `RendererOptions::shadow_filter`: "pcf" or "vsm-esm".
     pub shadow_filter: Option<String>,
     /// `RendererOptions::indirect`: "cones" or "leaves".
@@ -121,6 +123,7 @@ impl SceneSettings {
         }
         set!(o.voxel_resolution, self.voxel_resolution);
         set!(o.anisotropic, self.anisotropic);
+        set!(o.ndf_mips, self.ndf_mips);
         set!(o.gather_axes, self.gather_axes);
         if let Some(c) = &self.cones {
             o.cones = parse_cones(c)?;

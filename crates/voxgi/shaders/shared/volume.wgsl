@@ -38,6 +38,17 @@ struct Cones {
 }
 
 // Voxel linear index <-> coordinates (x fastest).
+// How much of a leaf the first directional level counts along direction `dir` (0..6: +X, -X,
+// +Y, -Y, +Z, -Z, the way a cone travels), from its mean normal (xyz) and its normals'
+// agreement (w): the twin of `voxel::cpu::ndf_weight`, which says why.
+fn ndf_weight(normal: vec4<f32>, dir: u32) -> f32 {
+    let len = length(normal.xyz);
+    let sign = select(-1.0, 1.0, (dir & 1u) == 0u);
+    let facing = -sign * normal[dir / 2u] / max(len, 1e-4);
+    let w = 1.0 + clamp(normal.w, 0.0, 1.0) * (0.5 * (1.0 + facing) - 1.0);
+    return select(w, 1.0, len < 1e-4);
+}
+
 fn voxel_coord(i: u32, res: u32) -> vec3<u32> {
     return vec3<u32>(i % res, (i / res) % res, i / (res * res));
 }

@@ -101,6 +101,26 @@ pub fn filter_parent(children: &[Vec4; 8], dir: Option<u32>) -> Vec4 {
     sum * 0.25
 }
 
+/// How much of a leaf the first directional level counts along direction `dir` (0..6: +X, -X,
+/// +Y, -Y, +Z, -Z, the way a cone travels), from its mean normal (xyz) and how well its
+/// fragments' normals agree (w, Toksvig's length of the mean normal): 1 where the cone meets
+/// its face head-on, 1/2 edge-on, 0 from behind (Salm, §4.4.2: a falloff from cosine 1 to -1,
+/// so that edge-on surfaces do not turn transparent), blended towards 1 as the normals
+/// disagree. `ndf_weight` in voxels/dense/filter.wgsl and octree_filter.wgsl.
+pub fn ndf_weight(normal: Vec4, dir: u32) -> f32 {
+    let n = normal.truncate();
+    let len = n.length();
+    if len < 1e-4 {
+        return 1.0;
+    }
+    let axis = (dir / 2) as usize;
+    let sign = if dir.is_multiple_of(2) { 1.0 } else { -1.0 };
+    // The face a cone travelling along +axis meets has its normal along -axis.
+    let facing = -sign * n[axis] / len;
+    let directional = 0.5 * (1.0 + facing);
+    1.0 + normal.w.clamp(0.0, 1.0) * (directional - 1.0)
+}
+
 /// A 3D texture's mip chain on the CPU: texels (x fastest) and size per level.
 pub struct Texture3d {
     /// Per mip level, finest first: the texels (x fastest, then y, then z) and the size in texels.
@@ -290,6 +310,22 @@ pub fn splat(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ndf_weight_counts_faces_by_how_a_cone_meets_them() {
+        let floor = Vec4::new(0.0, 1.0, 0.0, 1.0);
+        // A cone travelling down (-Y, direction 3) meets the floor head-on; up (+Y) from behind;
+        // along x edge-on.
+        assert_eq!(ndf_weight(floor, 3), 1.0);
+        assert_eq!(ndf_weight(floor, 2), 0.0);
+        assert_eq!(ndf_weight(floor, 0), 0.5);
+        assert_eq!(ndf_weight(floor, 5), 0.5);
+        // Normals that disagree (Toksvig's length 0.4) count 60 % isotropic.
+        let rough = Vec4::new(0.0, 0.4, 0.0, 0.4);
+        assert!((ndf_weight(rough, 2) - 0.6).abs() < 1e-6);
+        // Two-sided (normals cancel) or empty: isotropic.
+        assert_eq!(ndf_weight(Vec4::ZERO, 1), 1.0);
+    }
 
     #[test]
     fn a_points_region_overlaps_sum_to_its_volume() {

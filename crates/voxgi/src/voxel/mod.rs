@@ -107,6 +107,16 @@ pub trait VoxelStructure {
     );
 }
 
+/// How a structure filters its levels above the finest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Filtering {
+    /// Six directional values per voxel above the finest level (true) or one.
+    pub anisotropic: bool,
+    /// The first directional level weighs each leaf per direction by its normal distribution
+    /// (`RendererOptions::ndf_mips`; `cpu::ndf_weight`). Only with `anisotropic`.
+    pub ndf: bool,
+}
+
 /// Words of `VoxelStructure::pool_counter` read back after each build.
 pub const POOL_COUNTERS: usize = 4;
 

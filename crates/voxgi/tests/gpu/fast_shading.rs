@@ -19,6 +19,7 @@ fn leaves(kind: VoxelKind) -> Variant {
     Variant {
         kind,
         indirect: IndirectShading::Leaves,
+        ndf: false,
     }
 }
 

@@ -27,7 +27,7 @@ fn voxel_size(scene: &Scene, res: u32) -> f32 {
 /// renderer lays the grid it lays for the meshes and the two are compared voxel for voxel. Their
 /// discs and regions are a tenth of a millimetre (two lone points would get discs as wide as
 /// the distance between them).
-fn as_points(scene: &Scene, res: u32, per_voxel: f32) -> Scene {
+pub(crate) fn as_points(scene: &Scene, res: u32, per_voxel: f32) -> Scene {
     let mut points = pointcloud::sample_surfaces(scene, voxel_size(scene, res) / per_voxel);
     let b = scene.bounds();
     points.point_clouds.push(PointCloud {

@@ -25,6 +25,8 @@ pub(crate) fn vct(view: ViewMode, res: u32, bounces: u32) -> Setup {
 pub(crate) struct Variant {
     pub kind: VoxelKind,
     pub indirect: IndirectShading,
+    /// `RendererOptions::ndf_mips`.
+    pub ndf: bool,
 }
 
 impl From<VoxelKind> for Variant {
@@ -32,6 +34,7 @@ impl From<VoxelKind> for Variant {
         Variant {
             kind,
             indirect: IndirectShading::Cones,
+            ndf: false,
         }
     }
 }
@@ -41,6 +44,7 @@ pub(crate) fn on(kind: impl Into<Variant>, mut s: Setup) -> Setup {
     let v = kind.into();
     s.options.voxels = v.kind;
     s.options.indirect = v.indirect;
+    s.options.ndf_mips = v.ndf;
     s
 }
 

@@ -371,6 +371,60 @@ fn voxel_filter_matches_cpu_isotropic() {
     check_filtering(false);
 }
 
+/// With `ndf_mips` the first directional level weighs each finest voxel by its normals
+/// (`cpu::ndf_weight`) before the front-to-back pairs: the GPU's level 1 against the CPU's, per
+/// direction, from the finest radiance and normals read back.
+#[test]
+fn voxel_filter_weighs_leaves_by_their_normals() {
+    let settings = RendererOptions {
+        voxel_resolution: 16,
+        ndf_mips: true,
+        ..measuring()
+    };
+    let mut r = renderer(&builtin::cornell_box(), &settings);
+    let cam = clamped(r.default_camera());
+    frame(&mut r, &cam, 16, 16);
+    let vol = r.volume().dense().unwrap();
+    let (finest, res) = read_level(&vol.radiance, 0);
+    let (device, queue) = (&ctx().device, &ctx().queue);
+    let bytes = read_texture_3d(device, queue, &vol.normal, 0).expect("normal readback");
+    let normals: Vec<Vec4> = bytes
+        .chunks_exact(4)
+        .map(|b| {
+            let f = |v: u8| (v as i8 as f32 / 127.0).max(-1.0);
+            Vec4::new(f(b[0]), f(b[1]), f(b[2]), f(b[3]))
+        })
+        .collect();
+    assert_eq!(normals.len(), finest.len());
+    let level = read_level(&vol.chains, 0).0;
+    let n = res / 2;
+    let cube = (n * n * n) as usize;
+    let mut reduced = 0;
+    for dir in 0..6u32 {
+        // The children as this direction counts them, back in stored (optical depth) form.
+        let child: Vec<Vec4> = finest
+            .iter()
+            .zip(&normals)
+            .map(|(c, nl)| cpu::to_depth(cpu::ndf_weight(*nl, dir) * cpu::from_depth(*c)))
+            .collect();
+        reduced += finest
+            .iter()
+            .zip(&normals)
+            .filter(|(c, nl)| c.w > 0.0 && cpu::ndf_weight(**nl, dir) < 0.9)
+            .count();
+        let parent = level[dir as usize * cube..(dir as usize + 1) * cube].to_vec();
+        check_filter_step(
+            &child,
+            &parent,
+            n,
+            Some(dir),
+            &format!("NDF, direction {dir}"),
+        );
+    }
+    // The walls are seen edge-on or from behind along most directions: the weights must bite.
+    assert!(reduced > 100, "only {reduced} leaves weighed below 0.9");
+}
+
 const SIZE: u32 = 48;
 
 fn voxel_view(r: &mut Renderer, view: ViewMode, level: u32, dir: u32) -> voxgi::RenderOutput {

@@ -15,15 +15,27 @@ struct FilterParams {
     // 1: the source is the chains' previous level (blocks stacked like the destination's),
     // 0: the finest level (one block, shared by every direction).
     src_blocked: u32,
-    _pad: u32,
+    // 1: weigh each finest voxel per direction by its normals (`ndf_weight`; first level only).
+    ndf: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
 @group(0) @binding(1) var src: texture_3d<f32>;
 @group(0) @binding(2) var dst: texture_storage_3d<rgba16float, write>;
+// The finest level's normals and their agreement (read with `ndf`).
+@group(0) @binding(3) var normals: texture_3d<f32>;
 
 fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
     return from_depth(textureLoad(src, base + o, 0));
+}
+
+// A finest voxel as direction `block` counts it.
+fn leaf_child(base: vec3<i32>, o: vec3<i32>, block: u32) -> vec4<f32> {
+    var w = 1.0;
+    if params.ndf != 0u {
+        w = ndf_weight(textureLoad(normals, base + o, 0), block);
+    }
+    return w * child(base, o);
 }
 
 @compute @workgroup_size(4, 4, 4)
@@ -56,8 +68,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         back = front;
         front[axis] = select(1, 0, positive);
         back[axis] = select(0, 1, positive);
-        let f = child(base, front);
-        let b = child(base, back);
+        let f = leaf_child(base, front, block);
+        let b = leaf_child(base, back, block);
         sum += f + (1.0 - f.a) * b;
     }
     textureStore(dst, id, to_depth(sum * 0.25));

@@ -21,6 +21,8 @@ struct Level {
 @group(0) @binding(3) var src: texture_3d<f32>;
 @group(0) @binding(4) var dst: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(5) var<uniform> level: Level;
+// Per leaf slot, SLOT_STRIDE u32: word 3 its normal and agreement (for `tree.ndf`).
+@group(0) @binding(6) var<storage, read> slots: array<u32>;
 
 fn child(n: u32) -> u32 {
     return nodes[NODE_HEADER + n * NODE_STRIDE];
@@ -32,6 +34,18 @@ fn neighbour(n: u32, axis: u32) -> u32 {
 
 fn source(base: vec3<u32>, o: vec3<u32>) -> vec4<f32> {
     return from_depth(textureLoad(src, base + o, 0));
+}
+
+// Leaf voxel `o` of the leaf tile `below` (level 0) as direction d counts it: weighed by its
+// normals with `tree.ndf`, as the dense volume's filter weighs its finest voxels.
+fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
+    var w = 1.0;
+    if tree.ndf != 0u {
+        let word = nodes[child_word(tree, below * 8u + o.x + 2u * o.y + 4u * o.z)];
+        let normal = unpack4x8snorm(slots[(max(word, 1u) - 1u) * SLOT_STRIDE + 3u]);
+        w = select(1.0, ndf_weight(normal, d), word != 0u);
+    }
+    return w * source(base, o);
 }
 
 @compute @workgroup_size(64)
@@ -99,8 +113,15 @@ fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
         var back = front;
         front[axis] = select(1u, 0u, positive);
         back[axis] = select(0u, 1u, positive);
-        let f = source(base, front);
-        let b = source(base, back);
+        var f: vec4<f32>;
+        var b: vec4<f32>;
+        if k == 1u {
+            f = leaf_source(base, front, below, d);
+            b = leaf_source(base, back, below, d);
+        } else {
+            f = source(base, front);
+            b = source(base, back);
+        }
         value += f + (1.0 - f.a) * b;
     }
     return to_depth(value * 0.25);

@@ -63,7 +63,8 @@ struct Octree {
     tiles: u32,
     // Leaf slots the pool holds.
     slots: u32,
-    _pad0: u32,
+    // 1: the first directional level weighs the leaves by their normals (`ndf_weight`).
+    ndf: u32,
     _pad1: u32,
     _pad2: u32,
     leaf_atlas: AtlasShape,

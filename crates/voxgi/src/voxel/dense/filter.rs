@@ -32,6 +32,7 @@ impl FilterPass {
                 layout::uniform(0, c, true),
                 layout::texture_3d_load(1, c),
                 layout::storage_texture_3d(2, RADIANCE_FORMAT),
+                layout::texture_3d_load(3, c),
             ],
         });
         FilterPass {
@@ -49,10 +50,11 @@ impl FilterPass {
                 // Level 1 reads the finest (isotropic) level, one block; later ones their own
                 // blocks.
                 let src = (level > 1).then(|| level - 2);
+                let ndf = vol.ndf && vol.anisotropic && src.is_none();
                 Step {
                     src,
                     dst: level - 1,
-                    params: [mode, res >> level, src.is_some() as u32, 0],
+                    params: [mode, res >> level, src.is_some() as u32, ndf as u32],
                 }
             })
             .collect()
@@ -87,6 +89,7 @@ impl FilterPass {
                     Some(m) => mip_view(&vol.chains, m),
                 };
                 let dst = mip_view(&vol.chains, s.dst);
+                let normals = mip_view(&vol.normal, 0);
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("filter"),
                     layout: &self.layout,
@@ -98,6 +101,7 @@ impl FilterPass {
                         }),
                         wgpu::BindingResource::TextureView(&src),
                         wgpu::BindingResource::TextureView(&dst),
+                        wgpu::BindingResource::TextureView(&normals),
                     ]),
                 })
             })

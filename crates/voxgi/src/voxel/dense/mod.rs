@@ -19,7 +19,7 @@ use crate::fragments::Fragments;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::targets::FrameTargets;
-use crate::voxel::{DebugView, POOL_COUNTERS, VoxelStructure};
+use crate::voxel::{DebugView, Filtering, POOL_COUNTERS, VoxelStructure};
 use debug::DebugPass;
 use filter::FilterPass;
 use std::sync::Arc;
@@ -50,6 +50,8 @@ pub struct DenseVolume {
     pub grid: Grid,
     /// Six directional chains (true) or one isotropic chain.
     pub anisotropic: bool,
+    /// The first chain level weighs the finest voxels by their normals (`Filtering::ndf`).
+    pub ndf: bool,
     /// The volume's placement as a `GpuVolume` uniform.
     pub volume: wgpu::Buffer,
     /// Occupied voxels the slot buffers hold.
@@ -284,16 +286,17 @@ impl DensePipelines {
 }
 
 impl DenseVolume {
-    /// A volume on `grid` with room for `slot_capacity` occupied voxels, and for updates by
-    /// dynamic geometry when `dynamic`.
+    /// A volume on `grid`, its levels filtered as `filtering` says, with room for
+    /// `slot_capacity` occupied voxels, and for updates by dynamic geometry when `dynamic`.
     pub fn new(
         device: &wgpu::Device,
         pipelines: &Arc<DensePipelines>,
         grid: Grid,
-        anisotropic: bool,
+        filtering: Filtering,
         slot_capacity: u32,
         dynamic: bool,
     ) -> Self {
+        let anisotropic = filtering.anisotropic;
         let res = grid.resolution;
         let levels = grid.levels();
         let slots = slot_capacity.max(1) as u64;
@@ -381,6 +384,7 @@ impl DenseVolume {
         DenseVolume {
             grid,
             anisotropic,
+            ndf: filtering.ndf,
             volume,
             slot_capacity: slots as u32,
             counters,
@@ -709,7 +713,10 @@ impl VoxelStructure for DenseVolume {
                 device,
                 &self.pipelines,
                 self.grid,
-                self.anisotropic,
+                Filtering {
+                    anisotropic: self.anisotropic,
+                    ndf: self.ndf,
+                },
                 slots,
                 self.dynamic,
             )

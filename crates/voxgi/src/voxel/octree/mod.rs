@@ -17,7 +17,7 @@
 pub mod cpu;
 pub mod debug;
 
-use super::{DebugView, Grid, POOL_COUNTERS, VoxelStructure};
+use super::{DebugView, Filtering, Grid, POOL_COUNTERS, VoxelStructure};
 use crate::fragments::Fragments;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
@@ -78,8 +78,10 @@ pub struct GpuOctree {
     pub tiles: u32,
     /// Leaf slots.
     pub slots: u32,
+    /// 1: the first directional level weighs the leaves by their normals (`Filtering::ndf`).
+    pub ndf: u32,
     /// Padding; zero.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
     /// The even atlas's region of level 0.
     pub leaf_atlas: GpuAtlasShape,
     /// The even atlas's region of levels 2, 4, …
@@ -387,6 +389,7 @@ impl OctreePipelines {
                 layout::texture_3d_load(3, c),
                 layout::storage_texture_3d(4, ATLAS_FORMAT),
                 layout::uniform(5, c, true),
+                layout::storage(6, c, true),
             ],
         });
         let filter_module =
@@ -511,10 +514,11 @@ impl OctreeVolume {
         device: &wgpu::Device,
         pipelines: &Arc<OctreePipelines>,
         grid: Grid,
-        anisotropic: bool,
+        filtering: Filtering,
         pools: OctreePools,
         dynamic: bool,
     ) -> crate::Result<Self> {
+        let anisotropic = filtering.anisotropic;
         let depth = grid.resolution.ilog2();
         let dirs: u32 = if anisotropic { 6 } else { 1 };
         // Tile 0 is the root's; then classes E, O and V (`child_word` in tree.wgsl).
@@ -572,7 +576,8 @@ impl OctreeVolume {
             base_o: base_o as u32,
             tiles: tiles as u32,
             slots: pools.slots,
-            _pad: [0; 3],
+            ndf: (filtering.ndf && filtering.anisotropic) as u32,
+            _pad: [0; 2],
             leaf_atlas: leaf_shape,
             even_atlas: even_shape,
             odd_atlas: odd_shape,
@@ -670,6 +675,7 @@ impl OctreeVolume {
                     wgpu::BindingResource::TextureView(&view(src)),
                     wgpu::BindingResource::TextureView(&view(dst)),
                     level.clone(),
+                    slot_buf.as_entire_binding(),
                 ]),
             })
         };
@@ -1081,7 +1087,10 @@ impl VoxelStructure for OctreeVolume {
                 device,
                 &self.pipelines,
                 self.grid,
-                self.anisotropic,
+                Filtering {
+                    anisotropic: self.anisotropic,
+                    ndf: self.layout.ndf != 0,
+                },
                 pools,
                 self.snapshot.is_some(),
             )
