@@ -97,8 +97,39 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
         draft.progressive = false;
     }
     ui.checkbox(&mut draft.anisotropic, "anisotropic voxels");
+    ui.add_enabled(
+        draft.anisotropic,
+        egui::Checkbox::new(&mut draft.ndf_mips, "leaves weighed by their normals (NDF)"),
+    );
+    if !draft.anisotropic {
+        draft.ndf_mips = false;
+    }
+    egui::ComboBox::from_label("diffuse indirect")
+        .selected_text(match draft.indirect {
+            voxgi::IndirectShading::Cones => "cones per pixel",
+            voxgi::IndirectShading::Leaves => "leaves' irradiance (fast)",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(
+                &mut draft.indirect,
+                voxgi::IndirectShading::Cones,
+                "cones per pixel",
+            );
+            ui.selectable_value(
+                &mut draft.indirect,
+                voxgi::IndirectShading::Leaves,
+                "leaves' irradiance (fast)",
+            );
+        });
     ui.checkbox(&mut draft.half_resolution, "half-resolution gather");
     ui.checkbox(&mut draft.cone_shadows, "cone-traced area-light shadows");
+    egui::ComboBox::from_label("spot and sun shadows")
+        .selected_text(draft.shadow_filter.name())
+        .show_ui(ui, |ui| {
+            for f in voxgi::ShadowFilter::ALL {
+                ui.selectable_value(&mut draft.shadow_filter, f, f.name());
+            }
+        });
     ui.add(
         egui::Slider::new(&mut draft.voxel_update_interval, 1..=16)
             .text("voxel update every k frames"),
