@@ -123,7 +123,7 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
         });
     ui.checkbox(&mut draft.half_resolution, "half-resolution gather");
     ui.checkbox(&mut draft.cone_shadows, "cone-traced area-light shadows");
-    egui::ComboBox::from_label("spot and sun shadows")
+    egui::ComboBox::from_label("point, spot and sun shadows")
         .selected_text(draft.shadow_filter.name())
         .show_ui(ui, |ui| {
             for f in voxgi::ShadowFilter::ALL {

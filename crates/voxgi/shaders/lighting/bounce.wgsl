@@ -44,10 +44,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         e = g.irradiance;
         ao = g.ao;
     } else {
-        // Two-sided voxel: half the light from each side.
+        // Two-sided voxel: half the light from each side. Records turn their bundles by the
+        // pixels' window layout too; the stored bounces keep the fixed orientation.
         let n = vec3<f32>(0.0, 1.0, 0.0);
-        let up = gather_diffuse(center, n, 0.0, IRRADIANCE, ALL_CONES);
-        let down = gather_diffuse(center, -n, 0.0, IRRADIANCE, ALL_CONES);
+        var angle = 0.0;
+        if IRRADIANCE {
+            angle = leaf_rotation(c) * 2.0 * PI / f32(max(cones.count, 2u) - 1u);
+        }
+        let up = gather_diffuse(center, n, angle, IRRADIANCE, ALL_CONES);
+        let down = gather_diffuse(center, -n, angle, IRRADIANCE, ALL_CONES);
         e = 0.5 * (up.irradiance + down.irradiance);
         ao = 0.5 * (up.ao + down.ao);
     }

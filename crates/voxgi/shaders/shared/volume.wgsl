@@ -37,7 +37,6 @@ struct Cones {
     indirect: u32,
 }
 
-// Voxel linear index <-> coordinates (x fastest).
 // How much of a leaf the first directional level counts along direction `dir` (0..6: +X, -X,
 // +Y, -Y, +Z, -Z, the way a cone travels), from its mean normal (xyz) and its normals'
 // agreement (w): the twin of `voxel::cpu::ndf_weight`, which says why.
@@ -49,6 +48,7 @@ fn ndf_weight(normal: vec4<f32>, dir: u32) -> f32 {
     return select(w, 1.0, len < 1e-4);
 }
 
+// Voxel linear index <-> coordinates (x fastest).
 fn voxel_coord(i: u32, res: u32) -> vec3<u32> {
     return vec3<u32>(i % res, (i / res) % res, i / (res * res));
 }

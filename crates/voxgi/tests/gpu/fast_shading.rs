@@ -180,3 +180,40 @@ fn leaves_read_the_same_light_from_both_structures() {
     assert!(worst <= 4, "{worst}/255 apart");
     assert!(c.flip_mean < 0.02, "mean FLIP {}", c.flip_mean);
 }
+
+#[test]
+fn progressive_leaves_converge_to_unlimited_leaves() {
+    // Progressive bounces keep the records at every step, so pixels follow the light as it
+    // converges; the converged light must be the unlimited bounces' (not to the bit: the
+    // stored steps turn their bundles by the records' layout).
+    let scene = builtin::closed_box(0.5, 1.0);
+    let params = clamped(&scene.cameras[0]);
+    let options = |progressive: bool| RendererOptions {
+        voxel_resolution: 32,
+        bounces: voxgi::UNLIMITED_BOUNCES,
+        progressive,
+        indirect: IndirectShading::Leaves,
+        default_light: false,
+        ..RendererOptions::default()
+    };
+    let mut unlimited = renderer(&scene, &options(false));
+    let want = frame(&mut unlimited, &params, 24, 24).mean_radiance()[0];
+    let mut r = renderer(&scene, &options(true));
+    let mut means = vec![frame(&mut r, &params, 24, 24).mean_radiance()[0]];
+    while !r.voxels_settled() {
+        assert!(means.len() < 100, "progressive bounces never settle");
+        means.push(frame(&mut r, &params, 24, 24).mean_radiance()[0]);
+    }
+    let got = *means.last().unwrap();
+    eprintln!("progressive leaves by frame: {means:?}; unlimited {want}");
+    // Measured 1.97493 against 1.97550 (0.03 %), rising 1, 1.493, 1.737, … one bounce per
+    // frame. 0.5 %: a step lost or counted twice moves it by ρ^k of the series, 12 % at the
+    // second step and still 0.8 % at the eighth.
+    assert!(
+        rel(got, want) < 0.005,
+        "progressive {got} against unlimited {want}"
+    );
+    for w in means.windows(2) {
+        assert!(w[1] >= w[0] - 1e-3, "progressive light fell: {means:?}");
+    }
+}

@@ -40,9 +40,11 @@ fn source(base: vec3<u32>, o: vec3<u32>) -> vec4<f32> {
 // normals with `tree.ndf`, as the dense volume's filter weighs its finest voxels.
 fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
     var w = 1.0;
-    if tree.ndf != 0u {
+    // `filtered` also runs (and is discarded) for nodes without a brick: below 0.
+    if tree.ndf != 0u && below != 0u {
         let word = nodes[child_word(tree, below * 8u + o.x + 2u * o.y + 4u * o.z)];
-        let normal = unpack4x8snorm(slots[(max(word, 1u) - 1u) * SLOT_STRIDE + 3u]);
+        let slot = min(max(word, 1u) - 1u, tree.slots - 1u);
+        let normal = unpack4x8snorm(slots[slot * SLOT_STRIDE + 3u]);
         w = select(1.0, ndf_weight(normal, d), word != 0u);
     }
     return w * source(base, o);
