@@ -137,3 +137,13 @@ pub fn pixel_on_ground(cam: &Camera, w: u32, h: u32, x: u32, y: u32) -> Vec3 {
 pub fn rel(a: f32, b: f32) -> f32 {
     (a - b).abs() / b.abs().max(1e-6)
 }
+
+/// The largest difference between two images' 8-bit channels, in code values.
+pub fn largest_difference(a: &[u8], b: &[u8]) -> u8 {
+    assert_eq!(a.len(), b.len(), "images of different sizes");
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .unwrap_or(0)
+}

@@ -15,28 +15,20 @@ use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Material};
 use voxgi::{IndirectShading, RendererOptions, VoxelKind};
 
-fn leaves(kind: VoxelKind) -> Variant {
-    Variant {
-        kind,
-        indirect: IndirectShading::Leaves,
-        ndf: false,
-    }
-}
-
 #[test]
 fn leaves_keep_the_furnace_series() {
     // A uniform field: whatever the filter's weights, a pixel reads the leaves' one value, so
     // the bounce count is all that can go wrong (one bounce short or long is 12 % off).
     let scene = builtin::closed_box(0.5, 1.0);
     for kind in VoxelKind::ALL {
-        furnace_series(&scene, leaves(kind), &FURNACE_CASES);
+        furnace_series(&scene, Variant::leaves(kind), &FURNACE_CASES);
     }
 }
 
 #[test]
 fn leaves_see_an_open_plane_unoccluded() {
     for kind in VoxelKind::ALL {
-        ao_of_an_open_plane_on(&plane_scene(0.5), leaves(kind));
+        ao_of_an_open_plane_on(&plane_scene(0.5), Variant::leaves(kind));
     }
 }
 
@@ -51,7 +43,7 @@ fn leaves_occlude_beside_a_wall() {
     let cam = Camera::look_at(Vec3::new(-1.0, 3.0, 0.01), Vec3::new(-0.4, 0.0, 0.0), 30.0);
     for kind in VoxelKind::ALL {
         // The closed form's bound (0.1) holds as for the gather.
-        let worst = ao_beside_a_wall(&scene, &cam, leaves(kind));
+        let worst = ao_beside_a_wall(&scene, &cam, Variant::leaves(kind));
         eprintln!("leaves beside a wall ({kind:?}): worst error {worst:.3}");
     }
 }
@@ -65,7 +57,7 @@ fn leaves_keep_a_thin_wall_nearly_closed() {
     let scene = builtin::two_rooms(grid.voxel_size);
     for kind in VoxelKind::ALL {
         let cones = thin_wall_leak(&scene, kind, res);
-        let leak = thin_wall_leak(&scene, leaves(kind), res);
+        let leak = thin_wall_leak(&scene, Variant::leaves(kind), res);
         eprintln!(
             "thin wall ({kind:?}): room B gets {:.2} % of room A's indirect light with leaves, \
              {:.2} % with cones",
@@ -165,13 +157,7 @@ fn leaves_read_the_same_light_from_both_structures() {
         &Image::from_ldr_rgba8(w, h, &b.ldr),
     )
     .unwrap();
-    let worst = a
-        .ldr
-        .iter()
-        .zip(&b.ldr)
-        .map(|(x, y)| x.abs_diff(*y))
-        .max()
-        .unwrap_or(0);
+    let worst = largest_difference(&a.ldr, &b.ldr);
     eprintln!("leaves, octree vs dense: {c:?}, largest difference {worst}/255");
     // The octree finds a voxel's leaf by a descent, the dense volume by its occupancy: both
     // must find the same leaves, whose bounces agree as the gather's do (vct.rs,

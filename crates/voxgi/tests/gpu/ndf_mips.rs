@@ -10,15 +10,7 @@ use crate::reference::{opts, region, trace_with};
 use crate::vct::{FURNACE_CASES, Variant, ao_of_an_open_plane_on, furnace_series, thin_wall_leak};
 use voxgi::compare::{Image, compare};
 use voxgi::scene::builtin;
-use voxgi::{IndirectShading, RendererOptions, VoxelKind};
-
-fn ndf(kind: VoxelKind) -> Variant {
-    Variant {
-        kind,
-        indirect: IndirectShading::Cones,
-        ndf: true,
-    }
-}
+use voxgi::{RendererOptions, VoxelKind};
 
 #[test]
 fn ndf_mips_keep_the_furnace_series() {
@@ -28,7 +20,7 @@ fn ndf_mips_keep_the_furnace_series() {
     // walls' leaves at the box's edges hold two faces and count less along each.
     let scene = builtin::closed_box(0.5, 1.0);
     for kind in VoxelKind::ALL {
-        furnace_series(&scene, ndf(kind), &FURNACE_CASES);
+        furnace_series(&scene, Variant::ndf(kind), &FURNACE_CASES);
     }
 }
 
@@ -38,7 +30,7 @@ fn ndf_mips_see_an_open_plane_of_points_unoccluded() {
     // 1 (the bound and its reasons in `ao_of_an_open_plane`).
     let scene = as_points(&plane_scene(0.5), 64, 2.0);
     for kind in VoxelKind::ALL {
-        ao_of_an_open_plane_on(&scene, ndf(kind));
+        ao_of_an_open_plane_on(&scene, Variant::ndf(kind));
     }
 }
 
@@ -50,7 +42,7 @@ fn ndf_mips_keep_a_thin_wall_closed() {
     let grid = voxgi::voxel::Grid::around(b.min, b.max, res);
     let scene = builtin::two_rooms(grid.voxel_size);
     for kind in VoxelKind::ALL {
-        let leak = thin_wall_leak(&scene, ndf(kind), res);
+        let leak = thin_wall_leak(&scene, Variant::ndf(kind), res);
         eprintln!("thin wall with NDF mips ({kind:?}): {:.2} %", leak * 100.0);
         // The one-voxel wall holds both faces: their normals cancel and its own leaves count
         // as isotropic; the floor's and ceiling's leaves beside it, seen edge-on, now count
@@ -123,13 +115,7 @@ fn ndf_mips_cornell_box_against_the_path_tracer() {
     }
     // The octree filters its leaves' normals from its slots, the dense volume from its normal
     // texture: the same weights, so the same pictures (as `octree_and_dense_renders_agree`).
-    let worst = images[0]
-        .ldr
-        .iter()
-        .zip(&images[1].ldr)
-        .map(|(x, y)| x.abs_diff(*y))
-        .max()
-        .unwrap_or(0);
+    let worst = largest_difference(&images[0].ldr, &images[1].ldr);
     eprintln!("NDF mips, octree vs dense: largest difference {worst}/255");
     assert!(worst <= 4, "octree and dense {worst}/255 apart");
 }

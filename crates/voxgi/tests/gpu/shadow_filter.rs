@@ -123,13 +123,7 @@ fn vsm_esm_moments_follow_a_moving_occluder() {
     let mut fresh_scene = scene.clone();
     fresh_scene.instances[plate].transform = moved;
     let want = render_with(&fresh_scene, &opts, &params, SIZE, SIZE);
-    let worst = got
-        .ldr
-        .iter()
-        .zip(&want.ldr)
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap_or(0);
+    let worst = largest_difference(&got.ldr, &want.ldr);
     eprintln!("moved plate: largest difference from a fresh renderer {worst}/255");
     // Only the re-rendered rectangle of the map (grown by the prefilter's disc) is
     // prefiltered again: texels left stale would keep the old shadow (the whole 0-to-lit

@@ -29,6 +29,24 @@ pub(crate) struct Variant {
     pub ndf: bool,
 }
 
+impl Variant {
+    /// Structure `kind` read through the fast shading.
+    pub(crate) fn leaves(kind: VoxelKind) -> Self {
+        Variant {
+            indirect: IndirectShading::Leaves,
+            ..kind.into()
+        }
+    }
+
+    /// Structure `kind` with the NDF-weighted first level.
+    pub(crate) fn ndf(kind: VoxelKind) -> Self {
+        Variant {
+            ndf: true,
+            ..kind.into()
+        }
+    }
+}
+
 impl From<VoxelKind> for Variant {
     fn from(kind: VoxelKind) -> Self {
         Variant {
@@ -591,13 +609,7 @@ fn octree_and_dense_renders_agree() {
                 &Image::from_ldr_rgba8(w, h, &octree.ldr),
             )
             .unwrap();
-            let worst = dense
-                .ldr
-                .iter()
-                .zip(&octree.ldr)
-                .map(|(a, b)| a.abs_diff(*b))
-                .max()
-                .unwrap_or(0);
+            let worst = largest_difference(&dense.ldr, &octree.ldr);
             eprintln!("{name} at {res}³: octree vs dense {c:?}, largest difference {worst}/255");
             // The structures differ only by the atlases' filtering rounding (1e-5 in opacity
             // per sample) and the dense volume's z clamp at its chains' edges. Measured: at
