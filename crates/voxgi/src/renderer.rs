@@ -816,6 +816,16 @@ impl Renderer {
             }
         }
         let progressive = self.options.progressive;
+        // One bounce, and the filtering its stored light needs.
+        let bounce =
+            |encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer, steps: BounceSteps| {
+                let volume = self.volume.get();
+                p.bounce
+                    .record(&self.device, encoder, volume, &self.cones, steps, timer);
+                if steps.store {
+                    volume.record_filter(&self.device, encoder, timer);
+                }
+            };
         if geometry || pending.lights {
             p.inject.prepare(
                 &self.queue,
@@ -860,19 +870,7 @@ impl Renderer {
                         irradiance: last,
                         store: !last,
                     };
-                    p.bounce.record(
-                        &self.device,
-                        encoder,
-                        self.volume.get(),
-                        &self.cones,
-                        steps,
-                        timer,
-                    );
-                    if steps.store {
-                        self.volume
-                            .get()
-                            .record_filter(&self.device, encoder, timer);
-                    }
+                    bounce(encoder, timer, steps);
                 }
             }
         }
@@ -885,17 +883,7 @@ impl Renderer {
                 irradiance: leaves(&self.options),
                 store: true,
             };
-            p.bounce.record(
-                &self.device,
-                encoder,
-                self.volume.get(),
-                &self.cones,
-                steps,
-                timer,
-            );
-            self.volume
-                .get()
-                .record_filter(&self.device, encoder, timer);
+            bounce(encoder, timer, steps);
             self.progressive_left -= 1;
         }
         // The shadow views were consumed by `record_shadows` this frame; injection's start over.

@@ -29,28 +29,23 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let center = leaf_center(s);
     var e = vec3<f32>(0.0);
     var ao = 1.0;
+    // Records turn their bundles by the layout the pixels' window filter averages
+    // (shared/irradiance_record.wgsl).
+    let records_angle = leaf_rotation(c) * 2.0 * PI / f32(max(cones.count, 2u) - 1u);
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
         // A fixed bundle orientation per voxel, varied between voxels to break up patterns. It
         // follows the voxel's coordinates, not its slot: slots are handed out by atomics in
         // whatever order the GPU runs, and renders must not change from run to run. (The
         // constants are Roberts' R3 sequence: neighbouring voxels get well spread angles.)
-        var angle = fract(dot(vec3<f32>(c), vec3<f32>(0.8191725134, 0.6710436067, 0.5497004779))) * 2.0 * PI;
-        if IRRADIANCE {
-            // The layout the pixels' window filter averages (shared/irradiance_record.wgsl).
-            angle = leaf_rotation(c) * 2.0 * PI / f32(max(cones.count, 2u) - 1u);
-        }
-        let g = gather_diffuse(center, n, angle, IRRADIANCE, ALL_CONES);
+        let r3 = fract(dot(vec3<f32>(c), vec3<f32>(0.8191725134, 0.6710436067, 0.5497004779))) * 2.0 * PI;
+        let g = gather_diffuse(center, n, select(r3, records_angle, IRRADIANCE), IRRADIANCE, ALL_CONES);
         e = g.irradiance;
         ao = g.ao;
     } else {
-        // Two-sided voxel: half the light from each side. Records turn their bundles by the
-        // pixels' window layout too; the stored bounces keep the fixed orientation.
+        // Two-sided voxel: half the light from each side.
         let n = vec3<f32>(0.0, 1.0, 0.0);
-        var angle = 0.0;
-        if IRRADIANCE {
-            angle = leaf_rotation(c) * 2.0 * PI / f32(max(cones.count, 2u) - 1u);
-        }
+        let angle = select(0.0, records_angle, IRRADIANCE);
         let up = gather_diffuse(center, n, angle, IRRADIANCE, ALL_CONES);
         let down = gather_diffuse(center, -n, angle, IRRADIANCE, ALL_CONES);
         e = 0.5 * (up.irradiance + down.irradiance);

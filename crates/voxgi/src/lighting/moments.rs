@@ -114,16 +114,12 @@ impl MomentsPass {
             contents: &bytes,
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let storage = atlas.moments.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("moments"),
             layout: &self.layout,
             entries: &layout::entries(vec![
                 wgpu::BindingResource::TextureView(&atlas.array_view),
-                wgpu::BindingResource::TextureView(&storage),
+                wgpu::BindingResource::TextureView(&atlas.moments_view),
                 wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer: &uniforms,
                     offset: 0,

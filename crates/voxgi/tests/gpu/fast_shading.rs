@@ -3,13 +3,11 @@
 //! agreement with the path tracer and with the gather, and the two structures' lookups.
 
 use crate::common::*;
-use crate::point_gi::CORNELL_REGIONS;
-use crate::reference::{opts, region, trace_with};
 use crate::vct::{
-    FURNACE_CASES, Variant, ao_beside_a_wall, ao_of_an_open_plane_on, furnace_series,
-    thin_wall_leak, wall_mesh,
+    FURNACE_CASES, Variant, ao_beside_a_wall, ao_of_an_open_plane_on,
+    cornell_variant_against_the_path_tracer, furnace_series, octree_against_dense,
+    one_voxel_wall_rooms, thin_wall_leak, wall_mesh,
 };
-use voxgi::compare::{Image, compare};
 use voxgi::scene::builtin;
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Material};
@@ -51,10 +49,7 @@ fn leaves_occlude_beside_a_wall() {
 #[test]
 fn leaves_keep_a_thin_wall_nearly_closed() {
     let res = 64;
-    let probe = builtin::two_rooms(0.01);
-    let b = probe.bounds();
-    let grid = voxgi::voxel::Grid::around(b.min, b.max, res);
-    let scene = builtin::two_rooms(grid.voxel_size);
+    let scene = one_voxel_wall_rooms(res);
     for kind in VoxelKind::ALL {
         let cones = thin_wall_leak(&scene, kind, res);
         let leak = thin_wall_leak(&scene, Variant::leaves(kind), res);
@@ -79,85 +74,26 @@ fn leaves_keep_a_thin_wall_nearly_closed() {
 
 #[test]
 fn leaves_agree_with_the_path_tracer_and_the_gather() {
-    let scene = builtin::cornell_box();
-    let cam = scene.cameras[0].clone();
-    let (w, h) = (64, 64);
-    let settings = RendererOptions::default();
-    let params = voxgi::FrameParams::new(cam);
-    let pt = trace_with(
-        &scene,
-        &settings,
-        &params,
-        w,
-        h,
-        opts(128, voxgi::Bounces::Exactly(2)),
-    );
-    let ldr = |o: &voxgi::RenderOutput| Image::from_ldr_rgba8(w, h, &o.ldr);
-    for kind in VoxelKind::ALL {
-        let cones = RendererOptions {
-            voxels: kind,
-            ..settings.clone()
-        };
-        let fast = RendererOptions {
-            indirect: IndirectShading::Leaves,
-            ..cones.clone()
-        };
-        let gather = render_with(&scene, &cones, &params, w, h);
-        let read = render_with(&scene, &fast, &params, w, h);
-        let c = compare(&ldr(&pt), &ldr(&read)).unwrap();
-        let g = compare(&ldr(&pt), &ldr(&gather)).unwrap();
-        eprintln!(
-            "Cornell box ({kind:?}): mean FLIP against the path tracer {:.3} with leaves, \
-             {:.3} with cones",
-            c.flip_mean, g.flip_mean
-        );
-        for (name, r) in CORNELL_REGIONS {
-            let a = region(&pt, r.0, r.1, r.2, r.3);
-            let b = region(&read, r.0, r.1, r.2, r.3);
-            let bg = region(&gather, r.0, r.1, r.2, r.3);
-            eprintln!(
-                "{name} ({kind:?}): leaves / path tracer {:.3}, cones {:.3}",
-                b / a,
-                bg / a
-            );
-            // Measured within 0.6 % of the cones' ratios (back wall 1.04, floor 1.03-1.04,
-            // walls 1.03-1.05; the ceiling 1.33-1.35, the cones' known error). 12 % and the
-            // ceiling's 50 % are the gather's bounds in reference.rs plus the window filter's
-            // blur at the regions' edges; a bounce lost or counted twice moves a region 15 %.
-            let tolerance = if name == "ceiling" { 0.5 } else { 0.12 };
-            assert!(
-                (b / a - 1.0).abs() < tolerance,
-                "{kind:?}, {name}: leaves {b} vs path tracer {a}"
-            );
-        }
-        // LDR-FLIP, whole image: measured 0.143 (dense) and 0.142 (octree), the same as the
-        // cones. 0.17: the gather's bound (reference.rs) with room for the filter's blur.
-        assert!(c.flip_mean < 0.17, "{kind:?}: mean FLIP {}", c.flip_mean);
-    }
+    // Measured within 0.6 % of the cones' ratios (back wall 1.04, floor 1.03-1.04, walls
+    // 1.03-1.05; the ceiling 1.33-1.35, the cones' known error), and a whole-image LDR-FLIP
+    // of 0.143 (dense) and 0.142 (octree), the same as the cones'. The bounds are the
+    // gather's plus room for the window filter's blur at the regions' edges; a bounce lost or
+    // counted twice moves a region 15 %.
+    cornell_variant_against_the_path_tracer("leaves", |o| {
+        o.indirect = IndirectShading::Leaves;
+    });
 }
 
 #[test]
 fn leaves_read_the_same_light_from_both_structures() {
     let scene = builtin::cornell_box();
-    let (w, h) = (64, 64);
     let params = voxgi::FrameParams::new(scene.cameras[0].clone());
-    let dense = RendererOptions {
+    let options = RendererOptions {
         voxel_resolution: 64,
         indirect: IndirectShading::Leaves,
         ..RendererOptions::default()
     };
-    let octree = RendererOptions {
-        voxels: VoxelKind::Octree,
-        ..dense.clone()
-    };
-    let a = render_with(&scene, &dense, &params, w, h);
-    let b = render_with(&scene, &octree, &params, w, h);
-    let c = compare(
-        &Image::from_ldr_rgba8(w, h, &a.ldr),
-        &Image::from_ldr_rgba8(w, h, &b.ldr),
-    )
-    .unwrap();
-    let worst = largest_difference(&a.ldr, &b.ldr);
+    let (c, worst) = octree_against_dense(&scene, &options, &params, 64, 64);
     eprintln!("leaves, octree vs dense: {c:?}, largest difference {worst}/255");
     // The octree finds a voxel's leaf by a descent, the dense volume by its occupancy: both
     // must find the same leaves, whose bounces agree as the gather's do (vct.rs,

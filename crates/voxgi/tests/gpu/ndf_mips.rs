@@ -4,13 +4,13 @@
 //! voxels.rs (`voxel_filter_weighs_leaves_by_their_normals`).
 
 use crate::common::*;
-use crate::point_gi::CORNELL_REGIONS;
 use crate::point_gi::as_points;
-use crate::reference::{opts, region, trace_with};
-use crate::vct::{FURNACE_CASES, Variant, ao_of_an_open_plane_on, furnace_series, thin_wall_leak};
-use voxgi::compare::{Image, compare};
+use crate::vct::{
+    FURNACE_CASES, Variant, ao_of_an_open_plane_on, cornell_variant_against_the_path_tracer,
+    furnace_series, one_voxel_wall_rooms, thin_wall_leak,
+};
+use voxgi::VoxelKind;
 use voxgi::scene::builtin;
-use voxgi::{RendererOptions, VoxelKind};
 
 #[test]
 fn ndf_mips_keep_the_furnace_series() {
@@ -37,10 +37,7 @@ fn ndf_mips_see_an_open_plane_of_points_unoccluded() {
 #[test]
 fn ndf_mips_keep_a_thin_wall_closed() {
     let res = 64;
-    let probe = builtin::two_rooms(0.01);
-    let b = probe.bounds();
-    let grid = voxgi::voxel::Grid::around(b.min, b.max, res);
-    let scene = builtin::two_rooms(grid.voxel_size);
+    let scene = one_voxel_wall_rooms(res);
     for kind in VoxelKind::ALL {
         let leak = thin_wall_leak(&scene, Variant::ndf(kind), res);
         eprintln!("thin wall with NDF mips ({kind:?}): {:.2} %", leak * 100.0);
@@ -58,61 +55,11 @@ fn ndf_mips_keep_a_thin_wall_closed() {
 
 #[test]
 fn ndf_mips_cornell_box_against_the_path_tracer() {
-    let scene = builtin::cornell_box();
-    let (w, h) = (64, 64);
-    let params = voxgi::FrameParams::new(scene.cameras[0].clone());
-    let settings = RendererOptions::default();
-    let pt = trace_with(
-        &scene,
-        &settings,
-        &params,
-        w,
-        h,
-        opts(128, voxgi::Bounces::Exactly(2)),
-    );
-    let ldr = |o: &voxgi::RenderOutput| Image::from_ldr_rgba8(w, h, &o.ldr);
-    let mut images = Vec::new();
-    for kind in VoxelKind::ALL {
-        let plain = RendererOptions {
-            voxels: kind,
-            ..settings.clone()
-        };
-        let weighed = RendererOptions {
-            ndf_mips: true,
-            ..plain.clone()
-        };
-        let a = render_with(&scene, &plain, &params, w, h);
-        let b = render_with(&scene, &weighed, &params, w, h);
-        let ca = compare(&ldr(&pt), &ldr(&a)).unwrap();
-        let cb = compare(&ldr(&pt), &ldr(&b)).unwrap();
-        eprintln!(
-            "Cornell box ({kind:?}): mean FLIP against the path tracer {:.3} with NDF mips, \
-             {:.3} without",
-            cb.flip_mean, ca.flip_mean
-        );
-        for (name, r) in CORNELL_REGIONS {
-            let p = region(&pt, r.0, r.1, r.2, r.3);
-            eprintln!(
-                "{name} ({kind:?}): NDF mips / path tracer {:.3}, without {:.3}",
-                region(&b, r.0, r.1, r.2, r.3) / p,
-                region(&a, r.0, r.1, r.2, r.3) / p
-            );
-            // Measured (dense; the octree within 0.01): back wall 1.031, floor 0.994, red wall
-            // 1.047, green wall 1.040, ceiling 1.365, against 1.039, 1.040, 1.047, 1.039 and
-            // 1.357 without: the floor, whose cones skim the box's edge-on walls, comes down
-            // to the path tracer. The gather's bounds (reference.rs) with its reasons.
-            let tolerance = if name == "ceiling" { 0.5 } else { 0.12 };
-            let got = region(&b, r.0, r.1, r.2, r.3) / p;
-            assert!(
-                (got - 1.0).abs() < tolerance,
-                "{kind:?}, {name}: {got} of the path tracer"
-            );
-        }
-        // LDR-FLIP, whole image: measured 0.132 (dense) and 0.131 (octree), 0.143 and 0.142
-        // without. 0.17: the gather's bound with room for other drivers.
-        assert!(cb.flip_mean < 0.17, "{kind:?}: mean FLIP {}", cb.flip_mean);
-        images.push(b);
-    }
+    // Measured (dense; the octree within 0.01): back wall 1.031, floor 0.994, red wall 1.047,
+    // green wall 1.040, ceiling 1.365, against 1.039, 1.040, 1.047, 1.039 and 1.357 without:
+    // the floor, whose cones skim the box's edge-on walls, comes down to the path tracer.
+    // LDR-FLIP 0.132 (dense) and 0.131 (octree), 0.143 and 0.142 without.
+    let images = cornell_variant_against_the_path_tracer("NDF mips", |o| o.ndf_mips = true);
     // The octree filters its leaves' normals from its slots, the dense volume from its normal
     // texture: the same weights, so the same pictures (as `octree_and_dense_renders_agree`).
     let worst = largest_difference(&images[0].ldr, &images[1].ldr);

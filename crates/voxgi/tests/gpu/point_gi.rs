@@ -6,8 +6,8 @@
 use crate::common::*;
 use crate::reference::{opts, region, trace_with};
 use crate::vct::{
-    FURNACE_CASES, ao_beside_a_wall, ao_of_an_open_plane, furnace_series, on, thin_wall_leak, vct,
-    wall_mesh,
+    FURNACE_CASES, ao_beside_a_wall, ao_of_an_open_plane, furnace_series, on, one_voxel_wall_rooms,
+    thin_wall_leak, vct, wall_mesh,
 };
 use voxgi::compare::{Image, compare};
 use voxgi::gpu::readback::read_buffer_copy;
@@ -193,7 +193,7 @@ fn a_box_of_points_passes_the_furnace() {
 #[test]
 fn a_wall_of_points_leaks_as_little_as_the_mesh_wall() {
     let res = 64;
-    let scene = builtin::two_rooms(voxel_size(&builtin::two_rooms(0.01), res));
+    let scene = one_voxel_wall_rooms(res);
     let points = as_points(&scene, res, 2.0);
     for kind in VoxelKind::ALL {
         let mesh = thin_wall_leak(&scene, kind, res);

@@ -250,14 +250,17 @@ pub(crate) fn furnace_series(scene: &Scene, kind: impl Into<Variant>, cases: &[(
     }
 }
 
+/// `builtin::two_rooms` with its wall exactly one finest voxel thick at `res`³ (the rooms'
+/// bounds do not depend on the wall's thickness).
+pub(crate) fn one_voxel_wall_rooms(res: u32) -> Scene {
+    let b = builtin::two_rooms(0.01).bounds();
+    builtin::two_rooms(voxgi::voxel::Grid::around(b.min, b.max, res).voxel_size)
+}
+
 #[test]
 fn thin_wall_leaks_less_than_one_percent() {
     let res = 64;
-    // The rooms span 2 m in x: make the wall exactly one finest voxel thick.
-    let probe = builtin::two_rooms(0.01);
-    let b = probe.bounds();
-    let grid = voxgi::voxel::Grid::around(b.min, b.max, res);
-    let scene = builtin::two_rooms(grid.voxel_size);
+    let scene = one_voxel_wall_rooms(res);
     for kind in VoxelKind::ALL {
         let leak = thin_wall_leak(&scene, kind, res);
         eprintln!("indirect radiance ({kind:?}): room B / room A {leak}");
@@ -575,10 +578,7 @@ fn a_glossy_floor_in_a_glowing_box_reflects_its_directional_albedo() {
 /// two rooms (final image, two bounces) agree at 64³ and 128³.
 #[test]
 fn octree_and_dense_renders_agree() {
-    use voxgi::compare::{Image, compare};
-    let probe = builtin::two_rooms(0.01);
-    let b = probe.bounds();
-    let rooms = builtin::two_rooms(voxgi::voxel::Grid::around(b.min, b.max, 64).voxel_size);
+    let rooms = one_voxel_wall_rooms(64);
     let rooms_cam = Camera::look_at(Vec3::new(-0.9, 0.5, 0.9), Vec3::new(-0.1, 0.3, 0.1), 70.0);
     let cornell = builtin::cornell_box();
     let cases = [
@@ -593,23 +593,7 @@ fn octree_and_dense_renders_agree() {
                 voxel_resolution: res,
                 ..RendererOptions::default()
             };
-            let dense = render_with(scene, &options, &params, w, h);
-            let octree = render_with(
-                scene,
-                &RendererOptions {
-                    voxels: VoxelKind::Octree,
-                    ..options
-                },
-                &params,
-                w,
-                h,
-            );
-            let c = compare(
-                &Image::from_ldr_rgba8(w, h, &dense.ldr),
-                &Image::from_ldr_rgba8(w, h, &octree.ldr),
-            )
-            .unwrap();
-            let worst = largest_difference(&dense.ldr, &octree.ldr);
+            let (c, worst) = octree_against_dense(scene, &options, &params, w, h);
             eprintln!("{name} at {res}³: octree vs dense {c:?}, largest difference {worst}/255");
             // The structures differ only by the atlases' filtering rounding (1e-5 in opacity
             // per sample) and the dense volume's z clamp at its chains' edges. Measured: at
@@ -624,4 +608,84 @@ fn octree_and_dense_renders_agree() {
             );
         }
     }
+}
+
+/// `scene` from `params` at `w`×`h` with `options` on the dense volume and on the octree: their
+/// LDR comparison and their largest channel difference (code values).
+pub(crate) fn octree_against_dense(
+    scene: &Scene,
+    options: &RendererOptions,
+    params: &voxgi::FrameParams,
+    w: u32,
+    h: u32,
+) -> (voxgi::compare::Comparison, u8) {
+    use voxgi::compare::{Image, compare};
+    let on = |voxels| RendererOptions {
+        voxels,
+        ..options.clone()
+    };
+    let dense = render_with(scene, &on(VoxelKind::Dense), params, w, h);
+    let octree = render_with(scene, &on(VoxelKind::Octree), params, w, h);
+    let c = compare(
+        &Image::from_ldr_rgba8(w, h, &dense.ldr),
+        &Image::from_ldr_rgba8(w, h, &octree.ldr),
+    )
+    .unwrap();
+    (c, largest_difference(&dense.ldr, &octree.ldr))
+}
+
+/// The Cornell box (default options: 128³, two bounces; 64×64) with the options `change` makes,
+/// against the path tracer at 128 spp, beside the unchanged options, on each structure: prints
+/// both's mean LDR-FLIP and region ratios (reference.rs's regions), and asserts the changed
+/// renders within the gather's bounds there (each region within 12 %, the ceiling's known
+/// error within 50 %; FLIP below 0.17, the gather's 0.16 with room for other drivers). Returns
+/// the changed renders, in `VoxelKind::ALL`'s order.
+pub(crate) fn cornell_variant_against_the_path_tracer(
+    what: &str,
+    change: impl Fn(&mut RendererOptions),
+) -> Vec<voxgi::RenderOutput> {
+    use crate::point_gi::CORNELL_REGIONS;
+    use crate::reference::{opts, region, trace_with};
+    use voxgi::compare::{Image, compare};
+    let scene = builtin::cornell_box();
+    let (w, h) = (64, 64);
+    let settings = RendererOptions::default();
+    let params = voxgi::FrameParams::new(scene.cameras[0].clone());
+    let spp = opts(128, voxgi::Bounces::Exactly(2));
+    let pt = trace_with(&scene, &settings, &params, w, h, spp);
+    let ldr = |o: &voxgi::RenderOutput| Image::from_ldr_rgba8(w, h, &o.ldr);
+    let mut renders = Vec::new();
+    for kind in VoxelKind::ALL {
+        let plain = RendererOptions {
+            voxels: kind,
+            ..settings.clone()
+        };
+        let mut changed = plain.clone();
+        change(&mut changed);
+        let a = render_with(&scene, &plain, &params, w, h);
+        let b = render_with(&scene, &changed, &params, w, h);
+        let ca = compare(&ldr(&pt), &ldr(&a)).unwrap();
+        let cb = compare(&ldr(&pt), &ldr(&b)).unwrap();
+        eprintln!(
+            "Cornell box ({kind:?}): mean FLIP against the path tracer {:.3} with {what}, \
+             {:.3} without",
+            cb.flip_mean, ca.flip_mean
+        );
+        for (name, r) in CORNELL_REGIONS {
+            let p = region(&pt, r.0, r.1, r.2, r.3);
+            let got = region(&b, r.0, r.1, r.2, r.3) / p;
+            eprintln!(
+                "{name} ({kind:?}): {what} / path tracer {got:.3}, without {:.3}",
+                region(&a, r.0, r.1, r.2, r.3) / p
+            );
+            let tolerance = if name == "ceiling" { 0.5 } else { 0.12 };
+            assert!(
+                (got - 1.0).abs() < tolerance,
+                "{kind:?}, {name}: {what} {got} of the path tracer"
+            );
+        }
+        assert!(cb.flip_mean < 0.17, "{kind:?}: mean FLIP {}", cb.flip_mean);
+        renders.push(b);
+    }
+    renders
 }
