@@ -183,6 +183,7 @@ impl Scene {
             .extend(other.point_clouds.into_iter().map(|mut p| {
                 p.transform = transform * p.transform;
                 p.dynamic |= dynamic;
+                p.light = p.light.map(|l| l + light0);
                 p
             }));
         self.lights
@@ -370,6 +371,9 @@ impl Scene {
                     "point cloud {i} '{}': attribute counts differ from the {n} positions",
                     pc.name
                 ));
+            }
+            if pc.light.is_some_and(|l| l >= self.lights.len()) {
+                return bad(format!("point cloud {i} '{}': light out of range", pc.name));
             }
             if pc.positions.iter().any(|p| !p.is_finite()) {
                 return bad(format!(

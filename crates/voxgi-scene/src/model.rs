@@ -234,6 +234,10 @@ pub struct PointCloud {
     pub emission: Vec<[f32; 3]>,
     pub transform: Mat4,
     pub dynamic: bool,
+    /// Set when these points are the visible surface of area light `Scene::lights[i]`
+    /// (`io::emitters::promote_emissive_points`): they are drawn, but neither voxelized nor
+    /// shadowing their own light, as an area light's mesh.
+    pub light: Option<usize>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -377,6 +377,21 @@ struct SurfaceHit {
     light: u32,
 }
 
+// Whether p, on or near an area light's plane, lies within its rectangle or disc.
+fn within_area_light(l: Light, p: vec3<f32>) -> bool {
+    let q = p - l.position;
+    if l.kind == LIGHT_RECT {
+        // q's coordinates in the (axis_u, axis_v) basis, by the dual basis.
+        let uv = dot(cross(l.axis_u, l.axis_v), l.direction);
+        let a = dot(cross(q, l.axis_v), l.direction) / uv;
+        let b = dot(cross(l.axis_u, q), l.direction) / uv;
+        return abs(a) <= 1.0 && abs(b) <= 1.0;
+    }
+    let r2 = dot(l.axis_u, l.axis_u);
+    let flat = q - l.direction * dot(q, l.direction);
+    return dot(flat, flat) <= r2;
+}
+
 fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
     let tri = tris[h.tri];
     let sh = shading[h.tri];
@@ -384,7 +399,21 @@ fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
         // A point: matte, as the rasterizer's surfels (metallic 0, roughness 1, specular 0.5).
         let ng = select(-tri.p1, tri.p1, dot(tri.p1, d) < 0.0);
         let s = Surface(sh.n1.xyz, 0.0, 1.0, 0.5);
-        return SurfaceHit(o + d * h.t, ng, ng, s, sh.n2.xyz, NO_INDEX);
+        let p = o + d * h.t;
+        var emission = sh.n2.xyz;
+        var light = NO_INDEX;
+        if tri.light != NO_INDEX {
+            // A disc of an area light's surface emits, as an emitter triangle, on the light's
+            // side and only within the light's shape: where discs reach past its edge they are
+            // surface, so that the emitter is exactly the light that is sampled.
+            let l = lights[tri.light];
+            if dot(d, l.direction) < 0.0 && within_area_light(l, p) {
+                light = tri.light;
+            } else {
+                emission = vec3<f32>(0.0);
+            }
+        }
+        return SurfaceHit(p, ng, ng, s, emission, light);
     }
     let w = vec3<f32>(1.0 - h.b.x - h.b.y, h.b.x, h.b.y);
     var ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));

@@ -38,8 +38,10 @@ pub struct GpuFrame {
     /// 1: area lights' shadows by a cone traced through the voxels instead of the shadow map; 0
     /// otherwise.
     pub cone_shadows: u32,
+    /// `GpuScene::geometry_points`: the points from this index on show area lights.
+    pub geometry_points: u32,
     /// Padding to a multiple of 16 bytes; zero.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// Mirrors `Vertex` in shaders/shared/scene.wgsl.
@@ -308,7 +310,8 @@ pub struct GpuScene {
     /// One `GpuLight` per scene light; its shadow fields are written when the shadow views are
     /// planned.
     pub lights: wgpu::Buffer,
-    /// All point clouds' surfels (`GpuPoint`), in world space.
+    /// All point clouds' surfels (`GpuPoint`), in world space: first the geometry's, then the
+    /// area lights' surfaces (`gpu_cloud_order`).
     pub points: wgpu::Buffer,
     /// One f32 per point (shadow pass only): how far the point's neighbours stray from its
     /// tangent plane, in metres (`pointcloud::surface_spread`); shadow maps push the surfel
@@ -319,6 +322,12 @@ pub struct GpuScene {
     pub point_regions: wgpu::Buffer,
     /// Number of points in `points`.
     pub point_count: u32,
+    /// The first `geometry_points` of `points` are geometry: voxelized and shadowing every
+    /// light. The rest show area lights.
+    pub geometry_points: u32,
+    /// The points showing each area light: a range of `points` and the light's index. They
+    /// are drawn and shadow the other lights, but not their own.
+    pub emitter_points: Vec<(std::ops::Range<u32>, usize)>,
     /// Every material texture as one layer of a square RGBA8 sRGB 2D array with a full mip
     /// chain (a single white layer when no material has a texture).
     pub textures: wgpu::Texture,
@@ -495,7 +504,12 @@ impl GpuScene {
             })
             .collect();
         let lights = gpu_lights(scene);
-        let GpuPoints { points, regions } = gpu_points(scene);
+        let GpuPoints {
+            points,
+            regions,
+            geometry,
+            emitters,
+        } = gpu_points(scene);
         let spread = point_spread(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
@@ -542,6 +556,11 @@ impl GpuScene {
             point_spread: storage("point spread", bytemuck::cast_slice(&spread), 4),
             point_regions: storage("point regions", bytemuck::cast_slice(&regions), 4),
             point_count: points.len() as u32,
+            geometry_points: geometry as u32,
+            emitter_points: emitters
+                .into_iter()
+                .map(|(r, l)| (r.start as u32..r.end as u32, l))
+                .collect(),
             texture_view: textures.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
@@ -608,7 +627,13 @@ impl GpuScene {
 pub fn gpu_points(scene: &Scene) -> GpuPoints {
     let mut points = Vec::with_capacity(scene.point_count());
     let mut regions = Vec::with_capacity(scene.point_count());
-    for pc in &scene.point_clouds {
+    let mut emitters = Vec::new();
+    let mut geometry = 0;
+    for pc in gpu_cloud_order(scene) {
+        match pc.light {
+            None => geometry += pc.positions.len(),
+            Some(l) => emitters.push((points.len()..points.len() + pc.positions.len(), l)),
+        }
         let m = pc.transform;
         let normal_matrix = m.inverse().transpose();
         let normal_matrix = if normal_matrix.is_finite() {
@@ -617,22 +642,45 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
             Mat4::IDENTITY
         };
         let scale = cloud_scale(pc);
+        let volume_scale = m.determinant().abs();
         for (i, &p) in pc.positions.iter().enumerate() {
             let n = pc.normals.get(i).map_or(Vec3::ZERO, |&n| {
-                normal_matrix.transform_vector3(n).normalize_or_zero()
+                normal_matrix.transform_vector3(n.normalize_or_zero())
             });
-            let length = |v: Option<&f32>| v.map_or(0.0, |&v| finite_or_zero(v * scale).max(0.0));
-            regions.push(length(pc.regions.get(i)));
+            let length =
+                |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
+            regions.push(length(pc.regions.get(i), scale));
+            // A disc's area grows by |det| |M^-T n| (Nanson's formula), so under a non-uniform
+            // scale its radius follows its own plane's stretch, not the mean scale: a flattened
+            // box's faces would otherwise show holes between their discs.
+            let disc_scale = (volume_scale * n.length()).sqrt();
+            let disc_scale = if n != Vec3::ZERO && disc_scale.is_finite() {
+                disc_scale
+            } else {
+                scale
+            };
             points.push(GpuPoint::new(
                 m.transform_point3(p),
-                length(pc.radii.get(i)),
-                n,
+                length(pc.radii.get(i), disc_scale),
+                n.normalize_or_zero(),
                 pc.colors.get(i).copied().unwrap_or([0.8; 3]),
                 pc.emission.get(i).copied().unwrap_or([0.0; 3]),
             ));
         }
     }
-    GpuPoints { points, regions }
+    GpuPoints {
+        points,
+        regions,
+        geometry,
+        emitters,
+    }
+}
+
+/// The order in which the point clouds' points are uploaded: the geometry's clouds, then the
+/// area lights' surfaces, so that the passes that treat them apart take them as ranges.
+pub fn gpu_cloud_order(scene: &Scene) -> impl Iterator<Item = &voxgi_scene::PointCloud> {
+    let geometry = scene.point_clouds.iter().filter(|pc| pc.light.is_none());
+    geometry.chain(scene.point_clouds.iter().filter(|pc| pc.light.is_some()))
 }
 
 /// The point clouds as the GPU takes them, one entry per point in each.
@@ -641,17 +689,17 @@ pub struct GpuPoints {
     pub points: Vec<GpuPoint>,
     /// World-space edge of the region of influence (see `GpuScene::point_regions`).
     pub regions: Vec<f32>,
+    /// The first `geometry` points are geometry (see `GpuScene::geometry_points`).
+    pub geometry: usize,
+    /// The points showing each area light, and its index (see `GpuScene::emitter_points`).
+    pub emitters: Vec<(std::ops::Range<usize>, usize)>,
 }
 
 /// Each point's world-space surface spread (see `GpuScene::point_spread`), in `gpu_points`'
 /// order: a k-nearest-neighbour search per cloud, so only the rasterizer's upload pays for it.
 pub fn point_spread(scene: &Scene) -> Vec<f32> {
     let mut out = Vec::with_capacity(scene.point_count());
-    for pc in scene
-        .point_clouds
-        .iter()
-        .filter(|pc| !pc.positions.is_empty())
-    {
+    for pc in gpu_cloud_order(scene).filter(|pc| !pc.positions.is_empty()) {
         let start = std::time::Instant::now();
         // 24 neighbours (then dilated over 24 more) span a few point spacings each way.
         let spread = pointcloud::surface_spread(pc, 24);

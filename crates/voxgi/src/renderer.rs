@@ -719,7 +719,8 @@ impl Renderer {
             view_mode: p.view.id(),
             background: [p.background[0], p.background[1], p.background[2], 1.0],
             cone_shadows: self.options.cone_shadows as u32,
-            _pad: [0; 3],
+            geometry_points: self.scene.geometry_points,
+            _pad: [0; 2],
         }
     }
 

@@ -33,6 +33,7 @@ pub fn load(path: &Path) -> Result<Scene> {
         "ply" => {
             let mut s = ply::load(path)?;
             emitters::promote_emissive_quads(&mut s);
+            emitters::promote_emissive_points(&mut s);
             s
         }
         "cloud" => cloud::load(path)?,

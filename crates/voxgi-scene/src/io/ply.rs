@@ -600,6 +600,7 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
             emission,
             transform: Mat4::IDENTITY,
             dynamic: false,
+            light: None,
         });
     }
     Ok(scene)

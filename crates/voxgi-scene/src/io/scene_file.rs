@@ -340,6 +340,10 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
                 )));
             }
         }
+        // What the override made emissive, and points sampled from emissive meshes, may be
+        // area lights.
+        crate::io::emitters::promote_emissive_quads(&mut sub);
+        crate::io::emitters::promote_emissive_points(&mut sub);
         let scale = match inc.scale {
             None => Vec3::ONE,
             Some(Scale::Uniform(s)) => Vec3::splat(s),
@@ -441,6 +445,14 @@ fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Resul
         }
         if let Some(e) = o.emissive {
             pc.emission = vec![e; pc.positions.len()];
+        }
+    }
+    // An area light's surface and the light emit the same radiance.
+    if let Some(e) = o.emissive {
+        let shown = scene.instances.iter().filter_map(|i| i.light);
+        for l in shown.chain(scene.point_clouds.iter().filter_map(|p| p.light)) {
+            scene.lights[l].color = e;
+            scene.lights[l].intensity = 1.0;
         }
     }
     for m in &mut scene.materials {

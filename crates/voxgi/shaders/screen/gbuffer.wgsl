@@ -56,10 +56,14 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> GBuffer {
     if m.emissive_texture >= 0 {
         emission *= emit_t.rgb;
     }
-    // Back faces show their reverse side: flip the normal so it faces the viewer.
+    // Back faces show their reverse side: flip the normal so it faces the viewer. An area
+    // light's surface emits on the light's side only, as the light itself does.
     var n = normalize(in.normal);
     if !front {
         n = -n;
+        if draws[in.draw].light != NO_INDEX {
+            emission = vec3<f32>(0.0);
+        }
     }
     var out: GBuffer;
     out.albedo_metallic = vec4<f32>(base.rgb, m.metallic);
@@ -83,12 +87,16 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
     let p = points[vi / 6u];
     let to_camera = frame.camera_pos - p.position;
     var n = point_normal(p);
+    var emission = point_emission(p);
     if dot(n, n) == 0.0 {
         // No normal: face the camera.
         n = normalize(to_camera);
     } else if dot(n, to_camera) < 0.0 {
-        // The side the camera sees.
+        // The side the camera sees; an area light's surface does not emit on its back.
         n = -n;
+        if vi / 6u >= frame.geometry_points {
+            emission = vec3<f32>(0.0);
+        }
     }
     let corner = surfel_corner(vi);
     // A surfel is drawn at the front of its neighbourhood's spread, along its own normal: the
@@ -106,7 +114,7 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
     out.disc = corner;
     out.normal = n;
     out.albedo = point_albedo(p);
-    out.emission = point_emission(p);
+    out.emission = emission;
     return out;
 }
 

@@ -40,7 +40,8 @@ struct Frame {
     background: vec4<f32>,
     // 1: area lights' shadows by a cone traced through the voxels instead of the shadow map.
     cone_shadows: u32,
-    _pad0: u32,
+    // The points from this index on show area lights (GpuScene::geometry_points).
+    geometry_points: u32,
     _pad1: u32,
     _pad2: u32,
 }

@@ -157,7 +157,7 @@ impl FragmentEstimate {
                 e.triangles += k as u64;
             }
         }
-        for pc in &scene.point_clouds {
+        for pc in scene.point_clouds.iter().filter(|pc| pc.light.is_none()) {
             let scale = pc.transform.determinant().abs().cbrt() as f64;
             e.points += pc.positions.len() as u64;
             for &r in &pc.regions {

@@ -50,7 +50,9 @@ impl SplatPass {
             label: Some("splat"),
             timestamp_writes: timer.compute("splat"),
         });
-        if scene.point_count == 0 {
+        // Area lights' surfaces are not voxelized (see `triangle_table`); they follow the
+        // geometry's points.
+        if scene.geometry_points == 0 {
             return;
         }
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -59,14 +61,19 @@ impl SplatPass {
             entries: &layout::entries(vec![
                 fragments.grid_uniform.as_entire_binding(),
                 scene.points.as_entire_binding(),
-                scene.point_regions.as_entire_binding(),
+                // The shader's point count is this binding's length.
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &scene.point_regions,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(scene.geometry_points as u64 * 4),
+                }),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
             ]),
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        let (x, y) = layout::groups_2d(scene.point_count, 64);
+        let (x, y) = layout::groups_2d(scene.geometry_points, 64);
         pass.dispatch_workgroups(x, y, 1);
     }
 }

@@ -177,10 +177,14 @@ impl ShadowPass {
                     call.draw..call.draw + 1,
                 );
             }
-            // Points are never an emitter's surface, so they shadow every light.
             if scene.point_count > 0 {
                 pass.set_pipeline(&self.points);
-                pass.draw(0..scene.point_count * 6, 0..1);
+                pass.draw(0..scene.geometry_points * 6, 0..1);
+                for (range, light) in &scene.emitter_points {
+                    if *light != owner {
+                        pass.draw(range.start * 6..range.end * 6, 0..1);
+                    }
+                }
             }
         }
     }

@@ -239,7 +239,12 @@ pub fn flatten(scene: &Scene) -> FlatScene {
     }
     // The discs the rasterizer draws: the same points, normals, radii and colours.
     let mut faceless = 0usize;
-    for p in crate::gpu_scene::gpu_points(scene).points {
+    let points = crate::gpu_scene::gpu_points(scene);
+    let mut light_of = vec![NO_INDEX; points.points.len()];
+    for (range, l) in &points.emitters {
+        light_of[range.clone()].fill(*l as u32);
+    }
+    for (p, light) in points.points.into_iter().zip(light_of) {
         let n = p.normal();
         if n == Vec3::ZERO || p.radius.is_nan() || p.radius <= 0.0 {
             // Not drawn (radius 0) or drawn facing the viewer, which a ray cannot know.
@@ -250,7 +255,7 @@ pub fn flatten(scene: &Scene) -> FlatScene {
             p0: p.position,
             material: 0,
             p1: n.to_array(),
-            light: NO_INDEX,
+            light,
             p2: [p.radius, 0.0, 0.0],
             kind: PRIM_DISC,
         });

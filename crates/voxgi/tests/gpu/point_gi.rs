@@ -410,3 +410,175 @@ fn the_bunnys_vertices_bounce_light_as_its_mesh_does() {
         }
     }
 }
+
+/// A 30 cm square lamp 6 cm above a 4 m floor, facing down, emitting 8 W/(m² sr): a quad mesh,
+/// or a grid of 30 x 30 emissive points 1 cm apart, each promoted to an area light when
+/// `promote`.
+fn lamp_over_a_floor(points: bool, promote: bool) -> Scene {
+    let mut s = Scene::default();
+    s.add_mesh(
+        quad_mesh("floor", Vec3::ZERO, 4.0),
+        Material::diffuse("floor", [0.6; 3]),
+        Mat4::IDENTITY,
+    );
+    let (y, size, e) = (0.06, 0.3, [8.0; 3]);
+    if points {
+        let mut pc = PointCloud {
+            name: "lamp".into(),
+            transform: Mat4::IDENTITY,
+            ..Default::default()
+        };
+        for i in 0..30 {
+            for k in 0..30 {
+                let at = |j: i32| (j as f32 + 0.5) * 0.01 - 0.5 * size;
+                pc.positions.push(Vec3::new(at(i), y, at(k)));
+                pc.normals.push(Vec3::NEG_Y);
+                pc.colors.push([0.5; 3]);
+                pc.emission.push(e);
+            }
+        }
+        s.point_clouds.push(pc);
+        if promote {
+            voxgi::scene::io::emitters::promote_emissive_points(&mut s);
+        }
+    } else {
+        let mut lamp = quad_mesh("lamp", Vec3::new(0.0, y, 0.0), size);
+        // Clockwise seen from above: the quad faces down.
+        lamp.indices = vec![0, 2, 1, 0, 3, 2];
+        lamp.normals = vec![Vec3::NEG_Y; 4];
+        let mut m = Material::diffuse("lamp", [0.5; 3]);
+        m.emissive = e;
+        s.add_mesh(lamp, m, Mat4::IDENTITY);
+        if promote {
+            voxgi::scene::io::emitters::promote_emissive_quads(&mut s);
+        }
+    }
+    s
+}
+
+/// Mean radiance of the pixels whose view of the floor y = 0 lands where `on_floor` says.
+fn floor_mean(out: &voxgi::RenderOutput, cam: &Camera, on_floor: impl Fn(Vec3) -> bool) -> f32 {
+    plane_mean(out, cam, 0.0, on_floor)
+}
+
+/// Mean radiance of the pixels whose view of the plane y = `height` lands where `on_plane`
+/// says.
+fn plane_mean(
+    out: &voxgi::RenderOutput,
+    cam: &Camera,
+    height: f32,
+    on_plane: impl Fn(Vec3) -> bool,
+) -> f32 {
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 0..out.height {
+        for x in 0..out.width {
+            let d = pixel_ray(cam, out.width, out.height, x, y);
+            let t = (height - cam.position.y) / d.y;
+            if d.y >= -1e-3 || !on_plane(cam.position + d * t) {
+                continue;
+            }
+            let r = out.radiance(x, y);
+            sum += r[0] + r[1] + r[2];
+            n += 3;
+        }
+    }
+    assert!(n > 30, "too few pixels ({n}) to measure");
+    sum / n as f32
+}
+
+#[test]
+fn emissive_points_light_what_is_near_them_as_a_quad_lamp_does() {
+    // The lamp hangs half a voxel (12.5 cm at 32³) above the floor: there the voxels alone
+    // cannot carry its light (cones leave their own voxel before they look back at it). Flat
+    // rectangles of emissive points, like emissive quads, become area lights whose light is
+    // shaded per pixel and injected per voxel, and whose points are drawn but not voxelized.
+    let points = lamp_over_a_floor(true, true);
+    assert_eq!(points.lights.len(), 1);
+    assert_eq!(points.point_clouds[0].light, Some(0));
+    // 30 x 30 points 1 cm apart stand for exactly the 30 cm square.
+    assert!((points.lights[0].area() - 0.09).abs() < 1e-5);
+    let mesh = lamp_over_a_floor(false, true);
+    let unpromoted = lamp_over_a_floor(true, false);
+    let cam = Camera::look_at(Vec3::new(0.0, 0.5, 0.9), Vec3::new(0.0, 0.0, 0.1), 40.0);
+    let (w, h) = (64, 48);
+    let options = RendererOptions {
+        default_light: false,
+        voxel_resolution: 32,
+        bounces: 1,
+        ..RendererOptions::default()
+    };
+    let params = clamped(&cam);
+    // In front of the lamp (its near field, unseen by the camera's rays past its edge) and
+    // beyond, where its light is dimmer.
+    let near = |p: Vec3| p.x.abs() < 0.15 && (0.16..0.26).contains(&p.z);
+    let far = |p: Vec3| p.x.abs() < 0.3 && (0.3..0.5).contains(&p.z);
+    let pt = trace_with(
+        &points,
+        &options,
+        &params,
+        w,
+        h,
+        opts(256, voxgi::Bounces::Exactly(1)),
+    );
+    let pt_mesh = trace_with(
+        &mesh,
+        &options,
+        &params,
+        w,
+        h,
+        opts(256, voxgi::Bounces::Exactly(1)),
+    );
+    for kind in VoxelKind::ALL {
+        let options = RendererOptions {
+            voxels: kind,
+            ..options.clone()
+        };
+        let vct = render_with(&points, &options, &params, w, h);
+        let vct_mesh = render_with(&mesh, &options, &params, w, h);
+        let vct_voxels = render_with(&unpromoted, &options, &params, w, h);
+        if std::env::var_os("VOXGI_TEST_IMAGES").is_some() {
+            for (name, out) in [("vct", &vct), ("mesh", &vct_mesh), ("voxels", &vct_voxels)] {
+                out.save(std::path::Path::new(&format!("/tmp/lamp_{name}.png")))
+                    .unwrap();
+            }
+            pt.save(std::path::Path::new("/tmp/lamp_pt.png")).unwrap();
+        }
+        for (band, on_floor) in [("near", &near as &dyn Fn(Vec3) -> bool), ("far", &far)] {
+            let m = |out: &voxgi::RenderOutput| floor_mean(out, &cam, on_floor);
+            let (truth, got, as_mesh, truth_mesh, voxels) =
+                (m(&pt), m(&vct), m(&vct_mesh), m(&pt_mesh), m(&vct_voxels));
+            eprintln!(
+                "lamp ({kind:?}), floor {band}: path-traced points {truth:.4} (mesh {truth_mesh:.4}), \
+                 cone-traced points {got:.4}, mesh {as_mesh:.4}, points in the voxels only {voxels:.4}"
+            );
+            // Measured (both structures): near, path-traced points 0.668 and mesh 0.661,
+            // cone-traced 0.6575 for both; far 0.0219, 0.0218 and 0.0217. Points and quad give
+            // the same light, so the renderer shades the floor identically (2 % is room for a
+            // driver's rounding); the path tracer's discs and quad differ by its noise at 256
+            // spp, and the renderer is within 2 % of it (5 % allowed for other drivers' noise).
+            assert!(
+                rel(truth, truth_mesh) < 0.05,
+                "{band}: {truth} vs {truth_mesh}"
+            );
+            assert!(
+                rel(got, as_mesh) < 0.02,
+                "{kind:?} {band}: {got} vs {as_mesh}"
+            );
+            assert!(rel(got, truth) < 0.05, "{kind:?} {band}: {got} vs {truth}");
+        }
+        // An area light's surface emits on the light's side only, and its own light does not
+        // reach it: seen from above, the lamp is dark (measured 0.0000, and the path tracer's
+        // 0.0010 from light bounced round its edge) where a two-sided emitter, or one lit by
+        // itself, would show up to 8.
+        let top = |p: Vec3| p.x.abs() < 0.14 && p.z.abs() < 0.14;
+        for (name, out) in [("points", &vct), ("mesh", &vct_mesh), ("path tracer", &pt)] {
+            let m = plane_mean(out, &cam, 0.06, top);
+            eprintln!("lamp ({kind:?}), its top, {name}: {m:.4}");
+            assert!(m < 0.1, "{kind:?}: the lamp's top ({name}) shows {m}");
+        }
+        // Left in the voxels, the same points leave the near floor dark (measured 0.0000): the
+        // case the promotion exists for.
+        let voxels = floor_mean(&vct_voxels, &cam, near);
+        assert!(voxels < 0.5 * floor_mean(&pt, &cam, near), "{voxels}");
+    }
+}

@@ -40,6 +40,7 @@ fn grid(normals: bool, radii: bool) -> PointCloud {
         emission: vec![],
         transform: Mat4::IDENTITY,
         dynamic: false,
+        light: None,
     }
 }
 
