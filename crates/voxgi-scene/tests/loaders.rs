@@ -941,14 +941,27 @@ fn ply_point_emission_and_scene_file_points() {
         "points.toml",
         format!(
             "[[include]]\nfile = '{}'\npoints = 'vertices'\nmaterial = {{ base_color = [0.2, 0.4, 0.6], emissive = [3.0, 2.0, 1.0] }}\n\
-             [[include]]\nfile = '{}'\npoints = 0.1\ntranslate = [0.0, 1.0, 0.0]\n",
+             [[include]]\nfile = '{}'\npoints = 0.1\ntranslate = [0.0, 1.0, 0.0]\n\
+             [[include]]\nfile = '{}'\npoints = 0.1\nscale = [2.0, 1.0, 0.5]\n",
+            quad.display(),
             quad.display(),
             quad.display()
         ),
     );
     let s = io::load(&scene).unwrap();
     assert!(s.instances.is_empty(), "the meshes became points");
-    assert_eq!(s.point_clouds.len(), 2);
+    assert_eq!(s.point_clouds.len(), 3);
+    // The lattice is laid in the world, after the include's scale: 20 x 5 points on the
+    // 2 m x 0.5 m rectangle, not 10 x 10 stretched with it.
+    let scaled = &s.point_clouds[2];
+    assert_eq!(scaled.positions.len(), 100);
+    assert_eq!(scaled.transform, Mat4::IDENTITY);
+    let xs: std::collections::BTreeSet<i64> = scaled
+        .positions
+        .iter()
+        .map(|p| (p.x * 1000.0).round() as i64)
+        .collect();
+    assert_eq!(xs.len(), 20);
     let v = &s.point_clouds[0];
     assert_eq!(v.positions.len(), 4);
     assert_eq!(v.colors, vec![[0.2, 0.4, 0.6]; 4]);

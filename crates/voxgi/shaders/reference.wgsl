@@ -149,7 +149,14 @@ fn intersect_disc(tri: Tri, o: vec3<f32>, d: vec3<f32>, tmax: f32) -> vec3<f32> 
 fn intersect_tri(i: u32, o: vec3<f32>, d: vec3<f32>, tmax: f32) -> vec3<f32> {
     let tri = tris[i];
     if tri.kind == PRIM_DISC {
-        return intersect_disc(tri, o, d, tmax);
+        let r = intersect_disc(tri, o, d, tmax);
+        // An area light's surface is its shape: where the discs that show it reach past its
+        // edge (a point-sampled box's faces overlap at its edges) they are not there, so that
+        // the light is exactly what is sampled and nothing beyond it shades grazing light.
+        if r.x > 0.0 && tri.light != NO_INDEX && !within_area_light(lights[tri.light], o + d * r.x) {
+            return vec3<f32>(-1.0, 0.0, 0.0);
+        }
+        return r;
     }
     let e1 = tri.p1 - tri.p0;
     let e2 = tri.p2 - tri.p0;
@@ -403,11 +410,9 @@ fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
         var emission = sh.n2.xyz;
         var light = NO_INDEX;
         if tri.light != NO_INDEX {
-            // A disc of an area light's surface emits, as an emitter triangle, on the light's
-            // side and only within the light's shape: where discs reach past its edge they are
-            // surface, so that the emitter is exactly the light that is sampled.
-            let l = lights[tri.light];
-            if dot(d, l.direction) < 0.0 && within_area_light(l, p) {
+            // A disc of an area light's surface (only hit within the light's shape, see
+            // intersect_tri) emits, as an emitter triangle, on the light's side.
+            if dot(d, lights[tri.light].direction) < 0.0 {
                 light = tri.light;
             } else {
                 emission = vec3<f32>(0.0);

@@ -642,27 +642,27 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
             Mat4::IDENTITY
         };
         let scale = cloud_scale(pc);
-        let volume_scale = m.determinant().abs();
         for (i, &p) in pc.positions.iter().enumerate() {
-            let n = pc.normals.get(i).map_or(Vec3::ZERO, |&n| {
-                normal_matrix.transform_vector3(n.normalize_or_zero())
-            });
+            let local_n = pc
+                .normals
+                .get(i)
+                .map_or(Vec3::ZERO, |n| n.normalize_or_zero());
+            let n = normal_matrix.transform_vector3(local_n).normalize_or_zero();
             let length =
                 |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
             regions.push(length(pc.regions.get(i), scale));
-            // A disc's area grows by |det| |M^-T n| (Nanson's formula), so under a non-uniform
-            // scale its radius follows its own plane's stretch, not the mean scale: a flattened
-            // box's faces would otherwise show holes between their discs.
-            let disc_scale = (volume_scale * n.length()).sqrt();
-            let disc_scale = if n != Vec3::ZERO && disc_scale.is_finite() {
-                disc_scale
-            } else {
+            // Under a non-uniform scale a disc becomes an ellipse; drawn as a disc it takes the
+            // ellipse's long axis, so that neighbours still meet along it: with the mean scale a
+            // flattened box's sides showed rows of holes between their discs.
+            let disc_scale = if local_n == Vec3::ZERO {
                 scale
+            } else {
+                largest_stretch(m, local_n)
             };
             points.push(GpuPoint::new(
                 m.transform_point3(p),
                 length(pc.radii.get(i), disc_scale),
-                n.normalize_or_zero(),
+                n,
                 pc.colors.get(i).copied().unwrap_or([0.8; 3]),
                 pc.emission.get(i).copied().unwrap_or([0.0; 3]),
             ));
@@ -716,6 +716,17 @@ pub fn point_spread(scene: &Scene) -> Vec<f32> {
         );
     }
     out
+}
+
+/// How much `m`'s linear part stretches the plane normal to the unit vector `n` at most: the
+/// larger singular value of its restriction to that plane (1 when not finite).
+fn largest_stretch(m: Mat4, n: Vec3) -> f32 {
+    let (t, b) = n.any_orthonormal_pair();
+    let (mt, mb) = (m.transform_vector3(t), m.transform_vector3(b));
+    let (a, c, off) = (mt.dot(mt), mb.dot(mb), mt.dot(mb));
+    let largest = 0.5 * (a + c) + (0.25 * (a - c) * (a - c) + off * off).sqrt();
+    let s = largest.sqrt();
+    if s.is_finite() { s } else { 1.0 }
 }
 
 /// A cloud's mean scale: the cube root of its transform's volume scale (|det| of the linear
@@ -865,6 +876,24 @@ pub fn bounding_sphere(b: voxgi_scene::Aabb) -> (Vec3, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn discs_take_the_long_axis_of_their_plane_under_a_non_uniform_scale() {
+        // A box flattened to 0.25 x 0.02 x 0.25: its top keeps 0.25 both ways; its sides are
+        // stretched 0.25 along one axis and 0.02 along the other, and take 0.25. Rotation does
+        // not change a stretch.
+        let m = Mat4::from_rotation_y(0.3) * Mat4::from_scale(Vec3::new(0.25, 0.02, 0.25));
+        for (n, want) in [(Vec3::Y, 0.25), (Vec3::X, 0.25), (Vec3::Z, 0.25)] {
+            assert!((largest_stretch(m, n) - want).abs() < 1e-6, "{n}");
+        }
+        let tall = Mat4::from_scale(Vec3::new(1.0, 3.0, 2.0));
+        assert!((largest_stretch(tall, Vec3::Z) - 3.0).abs() < 1e-6);
+        assert!((largest_stretch(tall, Vec3::Y) - 2.0).abs() < 1e-6);
+        // The slanted plane holds x (stretched 1) and (0, 0.8, -0.6), which becomes
+        // (0, 2.4, -1.2).
+        let slanted = largest_stretch(tall, Vec3::new(0.0, 0.6, 0.8));
+        assert!((slanted - 7.2f32.sqrt()).abs() < 1e-5, "{slanted}");
+    }
 
     #[test]
     fn half_bits_rounds_like_ieee() {

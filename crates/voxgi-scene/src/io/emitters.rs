@@ -190,6 +190,8 @@ fn sub_mesh(mesh: &crate::Mesh, tris: &[usize], name: &str) -> crate::Mesh {
 /// The most flat faces one emissive cloud is split into: a box's six and a few more. More
 /// normal directions than this mean a curved emitter, which stays geometry.
 const MAX_FACES: usize = 8;
+/// Fewer points than a 4 x 4 grid are too coarse a sampling to say where a rectangle ends.
+const MIN_FACE_POINTS: usize = 16;
 /// Points whose normals lie within about 2° of each other can be one face's.
 const FACE_COS: f32 = 0.9994;
 /// A face's convex hull must cover this fraction of its bounding rectangle (a disc covers π/4).
@@ -389,7 +391,7 @@ pub fn emissive_faces(pc: &PointCloud) -> Result<Vec<PointFace>, String> {
 
 /// The filled rectangle the points `idx` (on one plane with unit `normal`) cover, if they do.
 fn rectangle_face(pc: &PointCloud, idx: Vec<usize>, normal: Vec3) -> Option<PointFace> {
-    if idx.len() < 4 {
+    if idx.len() < MIN_FACE_POINTS {
         return None;
     }
     let n = normal.as_dvec3();

@@ -317,12 +317,38 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         if let Some(o) = &inc.material {
             apply_override(&mut sub, o).map_err(|r| err(format!("{what}: {r}")))?;
         }
+        let scale = match inc.scale {
+            None => Vec3::ONE,
+            Some(Scale::Uniform(s)) => Vec3::splat(s),
+            Some(Scale::Axes(a)) => Vec3::from(a),
+        };
+        let t = Vec3::from(inc.translate);
+        let r = Vec3::from(inc.rotate);
+        if !(scale.is_finite() && scale.cmpne(Vec3::ZERO).all() && t.is_finite() && r.is_finite()) {
+            return Err(err(format!(
+                "{what}: translate, rotate and scale must be finite and scale non-zero"
+            )));
+        }
+        let mut transform = Mat4::from_translation(t)
+            * Mat4::from_rotation_z(r.z.to_radians())
+            * Mat4::from_rotation_y(r.y.to_radians())
+            * Mat4::from_rotation_x(r.x.to_radians())
+            * Mat4::from_scale(scale);
         match &inc.points {
             None => {}
             Some(AsPoints::Named(n)) if n == "vertices" => {
                 sub = crate::pointcloud::mesh_vertices(&sub);
             }
             Some(AsPoints::Spacing(h)) if h.is_finite() && *h > 0.0 => {
+                // The lattice is laid in the world, `h` metres apart whatever the include's
+                // scale: placed first, the include then needs no transform of its own.
+                let mut placed = Scene {
+                    name: sub.name.clone(),
+                    ..Default::default()
+                };
+                placed.append(sub, transform, false);
+                sub = placed;
+                transform = Mat4::IDENTITY;
                 // Each point of the lattice stands for at least h² of surface.
                 let count = crate::pointcloud::surface_area(&sub) / (*h as f64 * *h as f64);
                 if count > crate::limits::MAX_ELEMENTS as f64 {
@@ -344,23 +370,6 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         // area lights.
         crate::io::emitters::promote_emissive_quads(&mut sub);
         crate::io::emitters::promote_emissive_points(&mut sub);
-        let scale = match inc.scale {
-            None => Vec3::ONE,
-            Some(Scale::Uniform(s)) => Vec3::splat(s),
-            Some(Scale::Axes(a)) => Vec3::from(a),
-        };
-        let t = Vec3::from(inc.translate);
-        let r = Vec3::from(inc.rotate);
-        if !(scale.is_finite() && scale.cmpne(Vec3::ZERO).all() && t.is_finite() && r.is_finite()) {
-            return Err(err(format!(
-                "{what}: translate, rotate and scale must be finite and scale non-zero"
-            )));
-        }
-        let transform = Mat4::from_translation(t)
-            * Mat4::from_rotation_z(r.z.to_radians())
-            * Mat4::from_rotation_y(r.y.to_radians())
-            * Mat4::from_rotation_x(r.x.to_radians())
-            * Mat4::from_scale(scale);
         let first = scene.instances.len();
         scene.append(sub, transform, inc.dynamic);
         include_instances.push((

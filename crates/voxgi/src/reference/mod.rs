@@ -2,7 +2,8 @@
 //! rasterizer, and an ambient-occlusion reference.
 //!
 //! All mesh instances are flattened into world-space triangles and all point clouds into the
-//! oriented discs the rasterizer draws for them, a BVH is built on the CPU (obvhs' PLOC
+//! oriented discs the rasterizer draws for them (the discs showing an area light are that
+//! light's surface within its shape only, like its emitter triangles), a BVH is built on the CPU (obvhs' PLOC
 //! builder) and flattened into a node array the compute shader
 //! (`shaders/reference.wgsl`) walks with a stack. Samples accumulate in an f32 buffer, a batch
 //! per submit, so long renders report progress and never hold the GPU for long.

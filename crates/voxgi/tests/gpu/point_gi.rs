@@ -568,7 +568,7 @@ fn emissive_points_light_what_is_near_them_as_a_quad_lamp_does() {
         }
         // An area light's surface emits on the light's side only, and its own light does not
         // reach it: seen from above, the lamp is dark (measured 0.0000, and the path tracer's
-        // 0.0010 from light bounced round its edge) where a two-sided emitter, or one lit by
+        // 0.0019 from light bounced round its edge) where a two-sided emitter, or one lit by
         // itself, would show up to 8.
         let top = |p: Vec3| p.x.abs() < 0.14 && p.z.abs() < 0.14;
         for (name, out) in [("points", &vct), ("mesh", &vct_mesh), ("path tracer", &pt)] {
