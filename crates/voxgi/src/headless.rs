@@ -206,6 +206,21 @@ pub fn render(
                 reason: e.to_string(),
             })?;
         ctx.take_error("frame")?;
+        // The counters' map callback runs in whichever thread polls the device; on a device
+        // shared between threads that may be another one, a moment after this thread's wait
+        // returned. Until it has run, a build that overflowed looks finished (a flaky golden
+        // test showed such an image: voxels missing from one corner).
+        let waiting = std::time::Instant::now();
+        while renderer.feedback_in_flight() {
+            if waiting.elapsed() > std::time::Duration::from_secs(30) {
+                return Err(Error::Gpu {
+                    context: "voxel counters".into(),
+                    reason: "their readback did not complete within 30 s".into(),
+                });
+            }
+            let _ = ctx.device.poll(wgpu::PollType::Poll);
+            std::thread::yield_now();
+        }
         if !renderer.receive_feedback()? {
             break;
         }

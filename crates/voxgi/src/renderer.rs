@@ -681,6 +681,12 @@ impl Renderer {
         self.voxels_settled() && !self.counters.pending()
     }
 
+    /// Whether a voxel counter read back is submitted but has not completed (`headless::render`
+    /// waits for it before deciding that a frame is final).
+    pub(crate) fn feedback_in_flight(&self) -> bool {
+        self.counters.in_flight()
+    }
+
     /// The scene's own camera, or a view of its bounds.
     pub fn default_camera(&self) -> &Camera {
         &self.default_camera

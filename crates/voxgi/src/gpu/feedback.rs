@@ -96,6 +96,13 @@ impl CounterReadback {
         })
     }
 
+    /// Whether some read has been submitted but its map has not completed yet.
+    pub fn in_flight(&self) -> bool {
+        self.slots
+            .iter()
+            .any(|s| s.state.load(Ordering::Acquire) == IN_FLIGHT)
+    }
+
     /// Every read completed since the last call, as (tag, u32 words). Call after a
     /// non-blocking `Device::poll` so that completed maps have run their callbacks.
     pub fn take_ready(&mut self) -> Vec<(u64, Vec<u32>)> {
