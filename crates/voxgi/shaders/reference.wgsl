@@ -399,6 +399,15 @@ fn within_area_light(l: Light, p: vec3<f32>) -> bool {
     return dot(flat, flat) <= r2;
 }
 
+// The area light `shown` (a primitive's `light`, or NO_INDEX) when the ray d meets its emitting
+// side: an area light's surface emits on its light's side only. NO_INDEX otherwise.
+fn emitting_light(shown: u32, d: vec3<f32>) -> u32 {
+    if shown != NO_INDEX && dot(d, lights[shown].direction) < 0.0 {
+        return shown;
+    }
+    return NO_INDEX;
+}
+
 fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
     let tri = tris[h.tri];
     let sh = shading[h.tri];
@@ -406,19 +415,11 @@ fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
         // A point: matte, as the rasterizer's surfels (metallic 0, roughness 1, specular 0.5).
         let ng = select(-tri.p1, tri.p1, dot(tri.p1, d) < 0.0);
         let s = Surface(sh.n1.xyz, 0.0, 1.0, 0.5);
-        let p = o + d * h.t;
-        var emission = sh.n2.xyz;
-        var light = NO_INDEX;
-        if tri.light != NO_INDEX {
-            // A disc of an area light's surface (only hit within the light's shape, see
-            // intersect_tri) emits, as an emitter triangle, on the light's side.
-            if dot(d, lights[tri.light].direction) < 0.0 {
-                light = tri.light;
-            } else {
-                emission = vec3<f32>(0.0);
-            }
-        }
-        return SurfaceHit(p, ng, ng, s, emission, light);
+        // A disc of an area light's surface is only hit within the light's shape (see
+        // intersect_tri).
+        let light = emitting_light(tri.light, d);
+        let emission = select(sh.n2.xyz, vec3<f32>(0.0), tri.light != light);
+        return SurfaceHit(o + d * h.t, ng, ng, s, emission, light);
     }
     let w = vec3<f32>(1.0 - h.b.x - h.b.y, h.b.x, h.b.y);
     var ng = normalize(cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
@@ -444,14 +445,9 @@ fn surface_at(h: Hit, o: vec3<f32>, d: vec3<f32>) -> SurfaceHit {
     if m.emissive_texture >= 0 {
         emission *= textureSampleLevel(textures, texture_sampler, uv, m.emissive_texture, 0.0).rgb;
     }
-    var light = NO_INDEX;
-    if tri.light != NO_INDEX {
-        // An area light's surface emits on its light's side only.
-        if dot(d, lights[tri.light].direction) < 0.0 {
-            light = tri.light;
-        } else {
-            emission = vec3<f32>(0.0);
-        }
+    let light = emitting_light(tri.light, d);
+    if tri.light != light {
+        emission = vec3<f32>(0.0);
     }
     let s = Surface(base.rgb, m.metallic, m.roughness, m.specular);
     return SurfaceHit(o + d * h.t, ng, n, s, emission, light);

@@ -642,14 +642,13 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
             Mat4::IDENTITY
         };
         let scale = cloud_scale(pc);
+        let length = |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
         for (i, &p) in pc.positions.iter().enumerate() {
             let local_n = pc
                 .normals
                 .get(i)
                 .map_or(Vec3::ZERO, |n| n.normalize_or_zero());
             let n = normal_matrix.transform_vector3(local_n).normalize_or_zero();
-            let length =
-                |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
             regions.push(length(pc.regions.get(i), scale));
             // Under a non-uniform scale a disc becomes an ellipse; drawn as a disc it takes the
             // ellipse's long axis, so that neighbours still meet along it: with the mean scale a

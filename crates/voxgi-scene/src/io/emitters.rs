@@ -88,31 +88,20 @@ fn quad_light(name: String, q: Parallelogram, emissive: [f32; 3]) -> Light {
 /// parallelograms: each face's triangles (indices into the soup's triangles) and its shape.
 /// Empty when the soup has more than `MAX_FACES` planes (a curved surface).
 fn parallelogram_faces(tri_points: &[Vec3]) -> Vec<(Vec<usize>, Parallelogram)> {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for &p in tri_points {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    let tol = REL_TOL * (hi - lo).length();
-    // (normal, offset, triangles)
-    let mut planes: Vec<(Vec3, f32, Vec<usize>)> = Vec::new();
-    for (t, c) in tri_points.chunks_exact(3).enumerate() {
-        let Some(n) = (c[1] - c[0]).cross(c[2] - c[0]).try_normalize() else {
-            continue;
-        };
-        let d = n.dot(c[0]);
-        match planes
-            .iter()
-            .position(|p| p.0.dot(n) >= FACE_COS && (p.1 - d).abs() <= tol)
-        {
-            Some(k) => planes[k].2.push(t),
-            None if planes.len() < MAX_FACES => planes.push((n, d, vec![t])),
-            None => return Vec::new(),
-        }
-    }
+    let tol = REL_TOL * diagonal(tri_points);
+    // Each triangle's plane: its normal and offset (degenerate triangles have none).
+    let planes = tri_points.chunks_exact(3).enumerate().filter_map(|(t, c)| {
+        let n = (c[1] - c[0]).cross(c[2] - c[0]).try_normalize()?;
+        Some((t, (n, n.dot(c[0]))))
+    });
+    let Some(planes) = group_alike(planes, |a: &(Vec3, f32), b| {
+        a.0.dot(b.0) >= FACE_COS && (a.1 - b.1).abs() <= tol
+    }) else {
+        return Vec::new();
+    };
     planes
         .into_iter()
-        .filter_map(|(_, _, tris)| {
+        .filter_map(|(_, tris)| {
             let pts: Vec<Vec3> = tris
                 .iter()
                 .flat_map(|&t| tri_points[3 * t..3 * t + 3].iter().copied())
@@ -246,22 +235,14 @@ pub fn promote_emissive_points(scene: &mut Scene) {
                 *n = face.normal;
             }
             face.points.iter().for_each(|&i| taken[i] = true);
-            let light = Light {
-                name: part.name.clone(),
-                kind: LightKind::Area {
-                    shape: AreaShape::Rect {
-                        u: face.u,
-                        v: face.v,
-                    },
-                },
-                color: pc.emission[face.points[0]],
-                intensity: 1.0,
-                position: face.center,
-                direction: face.normal,
-                range: None,
-                cast_shadows: true,
-            }
-            .transformed(pc.transform);
+            let rect = Parallelogram {
+                center: face.center,
+                u: face.u,
+                v: face.v,
+                normal: face.normal,
+            };
+            let light = quad_light(part.name.clone(), rect, pc.emission[face.points[0]])
+                .transformed(pc.transform);
             log::info!(
                 "point cloud '{}': {} emissive points form a {:.3} m² rectangle; they are now \
                  area light '{}'",
@@ -323,48 +304,27 @@ pub struct PointFace {
 /// group tested as a filled rectangle. Groups failing the test are left out (they stay
 /// geometry); an error when the points are not a few flat faces at all.
 pub fn emissive_faces(pc: &PointCloud) -> Result<Vec<PointFace>, String> {
-    let size = {
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for &p in &pc.positions {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        (hi - lo).length()
+    let plane_tol = REL_TOL * diagonal(&pc.positions);
+    let unit_normal = |i: usize| pc.normals[i].normalize_or_zero();
+    // The emitting points with a normal, grouped by emission and direction.
+    let emitting = pc.emission.iter().enumerate().filter_map(|(i, &e)| {
+        let n = unit_normal(i);
+        (e != [0.0; 3] && n != Vec3::ZERO).then_some((i, (e, n)))
+    });
+    let alike = |a: &([f32; 3], Vec3), b: &([f32; 3], Vec3)| {
+        let m = a.0.iter().chain(&b.0).fold(0.0f32, |m, v| m.max(*v));
+        (0..3).all(|k| (a.0[k] - b.0[k]).abs() <= REL_TOL * m) && a.1.dot(b.1) >= FACE_COS
     };
-    let plane_tol = REL_TOL * size;
-    // (emission, first normal, normal sum, members)
-    let mut groups: Vec<([f32; 3], Vec3, Vec3, Vec<usize>)> = Vec::new();
-    for (i, &e) in pc.emission.iter().enumerate() {
-        if e == [0.0; 3] {
-            continue;
-        }
-        let n = pc.normals[i].normalize_or_zero();
-        if n == Vec3::ZERO {
-            continue;
-        }
-        let alike = |a: [f32; 3]| {
-            let m = a.iter().chain(&e).fold(0.0f32, |m, v| m.max(*v));
-            (0..3).all(|k| (a[k] - e[k]).abs() <= REL_TOL * m)
-        };
-        match groups
-            .iter()
-            .position(|g| alike(g.0) && g.1.dot(n) >= FACE_COS)
-        {
-            Some(g) => {
-                groups[g].2 += n;
-                groups[g].3.push(i);
-            }
-            None if groups.len() < MAX_FACES => groups.push((e, n, n, vec![i])),
-            None => {
-                return Err(format!(
-                    "face more than {MAX_FACES} directions or emit unevenly (not a few flat faces)"
-                ));
-            }
-        }
-    }
+    let groups = group_alike(emitting, alike).ok_or_else(|| {
+        format!("face more than {MAX_FACES} directions or emit unevenly (not a few flat faces)")
+    })?;
     let mut faces = Vec::new();
-    for (_, _, sum, members) in groups {
-        let normal = sum.normalize();
+    for (_, members) in groups {
+        let normal = members
+            .iter()
+            .map(|&i| unit_normal(i))
+            .sum::<Vec3>()
+            .normalize();
         // Parallel faces (the two lamps of one cloud, one above the other) part by their offset.
         let mut by_offset: Vec<(f32, usize)> = members
             .iter()
@@ -475,6 +435,30 @@ fn rectangle_face(pc: &PointCloud, idx: Vec<usize>, normal: Vec3) -> Option<Poin
     })
 }
 
+/// Sorts `items` (index, key) into groups whose first key each later key is `alike` to, in
+/// order; `None` when that needs more than `MAX_FACES` groups.
+fn group_alike<K>(
+    items: impl Iterator<Item = (usize, K)>,
+    alike: impl Fn(&K, &K) -> bool,
+) -> Option<Vec<(K, Vec<usize>)>> {
+    let mut groups: Vec<(K, Vec<usize>)> = Vec::new();
+    for (i, key) in items {
+        match groups.iter().position(|g| alike(&g.0, &key)) {
+            Some(g) => groups[g].1.push(i),
+            None if groups.len() < MAX_FACES => groups.push((key, vec![i])),
+            None => return None,
+        }
+    }
+    Some(groups)
+}
+
+/// The length of the diagonal of the points' bounds (infinite when there are none).
+fn diagonal(points: &[Vec3]) -> f32 {
+    let mut b = crate::Aabb::EMPTY;
+    points.iter().for_each(|&p| b.grow(p));
+    b.size().length()
+}
+
 /// Convex hull, counter-clockwise, without collinear points (Andrew's monotone chain).
 fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
     let mut p = points.to_vec();
@@ -530,12 +514,7 @@ pub fn parallelogram(tri_points: &[Vec3]) -> Option<Parallelogram> {
     if tri_points.len() < 6 || !tri_points.len().is_multiple_of(3) {
         return None;
     }
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for &p in tri_points {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    let size = (hi - lo).length();
+    let size = diagonal(tri_points);
     if !(size > 0.0 && size.is_finite()) {
         return None;
     }

@@ -105,12 +105,8 @@ fn area_specular(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f
 fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
     if is_area_light(light) {
         // The light's own surface, whose position from the depth buffer may fall a hair on the
-        // emitting side, where the emitter would fill its hemisphere: not lit by itself.
-        let eps = 1e-4 * length(frame.camera_pos - p);
-        if dot(p - light.position, light.direction) <= eps {
-            return vec3<f32>(0.0);
-        }
-        let e = area_irradiance(light, p, n);
+        // emitting side, where the emitter would fill its hemisphere, is not lit by itself.
+        let e = area_irradiance(light, p, n, 1e-4 * length(frame.camera_pos - p));
         if e <= 0.0 {
             return vec3<f32>(0.0);
         }

@@ -429,9 +429,10 @@ fn edge_integral(a: vec3<f32>, b: vec3<f32>) -> f32 {
 }
 
 // Irradiance at p (normal n) from an area light of unit radiance, unshadowed: the polygon's,
-// and none behind the one-sided emitter's plane.
-fn area_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    if dot(p - light.position, light.direction) <= 0.0 {
+// and none behind the one-sided emitter's plane or within `clearance` metres in front of it
+// (where a position from a depth buffer puts the light's own surface).
+fn area_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, clearance: f32) -> f32 {
+    if dot(p - light.position, light.direction) <= clearance {
         return 0.0;
     }
     return polygon_irradiance(light, p, n);
@@ -441,7 +442,7 @@ fn area_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
 // only Lambertian reflection matters (light injection into voxels).
 fn light_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> vec3<f32> {
     if is_area_light(light) {
-        let e = area_irradiance(light, p, n);
+        let e = area_irradiance(light, p, n, 0.0);
         if e <= 0.0 {
             return vec3<f32>(0.0);
         }

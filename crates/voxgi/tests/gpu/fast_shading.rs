@@ -5,12 +5,10 @@
 use crate::common::*;
 use crate::vct::{
     FURNACE_CASES, Variant, ao_beside_a_wall, ao_of_an_open_plane_on,
-    cornell_variant_against_the_path_tracer, furnace_series, octree_against_dense,
-    one_voxel_wall_rooms, thin_wall_leak, wall_mesh,
+    cornell_variant_against_the_path_tracer, floor_beside_a_wall, furnace_series,
+    octree_against_dense, one_voxel_wall_rooms, thin_wall_leak,
 };
 use voxgi::scene::builtin;
-use voxgi::scene::glam::{Mat4, Vec3};
-use voxgi::scene::{Camera, Material};
 use voxgi::{IndirectShading, RendererOptions, VoxelKind};
 
 #[test]
@@ -32,13 +30,7 @@ fn leaves_see_an_open_plane_unoccluded() {
 
 #[test]
 fn leaves_occlude_beside_a_wall() {
-    let mut scene = plane_scene(0.5);
-    scene.add_mesh(
-        wall_mesh(0.0, 10.0, 10.0),
-        Material::diffuse("wall", [0.5; 3]),
-        Mat4::IDENTITY,
-    );
-    let cam = Camera::look_at(Vec3::new(-1.0, 3.0, 0.01), Vec3::new(-0.4, 0.0, 0.0), 30.0);
+    let (scene, cam) = floor_beside_a_wall();
     for kind in VoxelKind::ALL {
         // The closed form's bound (0.1) holds as for the gather.
         let worst = ao_beside_a_wall(&scene, &cam, Variant::leaves(kind));

@@ -6,8 +6,8 @@
 use crate::common::*;
 use crate::reference::{opts, region, trace_with};
 use crate::vct::{
-    FURNACE_CASES, ao_beside_a_wall, ao_of_an_open_plane, furnace_series, on, one_voxel_wall_rooms,
-    thin_wall_leak, vct, wall_mesh,
+    FURNACE_CASES, ao_beside_a_wall, ao_of_an_open_plane, floor_beside_a_wall, furnace_series, on,
+    one_voxel_wall_rooms, thin_wall_leak, vct,
 };
 use voxgi::compare::{Image, compare};
 use voxgi::gpu::readback::read_buffer_copy;
@@ -167,14 +167,8 @@ fn points_of_an_open_plane_have_ao_one() {
 
 #[test]
 fn points_beside_a_wall_have_the_meshes_ao() {
-    let mut scene = plane_scene(0.5);
-    scene.add_mesh(
-        wall_mesh(0.0, 10.0, 10.0),
-        Material::diffuse("wall", [0.5; 3]),
-        Mat4::IDENTITY,
-    );
-    let scene = as_points(&scene, 64, 2.0);
-    let cam = Camera::look_at(Vec3::new(-1.0, 3.0, 0.01), Vec3::new(-0.4, 0.0, 0.0), 30.0);
+    let (mesh, cam) = floor_beside_a_wall();
+    let scene = as_points(&mesh, 64, 2.0);
     for kind in VoxelKind::ALL {
         // The closed form and the mesh's tolerance (vct.rs).
         ao_beside_a_wall(&scene, &cam, kind);

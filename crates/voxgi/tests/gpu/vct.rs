@@ -123,16 +123,22 @@ pub(crate) fn ao_of_an_open_plane_on(scene: &Scene, kind: Variant) {
     }
 }
 
-#[test]
-fn ao_beside_a_wall_matches_the_closed_form() {
+/// The floor beside a 10 m wall at x = 0 (`ao_beside_a_wall`'s scene), and a camera looking at
+/// the floor next to the wall from above and in front.
+pub(crate) fn floor_beside_a_wall() -> (Scene, Camera) {
     let mut scene = plane_scene(0.5);
     scene.add_mesh(
         wall_mesh(0.0, 10.0, 10.0),
         Material::diffuse("wall", [0.5; 3]),
         Mat4::IDENTITY,
     );
-    // Look at the floor next to the wall from above and in front.
     let cam = Camera::look_at(Vec3::new(-1.0, 3.0, 0.01), Vec3::new(-0.4, 0.0, 0.0), 30.0);
+    (scene, cam)
+}
+
+#[test]
+fn ao_beside_a_wall_matches_the_closed_form() {
+    let (scene, cam) = floor_beside_a_wall();
     for kind in VoxelKind::ALL {
         ao_beside_a_wall(&scene, &cam, kind);
     }
