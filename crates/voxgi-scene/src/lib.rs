@@ -10,6 +10,7 @@ mod error;
 pub mod io;
 mod model;
 pub mod pointcloud;
+pub mod prepare;
 mod util;
 
 pub use error::SceneError;

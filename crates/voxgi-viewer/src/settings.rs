@@ -3,12 +3,13 @@
 //! values (a resolution as a power of two, bounces as a count or unlimited) map to the options
 //! and back without loss.
 
-use voxgi::{ConeSet, FrameParams, RendererOptions, Tonemap, UNLIMITED_BOUNCES, ViewMode};
+use voxgi::{
+    ConeSet, DIRECTIONS, FrameParams, RendererOptions, Tonemap, UNLIMITED_BOUNCES, ViewMode,
+};
 
 /// Voxel resolutions the panel offers: 16..=512.
 pub const RESOLUTIONS: [u32; 6] = [16, 32, 64, 128, 256, 512];
 pub const CONE_SETS: [ConeSet; 3] = [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45];
-const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
 
 /// Bounces as the panel shows them: a count 0..=8 and an "unlimited" box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

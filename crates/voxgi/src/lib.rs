@@ -37,7 +37,7 @@ pub mod brdf;
 pub mod compare;
 mod error;
 pub mod fragments;
-mod globals;
+pub mod frame;
 pub mod gpu;
 pub mod gpu_scene;
 #[cfg(feature = "headless")]
@@ -51,25 +51,24 @@ mod renderer;
 mod scene_state;
 pub mod screen;
 mod settings;
-mod targets;
 mod view;
 pub mod voxel;
 
 pub use error::{Error, Result};
+pub use frame::targets::{FrameTargets, Target};
 pub use gpu::requirements::{check_device, minimum_limits, required_features, required_limits};
 pub use options::{
-    FrameParams, IndirectShading, MAX_BOUNCES, MAX_IMAGE_SIZE, RendererOptions, ShadowFilter,
-    Tonemap, UNLIMITED_BOUNCES, ViewMode, validate_size,
+    ConeSet, DIRECTIONS, FrameParams, IndirectShading, MAX_BOUNCES, MAX_IMAGE_SIZE,
+    RendererOptions, ShadowFilter, Tonemap, UNLIMITED_BOUNCES, ViewMode, VoxelKind, validate_size,
 };
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use renderer::{PointPreparation, Renderer, VOXEL_PASSES, VoxelCounts, prepare_points};
+pub use renderer::{Renderer, VOXEL_PASSES, VoxelCounts};
 pub use scene_state::swept_bounds;
 pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
-pub use targets::{FrameTargets, Target};
-pub use voxel::{ConeSet, VoxelKind};
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;
+pub use voxgi_scene::prepare::{PointPreparation, prepare_points};
 /// The wgpu voxgi is built on: use it to create the device and textures you hand to voxgi.
 pub use wgpu;

@@ -1,9 +1,73 @@
 //! The renderer's knobs with their documented defaults and range checks: creation-time
 //! options apart from per-frame parameters.
 
-use crate::voxel::{ConeSet, VoxelKind};
 use crate::{Error, Result};
 use voxgi_scene::Camera;
+
+/// Names of the directional chains (`FrameParams::debug_direction`), in the order the
+/// anisotropic filters store them.
+pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
+
+/// Which voxel structure a renderer builds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VoxelKind {
+    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
+    #[default]
+    Dense,
+    /// The sparse voxel octree: memory in proportion to the occupied voxels.
+    Octree,
+}
+
+impl VoxelKind {
+    /// Both, in the order of their names.
+    pub const ALL: [VoxelKind; 2] = [VoxelKind::Dense, VoxelKind::Octree];
+
+    /// The name settings and the command line use, also the WGSL folder `shaders/voxels/<name>/`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VoxelKind::Dense => "dense",
+            VoxelKind::Octree => "octree",
+        }
+    }
+
+    /// The structure named `s`.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| Error::Setting(format!("voxel structure '{s}' is not dense or octree")))
+    }
+}
+
+/// A set of diffuse cones around the normal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ConeSet {
+    /// Six cones of 60° aperture: one along the normal, five tilted 60° (Crassin et al.).
+    #[default]
+    Six60,
+    /// Seven cones of 45°: one along the normal, six tilted 45° (the 3D-texture paper).
+    Seven45,
+    /// Nine cones of 45°: one along the normal, eight tilted 50°.
+    Nine45,
+}
+
+impl ConeSet {
+    /// The set's name as settings and the command line spell it: "6x60", "7x45" or "9x45".
+    pub fn name(&self) -> &'static str {
+        match self {
+            ConeSet::Six60 => "6x60",
+            ConeSet::Seven45 => "7x45",
+            ConeSet::Nine45 => "9x45",
+        }
+    }
+
+    /// The set named `s` (as `name` spells it), or `None`.
+    pub fn parse(s: &str) -> Option<Self> {
+        [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45]
+            .into_iter()
+            .find(|c| c.name() == s)
+    }
+}
 
 /// The curve that maps exposed linear radiance to display values.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -2,11 +2,9 @@
 //! an application) shares one parser and one list of keys.
 
 use crate::options::{
-    FrameParams, IndirectShading, MAX_BOUNCES, RendererOptions, ShadowFilter, Tonemap,
-    UNLIMITED_BOUNCES, ViewMode,
+    ConeSet, DIRECTIONS, FrameParams, IndirectShading, MAX_BOUNCES, RendererOptions, ShadowFilter,
+    Tonemap, UNLIMITED_BOUNCES, ViewMode, VoxelKind,
 };
-use crate::voxel::dense::DIRECTIONS;
-use crate::voxel::{ConeSet, VoxelKind};
 use crate::{Error, Result};
 use serde::Deserialize;
 

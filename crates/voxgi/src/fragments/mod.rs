@@ -4,11 +4,13 @@
 //! its capacity; the count runs past it when a build overflowed, and the renderer grows the
 //! buffer a frame later.
 
+pub mod grid;
 pub mod splat;
 pub mod voxelize;
 
+pub use grid::Grid;
+
 use crate::gpu_scene::GpuScene;
-use crate::voxel::Grid;
 use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -244,5 +246,17 @@ pub fn triangle_table(
         buffer,
         count: n,
         dynamic,
+    })
+}
+
+/// The fragment buffer on `grid` with room for `wanted` fragments, or as many as this device's
+/// storage-buffer limit allows (a build that overflows it counts, and the pools grow).
+pub fn allocate(device: &wgpu::Device, grid: Grid, wanted: u64) -> Result<Fragments> {
+    let capacity = capacity(
+        device,
+        wanted.min(crate::gpu::max_entries(device, FRAGMENT_BYTES)),
+    )?;
+    crate::gpu::checked(device, "voxel fragments", || {
+        Fragments::new(device, grid, capacity)
     })
 }

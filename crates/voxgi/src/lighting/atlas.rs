@@ -2,12 +2,13 @@
 //! light's views are. A shared resource: `shadow` renders into it, `inject` and `composite`
 //! read it.
 
+use crate::Result;
 use crate::gpu::layout;
 use crate::gpu_scene::{
     CONE_SHADOW_LIGHTS, GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT,
     LIGHT_SPOT,
 };
-use crate::options::RendererOptions;
+use crate::options::{RendererOptions, ShadowFilter};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use wgpu::util::DeviceExt;
@@ -508,6 +509,26 @@ impl ShadowAtlas {
         };
         texels(&self.texture) * 8 + texels(&self.moments) * 16
     }
+}
+
+/// Plans the shadow views for the options (writing each light's views into `scene`'s
+/// lights) and makes the atlas that holds them.
+pub fn plan_atlas(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &mut GpuScene,
+    casts: &[bool],
+    options: &RendererOptions,
+    center: Vec3,
+    radius: f32,
+) -> Result<ShadowAtlas> {
+    crate::gpu::checked(device, "shadow atlas", || {
+        let res = atlas_resolution(options, &scene.gpu_lights);
+        let (views, owners) = plan_views(&mut scene.gpu_lights, casts, center, radius, res);
+        queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
+        let moments = options.shadow_filter == ShadowFilter::VsmEsm;
+        ShadowAtlas::new(device, views, owners, res, moments)
+    })
 }
 
 #[cfg(test)]

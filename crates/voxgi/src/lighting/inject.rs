@@ -19,8 +19,9 @@ pub struct InjectPass {
     args_layout: wgpu::BindGroupLayout,
     /// `main`'s dispatch size (written by `prepare`).
     args: wgpu::Buffer,
-    /// The leaves to recompute (`todo` in the WGSL), sized to the structure's leaves.
-    todo: std::cell::RefCell<Option<wgpu::Buffer>>,
+    /// The leaves to recompute (`todo` in the WGSL), grown by `prepare` to the structure's
+    /// leaves.
+    todo: wgpu::Buffer,
     light_count: u32,
     /// `InjectParams`: the light count, whether every leaf is recomputed, where geometry moved.
     params: wgpu::Buffer,
@@ -99,7 +100,7 @@ impl InjectPass {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
                 mapped_at_creation: false,
             }),
-            todo: std::cell::RefCell::new(None),
+            todo: todo_buffer(device, 4),
             args_layout,
             globals,
             light_count,
@@ -122,9 +123,12 @@ impl InjectPass {
     /// view (`views`, one per atlas layer of `res` texels). Leaves whose inputs none of this touches keep
     /// their direct light: what they would compute is the same, to the bit. Their radiance
     /// is stored again only when `store_all` (something else wrote it since: the bounces).
+    #[allow(clippy::too_many_arguments)]
     pub fn prepare(
-        &self,
+        &mut self,
+        device: &wgpu::Device,
         queue: &wgpu::Queue,
+        voxels: &dyn VoxelStructure,
         all: bool,
         store_all: bool,
         moved: Option<voxgi_scene::Aabb>,
@@ -143,6 +147,10 @@ impl InjectPass {
             moved_max: hi,
         };
         queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        let needed = todo_bytes(voxels);
+        if self.todo.size() < needed {
+            self.todo = todo_buffer(device, needed);
+        }
         let dirt: Vec<[f32; 4]> = views.iter().map(|v| v.to_gpu(res)).collect();
         if !dirt.is_empty() {
             queue.write_buffer(&self.dirt, 0, bytemuck::cast_slice(&dirt));
@@ -189,17 +197,11 @@ impl InjectPass {
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
-        let needed = (voxels.leaf_capacity() + 1) * 4;
-        let mut todo = self.todo.borrow_mut();
-        if todo.as_ref().is_none_or(|b| b.size() < needed) {
-            *todo = Some(device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("inject todo"),
-                size: needed,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
-        let todo = todo.as_ref().expect("made above");
+        debug_assert!(
+            self.todo.size() >= todo_bytes(voxels),
+            "inject: `prepare` sizes the list for these leaves"
+        );
+        let todo = &self.todo;
         encoder.clear_buffer(todo, 0, Some(4));
         let mut resources = vec![self.params.as_entire_binding()];
         resources.extend(atlas.lighting_resources(scene));
@@ -249,4 +251,18 @@ impl InjectPass {
         pass.set_bind_group(3, voxels.leaf_store(), &[]);
         pass.dispatch_workgroups_indirect(&self.args, 0);
     }
+}
+
+/// Bytes of the list of leaves to recompute: a count and a slot per leaf.
+fn todo_bytes(voxels: &dyn VoxelStructure) -> u64 {
+    (voxels.leaf_capacity() + 1) * 4
+}
+
+fn todo_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("inject todo"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }

@@ -6,6 +6,8 @@
 
 pub mod atlas;
 pub mod bounce;
+pub mod bounces;
+pub mod cones;
 pub mod inject;
 pub mod moments;
 pub mod shadow;

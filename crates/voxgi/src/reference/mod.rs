@@ -347,7 +347,7 @@ impl PathTracer {
             return Err(Error::EmptyScene);
         }
         let mut scene = lit_scene(scene, options.default_light);
-        crate::renderer::complete_point_attributes(&mut scene);
+        voxgi_scene::prepare::complete_point_attributes(&mut scene);
         let scene = scene.as_ref();
         let device = device.clone();
         let queue = queue.clone();

@@ -4,10 +4,10 @@
 //! the view or the options change, so a caller only says how many samples to add and where.
 
 use super::{Bounces, GpuParams, MAX_BOUNCES, PathTracer, ReferenceMode, ReferenceOptions};
+use crate::frame::targets::Target;
 use crate::gpu::{layout, shader};
 use crate::options::{FrameParams, Tonemap, validate_size};
 use crate::screen::tonemap::output_pipeline;
-use crate::targets::Target;
 use crate::view::camera_view_proj;
 use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};

@@ -1,15 +1,12 @@
 //! composite: deferred shading of direct light and emission into the HDR target, with the
 //! indirect light and cone-traced visibility upsampled from the gather's resolution.
 
+use crate::frame::formats::HDR_FORMAT;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::ShadowFilter;
-use crate::targets::FrameTargets;
-
-/// Format of the HDR target the composite writes: linear radiance, RGBA f32 (read back by
-/// headless rendering and tone mapped to the output).
-pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// The composite compute pass (shaders/composite.wgsl): its pipeline and bind group layout.
 pub struct CompositePass {
@@ -49,7 +46,7 @@ impl CompositePass {
                 f64::from(u8::from(filter == ShadowFilter::VsmEsm)),
             ),
         ];
-        let globals = crate::globals::layout(device);
+        let globals = crate::frame::globals::layout(device);
         let pipeline = grouped_pipeline(
             device,
             "composite",

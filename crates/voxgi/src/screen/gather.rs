@@ -4,22 +4,14 @@
 //! Bind groups: 0 the frame's globals, 1 the voxel structure's sampling group, 2 its own, 3 the
 //! structure's irradiance lookup.
 
+use crate::frame::formats::{GUIDE_FORMAT, INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::{IndirectShading, RendererOptions};
-use crate::targets::FrameTargets;
 use crate::voxel::VoxelStructure;
 use voxgi_scene::Scene;
-
-/// Format of the gather's indirect-light target: rgb the indirect radiance towards the camera,
-/// a the ambient occlusion.
-pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Cone-traced visibility of up to four area lights.
-pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-/// The gather pixels' geometry for the upsample's edge weights: normal (rgb) and distance to
-/// the camera (a; 0 for background).
-pub const GUIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// Whether anything on screen can have a specular lobe: a material with specular or metallic
 /// reflectance, or a point cloud (surfels shade with half the dielectric specular).
@@ -42,7 +34,7 @@ impl GatherPass {
     /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
     pub fn new(device: &wgpu::Device, settings: &RendererOptions, glossy: bool) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
-        let globals = crate::globals::layout(device);
+        let globals = crate::frame::globals::layout(device);
         let mut entries = FrameTargets::gbuffer_layout(0, c).to_vec();
         entries.extend([
             layout::storage_texture(4, INDIRECT_FORMAT),

@@ -1,19 +1,11 @@
 //! gbuffer: rasterizes all mesh instances into the G-buffer, then every point-cloud sample as a
 //! surfel (an oriented disc) into the same targets, depth-tested against the meshes.
 
+use crate::frame::formats::{ALBEDO_FORMAT, DEPTH_FORMAT, EMISSION_FORMAT, NORMAL_FORMAT};
+use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
-use crate::targets::FrameTargets;
-
-/// G-buffer albedo target: rgb linear base colour, a metallic.
-pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// G-buffer normal target: rgb world-space unit normal (facing the viewer), a perceptual roughness.
-pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// G-buffer emission target: rgb emitted radiance, a specular reflectance.
-pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// G-buffer depth target (cleared to 1, less-than test).
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// The G-buffer render pass (shaders/gbuffer.wgsl): the mesh and surfel pipelines and their
 /// shared bind group layout.

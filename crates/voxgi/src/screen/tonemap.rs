@@ -3,10 +3,10 @@
 //! target, so it is where the output format is adapted: one pipeline per target format, made
 //! the first time that format is seen.
 
+use crate::frame::targets::{FrameTargets, Target};
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, shader};
-use crate::targets::{FrameTargets, Target};
 use crate::{Error, Result};
 
 /// The tonemap render pass (shaders/tonemap.wgsl): a full-screen draw from the HDR target into
@@ -45,7 +45,7 @@ impl TonemapPass {
             label: Some("tonemap"),
             entries: &[layout::texture_2d_load(0, f)],
         });
-        let globals = crate::globals::layout(device);
+        let globals = crate::frame::globals::layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("tonemap"),
             bind_group_layouts: &[Some(&globals), None, Some(&layout)],

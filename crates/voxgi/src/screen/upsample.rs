@@ -3,11 +3,11 @@
 //! composite finishes the upsample with an edge-aware 2x2 filter at full resolution (joint
 //! bilateral upsampling): the wide window runs on a quarter of the pixels at half resolution.
 
+use crate::frame::formats::INDIRECT_FORMAT;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::screen::gather::INDIRECT_FORMAT;
-use crate::targets::FrameTargets;
 
 /// The upsample compute pass, stage one (shaders/upsample.wgsl): its pipeline and bind group
 /// layout.
@@ -28,7 +28,7 @@ impl UpsamplePass {
                 layout::storage_texture(2, INDIRECT_FORMAT),
             ],
         });
-        let globals = crate::globals::layout(device);
+        let globals = crate::frame::globals::layout(device);
         UpsamplePass {
             pipeline: grouped_pipeline(
                 device,

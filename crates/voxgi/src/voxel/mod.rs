@@ -1,4 +1,4 @@
-//! Voxels: where the volume sits, the cone sets, and the voxel structures built from fragments.
+//! Voxels: the voxel structures built from fragments.
 //!
 //! A structure is anything cone tracing can sample (DESIGN.md, seam 2). In Rust it implements
 //! `VoxelStructure`; in WGSL it provides `shaders/voxels/<kind>/sample.wgsl`, the contract of
@@ -8,14 +8,17 @@
 
 pub mod cpu;
 pub mod dense;
+pub mod factory;
 pub mod octree;
 
+pub use crate::fragments::Grid;
+pub use crate::options::VoxelKind;
+
 use crate::fragments::Fragments;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::options::ViewMode;
-use crate::targets::FrameTargets;
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
 
 /// What a voxel debug view shows: one of the voxel `ViewMode`s, at mip `level` (0 = finest),
 /// along directional chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) where there are chains.
@@ -120,38 +123,7 @@ pub struct Filtering {
 /// Words of `VoxelStructure::pool_counter` read back after each build.
 pub const POOL_COUNTERS: usize = 4;
 
-/// Which voxel structure a renderer builds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum VoxelKind {
-    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
-    #[default]
-    Dense,
-    /// The sparse voxel octree: memory in proportion to the occupied voxels.
-    Octree,
-}
-
 impl VoxelKind {
-    /// Both, in the order of their names.
-    pub const ALL: [VoxelKind; 2] = [VoxelKind::Dense, VoxelKind::Octree];
-
-    /// The name settings and the command line use, also the WGSL folder `shaders/voxels/<name>/`.
-    pub fn name(self) -> &'static str {
-        match self {
-            VoxelKind::Dense => "dense",
-            VoxelKind::Octree => "octree",
-        }
-    }
-
-    /// The structure named `s`.
-    pub fn parse(s: &str) -> crate::Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                crate::Error::Setting(format!("voxel structure '{s}' is not dense or octree"))
-            })
-    }
-
     /// The layout of @group(1), the structure's sampling resources.
     pub fn sampling_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
         match self {
@@ -253,188 +225,9 @@ pub struct GpuVolume {
     pub _pad: u32,
 }
 
-/// Mirrors `Cones` in shaders/shared/volume.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuCones {
-    /// Per cone: tangent-space axis (xyz, z = normal) and weight (w; the cone's share of the
-    /// cosine-weighted hemisphere, summing to 1 over the cones). Entries past `count` are zero.
-    pub dirs: [[f32; 4]; 16],
-    /// Number of cones used in `dirs` (at most 16).
-    pub count: u32,
-    /// Tangent of the diffuse cones' half-angle.
-    pub diffuse_tan: f32,
-    /// Sample step as a fraction of the cone diameter.
-    pub step_factor: f32,
-    /// Cones stop after this distance, metres.
-    pub max_distance: f32,
-    /// Ambient occlusion falloff lambda in 1/(1 + lambda r), per metre.
-    pub ao_lambda: f32,
-    /// Ambient occlusion rays stop at this distance, metres.
-    pub ao_radius: f32,
-    /// Offset of the cone origin along the normal, in finest voxels.
-    pub origin_offset: f32,
-    /// 1: the per-pixel gather adds indirect light, 0: it does not (bounces = 0).
-    pub indirect: u32,
-}
-
-/// A cubic grid over the scene: `resolution` voxels per side from `origin`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Grid {
-    /// World position of the grid's minimum corner, metres.
-    pub origin: Vec3,
-    /// Edge length of a voxel, metres.
-    pub voxel_size: f32,
-    /// Voxels per side (a power of two).
-    pub resolution: u32,
-}
-
-impl Grid {
-    /// The cube around the scene bounds with one empty voxel of margin on every side, so walls
-    /// on the bounds (the Cornell box's) lie inside the volume, not on its edge.
-    pub fn around(min: Vec3, max: Vec3, resolution: u32) -> Self {
-        let (min, max) = if min.x > max.x {
-            (Vec3::splat(-0.5), Vec3::splat(0.5))
-        } else {
-            (min, max)
-        };
-        let extent = (max - min).max_element().max(1e-3);
-        let side = extent * resolution as f32 / (resolution as f32 - 2.0);
-        let center = (min + max) * 0.5;
-        Grid {
-            origin: center - Vec3::splat(side * 0.5),
-            voxel_size: side / resolution as f32,
-            resolution,
-        }
-    }
-
-    /// Edge length of the whole grid, metres.
-    pub fn extent(&self) -> f32 {
-        self.voxel_size * self.resolution as f32
-    }
-
-    /// Mip levels including the finest (down to 1 voxel).
-    pub fn levels(&self) -> u32 {
-        self.resolution.ilog2() + 1
-    }
-}
-
-/// A set of diffuse cones around the normal.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum ConeSet {
-    /// Six cones of 60° aperture: one along the normal, five tilted 60° (Crassin et al.).
-    #[default]
-    Six60,
-    /// Seven cones of 45°: one along the normal, six tilted 45° (the 3D-texture paper).
-    Seven45,
-    /// Nine cones of 45°: one along the normal, eight tilted 50°.
-    Nine45,
-}
-
-impl ConeSet {
-    /// The set's name as settings and the command line spell it: "6x60", "7x45" or "9x45".
-    pub fn name(&self) -> &'static str {
-        match self {
-            ConeSet::Six60 => "6x60",
-            ConeSet::Seven45 => "7x45",
-            ConeSet::Nine45 => "9x45",
-        }
-    }
-
-    /// The set named `s` (as `name` spells it), or `None`.
-    pub fn parse(s: &str) -> Option<Self> {
-        [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45]
-            .into_iter()
-            .find(|c| c.name() == s)
-    }
-
-    /// Full aperture angle of each cone in radians.
-    pub fn aperture(&self) -> f32 {
-        match self {
-            ConeSet::Six60 => 60f32.to_radians(),
-            _ => 45f32.to_radians(),
-        }
-    }
-
-    /// Tangent-space axes (z = normal).
-    pub fn axes(&self) -> Vec<Vec3> {
-        let (ring, tilt) = match self {
-            ConeSet::Six60 => (5, 60f32),
-            ConeSet::Seven45 => (6, 45f32),
-            ConeSet::Nine45 => (8, 50f32),
-        };
-        let mut v = vec![Vec3::Z];
-        let t = tilt.to_radians();
-        for i in 0..ring {
-            let phi = i as f32 / ring as f32 * std::f32::consts::TAU;
-            v.push(Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos()));
-        }
-        v
-    }
-
-    /// Each cone's weight: the cosine-weighted solid angle of the part of the hemisphere whose
-    /// directions are nearest its axis, as a fraction of the whole (pi). The cones stand for
-    /// their cells, so the weights sum to exactly 1 and no empirical factor is needed.
-    pub fn weights(&self) -> Vec<f32> {
-        cell_weights(&self.axes())
-    }
-}
-
-/// Cosine-weighted hemisphere fractions of the nearest-axis cells, by midpoint quadrature in
-/// (cos²θ, φ), where the cosine-weighted measure is uniform.
-pub fn cell_weights(axes: &[Vec3]) -> Vec<f32> {
-    let (nu, nphi) = (256, 1024);
-    let mut w = vec![0f64; axes.len()];
-    for i in 0..nu {
-        // u = sin²θ is uniform under the cosine-weighted measure.
-        let u = (i as f32 + 0.5) / nu as f32;
-        let (s, c) = (u.sqrt(), (1.0 - u).sqrt());
-        for j in 0..nphi {
-            let phi = (j as f32 + 0.5) / nphi as f32 * std::f32::consts::TAU;
-            let d = Vec3::new(s * phi.cos(), s * phi.sin(), c);
-            let best = axes
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.dot(d).total_cmp(&b.1.dot(d)))
-                .map(|(k, _)| k)
-                .unwrap_or(0);
-            w[best] += 1.0;
-        }
-    }
-    let total: f64 = w.iter().sum();
-    w.into_iter().map(|x| (x / total) as f32).collect()
-}
-
 /// Bytes of a 3D texture with `mips` levels.
 pub fn texture_bytes(res: u32, bytes_per_texel: u64, mips: u32) -> u64 {
     (0..mips)
         .map(|m| ((res >> m).max(1) as u64).pow(3) * bytes_per_texel)
         .sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn cone_weights_partition_the_cosine_hemisphere() {
-        for set in [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45] {
-            let w = set.weights();
-            assert_eq!(w.len(), set.axes().len());
-            // Quadrature of a partition: the fractions sum to 1 up to float rounding.
-            assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{set:?}: {w:?}");
-            // The ring cones are symmetric, so they get equal weights (to quadrature error).
-            for &x in &w[2..] {
-                assert!((x - w[1]).abs() < 2e-3, "{set:?}: {w:?}");
-            }
-        }
-    }
-
-    #[test]
-    fn grid_has_a_margin_voxel() {
-        let g = Grid::around(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0), 64);
-        assert!((g.extent() - 2.0 * 64.0 / 62.0).abs() < 1e-5);
-        assert!((g.origin.x + g.voxel_size).abs() < 1e-5);
-        assert_eq!(g.levels(), 7);
-    }
 }

@@ -1,11 +1,13 @@
 //! Every WGSL file validates with naga, and every Rust struct that mirrors a WGSL struct has
 //! the size naga computes for it.
 
+use voxgi::frame::uniforms::GpuFrame;
 use voxgi::gpu::shader;
-use voxgi::gpu_scene::{GpuDraw, GpuFrame, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
+use voxgi::gpu_scene::{GpuDraw, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
 use voxgi::lighting::atlas::GpuShadowView;
+use voxgi::lighting::cones::GpuCones;
+use voxgi::voxel::GpuVolume;
 use voxgi::voxel::octree::GpuOctree;
-use voxgi::voxel::{GpuCones, GpuVolume};
 
 fn parse(name: &str) -> naga::Module {
     parse_for(name, "dense")

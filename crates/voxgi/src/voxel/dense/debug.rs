@@ -3,12 +3,12 @@
 //! before tonemap, only when such a view is selected.
 
 use super::DenseVolume;
+use crate::frame::formats::HDR_FORMAT;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::compute_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::ViewMode;
-use crate::screen::composite::HDR_FORMAT;
-use crate::targets::FrameTargets;
 use wgpu::util::DeviceExt;
 
 /// The voxel debug compute pass (shaders/voxels/dense/debug.wgsl): its pipeline and bind group

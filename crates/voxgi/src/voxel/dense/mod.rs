@@ -16,9 +16,9 @@ pub mod filter;
 
 use super::{GpuVolume, Grid, texture_bytes};
 use crate::fragments::Fragments;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
-use crate::targets::FrameTargets;
 use crate::voxel::{DebugView, Filtering, POOL_COUNTERS, VoxelStructure};
 use debug::DebugPass;
 use filter::FilterPass;
@@ -40,9 +40,6 @@ const ACCUM_STRIDE: u64 = 13;
 const DYN_STRIDE: u64 = 15;
 /// Bytes of the largest per-slot buffer (the dynamic part).
 pub const SLOT_BYTES: u64 = DYN_STRIDE * 4;
-/// Directions of the anisotropic chains, in the order of `filter.wgsl`.
-pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
-
 /// The dense volume: the finest level's textures, the compact slots of its occupied voxels, the
 /// radiance mip chains above it, and the bind groups the passes reach it through.
 pub struct DenseVolume {

@@ -3,12 +3,12 @@
 //! volume's debug pass.
 
 use super::OctreeVolume;
+use crate::frame::formats::HDR_FORMAT;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::options::ViewMode;
-use crate::screen::composite::HDR_FORMAT;
-use crate::targets::FrameTargets;
 use crate::voxel::DebugView;
 use wgpu::util::DeviceExt;
 

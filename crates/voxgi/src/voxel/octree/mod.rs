@@ -19,9 +19,9 @@ pub mod debug;
 
 use super::{DebugView, Filtering, Grid, POOL_COUNTERS, VoxelStructure};
 use crate::fragments::Fragments;
+use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
-use crate::targets::FrameTargets;
 use bytemuck::{Pod, Zeroable};
 use debug::DebugPass;
 use std::sync::Arc;

@@ -1,13 +1,11 @@
 //! The frame's globals, bound at `@group(0)` by the screen passes (gather, upsample,
 //! composite, tonemap): the frame uniform, the cone parameters, the lights and the shadow
-//! atlas, the BRDF tables and their sampler. One bind group per frame; each pass binds it and
+//! atlas, the BRDF tables and their sampler. One bind group, made again only when one of
+//! those resources is replaced (new targets, a new atlas); each pass binds it and
 //! adds its own resources at group 2. Twin: shaders/shared/globals.wgsl.
 
 use crate::brdf::BrdfTables;
 use crate::gpu::layout;
-use crate::gpu_scene::GpuScene;
-use crate::lighting::atlas::ShadowAtlas;
-use crate::targets::FrameTargets;
 
 /// The layout of the frame's globals.
 pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
@@ -36,16 +34,16 @@ pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// What the frame's globals are made of.
+/// What the frame's globals are made of. Resources, not their owners: the frame sits below
+/// the scene and the lighting.
 pub struct GlobalsSources<'a> {
-    /// The frame uniform lives with the targets of the frame's size.
-    pub targets: &'a FrameTargets,
+    /// The `GpuFrame` uniform (`FrameTargets::frame`).
+    pub frame: &'a wgpu::Buffer,
     /// `GpuCones`.
     pub cones: &'a wgpu::Buffer,
-    /// The lights.
-    pub scene: &'a GpuScene,
-    /// The shadow views and maps.
-    pub atlas: &'a ShadowAtlas,
+    /// The lights, the shadow views, the shadow maps and their moments
+    /// (`ShadowAtlas::lighting_resources`).
+    pub lighting: [wgpu::BindingResource<'a>; 4],
     /// The BRDF tables and their sampler.
     pub tables: &'a BrdfTables,
 }
@@ -56,11 +54,8 @@ pub fn bind_group(
     bgl: &wgpu::BindGroupLayout,
     s: &GlobalsSources,
 ) -> wgpu::BindGroup {
-    let mut entries = vec![
-        s.targets.frame.as_entire_binding(),
-        s.cones.as_entire_binding(),
-    ];
-    entries.extend(s.atlas.lighting_resources(s.scene));
+    let mut entries = vec![s.frame.as_entire_binding(), s.cones.as_entire_binding()];
+    entries.extend(s.lighting.iter().cloned());
     entries.extend([
         wgpu::BindingResource::TextureView(&s.tables.specular_albedo),
         wgpu::BindingResource::TextureView(&s.tables.ltc),

@@ -1,11 +1,12 @@
 //! Render targets of one output size, and their formats: the g-buffer, the gather's targets
 //! and the HDR image. Passes read and write them; only `tonemap` touches the caller's texture.
 
+use super::formats::{
+    ALBEDO_FORMAT, DEPTH_FORMAT, EMISSION_FORMAT, GUIDE_FORMAT, HDR_FORMAT, INDIRECT_FORMAT,
+    NORMAL_FORMAT, VISIBILITY_FORMAT,
+};
+use super::uniforms::GpuFrame;
 use crate::gpu::layout;
-use crate::gpu_scene::GpuFrame;
-use crate::screen::composite::HDR_FORMAT;
-use crate::screen::gather::{GUIDE_FORMAT, INDIRECT_FORMAT, VISIBILITY_FORMAT};
-use crate::screen::gbuffer;
 
 /// Render targets of one output size.
 pub struct FrameTargets {
@@ -15,13 +16,13 @@ pub struct FrameTargets {
     pub height: u32,
     /// The frame's `GpuFrame` uniform, written before each frame.
     pub frame: wgpu::Buffer,
-    /// G-buffer albedo (`gbuffer::ALBEDO_FORMAT`: rgb base colour, a metallic).
+    /// G-buffer albedo (`ALBEDO_FORMAT`: rgb base colour, a metallic).
     pub albedo: wgpu::TextureView,
-    /// G-buffer normal (`gbuffer::NORMAL_FORMAT`: rgb world normal, a roughness).
+    /// G-buffer normal (`NORMAL_FORMAT`: rgb world normal, a roughness).
     pub normal: wgpu::TextureView,
-    /// G-buffer emission (`gbuffer::EMISSION_FORMAT`: rgb emitted radiance, a specular).
+    /// G-buffer emission (`EMISSION_FORMAT`: rgb emitted radiance, a specular).
     pub emission: wgpu::TextureView,
-    /// G-buffer depth (`gbuffer::DEPTH_FORMAT`).
+    /// G-buffer depth (`DEPTH_FORMAT`).
     pub depth: wgpu::TextureView,
     /// Linear radiance (the composite's output, the debug views' too); `tonemap` reads it.
     pub hdr: wgpu::TextureView,
@@ -82,10 +83,10 @@ impl FrameTargets {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
-            albedo: view(make("gbuffer albedo", gbuffer::ALBEDO_FORMAT, rt)),
-            normal: view(make("gbuffer normal", gbuffer::NORMAL_FORMAT, rt)),
-            emission: view(make("gbuffer emission", gbuffer::EMISSION_FORMAT, rt)),
-            depth: view(make("gbuffer depth", gbuffer::DEPTH_FORMAT, rt)),
+            albedo: view(make("gbuffer albedo", ALBEDO_FORMAT, rt)),
+            normal: view(make("gbuffer normal", NORMAL_FORMAT, rt)),
+            emission: view(make("gbuffer emission", EMISSION_FORMAT, rt)),
+            depth: view(make("gbuffer depth", DEPTH_FORMAT, rt)),
             indirect: view(low("indirect", INDIRECT_FORMAT)),
             indirect_low: view(low("indirect gather", INDIRECT_FORMAT)),
             visibility_low: view(low("visibility gather", VISIBILITY_FORMAT)),

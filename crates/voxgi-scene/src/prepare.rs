@@ -1,0 +1,97 @@
+//! Point preparation: the attributes a point cloud needs for rendering (normals, regions of
+//! influence, disc radii), estimated where the file gave none.
+
+use crate::{Aabb, Scene, pointcloud};
+use glam::Vec3;
+use std::borrow::Cow;
+use web_time::{Duration, Instant};
+
+/// `prepare_points` when a point cloud lacks any attribute, on a copy of the scene (borrowed
+/// scenes that need nothing are not copied). voxgi's renderer and path tracer both call it, so
+/// both see the same points.
+pub fn complete_point_attributes(scene: &mut Cow<'_, Scene>) {
+    if scene.point_clouds.iter().any(|pc| {
+        !pc.positions.is_empty()
+            && (pc.normals.is_empty() || pc.radii.is_empty() || pc.regions.is_empty())
+    }) {
+        prepare_points(scene.to_mut());
+    }
+}
+
+/// How long `prepare_points` took for each attribute, summed over the clouds.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PointPreparation {
+    /// Points whose attributes were estimated.
+    pub points: usize,
+    /// Normal estimation (PCA over 16 neighbours).
+    pub normals: Duration,
+    /// Regions of influence (8 neighbours).
+    pub regions: Duration,
+    /// Disc radii (8 neighbours).
+    pub radii: Duration,
+}
+
+/// Fills in normals (k = 16), regions of influence and disc radii (k = 8) of point clouds that
+/// lack them, as voxgi's `Renderer::new` does (call it first to time it, or to keep the result for
+/// several renderers). Normals face the cloud's local origin when that lies outside the
+/// cloud's bounds (scanners put the sensor there), else the default camera.
+pub fn prepare_points(scene: &mut Scene) -> PointPreparation {
+    let mut timing = PointPreparation::default();
+    let camera = scene
+        .cameras
+        .first()
+        .cloned()
+        .unwrap_or_else(|| scene.default_camera())
+        .position;
+    for pc in &mut scene.point_clouds {
+        if pc.positions.is_empty()
+            || (!pc.normals.is_empty() && !pc.radii.is_empty() && !pc.regions.is_empty())
+        {
+            continue;
+        }
+        let start = Instant::now();
+        let mut local = Aabb::EMPTY;
+        for &p in &pc.positions {
+            local.grow(p);
+        }
+        let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
+        // `estimate_normals` takes the viewpoint in world space.
+        let viewpoint = if origin_outside {
+            pc.transform.transform_point3(Vec3::ZERO)
+        } else {
+            camera
+        };
+        let what: Vec<&str> = [
+            (pc.normals.is_empty(), "normals"),
+            (pc.radii.is_empty(), "radii"),
+            (pc.regions.is_empty(), "regions of influence"),
+        ]
+        .into_iter()
+        .filter_map(|(missing, name)| missing.then_some(name))
+        .collect();
+        let what = what.join(", ");
+        timing.points += pc.positions.len();
+        let t = Instant::now();
+        pointcloud::estimate_normals(pc, 16, viewpoint);
+        timing.normals += t.elapsed();
+        // Regions first: they take the file's radii, not estimated ones.
+        let t = Instant::now();
+        pointcloud::estimate_regions(pc, 8);
+        timing.regions += t.elapsed();
+        let t = Instant::now();
+        pointcloud::estimate_radii(pc, 8);
+        timing.radii += t.elapsed();
+        log::info!(
+            "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
+            pc.name,
+            pc.positions.len(),
+            start.elapsed().as_secs_f64(),
+            if origin_outside {
+                "the cloud's origin"
+            } else {
+                "the default camera"
+            }
+        );
+    }
+    timing
+}

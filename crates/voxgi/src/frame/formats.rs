@@ -1,0 +1,24 @@
+//! The formats of the frame's targets, in one place: the passes that write a target and those
+//! that read it name the same constant here, not each other.
+
+/// G-buffer albedo target: rgb linear base colour, a metallic.
+pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer normal target: rgb world-space unit normal (facing the viewer), a perceptual roughness.
+pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer emission target: rgb emitted radiance, a specular reflectance.
+pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer depth target (cleared to 1, less-than test).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Format of the HDR target the composite writes: linear radiance, RGBA f32 (read back by
+/// headless rendering and tone mapped to the output).
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// Format of the gather's indirect-light target: rgb the indirect radiance towards the camera,
+/// a the ambient occlusion.
+pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Cone-traced visibility of up to four area lights.
+pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// The gather pixels' geometry for the upsample's edge weights: normal (rgb) and distance to
+/// the camera (a; 0 for background).
+pub const GUIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

@@ -1,0 +1,588 @@
+//! The renderer: creation and the public API. It uploads a scene once, then records frames
+//! into the caller's encoder. The rest of it lives with its subject: the pass order in
+//! `order.rs`, scene updates and what they make out of date in `updates.rs`, the structure's
+//! creation in `voxel::factory`, bounce counts and cone uniforms in `lighting::{bounces, cones}`.
+//!
+//! Voxel work follows what changed (DESIGN.md, seam 6). The static geometry is voxelized and
+//! built once (on the first frame, after `invalidate`, a pool's growth or a voxel option's
+//! change); the dynamic geometry is voxelized and merged in on frames after it moved, undoing
+//! the previous merge. Camera motion alone does no voxel work. Overflow counters come back
+//! asynchronously (`gpu::feedback`): a build that overflowed is redone a frame later with room
+//! for everything, and no frame waits for the GPU.
+
+mod order;
+mod updates;
+
+pub use order::VOXEL_PASSES;
+
+use crate::brdf::BrdfTables;
+use crate::fragments::splat::SplatPass;
+use crate::fragments::voxelize::VoxelizePass;
+use crate::fragments::{self, FragmentEstimate, Fragments, TriangleTable, triangle_table};
+use crate::frame::targets::FrameTargets;
+use crate::gpu::feedback::CounterReadback;
+use crate::gpu::timer::GpuTimer;
+use crate::gpu::{checked, readback, requirements};
+use crate::gpu_scene::{GpuScene, bounding_sphere};
+use crate::lighting::atlas::{self as shadow, ShadowAtlas, plan_atlas};
+use crate::lighting::bounce::BouncePass;
+use crate::lighting::bounces::{leaves, voxel_bounce_count};
+use crate::lighting::cones::cone_uniforms;
+use crate::lighting::inject::InjectPass;
+use crate::lighting::moments::MomentsPass;
+use crate::lighting::shadow::ShadowPass;
+use crate::options::RendererOptions;
+use crate::scene_state::SceneState;
+use crate::screen::composite::CompositePass;
+use crate::screen::gather::{self, GatherPass};
+use crate::screen::gbuffer::GbufferPass;
+use crate::screen::tonemap::TonemapPass;
+use crate::screen::upsample::UpsamplePass;
+use crate::view::lit_scene;
+use crate::voxel::factory::{StructurePipelines, new_volume};
+use crate::voxel::{Grid, POOL_COUNTERS, Voxels};
+use crate::{Error, Result};
+use glam::Vec3;
+use updates::Pending;
+use voxgi_scene::{Aabb, Camera, Scene};
+use wgpu::util::DeviceExt;
+
+/// Every pass, by name.
+struct Passes {
+    shadow: ShadowPass,
+    moments: MomentsPass,
+    voxelize: VoxelizePass,
+    splat: SplatPass,
+    inject: InjectPass,
+    bounce: BouncePass,
+    gbuffer: GbufferPass,
+    gather: GatherPass,
+    upsample: UpsamplePass,
+    composite: CompositePass,
+    tonemap: TonemapPass,
+}
+
+/// Voxel statistics of a build, as the GPU counted them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VoxelCounts {
+    /// Fragments voxelization emitted (kept or not).
+    pub fragments: u64,
+    /// Voxels at least one fragment fell into.
+    pub occupied: u64,
+}
+
+/// A scene uploaded to the GPU, ready to render from any camera into the caller's targets.
+///
+/// The application owns the device: voxgi creates its resources on the `wgpu::Device` it is
+/// given, records into the caller's `CommandEncoder` and installs no handlers on the device.
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    options: RendererOptions,
+    scene: GpuScene,
+    atlas: ShadowAtlas,
+    passes: Passes,
+    brdf_tables: BrdfTables,
+    /// The layout of the screen passes' `@group(0)` (`globals`).
+    globals_layout: wgpu::BindGroupLayout,
+    /// The globals' bind group, made on the first frame after the targets or the atlas were
+    /// replaced.
+    globals: Option<wgpu::BindGroup>,
+    fragments: Fragments,
+    /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
+    /// (and `volume()`, for tests) names its kind.
+    volume: Voxels,
+    structure_pipelines: StructurePipelines,
+    /// Voxelize's triangle tables: the static instances' and the dynamic ones'.
+    static_triangles: TriangleTable,
+    dynamic_triangles: TriangleTable,
+    cones: wgpu::Buffer,
+    /// Voxel bounces per update (`voxel_bounce_count`: with cones the per-pixel gather adds the
+    /// last bounce; with leaves the last of these keeps the records and is not stored).
+    voxel_bounces: u32,
+    /// What changed since the voxels and shadow maps were last brought up to date.
+    pending: Pending,
+    /// Progressive bounces still to run before the voxel light has converged.
+    progressive_left: u32,
+    /// Frames rendered, for `voxel_update_interval`.
+    frame_index: u64,
+    /// Instances, lights and animations as last set.
+    state: SceneState,
+    counters: CounterReadback,
+    /// Counts every replacement of the fragments or the volume, so that counters read back
+    /// from pools that are gone are not acted on.
+    pools: u64,
+    last_counts: Option<VoxelCounts>,
+    timer: GpuTimer,
+    targets: Option<FrameTargets>,
+    center: Vec3,
+    radius: f32,
+    default_camera: Camera,
+    /// What option changes need from the scene, kept instead of the scene itself.
+    facts: SceneFacts,
+}
+
+/// What `set_options` needs to know of the scene to rebuild what an option feeds.
+struct SceneFacts {
+    /// Everything the scene draws at any time (what animations move, at all their poses).
+    bounds: Aabb,
+    /// Whether any instance is dynamic.
+    dynamic: bool,
+    estimate: FragmentEstimate,
+    /// The largest albedo of any material (the unlimited-bounce count's convergence).
+    max_albedo: f32,
+    /// Which lights cast shadows, in the scene's order.
+    casts: Vec<bool>,
+    /// Whether any surface may have a specular lobe.
+    glossy: bool,
+}
+
+impl SceneFacts {
+    /// Fragments the first buffer on `grid` has room for: the options' capacity, or the
+    /// scene's estimate.
+    fn fragments_wanted(&self, options: &RendererOptions, grid: &Grid) -> u64 {
+        options
+            .fragment_capacity
+            .unwrap_or_else(|| self.estimate.at(grid))
+    }
+}
+
+impl Renderer {
+    /// Uploads `scene` to `device`. A scene with nothing to draw (no triangles, no points) is
+    /// an error; a scene with no light at all gets a default sun (when
+    /// `options.default_light`) so it does not render black. Point clouds without normals or
+    /// radii get estimated ones. The device must offer `required_limits`' minimum
+    /// (`Error::DeviceLimits` names what it lacks).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        options: &RendererOptions,
+    ) -> Result<Self> {
+        options.validate()?;
+        requirements::check_device(device)?;
+        scene.validate()?;
+        if scene.triangle_count() == 0 && scene.point_count() == 0 {
+            return Err(Error::EmptyScene);
+        }
+        let mut scene = lit_scene(scene, options.default_light);
+        voxgi_scene::prepare::complete_point_attributes(&mut scene);
+        let scene = scene.as_ref();
+        let mut gpu_scene = checked(device, "scene upload", || {
+            GpuScene::new(device, queue, scene, options)
+        })??;
+        let state = SceneState::new(scene, &gpu_scene.instance_draw);
+        let bounds = state.swept_bounds(scene);
+        let (center, radius) = bounding_sphere(bounds);
+        let facts = SceneFacts {
+            bounds,
+            dynamic: scene.instances.iter().any(|i| i.dynamic),
+            estimate: FragmentEstimate::of(scene),
+            max_albedo: scene
+                .materials
+                .iter()
+                .map(|m| m.base_color[0].max(m.base_color[1]).max(m.base_color[2]))
+                .fold(0.0f32, f32::max),
+            casts: scene.lights.iter().map(|l| l.cast_shadows).collect(),
+            glossy: gather::has_glossy(scene, gpu_scene.point_count),
+        };
+        let atlas = plan_atlas(
+            device,
+            queue,
+            &mut gpu_scene,
+            &facts.casts,
+            options,
+            center,
+            radius,
+        )?;
+        let grid = grid(&facts, options);
+        let fragments = fragments::allocate(device, grid, facts.fragments_wanted(options, &grid))?;
+        let mut structure_pipelines = StructurePipelines::default();
+        let volume = new_volume(
+            device,
+            &mut structure_pipelines,
+            options,
+            grid,
+            facts.estimate.at(&grid),
+            facts.dynamic,
+        )?;
+        let passes = checked(device, "pipeline creation", || Passes {
+            shadow: ShadowPass::new(device),
+            moments: MomentsPass::new(device),
+            voxelize: VoxelizePass::new(device),
+            splat: SplatPass::new(device),
+            inject: InjectPass::new(
+                device,
+                options.voxels,
+                gpu_scene.light_count,
+                atlas.views.len(),
+                options.shadow_filter,
+            ),
+            bounce: BouncePass::new(device, options.voxels, options.anisotropic, leaves(options)),
+            gbuffer: GbufferPass::new(device),
+            gather: GatherPass::new(device, options, facts.glossy),
+            upsample: UpsamplePass::new(device),
+            composite: composite_pass(device, &gpu_scene, &facts, options),
+            tonemap: TonemapPass::new(device),
+        })?;
+        let (static_triangles, dynamic_triangles) = checked(device, "voxelization table", || {
+            Ok::<_, Error>((
+                triangle_table(device, &gpu_scene, false)?,
+                triangle_table(device, &gpu_scene, true)?,
+            ))
+        })??;
+        let brdf_tables = BrdfTables::new(device, queue);
+        let voxel_bounces = voxel_bounce_count(facts.max_albedo, options);
+        let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("cones"),
+            contents: bytemuck::bytes_of(&cone_uniforms(options, &grid)),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        // From the swept bounds, so that it is the same at every time of an animation.
+        let default_camera = scene
+            .cameras
+            .first()
+            .cloned()
+            .unwrap_or_else(|| Camera::viewing(bounds));
+        let views = atlas.views.len();
+        Ok(Renderer {
+            device: device.clone(),
+            queue: queue.clone(),
+            options: options.clone(),
+            scene: gpu_scene,
+            atlas,
+            passes,
+            brdf_tables,
+            globals_layout: crate::frame::globals::layout(device),
+            globals: None,
+            fragments,
+            volume,
+            structure_pipelines,
+            static_triangles,
+            dynamic_triangles,
+            cones,
+            voxel_bounces,
+            pending: Pending::everything(views),
+            progressive_left: 0,
+            frame_index: 0,
+            state,
+            counters: CounterReadback::new("voxel counters readback", 1 + POOL_COUNTERS),
+            pools: 0,
+            last_counts: None,
+            timer: GpuTimer::disabled(queue),
+            targets: None,
+            center,
+            radius,
+            default_camera,
+            facts,
+        })
+    }
+
+    /// Changes the options, rebuilding only what depends on the ones that changed: the fragments
+    /// for the resolution, the volume for its resolution or anisotropy, the shadow atlas for
+    /// its size or cone shadows, the gather, bounce and composite pipelines for what they are
+    /// specialised on; cone and AO parameters and the bounce count are uniform writes. Voxel
+    /// work is redone in the next frame only if something it depends on changed.
+    /// `max_texture_size` and `default_light` shape the uploaded scene: changing them is an
+    /// error (make a new renderer). `fragment_capacity` and `voxel_capacity` size a pool when
+    /// it is made anew (here, for a new resolution or anisotropy), not the pools in use.
+    pub fn set_options(&mut self, options: &RendererOptions) -> Result<()> {
+        options.validate()?;
+        let (old, new) = (&self.options, options);
+        if old.max_texture_size != new.max_texture_size || old.default_light != new.default_light {
+            return Err(Error::Setting(
+                "max_texture_size and default_light shape the uploaded scene: make a new \
+                 Renderer to change them"
+                    .into(),
+            ));
+        }
+        let device = &self.device;
+        let kind = old.voxels != new.voxels;
+        let volume = kind
+            || old.voxel_resolution != new.voxel_resolution
+            || old.anisotropic != new.anisotropic
+            || old.ndf_mips != new.ndf_mips;
+        let atlas = old.shadow_map_size != new.shadow_map_size
+            || old.cone_shadows != new.cone_shadows
+            || old.shadow_filter != new.shadow_filter
+            || shadow::atlas_resolution(old, &self.scene.gpu_lights)
+                != shadow::atlas_resolution(new, &self.scene.gpu_lights);
+        let cones = volume
+            || old.cones != new.cones
+            || old.step_factor != new.step_factor
+            || old.max_distance != new.max_distance
+            || old.ao_radius != new.ao_radius
+            || old.ao_lambda != new.ao_lambda
+            || old.origin_offset != new.origin_offset
+            || old.bounces != new.bounces
+            || old.indirect != new.indirect;
+        let grid = grid(&self.facts, new);
+        // Build everything first, so a failure leaves the renderer as it was.
+        let atlas_new = if atlas {
+            Some(plan_atlas(
+                device,
+                &self.queue,
+                &mut self.scene,
+                &self.facts.casts,
+                new,
+                self.center,
+                self.radius,
+            )?)
+        } else {
+            None
+        };
+        // The fragments depend on the grid only: a change of anisotropy keeps their grown pool.
+        let fragments_new = if old.voxel_resolution != new.voxel_resolution {
+            Some(fragments::allocate(
+                device,
+                grid,
+                self.facts.fragments_wanted(new, &grid),
+            )?)
+        } else {
+            None
+        };
+        let volume_new = if volume {
+            Some(new_volume(
+                device,
+                &mut self.structure_pipelines,
+                new,
+                grid,
+                self.facts.estimate.at(&grid),
+                self.facts.dynamic,
+            )?)
+        } else {
+            None
+        };
+        let indirect = old.indirect != new.indirect;
+        let filter = old.shadow_filter != new.shadow_filter;
+        let gather = volume || old.gather_axes != new.gather_axes || indirect;
+        let views = self.atlas.views.len();
+        let (gather_new, bounce_new, composite_new, inject_new) =
+            checked(device, "pipeline creation", || {
+                (
+                    gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
+                    (kind || old.anisotropic != new.anisotropic || indirect)
+                        .then(|| BouncePass::new(device, new.voxels, new.anisotropic, leaves(new))),
+                    (old.cone_shadows != new.cone_shadows || filter)
+                        .then(|| composite_pass(device, &self.scene, &self.facts, new)),
+                    (kind || filter).then(|| {
+                        InjectPass::new(
+                            device,
+                            new.voxels,
+                            self.scene.light_count,
+                            views,
+                            new.shadow_filter,
+                        )
+                    }),
+                )
+            })?;
+        if let Some(a) = atlas_new {
+            self.atlas = a;
+            self.globals = None;
+        }
+        if let Some(f) = fragments_new {
+            self.fragments = f;
+        }
+        if let Some(v) = volume_new {
+            self.volume = v;
+            self.pools += 1;
+        }
+        if let Some(p) = gather_new {
+            self.passes.gather = p;
+        }
+        if let Some(p) = bounce_new {
+            self.passes.bounce = p;
+        }
+        if let Some(p) = composite_new {
+            self.passes.composite = p;
+        }
+        if let Some(p) = inject_new {
+            self.passes.inject = p;
+        }
+        if cones {
+            self.queue.write_buffer(
+                &self.cones,
+                0,
+                bytemuck::bytes_of(&cone_uniforms(new, &grid)),
+            );
+            self.voxel_bounces = voxel_bounce_count(self.facts.max_albedo, new);
+        }
+        // The gather's resolution needs no work here: the next frame makes targets to match.
+        let progressive = old.progressive != new.progressive;
+        self.options = options.clone();
+        if volume || atlas || cones || progressive {
+            self.invalidate();
+        }
+        Ok(())
+    }
+
+    /// Whether the voxels (or progressive bounces) still have work queued for a coming frame:
+    /// false once everything set so far is in the voxels and the light has converged.
+    pub fn voxels_settled(&self) -> bool {
+        !self.voxel_work_pending()
+    }
+
+    /// Whether rendering again with the same frame parameters and target would give the same
+    /// image: the voxels are settled and no voxel counter is still on its way back (one that
+    /// overflowed would make the next frame rebuild). An application may then show its last
+    /// image instead of rendering.
+    pub fn is_idle(&self) -> bool {
+        self.voxels_settled() && !self.counters.pending()
+    }
+
+    /// Whether a voxel counter read back is submitted but has not completed (`headless::render`
+    /// waits for it before deciding that a frame is final).
+    #[cfg(feature = "headless")]
+    pub(crate) fn feedback_in_flight(&self) -> bool {
+        self.counters.in_flight()
+    }
+
+    /// The scene's own camera, or a view of its bounds.
+    pub fn default_camera(&self) -> &Camera {
+        &self.default_camera
+    }
+
+    /// The options this renderer was made with.
+    pub fn options(&self) -> &RendererOptions {
+        &self.options
+    }
+
+    /// Bytes of GPU memory per resource.
+    pub fn memory(&self) -> Vec<(&'static str, u64)> {
+        let mut m = self.scene.memory();
+        m.push(("shadow atlas", self.atlas.bytes()));
+        m.extend(self.fragments.memory());
+        m.extend(self.volume.get().memory());
+        if let Some(t) = &self.targets {
+            m.push(("render targets", t.bytes()));
+        }
+        m
+    }
+
+    /// Acts on voxel counters that have come back since the last call: when a build had more
+    /// fragments or occupied voxels than room, the pools grow to fit and the voxels are rebuilt
+    /// in the next frame. Never waits; `render` calls it first. Returns whether the next frame
+    /// rebuilds the voxels.
+    pub fn receive_feedback(&mut self) -> Result<bool> {
+        // Errors of resources made since the last frame, where the device reports them late.
+        crate::gpu::late_error(&self.device)?;
+        // Non-blocking: runs the callbacks of maps that have completed.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        for (pools, words) in self.counters.take_ready() {
+            if pools != self.pools {
+                continue;
+            }
+            let counts = VoxelCounts {
+                fragments: words[0] as u64,
+                occupied: words[1] as u64,
+            };
+            let mut pools = [0u32; POOL_COUNTERS];
+            pools.copy_from_slice(&words[1..1 + POOL_COUNTERS]);
+            self.last_counts = Some(counts);
+            let frags = self.fragments.capacity as u64;
+            let grow_volume = self.volume.get().needs_growth(&pools);
+            if counts.fragments <= frags && !grow_volume {
+                continue;
+            }
+            // Build what grows first and swap it in only when all of it succeeded. A count
+            // past this device's limits is an error here (once per overflowing build), not a
+            // pool grown to the limit and rebuilt forever.
+            let fragments = if counts.fragments > frags {
+                let capacity = fragments::capacity(&self.device, counts.fragments)?;
+                let grid = self.fragments.grid;
+                Some(checked(&self.device, "voxel fragments", || {
+                    Fragments::new(&self.device, grid, capacity)
+                })?)
+            } else {
+                None
+            };
+            if grow_volume {
+                self.volume.get_mut().grow(&self.device, &pools)?;
+            }
+            if let Some(f) = fragments {
+                self.fragments = f;
+            }
+            self.pools += 1;
+            log::info!(
+                "voxels: {} fragments, {} occupied voxels: growing the pools to {} fragments \
+                 and {} voxels and rebuilding",
+                counts.fragments,
+                counts.occupied,
+                self.fragments.capacity,
+                self.volume.get().leaf_capacity()
+            );
+            self.invalidate();
+        }
+        Ok(self.pending.rebuild)
+    }
+
+    /// Voxel statistics of the most recent build whose counters have come back.
+    pub fn last_voxel_counts(&self) -> Option<VoxelCounts> {
+        self.last_counts
+    }
+
+    /// Voxel statistics of the last build, read back now. This waits for the GPU: it is for
+    /// tools and tests, never called by a frame.
+    pub fn voxel_counts(&self) -> Result<VoxelCounts> {
+        let read = |b: &wgpu::Buffer| -> Result<u64> {
+            let bytes = readback::read_buffer_copy(&self.device, &self.queue, b)?;
+            Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[0] as u64)
+        };
+        Ok(VoxelCounts {
+            fragments: read(&self.fragments.count)?,
+            occupied: read(self.volume.get().pool_counter())?,
+        })
+    }
+
+    /// The fragments of the last build, for tests and debugging.
+    pub fn fragments(&self) -> &Fragments {
+        &self.fragments
+    }
+
+    /// The voxel structure, for tests and debugging.
+    pub fn volume(&self) -> &Voxels {
+        &self.volume
+    }
+
+    /// Turns per-pass GPU timing on or off (when the device has `TIMESTAMP_QUERY`).
+    pub fn enable_timing(&mut self, on: bool) {
+        self.timer = GpuTimer::new(&self.device, &self.queue, on);
+    }
+
+    /// Milliseconds per pass of everything recorded since the last call, once it has been
+    /// submitted. This waits for the GPU (for `voxgi bench`).
+    pub fn pass_times(&mut self) -> Result<Vec<(&'static str, f64)>> {
+        self.timer.read(&self.device)
+    }
+
+    /// Marks everything as changed: the next frame re-renders every shadow view and rebuilds
+    /// the voxels, static geometry included.
+    pub fn invalidate(&mut self) {
+        self.pending = Pending::everything(self.atlas.views.len());
+    }
+
+    /// The linear HDR radiance of the last frame (before exposure and tone mapping),
+    /// `Rgba32Float` at the last target's size, with `COPY_SRC` and `TEXTURE_BINDING` usage.
+    pub fn hdr_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.hdr_texture)
+    }
+}
+
+/// The volume's grid around the scene.
+fn grid(facts: &SceneFacts, options: &RendererOptions) -> Grid {
+    Grid::around(facts.bounds.min, facts.bounds.max, options.voxel_resolution)
+}
+
+fn composite_pass(
+    device: &wgpu::Device,
+    scene: &GpuScene,
+    facts: &SceneFacts,
+    options: &RendererOptions,
+) -> CompositePass {
+    CompositePass::new(
+        device,
+        shadow::composite_reads_shadow_maps(&scene.gpu_lights, options.cone_shadows),
+        facts.glossy,
+        options.shadow_filter,
+    )
+}

@@ -1,0 +1,324 @@
+//! The pass order: every pass a frame runs, called in one fixed order from here. This is where
+//! a reader learns the pipeline (docs/ARCHITECTURE.md draws it):
+//!
+//! ```text
+//! shadow → [moments] → [voxelize (static) → splat → <kind>_build] → [voxelize (dynamic) → <kind>_update]
+//!        → inject → filter → (bounce → filter) × (bounces − 1) → [bounce (records)]
+//!        → gbuffer → gather → upsample → composite → [debug] → tonemap
+//! ```
+//!
+//! The voxel passes (up to the last `filter` or `bounce`) run only for what changed since the
+//! last voxel update (`updates::Pending`), every `voxel_update_interval` frames; a rebuild
+//! never waits. With progressive bounces one bounce runs per frame until the light converges.
+//! With the fast shading (`IndirectShading::Leaves`) one more bounce keeps every leaf's
+//! irradiance and is neither stored nor filtered. `debug` runs only for the voxel views and
+//! replaces the composite's output; `tonemap` writes the caller's target. Passes depend on
+//! shared resources (the GPU scene, the shadow atlas, the fragments, the structure, the
+//! frame's targets), never on each other. Nothing here waits for the GPU.
+
+use super::Renderer;
+use crate::Result;
+use crate::frame::globals::{self, GlobalsSources};
+use crate::frame::targets::{FrameTargets, Target};
+use crate::frame::uniforms::{FrameScene, GpuFrame};
+use crate::gpu::checked;
+use crate::gpu::timer::GpuTimer;
+use crate::lighting::atlas::ViewDirt;
+use crate::lighting::bounce::BounceSteps;
+use crate::lighting::bounces;
+use crate::lighting::inject::InjectPass;
+use crate::options::{FrameParams, ShadowFilter, validate_size};
+use crate::voxel::{DebugView, POOL_COUNTERS};
+
+/// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
+/// camera), in the order they run; every other pass is the screen's.
+pub const VOXEL_PASSES: [&str; 12] = [
+    "shadow",
+    "moments",
+    "voxelize",
+    "splat",
+    "dense_build",
+    "dense_update",
+    "octree_build",
+    "octree_update",
+    "inject",
+    "filter",
+    "octree_filter",
+    "bounce",
+];
+
+impl Renderer {
+    /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
+    /// whole extent). Submit the encoder before the next call: the frame's uniforms are written
+    /// through the queue, so two frames in one submission would share the last one's; and a
+    /// frame that records the voxel update counts on that encoder being submitted (dropped,
+    /// the update is lost until the next `invalidate`).
+    ///
+    /// The target's texture needs `TextureUsages::RENDER_ATTACHMENT` (nothing else), in a
+    /// renderable colour format: `Bgra8UnormSrgb` or `Rgba8UnormSrgb` (a swapchain's; the GPU
+    /// encodes sRGB), `Rgba8Unorm` or `Bgra8Unorm` (voxgi applies the sRGB curve), or a float
+    /// format such as `Rgba16Float` (tone-mapped linear values). Its previous contents are
+    /// overwritten. The first frame in a new format creates that format's pipeline.
+    ///
+    /// On the first frame (and after `invalidate`, a pool's growth or a voxel option's change)
+    /// this also records the voxel update. Nothing here waits for the GPU.
+    pub fn render(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        params: &FrameParams,
+    ) -> Result<()> {
+        let (width, height) = (target.width, target.height);
+        validate_size(width, height)?;
+        params.validate(self.options.voxel_levels())?;
+        self.receive_feedback()?;
+        self.passes.tonemap.prepare(&self.device, target.format)?;
+        let half = self.options.half_resolution;
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| t.width != width || t.height != height || t.half != half)
+        {
+            // Out of memory for large sizes is an error here, not the device's handler's.
+            self.targets = Some(checked(&self.device, "render targets", || {
+                FrameTargets::new(&self.device, width, height, half)
+            })?);
+            self.globals = None;
+        }
+        self.record_shadows(encoder);
+        let interval = self.options.voxel_update_interval.max(1) as u64;
+        // A rebuild (the first frame among them) never waits for its turn.
+        if self.voxel_work_pending()
+            && (self.pending.rebuild || self.frame_index.is_multiple_of(interval))
+        {
+            self.record_voxels(encoder);
+        }
+        self.frame_index += 1;
+        let frame = GpuFrame::new(
+            params,
+            &FrameScene {
+                center: self.center,
+                radius: self.radius,
+                light_count: self.scene.light_count,
+                cone_shadows: self.options.cone_shadows,
+                geometry_points: self.scene.geometry_points,
+            },
+            width,
+            height,
+        );
+        let t = self.targets.as_ref().expect("targets were just created");
+        self.queue
+            .write_buffer(&t.frame, 0, bytemuck::bytes_of(&frame));
+        // Made again only when a resource it binds was replaced (new targets, a new atlas).
+        let globals = self.globals.get_or_insert_with(|| {
+            globals::bind_group(
+                &self.device,
+                &self.globals_layout,
+                &GlobalsSources {
+                    frame: &t.frame,
+                    cones: &self.cones,
+                    lighting: self.atlas.lighting_resources(&self.scene),
+                    tables: &self.brdf_tables,
+                },
+            )
+        });
+        let timer = &mut self.timer;
+        let p = &self.passes;
+        p.gbuffer
+            .record(&self.device, encoder, t, &self.scene, timer);
+        p.gather
+            .record(&self.device, encoder, t, globals, self.volume.get(), timer);
+        p.upsample.record(&self.device, encoder, t, globals, timer);
+        p.composite.record(&self.device, encoder, t, globals, timer);
+        // Only for the voxel views: replaces the composite's output.
+        if params.view.is_voxel() {
+            self.volume.get().record_debug(
+                &self.device,
+                encoder,
+                t,
+                DebugView {
+                    mode: params.view,
+                    level: params.debug_level,
+                    direction: params.debug_direction,
+                },
+                timer,
+            );
+        }
+        p.tonemap
+            .record(&self.device, encoder, t, globals, target, timer);
+        timer.resolve(encoder);
+        Ok(())
+    }
+
+    /// Records the shadow views that must be re-rendered (all after a rebuild).
+    fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let views = std::mem::take(&mut self.pending.views);
+        if views.iter().any(|&v| v != ViewDirt::Clean) {
+            self.passes.shadow.record(
+                &self.device,
+                encoder,
+                &self.atlas,
+                &self.scene,
+                &views,
+                &mut self.timer,
+            );
+            if self.options.shadow_filter == ShadowFilter::VsmEsm {
+                self.passes.moments.record(
+                    &self.device,
+                    encoder,
+                    &self.atlas,
+                    &views,
+                    &mut self.timer,
+                );
+            }
+        }
+        self.pending.views = vec![ViewDirt::Clean; self.atlas.views.len()];
+    }
+
+    /// Whether the next voxel update has work: something changed, or progressive bounces
+    /// have not converged.
+    pub(super) fn voxel_work_pending(&self) -> bool {
+        let p = &self.pending;
+        p.rebuild || p.geometry || p.lights || self.progressive_left > 0
+    }
+
+    /// Records what the changes since the last voxel update need, in the fixed order:
+    /// voxelize the static geometry and build (after a rebuild), voxelize the dynamic geometry
+    /// and update (after it moved), inject, then filter and bounce; with progressive bounces,
+    /// one bounce per update until converged.
+    fn record_voxels(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let pending = std::mem::take(&mut self.pending);
+        let geometry = pending.rebuild || pending.geometry;
+        if geometry || pending.lights {
+            self.passes.inject.prepare(
+                &self.device,
+                &self.queue,
+                self.volume.get(),
+                pending.rebuild || pending.lights,
+                // Stored bounces overwrite the radiance: it must start from the direct light
+                // again.
+                bounces::stored_bounces(&self.options, self.voxel_bounces) > 0,
+                pending.moved,
+                &pending.inject_views,
+                self.atlas.texture.width(),
+            );
+        }
+        let timer = &mut self.timer;
+        let p = &self.passes;
+        if pending.rebuild {
+            self.fragments.record_clear(encoder);
+            let t = &self.static_triangles;
+            p.voxelize.record(
+                &self.device,
+                encoder,
+                &self.scene,
+                t,
+                &self.fragments,
+                timer,
+            );
+            // Point clouds are static: the renderer places them once.
+            p.splat
+                .record(&self.device, encoder, &self.scene, &self.fragments, timer);
+            self.fragments.record_mark(encoder);
+            self.volume
+                .get()
+                .record_build(&self.device, encoder, &self.fragments, timer);
+        }
+        if geometry && self.facts.dynamic {
+            self.fragments.record_truncate(encoder);
+            let t = &self.dynamic_triangles;
+            p.voxelize.record(
+                &self.device,
+                encoder,
+                &self.scene,
+                t,
+                &self.fragments,
+                timer,
+            );
+            self.volume
+                .get()
+                .record_update(&self.device, encoder, &self.fragments, timer);
+        }
+        if geometry {
+            // The kernels never write past their buffers, they only count: the counts come
+            // back a frame or more later and grow the pools then (`receive_feedback`).
+            if !self.counters.request(
+                &self.device,
+                encoder,
+                &[
+                    (&self.fragments.count, 1),
+                    (self.volume.get().pool_counter(), POOL_COUNTERS),
+                ],
+                self.pools,
+            ) {
+                log::warn!(
+                    "voxel counters: too many readbacks in flight; is the encoder submitted?"
+                );
+            }
+        }
+        let progressive = self.options.progressive;
+        // One bounce, and the filtering its stored light needs.
+        let bounce =
+            |encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer, steps: BounceSteps| {
+                let volume = self.volume.get();
+                p.bounce
+                    .record(&self.device, encoder, volume, &self.cones, steps, timer);
+                if steps.store {
+                    volume.record_filter(&self.device, encoder, timer);
+                }
+            };
+        if geometry || pending.lights {
+            let inject = if progressive {
+                InjectPass::record_direct_only
+            } else {
+                InjectPass::record
+            };
+            inject(
+                &p.inject,
+                &self.device,
+                encoder,
+                &self.scene,
+                &self.atlas,
+                self.volume.get(),
+                timer,
+            );
+            if progressive {
+                // One bounce per update from the previous update's light; after a change
+                // this many updates make every leaf's light converge again (the first from
+                // a cleared volume only reproduces the direct light).
+                self.progressive_left = self.voxel_bounces + 1;
+            } else {
+                self.volume
+                    .get()
+                    .record_filter(&self.device, encoder, timer);
+                let n = self.voxel_bounces;
+                for i in 0..n {
+                    // With leaves the last bounce's light is what the pixels read: it keeps
+                    // the irradiance and need not be stored or filtered (the glossy cones
+                    // then see the same light as with cones).
+                    let last = bounces::leaves(&self.options) && i + 1 == n;
+                    let steps = BounceSteps {
+                        irradiance: last,
+                        store: !last,
+                    };
+                    bounce(encoder, timer, steps);
+                }
+            }
+        }
+        if progressive && self.progressive_left > 0 {
+            // Every step is stored (the next builds on it) and, with leaves, keeps the records
+            // too, so pixels follow the light as it converges. Its bundles are then turned by
+            // the records' layout and it traces occlusion at every step; the converged light
+            // is the same as without (the last bounces add less than 0.1 %), not bit for bit.
+            let steps = BounceSteps {
+                irradiance: bounces::leaves(&self.options),
+                store: true,
+            };
+            bounce(encoder, timer, steps);
+            self.progressive_left -= 1;
+        }
+        // The shadow views were consumed by `record_shadows` this frame; injection's start over.
+        self.pending.views = pending.views;
+        self.pending.inject_views = vec![ViewDirt::Clean; self.atlas.views.len()];
+    }
+}

@@ -1,0 +1,177 @@
+//! Scene updates between frames: moving instances, changing lights and the animations' time,
+//! and the record of what they made out of date (`Pending`) for the next frame's voxel update
+//! and shadow views.
+
+use super::Renderer;
+use crate::gpu_scene::{check_light, gpu_light};
+use crate::lighting::atlas::{self as shadow, ViewDirt};
+use crate::{Error, Result};
+use glam::Mat4;
+use voxgi_scene::{Aabb, Light};
+
+/// What changed since the last voxel update.
+#[derive(Default)]
+pub(super) struct Pending {
+    /// Everything: the static geometry too, and every shadow view.
+    pub(super) rebuild: bool,
+    /// Dynamic geometry moved.
+    pub(super) geometry: bool,
+    /// A light changed.
+    pub(super) lights: bool,
+    /// What of each shadow view (by atlas layer) to re-render; consumed every frame, unlike
+    /// the rest, which waits for the next voxel update.
+    pub(super) views: Vec<ViewDirt>,
+    /// What of each view changed since the last injection: the leaves reading only texels
+    /// outside it keep their direct light.
+    pub(super) inject_views: Vec<ViewDirt>,
+    /// Where dynamic geometry was or is now since the last injection (world space): leaves
+    /// there are re-injected, their voxels may have changed.
+    pub(super) moved: Option<Aabb>,
+}
+
+impl Pending {
+    /// Everything out of date, for an atlas of `views` views.
+    pub(super) fn everything(views: usize) -> Self {
+        Pending {
+            rebuild: true,
+            views: vec![ViewDirt::All; views],
+            inject_views: vec![ViewDirt::All; views],
+            ..Default::default()
+        }
+    }
+
+    /// Marks view `i` out of date within `dirt`, for the shadow pass and for injection.
+    fn view(&mut self, i: usize, dirt: ViewDirt) {
+        self.views[i] = self.views[i].merge(dirt);
+        self.inject_views[i] = self.inject_views[i].merge(dirt);
+    }
+}
+
+impl Renderer {
+    /// Moves instance `instance` (an index into the scene's instances) to `transform`. Only
+    /// dynamic instances move (`Instance::dynamic`); moving a static one is an error, as is a
+    /// transform that is not finite. The next voxel update re-voxelizes the dynamic geometry,
+    /// and the shadow views that see the instance's old or new place re-render. Geometry moved
+    /// outside the volume (the scene's bounds, with every pose of its animations) is not
+    /// voxelized there.
+    pub fn set_instance_transform(&mut self, instance: usize, transform: Mat4) -> Result<()> {
+        let count = self.state.instances.len();
+        let inst = self.state.instances.get(instance).ok_or_else(|| {
+            Error::Setting(format!(
+                "instance {instance} does not exist (the scene has {count})"
+            ))
+        })?;
+        if !transform.is_finite() {
+            return Err(Error::Setting(format!(
+                "instance '{}': the transform is not finite",
+                inst.name
+            )));
+        }
+        if transform == inst.transform {
+            return Ok(());
+        }
+        if !inst.dynamic {
+            return Err(Error::Setting(format!(
+                "instance '{}' is static: only dynamic instances move (mark it dynamic in the \
+                 scene: `dynamic = true` on its include)",
+                inst.name
+            )));
+        }
+        let (old, new) = (
+            inst.world_bounds(inst.transform),
+            inst.world_bounds(transform),
+        );
+        if let Some(draw) = inst.draw {
+            self.scene.set_transform(&self.queue, draw, transform);
+            for i in 0..self.atlas.views.len() {
+                let v = &self.atlas.views[i];
+                let dirt = shadow::box_dirt(v, old.min, old.max)
+                    .merge(shadow::box_dirt(v, new.min, new.max));
+                self.pending.view(i, dirt);
+            }
+            let moved = old.union(&new);
+            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
+            self.pending.geometry = true;
+        }
+        self.state.instances[instance].transform = transform;
+        Ok(())
+    }
+
+    /// Changes light `index` (into the scene's lights) to `light`: its position, direction,
+    /// colour, intensity, range, cone angles or area shape. Its kind (directional, point,
+    /// spot, area) and whether it casts shadows are fixed once uploaded (an error: make a new
+    /// `Renderer`). The light's shadow views re-render and the voxel light is redone.
+    pub fn set_light(&mut self, index: usize, light: &Light) -> Result<()> {
+        let count = self.state.lights.len();
+        let old = self.state.lights.get(index).ok_or_else(|| {
+            Error::Setting(format!(
+                "light {index} does not exist (the scene has {count})"
+            ))
+        })?;
+        if old == light {
+            return Ok(());
+        }
+        let mut g = gpu_light(light);
+        let was = self.scene.gpu_lights[index];
+        check_light(light)?;
+        if g.kind != was.kind || light.cast_shadows != old.cast_shadows {
+            return Err(Error::Setting(format!(
+                "light '{}': its kind and whether it casts shadows are fixed once uploaded; make \
+                 a new Renderer to change them",
+                light.name
+            )));
+        }
+        g.shadow_first = was.shadow_first;
+        g.shadow_count = was.shadow_count;
+        self.scene.gpu_lights[index] = g;
+        self.state.lights[index] = light.clone();
+        // Re-plan every view (a light's views follow its position and direction) and re-render
+        // those that changed: the moved light's.
+        let res = self.atlas.texture.width();
+        let (views, _) = shadow::plan_views(
+            &mut self.scene.gpu_lights,
+            &self.facts.casts,
+            self.center,
+            self.radius,
+            res,
+        );
+        for (i, (new, old)) in views.iter().zip(&self.atlas.views).enumerate() {
+            if bytemuck::bytes_of(new) != bytemuck::bytes_of(old) {
+                self.pending.view(i, ViewDirt::All);
+            }
+        }
+        self.atlas.update_views(&self.queue, views);
+        self.queue.write_buffer(
+            &self.scene.lights,
+            0,
+            bytemuck::cast_slice(&self.scene.gpu_lights),
+        );
+        self.pending.lights = true;
+        Ok(())
+    }
+
+    /// Sets the scene's time, in seconds: every animation moves its instances and lights to
+    /// their state at `t` (`Scene::set_time`), through `set_instance_transform` and
+    /// `set_light`. Only what changed is updated.
+    pub fn set_time(&mut self, t: f32) -> Result<()> {
+        let changes = self.state.set_time(t)?;
+        for (i, m) in changes.instances {
+            self.set_instance_transform(i, m)?;
+        }
+        for (l, light) in changes.lights {
+            self.set_light(l, &light)?;
+        }
+        Ok(())
+    }
+
+    /// The lights as last set (the scene's, and the default sun when one was added), in the
+    /// order `set_light` indexes them.
+    pub fn lights(&self) -> &[Light] {
+        &self.state.lights
+    }
+
+    /// The scene's animations (as `Scene::animations`).
+    pub fn animations(&self) -> &[voxgi_scene::animation::Animation] {
+        self.state.animations()
+    }
+}
