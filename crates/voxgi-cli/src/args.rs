@@ -43,7 +43,7 @@ pub struct SettingsArgs {
     pub shadow_map_size: Option<u32>,
     /// Voxel structure: dense (the mip-mapped volume) or octree (the sparse voxel octree,
     /// memory in proportion to the occupied voxels). Default dense.
-    #[arg(long, value_parser = names(voxgi::VoxelKind::ALL.map(voxgi::VoxelKind::name)))]
+    #[arg(long, value_parser = names(voxgi::VoxelKind::names()))]
     pub voxels: Option<String>,
     /// Voxels per side of the volume (power of two, 16..=512; the octree 16..=1024). Default 128.
     #[arg(long, value_name = "N")]
@@ -173,7 +173,7 @@ pub fn default_camera(scene: &Scene) -> Camera {
 }
 
 /// A clap parser for one of the library's names.
-fn names<const N: usize>(names: [&'static str; N]) -> clap::builder::PossibleValuesParser {
+fn names(names: impl IntoIterator<Item = &'static str>) -> clap::builder::PossibleValuesParser {
     clap::builder::PossibleValuesParser::new(names)
 }
 

@@ -116,6 +116,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let (mut voxel_sums, mut screen_sums) = (Vec::new(), Vec::new());
     let mut walls = Vec::new();
     let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
+    let voxel_passes = voxgi::voxel_passes();
     for i in 0..args.warmup + args.frames {
         // Wall time from recording to the timestamps' readback: the whole frame, CPU included,
         // whatever a driver's timestamps miss (lavapipe's read about 0 for some passes).
@@ -141,7 +142,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         totals.push(times.iter().map(|(_, ms)| ms).sum::<f64>());
         let voxel: f64 = times
             .iter()
-            .filter(|(n, _)| voxgi::VOXEL_PASSES.contains(n))
+            .filter(|(n, _)| voxel_passes.contains(n))
             .map(|(_, ms)| ms)
             .sum();
         voxel_sums.push(voxel);
@@ -168,10 +169,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // Voxel passes first, in the order they run; a pass that ran in only some frames says in
     // how many (its median is over those).
     per_pass.sort_by_key(|(n, _)| {
-        voxgi::VOXEL_PASSES
+        voxel_passes
             .iter()
             .position(|v| v == n)
-            .unwrap_or(voxgi::VOXEL_PASSES.len())
+            .unwrap_or(voxel_passes.len())
     });
     for (name, v) in &mut per_pass {
         v.sort_by(f64::total_cmp);

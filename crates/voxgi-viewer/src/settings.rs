@@ -63,7 +63,7 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
     egui::ComboBox::from_label("voxel structure")
         .selected_text(draft.voxels.name())
         .show_ui(ui, |ui| {
-            for k in voxgi::VoxelKind::ALL {
+            for &k in voxgi::VoxelKind::ALL {
                 ui.selectable_value(&mut draft.voxels, k, k.name());
             }
         });

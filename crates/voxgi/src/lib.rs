@@ -59,14 +59,15 @@ pub use frame::targets::{FrameTargets, Target};
 pub use gpu::requirements::{check_device, minimum_limits, required_features, required_limits};
 pub use options::{
     ConeSet, DIRECTIONS, FrameParams, IndirectShading, MAX_BOUNCES, MAX_IMAGE_SIZE,
-    RendererOptions, ShadowFilter, Tonemap, UNLIMITED_BOUNCES, ViewMode, VoxelKind, validate_size,
+    RendererOptions, ShadowFilter, Tonemap, UNLIMITED_BOUNCES, ViewMode, validate_size,
 };
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use renderer::{Renderer, VOXEL_PASSES, VoxelCounts};
+pub use renderer::{Renderer, VoxelCounts};
 pub use scene_state::swept_bounds;
 pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
+pub use voxel::{VoxelKind, voxel_passes};
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;
 pub use voxgi_scene::prepare::{PointPreparation, prepare_points};

@@ -1,43 +1,14 @@
 //! The renderer's knobs with their documented defaults and range checks: creation-time
 //! options apart from per-frame parameters.
 
+pub use crate::voxel::VoxelKind;
+use crate::voxel::VoxelView;
 use crate::{Error, Result};
 use voxgi_scene::Camera;
 
 /// Names of the directional chains (`FrameParams::debug_direction`), in the order the
 /// anisotropic filters store them.
 pub const DIRECTIONS: [&str; 6] = ["+x", "-x", "+y", "-y", "+z", "-z"];
-
-/// Which voxel structure a renderer builds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum VoxelKind {
-    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
-    #[default]
-    Dense,
-    /// The sparse voxel octree: memory in proportion to the occupied voxels.
-    Octree,
-}
-
-impl VoxelKind {
-    /// Both, in the order of their names.
-    pub const ALL: [VoxelKind; 2] = [VoxelKind::Dense, VoxelKind::Octree];
-
-    /// The name settings and the command line use, also the WGSL folder `shaders/voxels/<name>/`.
-    pub fn name(self) -> &'static str {
-        match self {
-            VoxelKind::Dense => "dense",
-            VoxelKind::Octree => "octree",
-        }
-    }
-
-    /// The structure named `s`.
-    pub fn parse(s: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| Error::Setting(format!("voxel structure '{s}' is not dense or octree")))
-    }
-}
 
 /// A set of diffuse cones around the normal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -182,6 +153,17 @@ impl ViewMode {
                 let names: Vec<&str> = Self::ALL.iter().map(|v| v.name()).collect();
                 Error::Setting(format!("view '{s}' is not one of {}", names.join(", ")))
             })
+    }
+
+    /// What the `debug` pass draws for a voxel view; `None` for the others.
+    pub fn voxel_view(&self) -> Option<VoxelView> {
+        match self {
+            ViewMode::VoxelAlbedo => Some(VoxelView::Albedo),
+            ViewMode::VoxelOpacity => Some(VoxelView::Opacity),
+            ViewMode::VoxelRadiance => Some(VoxelView::Radiance),
+            ViewMode::VoxelNodes => Some(VoxelView::Nodes),
+            _ => None,
+        }
     }
 
     /// The views the `debug` pass draws by ray-marching the voxel volume.
@@ -357,7 +339,7 @@ impl Default for RendererOptions {
             shadow_filter: ShadowFilter::Pcf,
             max_texture_size: 1024,
             default_light: true,
-            voxels: VoxelKind::Dense,
+            voxels: VoxelKind::DENSE,
             voxel_resolution: 128,
             anisotropic: true,
             ndf_mips: false,
@@ -397,12 +379,7 @@ impl RendererOptions {
             ));
         }
         let r = self.voxel_resolution;
-        // The fragments' 10-bit coordinates reach 1024; a dense volume past 512 is 1 GiB a
-        // texture.
-        let top = match self.voxels {
-            VoxelKind::Dense => 512,
-            VoxelKind::Octree => 1024,
-        };
+        let top = self.voxels.info().max_resolution;
         if !(16..=top).contains(&r) || !r.is_power_of_two() {
             return fail(format!(
                 "voxel resolution {r} is not a power of two in 16..={top} (the {} structure)",

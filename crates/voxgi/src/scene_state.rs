@@ -63,6 +63,16 @@ pub struct SceneState {
     animated_lights: Vec<usize>,
 }
 
+impl SceneState {
+    /// Where the dynamic instances are now (empty when there are none).
+    pub fn dynamic_bounds(&self) -> Aabb {
+        self.instances
+            .iter()
+            .filter(|i| i.dynamic && i.draw.is_some())
+            .fold(Aabb::EMPTY, |b, i| b.union(&i.world_bounds(i.transform)))
+    }
+}
+
 /// The bounds of everything `scene` draws at any time of its animations (what the renderer's
 /// volume and default camera are placed around).
 pub fn swept_bounds(scene: &Scene) -> Aabb {

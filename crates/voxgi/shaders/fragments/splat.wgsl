@@ -27,6 +27,8 @@
 @group(0) @binding(3) var<storage, read_write> fragments: array<Fragment>;
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
 @group(0) @binding(4) var<storage, read_write> fragment_count: array<atomic<u32>>;
+// Fragments are made in these voxels only.
+@group(0) @binding(5) var<uniform> region: FragmentRegion;
 
 const SUB: u32 = 1024u;
 
@@ -60,7 +62,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let c0 = lo >> vec3<u32>(10u);
     let o0 = vec3<u32>(min(lo + vec3<i32>(i32(eq)), (c0 + vec3<i32>(1)) << vec3<u32>(10u)) - lo);
     let o1 = vec3<u32>(eq) - o0;
-    let res = i32(grid.resolution);
     let albedo = point_albedo(pt);
     var n = n_in;
     if dot(n, n) == 0.0 {
@@ -75,7 +76,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let b = vec3<u32>(k & 1u, (k >> 1u) & 1u, (k >> 2u) & 1u);
         let o = select(o0, o1, b == vec3<u32>(1u));
         let cell = c0 + vec3<i32>(b);
-        if any(o == vec3<u32>(0u)) || any(cell < vec3<i32>(0)) || any(cell >= vec3<i32>(res)) {
+        if any(o == vec3<u32>(0u)) || any(cell < vec3<i32>(region.lo)) || any(cell > vec3<i32>(region.hi)) {
             continue;
         }
         let volume = o.x * o.y * o.z;

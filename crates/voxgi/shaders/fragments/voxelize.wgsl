@@ -21,6 +21,8 @@
 @group(0) @binding(8) var<storage, read_write> fragments: array<Fragment>;
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
 @group(0) @binding(9) var<storage, read_write> fragment_count: array<atomic<u32>>;
+// Fragments are made in these voxels only.
+@group(0) @binding(10) var<uniform> region: FragmentRegion;
 
 // The dynamic geometry's pass: a fragment's voxel is filled only by the part of it that lies
 // behind the surface (inside the solid), and the voxel behind it, inside, is filled wholly.
@@ -131,9 +133,8 @@ fn main(
     }
     let u = (w + 1u) % 3u;
     let v = (w + 2u) % 3u;
-    let res = i32(grid.resolution);
-    let lo = max(vec3<i32>(floor(min(a, min(b, c)))), vec3<i32>(0));
-    let hi = min(vec3<i32>(floor(max(a, max(b, c)))), vec3<i32>(res - 1));
+    let lo = max(vec3<i32>(floor(min(a, min(b, c)))), vec3<i32>(region.lo));
+    let hi = min(vec3<i32>(floor(max(a, max(b, c)))), vec3<i32>(region.hi));
     if any(hi < lo) {
         return;
     }
@@ -202,7 +203,7 @@ fn main(
             emit(cell, diffuse, behind, n, emission, surface);
             var inner = cell;
             inner[w] -= select(-1, 1, n[w] > 0.0);
-            if inner[w] >= 0 && inner[w] < res {
+            if inner[w] >= i32(region.lo[w]) && inner[w] <= i32(region.hi[w]) {
                 // Inside the solid: no surface of its own, so shaded at its centre (a surface
                 // distance of 0 puts the shading point inside, where the light does not reach).
                 emit(inner, diffuse, 1.0, n, emission, 0.0);

@@ -18,6 +18,13 @@ struct FragmentGrid {
     _pad2: u32,
 }
 
+// The voxels a pass makes fragments in, bounds included (empty when hi < lo on an axis). Twin:
+// `GpuRegion` in src/fragments/grid.rs.
+struct FragmentRegion {
+    lo: vec3<u32>,
+    hi: vec3<u32>,
+}
+
 struct Fragment {
     // x | y << 10 | z << 20, finest-level voxel coordinates.
     coord: u32,

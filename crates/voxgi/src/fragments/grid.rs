@@ -1,6 +1,7 @@
 //! The grid fragments lie on and structures are built over: a cube of `resolution`³ voxels.
 
-use glam::Vec3;
+use bytemuck::{Pod, Zeroable};
+use glam::{UVec3, Vec3};
 
 /// A cubic grid over the scene: `resolution` voxels per side from `origin`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,6 +44,84 @@ impl Grid {
     }
 }
 
+/// A box of a grid's voxels, bounds included, where fragments are made: a pass that makes
+/// fragments makes none outside it. Empty when `hi` lies below `lo` on some axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Region {
+    /// The first voxel inside, per axis.
+    pub lo: UVec3,
+    /// The last voxel inside, per axis.
+    pub hi: UVec3,
+}
+
+impl Region {
+    /// Every voxel of `grid`.
+    pub fn all(grid: &Grid) -> Self {
+        Region {
+            lo: UVec3::ZERO,
+            hi: UVec3::splat(grid.resolution - 1),
+        }
+    }
+
+    /// No voxel.
+    pub const EMPTY: Region = Region {
+        lo: UVec3::ONE,
+        hi: UVec3::ZERO,
+    };
+
+    /// The voxels of `grid` that the world box `min..max` touches, grown by `margin` voxels
+    /// on every side and clipped to the grid (empty when the box lies outside).
+    pub fn around(grid: &Grid, min: Vec3, max: Vec3, margin: u32) -> Self {
+        let top = grid.resolution as f32 - 1.0;
+        let voxel = |p: Vec3| (p - grid.origin) / grid.voxel_size;
+        let (lo, hi) = (
+            voxel(min).floor() - margin as f32,
+            voxel(max).floor() + margin as f32,
+        );
+        if min.cmpgt(max).any()
+            || !lo.is_finite()
+            || !hi.is_finite()
+            || lo.cmpgt(Vec3::splat(top)).any()
+            || hi.cmplt(Vec3::ZERO).any()
+        {
+            return Region::EMPTY;
+        }
+        Region {
+            lo: lo.max(Vec3::ZERO).as_uvec3(),
+            hi: hi.min(Vec3::splat(top)).as_uvec3(),
+        }
+    }
+
+    /// Whether it holds no voxel.
+    pub fn is_empty(&self) -> bool {
+        self.hi.cmplt(self.lo).any()
+    }
+
+    /// As `FragmentRegion` in shaders/shared/fragment.wgsl.
+    pub fn to_gpu(self) -> GpuRegion {
+        GpuRegion {
+            lo: self.lo.to_array(),
+            _pad0: 0,
+            hi: self.hi.to_array(),
+            _pad1: 0,
+        }
+    }
+}
+
+/// Mirrors `FragmentRegion` in shaders/shared/fragment.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuRegion {
+    /// `Region::lo`.
+    pub lo: [u32; 3],
+    /// Padding; zero.
+    pub _pad0: u32,
+    /// `Region::hi`.
+    pub hi: [u32; 3],
+    /// Padding; zero.
+    pub _pad1: u32,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -53,5 +132,22 @@ mod tests {
         assert!((g.extent() - 2.0 * 64.0 / 62.0).abs() < 1e-5);
         assert!((g.origin.x + g.voxel_size).abs() < 1e-5);
         assert_eq!(g.levels(), 7);
+    }
+
+    #[test]
+    fn regions_cover_the_box_and_clip_to_the_grid() {
+        let g = Grid::around(Vec3::ZERO, Vec3::splat(1.0), 16);
+        assert_eq!(
+            Region::around(&g, g.origin, g.origin + g.extent(), 0).hi,
+            UVec3::splat(15)
+        );
+        let r = Region::around(&g, Vec3::splat(0.5), Vec3::splat(0.5), 1);
+        let c = ((Vec3::splat(0.5) - g.origin) / g.voxel_size)
+            .floor()
+            .as_uvec3();
+        assert_eq!((r.lo, r.hi), (c - 1, c + 1));
+        assert!(Region::around(&g, Vec3::splat(5.0), Vec3::splat(6.0), 2).is_empty());
+        assert!(!Region::all(&g).is_empty());
+        assert!(Region::EMPTY.is_empty());
     }
 }

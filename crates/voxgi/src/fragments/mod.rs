@@ -8,7 +8,7 @@ pub mod grid;
 pub mod splat;
 pub mod voxelize;
 
-pub use grid::Grid;
+pub use grid::{GpuRegion, Grid, Region};
 
 use crate::gpu_scene::GpuScene;
 use crate::{Error, Result};
@@ -49,6 +49,22 @@ pub struct Fragments {
     pub mark: wgpu::Buffer,
     /// Fragments `buffer` holds; a build that makes more counts them and drops the rest.
     pub capacity: u32,
+    /// Where fragments are made (`FragmentRegion`): the static geometry's and the points' at
+    /// offset 0, the dynamic geometry's at `REGION_STRIDE` (`set_regions`).
+    pub regions: wgpu::Buffer,
+}
+
+/// Bytes between the two regions of `Fragments::regions` (the largest uniform offset
+/// alignment WebGPU allows a device to ask for).
+pub const REGION_STRIDE: u64 = 256;
+
+/// Which geometry a pass makes fragments of: it decides the region the pass binds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Geometry {
+    /// The static geometry and the point clouds, for a build.
+    Static,
+    /// The dynamic geometry, for an update.
+    Dynamic,
 }
 
 impl Fragments {
@@ -90,7 +106,30 @@ impl Fragments {
                 mapped_at_creation: false,
             }),
             capacity,
+            regions: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("fragment regions"),
+                contents: &regions_bytes(Region::all(&grid), Region::all(&grid)),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
         }
+    }
+
+    /// Sets where the next build (`build`) and update (`update`) make fragments.
+    pub fn set_regions(&self, queue: &wgpu::Queue, build: Region, update: Region) {
+        queue.write_buffer(&self.regions, 0, &regions_bytes(build, update));
+    }
+
+    /// The region a pass making fragments of `geometry` binds.
+    pub fn region(&self, geometry: Geometry) -> wgpu::BindingResource<'_> {
+        let offset = match geometry {
+            Geometry::Static => 0,
+            Geometry::Dynamic => REGION_STRIDE,
+        };
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.regions,
+            offset,
+            size: wgpu::BufferSize::new(size_of::<GpuRegion>() as u64),
+        })
     }
 
     /// Records the start of a build: no fragments yet.
@@ -115,6 +154,14 @@ impl Fragments {
     pub fn memory(&self) -> Vec<(&'static str, u64)> {
         vec![("voxel fragments", self.buffer.size())]
     }
+}
+
+/// The two regions at their offsets in `Fragments::regions`.
+fn regions_bytes(build: Region, update: Region) -> Vec<u8> {
+    let mut bytes = vec![0u8; (REGION_STRIDE as usize) + size_of::<GpuRegion>()];
+    bytes[..size_of::<GpuRegion>()].copy_from_slice(bytemuck::bytes_of(&build.to_gpu()));
+    bytes[REGION_STRIDE as usize..].copy_from_slice(bytemuck::bytes_of(&update.to_gpu()));
+    bytes
 }
 
 /// Checks a fragment capacity against the device's storage-buffer limit (at least 1024).

@@ -1,7 +1,7 @@
 //! splat: every point-cloud sample into voxel fragments through its region of influence (seed
 //! 004 §4.3.4). It writes the fragments and their count, nothing else.
 
-use crate::fragments::Fragments;
+use crate::fragments::{Fragments, Geometry};
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
@@ -24,6 +24,7 @@ impl SplatPass {
                 layout::storage(2, c, true),
                 layout::storage(3, c, false),
                 layout::storage(4, c, false),
+                layout::uniform(5, c, false),
             ],
         });
         let pipeline = crate::gpu::shader::grouped_pipeline(
@@ -69,6 +70,7 @@ impl SplatPass {
                 }),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
+                fragments.region(Geometry::Static),
             ]),
         });
         pass.set_pipeline(&self.pipeline);

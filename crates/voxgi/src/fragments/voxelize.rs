@@ -1,7 +1,7 @@
 //! voxelize: every mesh triangle into voxel fragments (conservative, exact overlap). It writes
 //! the fragments and their count, nothing else.
 
-use crate::fragments::{Fragments, TriangleTable};
+use crate::fragments::{Fragments, Geometry, TriangleTable};
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
@@ -36,6 +36,7 @@ impl VoxelizePass {
                 layout::storage(7, c, true),
                 layout::storage(8, c, false),
                 layout::storage(9, c, false),
+                layout::uniform(10, c, false),
             ],
         });
         let layouts = [Some(&layout)];
@@ -81,6 +82,11 @@ impl VoxelizePass {
                 triangles.buffer.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
+                fragments.region(if triangles.dynamic {
+                    Geometry::Dynamic
+                } else {
+                    Geometry::Static
+                }),
             ]),
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

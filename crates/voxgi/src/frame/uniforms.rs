@@ -1,10 +1,8 @@
 //! The frame uniform (`Frame` in shaders/shared/scene.wgsl): camera, output size, exposure and
-//! view, written once per frame and bound by every screen pass through the globals.
+//! view, written once per frame and bound by every screen pass through the globals. The
+//! renderer fills it from the frame's parameters (`renderer/order.rs`).
 
-use crate::options::FrameParams;
-use crate::view::camera_view_proj;
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
 
 /// Mirrors `Frame` in shaders/shared/scene.wgsl.
 #[repr(C)]
@@ -39,44 +37,4 @@ pub struct GpuFrame {
     pub geometry_points: u32,
     /// Padding to a multiple of 16 bytes; zero.
     pub _pad: [u32; 2],
-}
-
-/// What the frame uniform takes from the scene and the options rather than from the frame's
-/// parameters.
-#[derive(Clone, Copy, Debug)]
-pub struct FrameScene {
-    /// The scene's bounding sphere (the camera's clip planes fit it).
-    pub center: Vec3,
-    /// Radius of the bounding sphere, metres.
-    pub radius: f32,
-    /// Lights in the lights buffer.
-    pub light_count: u32,
-    /// Whether area lights are shadowed by cones (`RendererOptions::cone_shadows`).
-    pub cone_shadows: bool,
-    /// `GpuScene::geometry_points`.
-    pub geometry_points: u32,
-}
-
-impl GpuFrame {
-    /// The uniform for a `width` x `height` frame of `p`.
-    pub fn new(p: &FrameParams, s: &FrameScene, width: u32, height: u32) -> Self {
-        let view_proj = camera_view_proj(&p.camera, width, height, s.center, s.radius);
-        GpuFrame {
-            view_proj: view_proj.to_cols_array_2d(),
-            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-            camera_pos: p.camera.position.to_array(),
-            light_count: s.light_count,
-            size: [width as f32, height as f32],
-            inv_size: [1.0 / width as f32, 1.0 / height as f32],
-            exposure: 2f32.powf(p.exposure),
-            tonemap: p.tonemap.id(),
-            shadow_softness: p.shadow_softness,
-            // The debug pass draws the voxel views; composite writes the lit image underneath.
-            view_mode: p.view.id(),
-            background: [p.background[0], p.background[1], p.background[2], 1.0],
-            cone_shadows: s.cone_shadows as u32,
-            geometry_points: s.geometry_points,
-            _pad: [0; 2],
-        }
-    }
 }

@@ -4,13 +4,30 @@
 //! written once, meets a structure. Tiny on purpose: WGSL has no modules yet, and this is all
 //! voxgi needs.
 
+/// `&[(path, source)]` of WGSL files by path relative to `crates/voxgi/shaders`, their
+/// sources built in.
+#[macro_export]
+#[doc(hidden)]
 macro_rules! wgsl {
     ($($path:literal),* $(,)?) => {
-        &[$(($path, include_str!(concat!("../../shaders/", $path)))),*]
+        &[$(($path, include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/", $path)))),*]
     };
 }
 
-/// Every WGSL file, by path relative to `crates/voxgi/shaders`.
+/// A voxel structure's WGSL files (`shaders/voxels/<name>/`): the contract files that shared
+/// shaders include as `//!include voxels/FILE.wgsl`, and its own passes.
+#[derive(Clone, Copy, Debug)]
+pub struct StructureShaders {
+    /// The structure's name: its folder under `shaders/voxels/`.
+    pub name: &'static str,
+    /// Every file of the folder, by path relative to `crates/voxgi/shaders`.
+    pub sources: &'static [(&'static str, &'static str)],
+    /// Of those, the shaders with entry points of the structure's own passes (validated on
+    /// their own by the tests).
+    pub passes: &'static [&'static str],
+}
+
+/// Every WGSL file outside the structures' folders, by path relative to `crates/voxgi/shaders`.
 const SOURCES: &[(&str, &str)] = wgsl![
     "shared/scene.wgsl",
     "shared/tone_curves.wgsl",
@@ -22,20 +39,6 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/volume.wgsl",
     "shared/fragment.wgsl",
     "shared/voxel_debug.wgsl",
-    "voxels/dense/sample.wgsl",
-    "voxels/dense/leaves.wgsl",
-    "voxels/dense/leaf_store.wgsl",
-    "voxels/dense/irradiance.wgsl",
-    "voxels/octree/tree.wgsl",
-    "voxels/octree/sample.wgsl",
-    "voxels/octree/leaves.wgsl",
-    "voxels/octree/leaf_store.wgsl",
-    "voxels/octree/irradiance.wgsl",
-    "voxels/octree/build_shared.wgsl",
-    "voxels/octree/octree_build.wgsl",
-    "voxels/octree/octree_update.wgsl",
-    "voxels/octree/octree_filter.wgsl",
-    "voxels/octree/debug.wgsl",
     "shared/cone.wgsl",
     "shared/irradiance_record.wgsl",
     "shared/leaf_irradiance.wgsl",
@@ -47,17 +50,12 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "screen/gbuffer.wgsl",
     "fragments/voxelize.wgsl",
     "fragments/splat.wgsl",
-    "voxels/dense/build_shared.wgsl",
-    "voxels/dense/dense_build.wgsl",
-    "voxels/dense/dense_update.wgsl",
     "lighting/inject.wgsl",
-    "voxels/dense/filter.wgsl",
     "lighting/bounce.wgsl",
     "lighting/bounce_store.wgsl",
     "screen/gather.wgsl",
     "screen/upsample.wgsl",
     "screen/composite.wgsl",
-    "voxels/dense/debug.wgsl",
     "screen/tonemap.wgsl",
     "reference.wgsl",
     "reference_display.wgsl",
@@ -68,7 +66,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
 /// file missing there falls back to the built-in copy.
 const SHADER_DIR_VAR: &str = "VOXGI_SHADER_DIR";
 
-fn raw(name: &str) -> std::borrow::Cow<'static, str> {
+fn raw(name: &str, kind: Option<&StructureShaders>) -> std::borrow::Cow<'static, str> {
     if let Some(dir) = std::env::var_os(SHADER_DIR_VAR) {
         let dir = std::path::Path::new(&dir);
         if let Ok(text) = std::fs::read_to_string(dir.join(name)) {
@@ -87,39 +85,50 @@ fn raw(name: &str) -> std::borrow::Cow<'static, str> {
     }
     SOURCES
         .iter()
+        .chain(kind.map_or(&[][..], |k| k.sources))
         .find(|(n, _)| *n == name)
         .map(|(_, s)| (*s).into())
+        // The sources are built in: a missing one is a bug in voxgi, found by its tests.
         .unwrap_or_else(|| panic!("unknown shader file {name}"))
 }
 
-/// The voxel structures whose WGSL lives under `shaders/voxels/<kind>/`.
-pub const STRUCTURES: &[&str] = &["dense", "octree"];
-
-/// The full WGSL of shader `name` with its includes expanded; `voxels/` includes come from
-/// the dense volume (shaders that include none are the same for every structure).
+/// The full WGSL of shader `name` with its includes expanded, for a shader that reaches no
+/// voxel structure.
 pub fn compose(name: &str) -> String {
-    compose_for(name, "dense")
+    compose_with(name, None)
 }
 
 /// The full WGSL of shader `name` with `voxels/` includes taken from structure `kind`.
-pub fn compose_for(name: &str, kind: &str) -> String {
+pub fn compose_with(name: &str, kind: Option<&StructureShaders>) -> String {
     let mut out = String::new();
     let mut seen = Vec::new();
     expand(name, kind, &mut out, &mut seen);
     out
 }
 
-fn expand(name: &str, kind: &str, out: &mut String, seen: &mut Vec<String>) {
+fn expand(name: &str, kind: Option<&StructureShaders>, out: &mut String, seen: &mut Vec<String>) {
     if seen.iter().any(|s| s == name) {
         return;
     }
     seen.push(name.to_string());
-    for line in raw(name).lines() {
+    for line in raw(name, kind).lines() {
         if let Some(inc) = line.trim().strip_prefix("//!include ") {
             let inc = inc.trim();
-            match inc.strip_prefix("voxels/") {
-                Some(file) => expand(&format!("voxels/{kind}/{file}"), kind, out, seen),
-                None => expand(inc, kind, out, seen),
+            match (inc.strip_prefix("voxels/"), kind) {
+                (Some(file), Some(k)) => {
+                    let own = format!("voxels/{}/", k.name);
+                    // A structure's files name each other by their full path.
+                    let path = if inc.starts_with(&own) {
+                        inc.to_string()
+                    } else {
+                        format!("{own}{file}")
+                    };
+                    expand(&path, kind, out, seen)
+                }
+                (Some(_), None) => {
+                    panic!("shader {name} includes {inc}: compose it for a voxel structure")
+                }
+                (None, _) => expand(inc, kind, out, seen),
             }
         } else {
             out.push_str(line);
@@ -130,14 +139,26 @@ fn expand(name: &str, kind: &str, out: &mut String, seen: &mut Vec<String>) {
 
 /// Compiles shader `name`; the label is the shader's name so pipelines and timings agree.
 pub fn module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
-    module_for(device, name, "dense")
+    module_with(device, name, None)
 }
 
 /// Compiles shader `name` for voxel structure `kind` (its `voxels/` includes).
-pub fn module_for(device: &wgpu::Device, name: &str, kind: &str) -> wgpu::ShaderModule {
+pub fn module_for(
+    device: &wgpu::Device,
+    name: &str,
+    kind: &StructureShaders,
+) -> wgpu::ShaderModule {
+    module_with(device, name, Some(kind))
+}
+
+fn module_with(
+    device: &wgpu::Device,
+    name: &str,
+    kind: Option<&StructureShaders>,
+) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
-        source: wgpu::ShaderSource::Wgsl(compose_for(name, kind).into()),
+        source: wgpu::ShaderSource::Wgsl(compose_with(name, kind).into()),
     })
 }
 
@@ -173,7 +194,7 @@ pub fn grouped_pipeline(
     layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    voxel_pipeline(device, label, file, "dense", layouts, constants)
+    pipeline_with(device, label, file, None, layouts, constants)
 }
 
 /// `grouped_pipeline` for a shader that reaches voxel structure `kind` (`voxels/` includes).
@@ -181,11 +202,22 @@ pub fn voxel_pipeline(
     device: &wgpu::Device,
     label: &str,
     file: &str,
-    kind: &str,
+    kind: &StructureShaders,
     layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    let module = module_for(device, file, kind);
+    pipeline_with(device, label, file, Some(kind), layouts, constants)
+}
+
+fn pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    kind: Option<&StructureShaders>,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    let module = module_with(device, file, kind);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: layouts,
@@ -204,18 +236,12 @@ pub fn voxel_pipeline(
     })
 }
 
-/// The names of all pass shaders (for tests that validate every one).
+/// The names of the pass shaders outside the structures' folders (for tests that validate
+/// every one, composed for each structure; each structure lists its own in
+/// `StructureShaders::passes`).
 pub fn pass_shaders() -> impl Iterator<Item = &'static str> {
-    SOURCES.iter().map(|(n, _)| *n).filter(|n| {
-        !n.starts_with("shared/")
-            && ![
-                "sample.wgsl",
-                "leaves.wgsl",
-                "leaf_store.wgsl",
-                "build_shared.wgsl",
-                "tree.wgsl",
-            ]
-            .iter()
-            .any(|f| n.ends_with(&format!("/{f}")))
-    })
+    SOURCES
+        .iter()
+        .map(|(n, _)| *n)
+        .filter(|n| !n.starts_with("shared/"))
 }

@@ -51,7 +51,7 @@ impl BouncePass {
                 device,
                 "bounce",
                 "lighting/bounce.wgsl",
-                kind.name(),
+                kind.shaders(),
                 &[Some(&globals), Some(&voxels), Some(&leaves)],
                 &[iso, axes, ("IRRADIANCE", f64::from(u8::from(irradiance)))],
             )
@@ -63,7 +63,7 @@ impl BouncePass {
                 device,
                 "bounce",
                 "lighting/bounce_store.wgsl",
-                kind.name(),
+                kind.shaders(),
                 &[None, None, Some(&leaves), Some(&store)],
                 &[],
             ),

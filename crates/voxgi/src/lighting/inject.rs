@@ -67,7 +67,7 @@ impl InjectPass {
             label: Some("inject args"),
             entries: &[layout::storage(0, c, false)],
         });
-        let module = crate::gpu::shader::module_for(device, "lighting/inject.wgsl", kind.name());
+        let module = crate::gpu::shader::module_for(device, "lighting/inject.wgsl", kind.shaders());
         let pipe = |entry: &str, layouts: &[Option<&wgpu::BindGroupLayout>], store: bool| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("inject"),

@@ -1,7 +1,7 @@
 //! The renderer: creation and the public API. It uploads a scene once, then records frames
 //! into the caller's encoder. The rest of it lives with its subject: the pass order in
 //! `order.rs`, scene updates and what they make out of date in `updates.rs`, the structure's
-//! creation in `voxel::factory`, bounce counts and cone uniforms in `lighting::{bounces, cones}`.
+//! creation in each kind's `KindInfo::create` (`voxel::registry`), bounce counts and cone uniforms in `lighting::{bounces, cones}`.
 //!
 //! Voxel work follows what changed (DESIGN.md, seam 6). The static geometry is voxelized and
 //! built once (on the first frame, after `invalidate`, a pool's growth or a voxel option's
@@ -12,8 +12,6 @@
 
 mod order;
 mod updates;
-
-pub use order::VOXEL_PASSES;
 
 use crate::brdf::BrdfTables;
 use crate::fragments::splat::SplatPass;
@@ -39,8 +37,7 @@ use crate::screen::gbuffer::GbufferPass;
 use crate::screen::tonemap::TonemapPass;
 use crate::screen::upsample::UpsamplePass;
 use crate::view::lit_scene;
-use crate::voxel::factory::{StructurePipelines, new_volume};
-use crate::voxel::{Grid, POOL_COUNTERS, Voxels};
+use crate::voxel::{Filtering, Grid, POOL_COUNTERS, StructureDesc, VoxelStructure};
 use crate::{Error, Result};
 use glam::Vec3;
 use updates::Pending;
@@ -90,9 +87,8 @@ pub struct Renderer {
     globals: Option<wgpu::BindGroup>,
     fragments: Fragments,
     /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
-    /// (and `volume()`, for tests) names its kind.
-    volume: Voxels,
-    structure_pipelines: StructurePipelines,
+    /// names its kind.
+    volume: Box<dyn VoxelStructure>,
     /// Voxelize's triangle tables: the static instances' and the dynamic ones'.
     static_triangles: TriangleTable,
     dynamic_triangles: TriangleTable,
@@ -138,6 +134,25 @@ struct SceneFacts {
 }
 
 impl SceneFacts {
+    /// The structure `options` ask for on `grid`. Its pools start with room for the options'
+    /// voxel capacity, or a quarter of the fragment estimate (slots: at most one per voxel,
+    /// usually far fewer than fragments, and the estimate is itself an upper bound); the first
+    /// build's counters grow them to the exact count if that is short.
+    fn structure_desc(&self, options: &RendererOptions, grid: Grid) -> StructureDesc {
+        StructureDesc {
+            grid,
+            filtering: Filtering {
+                anisotropic: options.anisotropic,
+                ndf: options.ndf_mips,
+            },
+            leaves: options
+                .voxel_capacity
+                .unwrap_or_else(|| self.estimate.at(&grid) / 4)
+                .min((grid.resolution as u64).pow(3)),
+            dynamic: self.dynamic,
+        }
+    }
+
     /// Fragments the first buffer on `grid` has room for: the options' capacity, or the
     /// scene's estimate.
     fn fragments_wanted(&self, options: &RendererOptions, grid: &Grid) -> u64 {
@@ -197,15 +212,8 @@ impl Renderer {
         )?;
         let grid = grid(&facts, options);
         let fragments = fragments::allocate(device, grid, facts.fragments_wanted(options, &grid))?;
-        let mut structure_pipelines = StructurePipelines::default();
-        let volume = new_volume(
-            device,
-            &mut structure_pipelines,
-            options,
-            grid,
-            facts.estimate.at(&grid),
-            facts.dynamic,
-        )?;
+        let volume =
+            (options.voxels.info().create)(device, &facts.structure_desc(options, grid), None)?;
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             moments: MomentsPass::new(device),
@@ -257,7 +265,6 @@ impl Renderer {
             globals: None,
             fragments,
             volume,
-            structure_pipelines,
             static_triangles,
             dynamic_triangles,
             cones,
@@ -342,13 +349,10 @@ impl Renderer {
             None
         };
         let volume_new = if volume {
-            Some(new_volume(
+            Some((new.voxels.info().create)(
                 device,
-                &mut self.structure_pipelines,
-                new,
-                grid,
-                self.facts.estimate.at(&grid),
-                self.facts.dynamic,
+                &self.facts.structure_desc(new, grid),
+                Some(self.volume.as_ref()),
             )?)
         } else {
             None
@@ -452,7 +456,7 @@ impl Renderer {
         let mut m = self.scene.memory();
         m.push(("shadow atlas", self.atlas.bytes()));
         m.extend(self.fragments.memory());
-        m.extend(self.volume.get().memory());
+        m.extend(self.volume.memory());
         if let Some(t) = &self.targets {
             m.push(("render targets", t.bytes()));
         }
@@ -480,7 +484,7 @@ impl Renderer {
             pools.copy_from_slice(&words[1..1 + POOL_COUNTERS]);
             self.last_counts = Some(counts);
             let frags = self.fragments.capacity as u64;
-            let grow_volume = self.volume.get().needs_growth(&pools);
+            let grow_volume = self.volume.needs_growth(&pools);
             if counts.fragments <= frags && !grow_volume {
                 continue;
             }
@@ -497,7 +501,7 @@ impl Renderer {
                 None
             };
             if grow_volume {
-                self.volume.get_mut().grow(&self.device, &pools)?;
+                self.volume.grow(&self.device, &pools)?;
             }
             if let Some(f) = fragments {
                 self.fragments = f;
@@ -509,7 +513,7 @@ impl Renderer {
                 counts.fragments,
                 counts.occupied,
                 self.fragments.capacity,
-                self.volume.get().leaf_capacity()
+                self.volume.leaf_capacity()
             );
             self.invalidate();
         }
@@ -530,7 +534,7 @@ impl Renderer {
         };
         Ok(VoxelCounts {
             fragments: read(&self.fragments.count)?,
-            occupied: read(self.volume.get().pool_counter())?,
+            occupied: read(self.volume.pool_counter())?,
         })
     }
 
@@ -539,9 +543,14 @@ impl Renderer {
         &self.fragments
     }
 
-    /// The voxel structure, for tests and debugging.
-    pub fn volume(&self) -> &Voxels {
-        &self.volume
+    /// The voxel structure, for tests and debugging (`structure` for its own type).
+    pub fn volume(&self) -> &dyn VoxelStructure {
+        self.volume.as_ref()
+    }
+
+    /// The voxel structure as its own type `T`, if it is one (for a kind's own tests).
+    pub fn structure<T: 'static>(&self) -> Option<&T> {
+        self.volume.as_any().downcast_ref()
     }
 
     /// Turns per-pass GPU timing on or off (when the device has `TIMESTAMP_QUERY`).

@@ -20,7 +20,7 @@ use super::Renderer;
 use crate::Result;
 use crate::frame::globals::{self, GlobalsSources};
 use crate::frame::targets::{FrameTargets, Target};
-use crate::frame::uniforms::{FrameScene, GpuFrame};
+use crate::frame::uniforms::GpuFrame;
 use crate::gpu::checked;
 use crate::gpu::timer::GpuTimer;
 use crate::lighting::atlas::ViewDirt;
@@ -28,24 +28,8 @@ use crate::lighting::bounce::BounceSteps;
 use crate::lighting::bounces;
 use crate::lighting::inject::InjectPass;
 use crate::options::{FrameParams, ShadowFilter, validate_size};
-use crate::voxel::{DebugView, POOL_COUNTERS};
-
-/// The timing scopes of the voxel update (what depends on the scene and its lights, not on the
-/// camera), in the order they run; every other pass is the screen's.
-pub const VOXEL_PASSES: [&str; 12] = [
-    "shadow",
-    "moments",
-    "voxelize",
-    "splat",
-    "dense_build",
-    "dense_update",
-    "octree_build",
-    "octree_update",
-    "inject",
-    "filter",
-    "octree_filter",
-    "bounce",
-];
+use crate::view::camera_view_proj;
+use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, Region, VoxelWork};
 
 impl Renderer {
     /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
@@ -88,24 +72,21 @@ impl Renderer {
         self.record_shadows(encoder);
         let interval = self.options.voxel_update_interval.max(1) as u64;
         // A rebuild (the first frame among them) never waits for its turn.
-        if self.voxel_work_pending()
-            && (self.pending.rebuild || self.frame_index.is_multiple_of(interval))
-        {
-            self.record_voxels(encoder);
+        let due = self.voxel_work_pending()
+            && (self.pending.rebuild || self.frame_index.is_multiple_of(interval));
+        let moved = due && (self.pending.rebuild || self.pending.geometry);
+        // The structure's per-frame step: it may ask for voxels of its own (a camera-following
+        // structure) even when nothing changed.
+        let work = self.volume.plan(&FrameChanges {
+            camera: params.camera.position,
+            rebuild: due && self.pending.rebuild,
+            dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
+        });
+        if due || !work.is_empty() {
+            self.record_voxels(encoder, work);
         }
         self.frame_index += 1;
-        let frame = GpuFrame::new(
-            params,
-            &FrameScene {
-                center: self.center,
-                radius: self.radius,
-                light_count: self.scene.light_count,
-                cone_shadows: self.options.cone_shadows,
-                geometry_points: self.scene.geometry_points,
-            },
-            width,
-            height,
-        );
+        let frame = self.frame_uniforms(params, width, height);
         let t = self.targets.as_ref().expect("targets were just created");
         self.queue
             .write_buffer(&t.frame, 0, bytemuck::bytes_of(&frame));
@@ -127,17 +108,17 @@ impl Renderer {
         p.gbuffer
             .record(&self.device, encoder, t, &self.scene, timer);
         p.gather
-            .record(&self.device, encoder, t, globals, self.volume.get(), timer);
+            .record(&self.device, encoder, t, globals, &*self.volume, timer);
         p.upsample.record(&self.device, encoder, t, globals, timer);
         p.composite.record(&self.device, encoder, t, globals, timer);
         // Only for the voxel views: replaces the composite's output.
-        if params.view.is_voxel() {
-            self.volume.get().record_debug(
+        if let Some(mode) = params.view.voxel_view() {
+            self.volume.record_debug(
                 &self.device,
                 encoder,
                 t,
                 DebugView {
-                    mode: params.view,
+                    mode,
                     level: params.debug_level,
                     direction: params.debug_direction,
                 },
@@ -148,6 +129,28 @@ impl Renderer {
             .record(&self.device, encoder, t, globals, target, timer);
         timer.resolve(encoder);
         Ok(())
+    }
+
+    /// The frame uniform for a `width` x `height` frame of `p`.
+    fn frame_uniforms(&self, p: &FrameParams, width: u32, height: u32) -> GpuFrame {
+        let view_proj = camera_view_proj(&p.camera, width, height, self.center, self.radius);
+        GpuFrame {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            camera_pos: p.camera.position.to_array(),
+            light_count: self.scene.light_count,
+            size: [width as f32, height as f32],
+            inv_size: [1.0 / width as f32, 1.0 / height as f32],
+            exposure: 2f32.powf(p.exposure),
+            tonemap: p.tonemap.id(),
+            shadow_softness: p.shadow_softness,
+            // The debug pass draws the voxel views; composite writes the lit image underneath.
+            view_mode: p.view.id(),
+            background: [p.background[0], p.background[1], p.background[2], 1.0],
+            cone_shadows: self.options.cone_shadows as u32,
+            geometry_points: self.scene.geometry_points,
+            _pad: [0; 2],
+        }
     }
 
     /// Records the shadow views that must be re-rendered (all after a rebuild).
@@ -186,14 +189,19 @@ impl Renderer {
     /// voxelize the static geometry and build (after a rebuild), voxelize the dynamic geometry
     /// and update (after it moved), inject, then filter and bounce; with progressive bounces,
     /// one bounce per update until converged.
-    fn record_voxels(&mut self, encoder: &mut wgpu::CommandEncoder) {
+    fn record_voxels(&mut self, encoder: &mut wgpu::CommandEncoder, work: VoxelWork) {
         let pending = std::mem::take(&mut self.pending);
-        let geometry = pending.rebuild || pending.geometry;
+        let geometry = !work.is_empty();
+        self.fragments.set_regions(
+            &self.queue,
+            work.build.unwrap_or(Region::EMPTY),
+            work.update.unwrap_or(Region::EMPTY),
+        );
         if geometry || pending.lights {
             self.passes.inject.prepare(
                 &self.device,
                 &self.queue,
-                self.volume.get(),
+                &*self.volume,
                 pending.rebuild || pending.lights,
                 // Stored bounces overwrite the radiance: it must start from the direct light
                 // again.
@@ -205,7 +213,7 @@ impl Renderer {
         }
         let timer = &mut self.timer;
         let p = &self.passes;
-        if pending.rebuild {
+        if work.build.is_some() {
             self.fragments.record_clear(encoder);
             let t = &self.static_triangles;
             p.voxelize.record(
@@ -221,10 +229,9 @@ impl Renderer {
                 .record(&self.device, encoder, &self.scene, &self.fragments, timer);
             self.fragments.record_mark(encoder);
             self.volume
-                .get()
                 .record_build(&self.device, encoder, &self.fragments, timer);
         }
-        if geometry && self.facts.dynamic {
+        if work.update.is_some() {
             self.fragments.record_truncate(encoder);
             let t = &self.dynamic_triangles;
             p.voxelize.record(
@@ -236,7 +243,6 @@ impl Renderer {
                 timer,
             );
             self.volume
-                .get()
                 .record_update(&self.device, encoder, &self.fragments, timer);
         }
         if geometry {
@@ -247,7 +253,7 @@ impl Renderer {
                 encoder,
                 &[
                     (&self.fragments.count, 1),
-                    (self.volume.get().pool_counter(), POOL_COUNTERS),
+                    (self.volume.pool_counter(), POOL_COUNTERS),
                 ],
                 self.pools,
             ) {
@@ -260,7 +266,7 @@ impl Renderer {
         // One bounce, and the filtering its stored light needs.
         let bounce =
             |encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer, steps: BounceSteps| {
-                let volume = self.volume.get();
+                let volume = &*self.volume;
                 p.bounce
                     .record(&self.device, encoder, volume, &self.cones, steps, timer);
                 if steps.store {
@@ -279,7 +285,7 @@ impl Renderer {
                 encoder,
                 &self.scene,
                 &self.atlas,
-                self.volume.get(),
+                &*self.volume,
                 timer,
             );
             if progressive {
@@ -288,9 +294,7 @@ impl Renderer {
                 // a cleared volume only reproduces the direct light).
                 self.progressive_left = self.voxel_bounces + 1;
             } else {
-                self.volume
-                    .get()
-                    .record_filter(&self.device, encoder, timer);
+                self.volume.record_filter(&self.device, encoder, timer);
                 let n = self.voxel_bounces;
                 for i in 0..n {
                     // With leaves the last bounce's light is what the pixels read: it keeps

@@ -61,7 +61,7 @@ impl GatherPass {
                 device,
                 "gather",
                 "screen/gather.wgsl",
-                kind.name(),
+                kind.shaders(),
                 &[
                     Some(&globals),
                     Some(&voxels),

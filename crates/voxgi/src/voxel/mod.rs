@@ -8,24 +8,51 @@
 
 pub mod cpu;
 pub mod dense;
-pub mod factory;
 pub mod octree;
+pub mod registry;
 
-pub use crate::fragments::Grid;
-pub use crate::options::VoxelKind;
+pub use crate::fragments::{Grid, Region};
+pub use registry::{KindInfo, StructureDesc, VoxelKind, voxel_passes};
 
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
-use crate::options::ViewMode;
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use voxgi_scene::Aabb;
 
-/// What a voxel debug view shows: one of the voxel `ViewMode`s, at mip `level` (0 = finest),
-/// along directional chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) where there are chains.
+/// What a voxel debug view shows of the first voxel along each pixel's ray with opacity > 0.5
+/// at its level (`ViewMode::voxel_view`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VoxelView {
+    /// Its albedo (the finest level's under it).
+    Albedo,
+    /// Its opacity, as grey.
+    Opacity,
+    /// Its radiance, un-premultiplied.
+    Radiance,
+    /// The structure's occupied cells of the level, coloured by level, edges darkened.
+    Nodes,
+}
+
+impl VoxelView {
+    /// The id the debug shaders take (`mode` in voxels/<kind>/debug.wgsl).
+    pub fn id(self) -> u32 {
+        match self {
+            VoxelView::Albedo => 0,
+            VoxelView::Opacity => 1,
+            VoxelView::Radiance => 2,
+            VoxelView::Nodes => 3,
+        }
+    }
+}
+
+/// What a voxel debug view shows: `mode` at mip `level` (0 = finest), along directional chain
+/// `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) where there are chains.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DebugView {
-    /// Which voxel property to show (`ViewMode::is_voxel` holds).
-    pub mode: ViewMode,
+    /// Which voxel property to show.
+    pub mode: VoxelView,
     /// Mip level to show, 0 = finest.
     pub level: u32,
     /// Directional chain to show, 0..6 for +X, -X, +Y, -Y, +Z, -Z (ignored where there are no
@@ -36,9 +63,29 @@ pub struct DebugView {
 /// A voxel structure: built from fragments and nothing else, holding the radiance of its
 /// leaves, filtered into coarser levels, sampled by cone tracing through `sampling()` at
 /// `@group(1)` of every pipeline that traces cones.
-pub trait VoxelStructure {
-    /// The structure's name, also its WGSL folder: `shaders/voxels/<kind>/`.
-    fn kind(&self) -> &'static str;
+pub trait VoxelStructure: wgpu::WasmNotSendSync {
+    /// The per-frame step, asked every frame before any voxel pass: sees the camera and what
+    /// changed, and says which regions of its grid it needs voxelized this frame. The default
+    /// is the dense volume's and the octree's answer: everything on a rebuild, then the box
+    /// of the dynamic instances whenever they moved (a camera-following structure answers
+    /// with the slabs newly inside it).
+    fn plan(&mut self, changes: &FrameChanges) -> VoxelWork {
+        let grid = self.grid();
+        VoxelWork {
+            build: changes.rebuild.then(|| Region::all(&grid)),
+            // Two voxels of margin: a dynamic fragment's voxel holds a vertex, or lies one
+            // voxel behind one (the solid's inner voxel), and the GPU's transform of a vertex
+            // may round across a voxel face the CPU's box does not.
+            update: changes
+                .dynamic
+                .map(|b| Region::around(&grid, b.min, b.max, 2)),
+        }
+    }
+    /// The structure's kind (its name is also its WGSL folder: `shaders/voxels/<kind>/`).
+    fn kind(&self) -> VoxelKind;
+    /// The structure itself, for code that knows its kind (its own tests, its `create`
+    /// taking over a previous structure's pipelines).
+    fn as_any(&self) -> &dyn std::any::Any;
     /// The grid of its finest voxels (the fragments' grid).
     fn grid(&self) -> Grid;
     /// Records a build from `fragments` (the static geometry's), replacing the previous one:
@@ -110,6 +157,35 @@ pub trait VoxelStructure {
     );
 }
 
+/// What changed since the structure's last update, as its per-frame step sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameChanges {
+    /// The camera's position this frame.
+    pub camera: Vec3,
+    /// Everything is out of date (the first frame, `invalidate`, grown pools, new options).
+    pub rebuild: bool,
+    /// Dynamic geometry is to be voxelized again: where every dynamic instance is now (world
+    /// space). `None` when nothing moved or the scene has no dynamic instances.
+    pub dynamic: Option<Aabb>,
+}
+
+/// The regions a structure needs voxelized this frame (`VoxelStructure::plan`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VoxelWork {
+    /// Build from the static geometry and the points in this region (`record_build`).
+    pub build: Option<Region>,
+    /// Merge the dynamic geometry in this region (`record_update`; it runs even when the
+    /// region is empty, to take out the last update).
+    pub update: Option<Region>,
+}
+
+impl VoxelWork {
+    /// Whether there is nothing to voxelize.
+    pub fn is_empty(&self) -> bool {
+        self.build.is_none() && self.update.is_none()
+    }
+}
+
 /// How a structure filters its levels above the finest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Filtering {
@@ -122,90 +198,6 @@ pub struct Filtering {
 
 /// Words of `VoxelStructure::pool_counter` read back after each build.
 pub const POOL_COUNTERS: usize = 4;
-
-impl VoxelKind {
-    /// The layout of @group(1), the structure's sampling resources.
-    pub fn sampling_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        match self {
-            VoxelKind::Dense => dense::DenseVolume::sampling_layout(device),
-            VoxelKind::Octree => octree::OctreeVolume::sampling_layout(device),
-        }
-    }
-
-    /// The layout of @group(2) of the lighting passes, the structure's leaves.
-    pub fn leaves_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        match self {
-            VoxelKind::Dense => dense::DenseVolume::leaves_layout(device),
-            VoxelKind::Octree => octree::OctreeVolume::leaves_layout(device),
-        }
-    }
-
-    /// The layout of @group(3) of the passes that store leaf radiance.
-    pub fn leaf_store_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        match self {
-            VoxelKind::Dense => dense::DenseVolume::leaf_store_layout(device),
-            VoxelKind::Octree => octree::OctreeVolume::leaf_store_layout(device),
-        }
-    }
-
-    /// The layout of @group(3) of the gather, the structure's irradiance lookup.
-    pub fn irradiance_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        match self {
-            VoxelKind::Dense => dense::DenseVolume::irradiance_layout(device),
-            VoxelKind::Octree => octree::OctreeVolume::irradiance_layout(device),
-        }
-    }
-
-    /// Values for the `override` constants of the structure's sample.wgsl.
-    pub fn sampling_constants(self, anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
-        match self {
-            VoxelKind::Dense => dense::DenseVolume::sampling_constants(anisotropic, axes),
-            VoxelKind::Octree => octree::OctreeVolume::sampling_constants(anisotropic, axes),
-        }
-    }
-}
-
-/// The renderer's voxel structure, whichever kind it is.
-pub enum Voxels {
-    /// The dense volume.
-    Dense(dense::DenseVolume),
-    /// The sparse voxel octree.
-    Octree(octree::OctreeVolume),
-}
-
-impl Voxels {
-    /// The structure, for the passes (which know it only through the trait).
-    pub fn get(&self) -> &dyn VoxelStructure {
-        match self {
-            Voxels::Dense(v) => v,
-            Voxels::Octree(v) => v,
-        }
-    }
-
-    /// The structure, mutably (to grow it).
-    pub fn get_mut(&mut self) -> &mut dyn VoxelStructure {
-        match self {
-            Voxels::Dense(v) => v,
-            Voxels::Octree(v) => v,
-        }
-    }
-
-    /// The dense volume, if that is the kind.
-    pub fn dense(&self) -> Option<&dense::DenseVolume> {
-        match self {
-            Voxels::Dense(v) => Some(v),
-            Voxels::Octree(_) => None,
-        }
-    }
-
-    /// The octree, if that is the kind.
-    pub fn octree(&self) -> Option<&octree::OctreeVolume> {
-        match self {
-            Voxels::Octree(v) => Some(v),
-            Voxels::Dense(_) => None,
-        }
-    }
-}
 
 /// Mirrors `Volume` in shaders/shared/volume.wgsl.
 #[repr(C)]

@@ -8,6 +8,11 @@ use voxgi::gpu::shader;
 use voxgi::scene::builtin;
 use voxgi::scene::glam::{UVec3, Vec3, Vec4};
 use voxgi::voxel::VoxelKind;
+
+/// `voxel::registry::compose_for` of a registered kind.
+fn compose_for(name: &str, kind: &str) -> String {
+    voxgi::voxel::registry::compose_for(name, kind).expect("a registered kind")
+}
 use voxgi::voxel::cpu::{DenseSampler, Texture3d};
 use voxgi::{FrameParams, RendererOptions, wgpu};
 
@@ -87,8 +92,8 @@ const CONTRACT: &[(&str, &[&str], &str)] = &[
 
 #[test]
 fn every_structure_defines_the_voxel_contract() {
-    for kind in shader::STRUCTURES {
-        let src = shader::compose_for(&format!("voxels/{kind}/sample.wgsl"), kind);
+    for kind in VoxelKind::names() {
+        let src = compose_for(&format!("voxels/{kind}/sample.wgsl"), kind);
         let m = parse(&src);
         validate(&m);
         check_functions(&m, kind, CONTRACT);
@@ -122,8 +127,8 @@ const LEAVES: &[(&str, &[&str], &str)] = &[
 
 #[test]
 fn every_structure_defines_the_leaf_contract() {
-    for kind in shader::STRUCTURES {
-        let src = shader::compose_for(&format!("voxels/{kind}/leaf_store.wgsl"), kind);
+    for kind in VoxelKind::names() {
+        let src = compose_for(&format!("voxels/{kind}/leaf_store.wgsl"), kind);
         let m = parse(&src);
         validate(&m);
         check_functions(&m, kind, LEAVES);
@@ -166,8 +171,8 @@ fn every_structure_defines_the_leaf_contract() {
 /// signatures, and its own resources at group 3 (the sampling group's at 1).
 #[test]
 fn every_structure_defines_the_irradiance_lookup() {
-    for kind in shader::STRUCTURES {
-        let src = shader::compose_for(&format!("voxels/{kind}/irradiance.wgsl"), kind);
+    for kind in VoxelKind::names() {
+        let src = compose_for(&format!("voxels/{kind}/irradiance.wgsl"), kind);
         let m = parse(&src);
         validate(&m);
         check_functions(
@@ -195,8 +200,8 @@ fn every_structure_defines_the_irradiance_lookup() {
 /// else: it reaches into no structure's own names.
 #[test]
 fn cone_tracing_uses_only_the_contract() {
-    let cone = shader::compose_for("shared/cone.wgsl", "dense");
-    let dense = shader::compose_for("voxels/dense/sample.wgsl", "dense");
+    let cone = compose_for("shared/cone.wgsl", "dense");
+    let dense = compose_for("voxels/dense/sample.wgsl", "dense");
     // What the including shader brings: the shared structs and constants.
     let volume = shader::compose("shared/volume.wgsl");
     let scene = shader::compose("shared/scene.wgsl");
@@ -300,8 +305,7 @@ pub fn run_probes(r: &voxgi::Renderer, probes: &[[f32; 8]]) -> Vec<Vec4> {
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let src =
-        shader::compose_for(&format!("voxels/{}/sample.wgsl", kind.name()), kind.name()) + PROBE;
+    let src = compose_for(&format!("voxels/{}/sample.wgsl", kind.name()), kind.name()) + PROBE;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("probe"),
         source: wgpu::ShaderSource::Wgsl(src.into()),
@@ -345,7 +349,7 @@ pub fn run_probes(r: &voxgi::Renderer, probes: &[[f32; 8]]) -> Vec<Vec4> {
         let mut pass = encoder.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.set_bind_group(1, r.volume().get().sampling(), &[]);
+        pass.set_bind_group(1, r.volume().sampling(), &[]);
         pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
     }
     queue.submit([encoder.finish()]);
@@ -367,7 +371,7 @@ fn probe_matches_cpu(anisotropic: bool) {
     let mut r = renderer(&builtin::cornell_box(), &options);
     let params = FrameParams::new(r.default_camera().clone());
     frame(&mut r, &params, 8, 8);
-    let vol = r.volume().dense().unwrap();
+    let vol = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
     let grid = vol.grid;
     // Diameters of one to 24 voxels: every level.
     let n = 512;
@@ -424,7 +428,7 @@ fn octree_matches_dense(anisotropic: bool) {
         ..measuring()
     };
     let octree = RendererOptions {
-        voxels: VoxelKind::Octree,
+        voxels: VoxelKind::OCTREE,
         ..dense.clone()
     };
     let scene = builtin::cornell_box();
@@ -434,7 +438,7 @@ fn octree_matches_dense(anisotropic: bool) {
         let mut r = renderer(&scene, options);
         let params = FrameParams::new(r.default_camera().clone());
         frame(&mut r, &params, 8, 8);
-        let g = r.volume().get().grid();
+        let g = r.volume().grid();
         let probes = random_probes(g, 1024, 48.0);
         grid = Some(g);
         results.push((probes.clone(), run_probes(&r, &probes)));
@@ -495,7 +499,7 @@ fn octree_samples_what_the_dense_volume_samples() {
 fn octree_probe_matches_cpu(anisotropic: bool) {
     use voxgi::voxel::octree::cpu::OctreeSampler;
     let options = RendererOptions {
-        voxels: VoxelKind::Octree,
+        voxels: VoxelKind::OCTREE,
         voxel_resolution: 16,
         anisotropic,
         ..measuring()
@@ -503,7 +507,7 @@ fn octree_probe_matches_cpu(anisotropic: bool) {
     let mut r = renderer(&builtin::cornell_box(), &options);
     let params = FrameParams::new(r.default_camera().clone());
     frame(&mut r, &params, 8, 8);
-    let tree = r.volume().octree().unwrap();
+    let tree = r.structure::<voxgi::voxel::octree::OctreeVolume>().unwrap();
     let probes = random_probes(tree.grid, 512, 24.0);
     let gpu = run_probes(&r, &probes);
     let bytes = voxgi::gpu::readback::read_buffer_copy(&ctx().device, &ctx().queue, &tree.nodes)
@@ -556,14 +560,14 @@ fn octree_sample_voxels_matches_its_cpu_twin() {
 #[test]
 fn octree_interpolation_is_continuous_across_bricks() {
     let options = RendererOptions {
-        voxels: VoxelKind::Octree,
+        voxels: VoxelKind::OCTREE,
         voxel_resolution: 32,
         ..measuring()
     };
     let mut r = renderer(&builtin::cornell_box(), &options);
     let params = FrameParams::new(r.default_camera().clone());
     frame(&mut r, &params, 8, 8);
-    let grid = r.volume().get().grid();
+    let grid = r.volume().grid();
     let mut seed = 0x1234_5678_u32;
     let mut rnd = move || {
         seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);

@@ -37,7 +37,7 @@ fn options() -> RendererOptions {
 /// recomputed (nothing else writes their radiance); each for both voxel structures.
 fn both_paths() -> Vec<RendererOptions> {
     let mut out = Vec::new();
-    for voxels in voxgi::VoxelKind::ALL {
+    for &voxels in voxgi::VoxelKind::ALL {
         for bounces in [2, 1] {
             out.push(RendererOptions {
                 voxels,
@@ -59,7 +59,7 @@ fn params(r: &Renderer) -> FrameParams {
 /// not keep their texels, which nothing reads.
 fn volume_bytes(r: &Renderer) -> Vec<(&'static str, Vec<u8>)> {
     let c = ctx();
-    if let Some(o) = r.volume().octree() {
+    if let Some(o) = r.structure::<voxgi::voxel::octree::OctreeVolume>() {
         let nodes = readback::read_buffer_copy(&c.device, &c.queue, &o.nodes).expect("nodes");
         let words: &[u32] = bytemuck::cast_slice(&nodes);
         let walked = voxgi::voxel::octree::cpu::walk(words, &o.layout);
@@ -77,7 +77,7 @@ fn volume_bytes(r: &Renderer) -> Vec<(&'static str, Vec<u8>)> {
             ("leaves", bytemuck::cast_slice(&leaves).to_vec()),
         ];
     }
-    let v = r.volume().dense().unwrap();
+    let v = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
     [
         ("albedo", &v.albedo),
         ("normal", &v.normal),
@@ -173,7 +173,7 @@ fn sequence_of_moves(options: &RendererOptions) {
 /// The two rooms with the lamp carried from room A into room B and halfway back.
 #[test]
 fn a_moving_light_renders_like_a_fresh_renderer() {
-    for voxels in voxgi::VoxelKind::ALL {
+    for &voxels in voxgi::VoxelKind::ALL {
         let options = RendererOptions {
             voxels,
             ..options()
@@ -233,9 +233,10 @@ fn moved_object_leaves_nothing(options: &RendererOptions) {
     // The renderer with the cube sized its octree's pools for more geometry: its bricks lie
     // elsewhere in larger atlases, and a fetch's filtering weights round by its position
     // (measured 8e-6 apart; the tree and every leaf are equal above).
-    let tolerance = match options.voxels {
-        voxgi::VoxelKind::Dense => 0.0,
-        voxgi::VoxelKind::Octree => 1e-4,
+    let tolerance = if options.voxels == voxgi::VoxelKind::OCTREE {
+        1e-4
+    } else {
+        0.0
     };
     assert_close_image(
         &got,
@@ -250,7 +251,7 @@ fn moved_object_leaves_nothing(options: &RendererOptions) {
 /// the structure without rebuilding the static voxels.
 #[test]
 fn camera_motion_alone_does_no_voxel_work() {
-    for voxels in voxgi::VoxelKind::ALL {
+    for &voxels in voxgi::VoxelKind::ALL {
         camera_motion_alone(voxels);
     }
 }
@@ -281,10 +282,10 @@ fn camera_motion_alone(voxels: voxgi::VoxelKind) {
         eprintln!("skipped: this device has no timestamp queries");
         return;
     }
-    let (build, update) = match voxels {
-        voxgi::VoxelKind::Dense => ("dense_build", "dense_update"),
-        voxgi::VoxelKind::Octree => ("octree_build", "octree_update"),
+    let [build, update] = voxels.info().build_passes else {
+        panic!("{voxels:?}: its build and update passes")
     };
+    let (build, update) = (*build, *update);
     assert!(
         first.contains(&build) && first.contains(&"inject"),
         "{first:?}"
@@ -293,7 +294,7 @@ fn camera_motion_alone(voxels: voxgi::VoxelKind) {
     p.camera.position += Vec3::new(0.05, 0.02, 0.0);
     frame(&mut r, &p, SIZE, SIZE);
     let camera_only = names(&mut r);
-    for pass in voxgi::VOXEL_PASSES {
+    for pass in voxgi::voxel_passes() {
         assert!(
             !camera_only.contains(&pass),
             "{voxels:?}: a camera-only frame ran {pass}: {camera_only:?}"
@@ -496,7 +497,7 @@ fn lag(
 /// whole series' (docs/QUALITY.md has the measured values; the bounds allow a frame more).
 #[test]
 fn progressive_bounces_and_update_intervals_catch_up_after_a_change() {
-    for voxels in voxgi::VoxelKind::ALL {
+    for &voxels in voxgi::VoxelKind::ALL {
         catch_up_after_a_change(voxels);
     }
 }

@@ -160,7 +160,9 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
     let mut r = renderer(&scene, &small);
     let (frags0, slots0) = (
         r.fragments().capacity,
-        r.volume().dense().unwrap().slot_capacity,
+        r.structure::<voxgi::voxel::dense::DenseVolume>()
+            .unwrap()
+            .slot_capacity,
     );
     let params = FrameParams::new(r.default_camera().clone());
     let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
@@ -172,7 +174,9 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
     let counts = r.last_voxel_counts().expect("counters came back");
     let (frags1, slots1) = (
         r.fragments().capacity,
-        r.volume().dense().unwrap().slot_capacity,
+        r.structure::<voxgi::voxel::dense::DenseVolume>()
+            .unwrap()
+            .slot_capacity,
     );
     // The Cornell box at 32³ has several thousand fragments and occupied voxels: the
     // 1024-entry minimum pools overflowed, and grew to the exact counts.
@@ -194,7 +198,10 @@ fn overflowing_pools_grow_and_converge_to_the_right_image() {
     draw(&mut sized, &params, &t);
     let want = rgba8(&t);
     assert_eq!(
-        sized.volume().dense().unwrap().slot_capacity,
+        sized
+            .structure::<voxgi::voxel::dense::DenseVolume>()
+            .unwrap()
+            .slot_capacity,
         slots1,
         "no growth when sized right"
     );
@@ -288,11 +295,14 @@ fn an_overflowing_octree_grows_and_converges_to_the_right_image() {
     let scene = builtin::cornell_box();
     let (w, h) = (32, 32);
     let small = RendererOptions {
-        voxels: VoxelKind::Octree,
+        voxels: VoxelKind::OCTREE,
         ..tiny_pools()
     };
     let mut r = renderer(&scene, &small);
-    let pools0 = r.volume().octree().unwrap().pools;
+    let pools0 = r
+        .structure::<voxgi::voxel::octree::OctreeVolume>()
+        .unwrap()
+        .pools;
     let params = FrameParams::new(r.default_camera().clone());
     let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
     let mut frames = 0;
@@ -307,7 +317,10 @@ fn an_overflowing_octree_grows_and_converges_to_the_right_image() {
     assert!(r.is_idle(), "still growing after {frames} frames");
     draw(&mut r, &params, &t);
     let got = rgba8(&t);
-    let pools1 = r.volume().octree().unwrap().pools;
+    let pools1 = r
+        .structure::<voxgi::voxel::octree::OctreeVolume>()
+        .unwrap()
+        .pools;
     eprintln!("octree pools {pools0:?} grew to {pools1:?} in {frames} frames");
     assert!(pools1.slots > pools0.slots && pools1.leaf_tiles > pools0.leaf_tiles);
 
@@ -320,7 +333,7 @@ fn an_overflowing_octree_grows_and_converges_to_the_right_image() {
     draw(&mut sized, &params, &t);
     let want = rgba8(&t);
     let tree = |r: &voxgi::Renderer| {
-        let o = r.volume().octree().unwrap();
+        let o = r.structure::<voxgi::voxel::octree::OctreeVolume>().unwrap();
         let bytes = voxgi::gpu::readback::read_buffer_copy(&ctx().device, &ctx().queue, &o.nodes)
             .expect("nodes");
         walk(bytemuck::cast_slice(&bytes), &o.layout)

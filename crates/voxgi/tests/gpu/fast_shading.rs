@@ -16,14 +16,14 @@ fn leaves_keep_the_furnace_series() {
     // A uniform field: whatever the filter's weights, a pixel reads the leaves' one value, so
     // the bounce count is all that can go wrong (one bounce short or long is 12 % off).
     let scene = builtin::closed_box(0.5, 1.0);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         furnace_series(&scene, Variant::leaves(kind), &FURNACE_CASES);
     }
 }
 
 #[test]
 fn leaves_see_an_open_plane_unoccluded() {
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         ao_of_an_open_plane_on(&plane_scene(0.5), Variant::leaves(kind));
     }
 }
@@ -31,7 +31,7 @@ fn leaves_see_an_open_plane_unoccluded() {
 #[test]
 fn leaves_occlude_beside_a_wall() {
     let (scene, cam) = floor_beside_a_wall();
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         // The closed form's bound (0.1) holds as for the gather.
         let worst = ao_beside_a_wall(&scene, &cam, Variant::leaves(kind));
         eprintln!("leaves beside a wall ({kind:?}): worst error {worst:.3}");
@@ -42,7 +42,7 @@ fn leaves_occlude_beside_a_wall() {
 fn leaves_keep_a_thin_wall_nearly_closed() {
     let res = 64;
     let scene = one_voxel_wall_rooms(res);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let cones = thin_wall_leak(&scene, kind, res);
         let leak = thin_wall_leak(&scene, Variant::leaves(kind), res);
         eprintln!(

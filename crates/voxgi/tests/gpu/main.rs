@@ -16,6 +16,7 @@ mod options;
 mod point_gi;
 mod points;
 mod reference;
+mod registry;
 mod shaders;
 mod shadow_filter;
 mod vct;

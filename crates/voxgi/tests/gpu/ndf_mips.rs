@@ -19,7 +19,7 @@ fn ndf_mips_keep_the_furnace_series() {
     // 1.976 (dense; octree 1.495, 1.740, 1.981) against 1.496, 1.742, 1.985 without: the
     // walls' leaves at the box's edges hold two faces and count less along each.
     let scene = builtin::closed_box(0.5, 1.0);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         furnace_series(&scene, Variant::ndf(kind), &FURNACE_CASES);
     }
 }
@@ -29,7 +29,7 @@ fn ndf_mips_see_an_open_plane_of_points_unoccluded() {
     // The plane's own leaves, seen edge-on by the ring's cones, now count half: AO must stay
     // 1 (the bound and its reasons in `ao_of_an_open_plane`).
     let scene = as_points(&plane_scene(0.5), 64, 2.0);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         ao_of_an_open_plane_on(&scene, Variant::ndf(kind));
     }
 }
@@ -38,7 +38,7 @@ fn ndf_mips_see_an_open_plane_of_points_unoccluded() {
 fn ndf_mips_keep_a_thin_wall_closed() {
     let res = 64;
     let scene = one_voxel_wall_rooms(res);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let leak = thin_wall_leak(&scene, Variant::ndf(kind), res);
         eprintln!("thin wall with NDF mips ({kind:?}): {:.2} %", leak * 100.0);
         // The one-voxel wall holds both faces: their normals cancel and its own leaves count

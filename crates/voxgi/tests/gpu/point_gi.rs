@@ -169,7 +169,7 @@ fn points_of_an_open_plane_have_ao_one() {
 fn points_beside_a_wall_have_the_meshes_ao() {
     let (mesh, cam) = floor_beside_a_wall();
     let scene = as_points(&mesh, 64, 2.0);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         // The closed form and the mesh's tolerance (vct.rs).
         ao_beside_a_wall(&scene, &cam, kind);
     }
@@ -179,7 +179,7 @@ fn points_beside_a_wall_have_the_meshes_ao() {
 fn a_box_of_points_passes_the_furnace() {
     // The glowing white box with its walls as points that emit and reflect.
     let scene = as_points(&builtin::closed_box(0.5, 1.0), 64, 2.0);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         furnace_series(&scene, kind, &FURNACE_CASES);
     }
 }
@@ -189,7 +189,7 @@ fn a_wall_of_points_leaks_as_little_as_the_mesh_wall() {
     let res = 64;
     let scene = one_voxel_wall_rooms(res);
     let points = as_points(&scene, res, 2.0);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let mesh = thin_wall_leak(&scene, kind, res);
         let pts = thin_wall_leak(&points, kind, res);
         eprintln!(
@@ -256,7 +256,7 @@ fn cornell_box_of_points_agrees_with_the_path_tracer() {
             "{name}: discs {b} against triangles {a}"
         );
     }
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let settings = RendererOptions {
             voxels: kind,
             ..settings.clone()
@@ -367,7 +367,7 @@ fn the_bunnys_vertices_bounce_light_as_its_mesh_does() {
     assert_eq!(points_scene.point_clouds.len(), 1);
     let cam = Camera::look_at(Vec3::new(-0.3, 0.6, 1.9), Vec3::new(-0.1, 0.35, 0.0), 40.0);
     let (w, h) = (96, 64);
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let s = on(kind, vct(ViewMode::Indirect, 128, 2));
         let a = render(&mesh, s.clone(), &cam, w, h);
         let b = render(&points_scene, s, &cam, w, h);
@@ -522,7 +522,7 @@ fn emissive_points_light_what_is_near_them_as_a_quad_lamp_does() {
         h,
         opts(256, voxgi::Bounces::Exactly(1)),
     );
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let options = RendererOptions {
             voxels: kind,
             ..options.clone()

@@ -407,7 +407,7 @@ fn cone_traced_cornell_box_agrees_with_the_path_tracer() {
         h,
         opts(128, Bounces::Exactly(2)),
     );
-    for kind in VoxelKind::ALL {
+    for &kind in VoxelKind::ALL {
         let settings = RendererOptions {
             voxels: kind,
             ..settings.clone()

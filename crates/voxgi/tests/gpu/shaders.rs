@@ -14,7 +14,7 @@ fn parse(name: &str) -> naga::Module {
 }
 
 fn parse_for(name: &str, kind: &str) -> naga::Module {
-    let src = shader::compose_for(name, kind);
+    let src = voxgi::voxel::registry::compose_for(name, kind).expect("a kind");
     naga::front::wgsl::parse_str(&src)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)))
 }
@@ -22,20 +22,18 @@ fn parse_for(name: &str, kind: &str) -> naga::Module {
 #[test]
 fn every_shader_validates() {
     let mut n = 0;
-    // Every pass shader for every structure: a structure's own files with its own includes,
-    // the shared passes (which reach a structure through `voxels/` includes) with each.
-    for name in shader::pass_shaders() {
-        for kind in shader::STRUCTURES {
-            if name.starts_with("voxels/") && !name.starts_with(&format!("voxels/{kind}/")) {
-                continue;
-            }
-            let module = parse_for(name, kind);
+    // Every pass shader for every structure: the shared passes (which reach a structure
+    // through `voxels/` includes) with each, and each structure's own with its own includes.
+    for &kind in voxgi::VoxelKind::ALL {
+        let own = kind.shaders().passes.iter().copied();
+        for name in shader::pass_shaders().chain(own) {
+            let module = parse_for(name, kind.name());
             naga::valid::Validator::new(
                 naga::valid::ValidationFlags::all(),
                 naga::valid::Capabilities::all(),
             )
             .validate(&module)
-            .unwrap_or_else(|e| panic!("{name} ({kind}): {e:?}"));
+            .unwrap_or_else(|e| panic!("{name} ({kind:?}): {e:?}"));
             n += 1;
         }
     }

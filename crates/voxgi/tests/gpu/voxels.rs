@@ -36,7 +36,7 @@ fn triangle_scene(tris: &[[Vec3; 3]]) -> Scene {
 /// values themselves.
 fn occupied(r: &Renderer) -> (BTreeSet<[u32; 3]>, Vec<u32>) {
     let (device, queue) = (&ctx().device, &ctx().queue);
-    let vol = r.volume().dense().unwrap();
+    let vol = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
     let bytes = read_buffer_copy(device, queue, &vol.occupancy).expect("occupancy readback");
     let words: &[u32] = bytemuck::cast_slice(&bytes);
     let res = vol.grid.resolution;
@@ -104,7 +104,7 @@ fn voxelize_matches_cpu_exactly() {
         ..measuring()
     };
     let mut r = renderer(&scene, &settings);
-    assert_eq!(r.volume().get().grid(), grid);
+    assert_eq!(r.volume().grid(), grid);
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 16, 16);
 
@@ -170,7 +170,7 @@ fn walls_on_voxel_faces_leave_no_holes() {
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 8, 8);
     let (gpu, _) = occupied(&r);
-    let grid = r.volume().get().grid();
+    let grid = r.volume().grid();
     let voxel = |m: f32, axis: usize| (m * 0.001 - grid.origin[axis]) / grid.voxel_size;
 
     // (wall, axis of its normal, its plane in mm, and its extent in mm along the other two
@@ -316,7 +316,7 @@ fn check_filtering(anisotropic: bool) {
     let mut r = cornell(16, anisotropic);
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 16, 16);
-    let vol = r.volume().dense().unwrap();
+    let vol = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
     let levels = vol.grid.levels();
     let (finest, res) = read_level(&vol.radiance, 0);
     assert_eq!(res, 16);
@@ -384,7 +384,7 @@ fn voxel_filter_weighs_leaves_by_their_normals() {
     let mut r = renderer(&builtin::cornell_box(), &settings);
     let cam = clamped(r.default_camera());
     frame(&mut r, &cam, 16, 16);
-    let vol = r.volume().dense().unwrap();
+    let vol = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
     let (finest, res) = read_level(&vol.radiance, 0);
     let (device, queue) = (&ctx().device, &ctx().queue);
     let bytes = read_texture_3d(device, queue, &vol.normal, 0).expect("normal readback");
@@ -515,7 +515,7 @@ fn octree_build_matches_its_cpu_twin() {
         ..measuring()
     };
     let octree_options = RendererOptions {
-        voxels: voxgi::VoxelKind::Octree,
+        voxels: voxgi::VoxelKind::OCTREE,
         ..dense_options.clone()
     };
     let params = |r: &Renderer| FrameParams::new(r.default_camera().clone());
@@ -526,7 +526,9 @@ fn octree_build_matches_its_cpu_twin() {
     let mut octree = renderer(&scene, &octree_options);
     let p = params(&octree);
     frame(&mut octree, &p, 8, 8);
-    let tree = octree.volume().octree().unwrap();
+    let tree = octree
+        .structure::<voxgi::voxel::octree::OctreeVolume>()
+        .unwrap();
     let nodes_bytes = read_buffer_copy(device, queue, &tree.nodes).expect("nodes");
     let nodes: &[u32] = bytemuck::cast_slice(&nodes_bytes);
     let got = ocpu::walk(nodes, &tree.layout);
@@ -542,7 +544,9 @@ fn octree_build_matches_its_cpu_twin() {
     assert!(want_voxels.len() > 1000, "the scene must fill the tree");
 
     // Leaves: every slot's attributes equal the dense volume's at its voxel.
-    let vol = dense.volume().dense().unwrap();
+    let vol = dense
+        .structure::<voxgi::voxel::dense::DenseVolume>()
+        .unwrap();
     let res = vol.grid.resolution;
     let texels = |t: &wgpu::Texture| read_texture_3d(device, queue, t, 0).expect("texture");
     let (albedo, normal, emission) = (

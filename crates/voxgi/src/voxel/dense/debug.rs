@@ -6,9 +6,9 @@ use super::DenseVolume;
 use crate::frame::formats::HDR_FORMAT;
 use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
-use crate::gpu::shader::compute_pipeline;
+use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::options::ViewMode;
+use crate::voxel::VoxelView;
 use wgpu::util::DeviceExt;
 
 /// The voxel debug compute pass (shaders/voxels/dense/debug.wgsl): its pipeline and bind group
@@ -35,7 +35,14 @@ impl DebugPass {
             ],
         });
         DebugPass {
-            pipeline: compute_pipeline(device, "debug", "voxels/dense/debug.wgsl", &layout),
+            pipeline: voxel_pipeline(
+                device,
+                "debug",
+                "voxels/dense/debug.wgsl",
+                &super::KIND.shaders,
+                &[Some(&layout)],
+                &[],
+            ),
             layout,
         }
     }
@@ -49,17 +56,12 @@ impl DebugPass {
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
         vol: &DenseVolume,
-        view: ViewMode,
+        view: VoxelView,
         level: u32,
         direction: u32,
         timer: &mut GpuTimer,
     ) {
-        let mode: u32 = match view {
-            ViewMode::VoxelAlbedo => 0,
-            ViewMode::VoxelOpacity => 1,
-            ViewMode::VoxelNodes => 3,
-            _ => 2,
-        };
+        let mode = view.id();
         let level = level.min(vol.grid.levels() - 1);
         // In isotropic mode the one block serves every direction.
         let block = direction.min(vol.chain_blocks() - 1);

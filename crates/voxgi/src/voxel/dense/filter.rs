@@ -2,7 +2,7 @@
 
 use super::{DenseVolume, RADIANCE_FORMAT, mip_view};
 use crate::gpu::layout;
-use crate::gpu::shader::compute_pipeline;
+use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
 use wgpu::util::DeviceExt;
 
@@ -36,7 +36,14 @@ impl FilterPass {
             ],
         });
         FilterPass {
-            pipeline: compute_pipeline(device, "filter", "voxels/dense/filter.wgsl", &layout),
+            pipeline: voxel_pipeline(
+                device,
+                "filter",
+                "voxels/dense/filter.wgsl",
+                &super::KIND.shaders,
+                &[Some(&layout)],
+                &[],
+            ),
             layout,
         }
     }

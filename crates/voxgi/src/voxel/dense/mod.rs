@@ -17,9 +17,13 @@ pub mod filter;
 use super::{GpuVolume, Grid, texture_bytes};
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
+use crate::gpu::checked;
+use crate::gpu::shader::StructureShaders;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
+use crate::voxel::registry::{KindInfo, StructureDesc};
 use crate::voxel::{DebugView, Filtering, POOL_COUNTERS, VoxelStructure};
+use crate::{Error, Result};
 use debug::DebugPass;
 use filter::FilterPass;
 use std::sync::Arc;
@@ -40,6 +44,95 @@ const ACCUM_STRIDE: u64 = 13;
 const DYN_STRIDE: u64 = 15;
 /// Bytes of the largest per-slot buffer (the dynamic part).
 pub const SLOT_BYTES: u64 = DYN_STRIDE * 4;
+/// The dense volume in the registry of kinds.
+pub const KIND: KindInfo = KindInfo {
+    name: "dense",
+    summary: "the dense mip-mapped volume: every voxel stored, fastest to sample and to update",
+    // The occupancy buffer of 512³ is 512 MiB, the most a device's storage binding usually takes.
+    max_resolution: 512,
+    build_passes: &["dense_build", "dense_update"],
+    filter_passes: &["filter"],
+    shaders: StructureShaders {
+        name: "dense",
+        sources: crate::wgsl![
+            "voxels/dense/sample.wgsl",
+            "voxels/dense/leaves.wgsl",
+            "voxels/dense/leaf_store.wgsl",
+            "voxels/dense/irradiance.wgsl",
+            "voxels/dense/build_shared.wgsl",
+            "voxels/dense/dense_build.wgsl",
+            "voxels/dense/dense_update.wgsl",
+            "voxels/dense/filter.wgsl",
+            "voxels/dense/debug.wgsl",
+        ],
+        passes: &[
+            "voxels/dense/dense_build.wgsl",
+            "voxels/dense/dense_update.wgsl",
+            "voxels/dense/filter.wgsl",
+            "voxels/dense/debug.wgsl",
+        ],
+    },
+    sampling_layout: DenseVolume::sampling_layout,
+    leaves_layout: DenseVolume::leaves_layout,
+    leaf_store_layout: DenseVolume::leaf_store_layout,
+    irradiance_layout: DenseVolume::irradiance_layout,
+    sampling_constants: DenseVolume::sampling_constants,
+    create,
+};
+
+/// A dense volume for `desc`, with the pipelines of `previous` when it is one.
+fn create(
+    device: &wgpu::Device,
+    desc: &StructureDesc,
+    previous: Option<&dyn VoxelStructure>,
+) -> Result<Box<dyn VoxelStructure>> {
+    check_volume_fits(device, &desc.grid)?;
+    let slots = slot_capacity(
+        device,
+        desc.leaves.min(crate::gpu::max_entries(device, SLOT_BYTES)),
+    )?;
+    let p = match previous.and_then(|v| v.as_any().downcast_ref::<DenseVolume>()) {
+        Some(v) => v.pipelines.clone(),
+        None => checked(device, "pipeline creation", || DensePipelines::new(device))?,
+    };
+    let v = checked(device, "voxel volume", || {
+        DenseVolume::new(device, &p, desc.grid, desc.filtering, slots, desc.dynamic)
+    })?;
+    Ok(Box::new(v))
+}
+
+/// Checks a slot capacity (occupied voxels) against the device's storage-buffer limit.
+fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
+    crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")
+}
+
+/// Checks that the volume's per-voxel buffers fit the device's limits.
+fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
+    let l = device.limits();
+    let occupancy = (grid.resolution as u64).pow(3) * 4;
+    if occupancy > l.max_storage_buffer_binding_size {
+        return Err(Error::Setting(format!(
+            "a {r}³ volume needs a {} MiB occupancy buffer, more than this GPU's {} MiB \
+             storage-buffer limit; use a voxel resolution of at most {}",
+            occupancy >> 20,
+            l.max_storage_buffer_binding_size >> 20,
+            ((l.max_storage_buffer_binding_size / 4) as f64)
+                .cbrt()
+                .log2()
+                .floor()
+                .exp2() as u32,
+            r = grid.resolution
+        )));
+    }
+    if grid.resolution > l.max_texture_dimension_3d {
+        return Err(Error::Setting(format!(
+            "a {}³ volume exceeds this GPU's 3D texture limit of {}",
+            grid.resolution, l.max_texture_dimension_3d
+        )));
+    }
+    Ok(())
+}
+
 /// The dense volume: the finest level's textures, the compact slots of its occupied voxels, the
 /// radiance mip chains above it, and the bind groups the passes reach it through.
 pub struct DenseVolume {
@@ -242,7 +335,7 @@ impl DensePipelines {
                 cache: None,
             })
         };
-        let m = shader::module(device, "voxels/dense/dense_build.wgsl");
+        let m = shader::module_for(device, "voxels/dense/dense_build.wgsl", &KIND.shaders);
         let b = |entry: &str| pipe(&m, "dense_build", entry, entry.starts_with("prepare"));
         let build = BuildPipelines {
             begin: b("begin"),
@@ -253,7 +346,7 @@ impl DensePipelines {
             prepare_slots: b("prepare_slots"),
             resolve: b("resolve"),
         };
-        let m = shader::module(device, "voxels/dense/dense_update.wgsl");
+        let m = shader::module_for(device, "voxels/dense/dense_update.wgsl", &KIND.shaders);
         let u = |entry: &str| {
             pipe(
                 &m,
@@ -652,8 +745,12 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 impl VoxelStructure for DenseVolume {
-    fn kind(&self) -> &'static str {
-        "dense"
+    fn kind(&self) -> crate::voxel::VoxelKind {
+        crate::voxel::VoxelKind::DENSE
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 
     fn grid(&self) -> Grid {

@@ -8,7 +8,6 @@ use crate::frame::targets::FrameTargets;
 use crate::gpu::layout;
 use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
-use crate::options::ViewMode;
 use crate::voxel::DebugView;
 use wgpu::util::DeviceExt;
 
@@ -40,7 +39,7 @@ impl DebugPass {
                 device,
                 "debug",
                 "voxels/octree/debug.wgsl",
-                "octree",
+                &super::KIND.shaders,
                 &[Some(&layout)],
                 &[],
             ),
@@ -58,12 +57,7 @@ impl DebugPass {
         view: DebugView,
         timer: &mut GpuTimer,
     ) {
-        let mode: u32 = match view.mode {
-            ViewMode::VoxelAlbedo => 0,
-            ViewMode::VoxelOpacity => 1,
-            ViewMode::VoxelNodes => 3,
-            _ => 2,
-        };
+        let mode = view.mode.id();
         let block = if tree.anisotropic {
             view.direction.min(5)
         } else {

@@ -17,15 +17,74 @@
 pub mod cpu;
 pub mod debug;
 
+use super::registry::{KindInfo, StructureDesc};
 use super::{DebugView, Filtering, Grid, POOL_COUNTERS, VoxelStructure};
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
+use crate::gpu::checked;
+use crate::gpu::shader::StructureShaders;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use bytemuck::{Pod, Zeroable};
 use debug::DebugPass;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
+
+/// The sparse voxel octree in the registry of kinds.
+pub const KIND: KindInfo = KindInfo {
+    name: "octree",
+    summary: "the sparse voxel octree: memory in proportion to the occupied voxels",
+    // Node coordinates are packed ten bits per axis (`pack_coord`).
+    max_resolution: 1024,
+    build_passes: &["octree_build", "octree_update"],
+    filter_passes: &["octree_filter"],
+    shaders: StructureShaders {
+        name: "octree",
+        sources: crate::wgsl![
+            "voxels/octree/tree.wgsl",
+            "voxels/octree/sample.wgsl",
+            "voxels/octree/leaves.wgsl",
+            "voxels/octree/leaf_store.wgsl",
+            "voxels/octree/irradiance.wgsl",
+            "voxels/octree/build_shared.wgsl",
+            "voxels/octree/octree_build.wgsl",
+            "voxels/octree/octree_update.wgsl",
+            "voxels/octree/octree_filter.wgsl",
+            "voxels/octree/debug.wgsl",
+        ],
+        passes: &[
+            "voxels/octree/octree_build.wgsl",
+            "voxels/octree/octree_update.wgsl",
+            "voxels/octree/octree_filter.wgsl",
+            "voxels/octree/debug.wgsl",
+        ],
+    },
+    sampling_layout: OctreeVolume::sampling_layout,
+    leaves_layout: OctreeVolume::leaves_layout,
+    leaf_store_layout: OctreeVolume::leaf_store_layout,
+    irradiance_layout: OctreeVolume::irradiance_layout,
+    sampling_constants: OctreeVolume::sampling_constants,
+    create,
+};
+
+/// An octree for `desc`, with the pipelines of `previous` when it is one.
+fn create(
+    device: &wgpu::Device,
+    desc: &StructureDesc,
+    previous: Option<&dyn VoxelStructure>,
+) -> crate::Result<Box<dyn VoxelStructure>> {
+    let p = match previous.and_then(|v| v.as_any().downcast_ref::<OctreeVolume>()) {
+        Some(v) => v.pipelines.clone(),
+        None => checked(device, "pipeline creation", || OctreePipelines::new(device))?,
+    };
+    let l = device.limits();
+    let pools = OctreePools::for_leaves(desc.leaves)
+        .within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
+    let v = checked(device, "voxel octree", || {
+        OctreeVolume::new(device, &p, desc.grid, desc.filtering, pools, desc.dynamic)
+    })??;
+    Ok(Box::new(v))
+}
 
 /// Format of both atlases: optical depth (L sigma, sigma), as the dense volume's radiance.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -339,7 +398,7 @@ impl OctreePipelines {
                 cache: None,
             })
         };
-        let m = shader::module_for(device, "voxels/octree/octree_build.wgsl", "octree");
+        let m = shader::module_for(device, "voxels/octree/octree_build.wgsl", &KIND.shaders);
         let b = |entry: &str, args: bool| pipe(&m, "octree_build", entry, args);
         let build = BuildPipelines {
             begin: b("begin", true),
@@ -357,7 +416,7 @@ impl OctreePipelines {
             resolve: b("resolve", false),
             seal: b("seal", false),
         };
-        let m = shader::module_for(device, "voxels/octree/octree_update.wgsl", "octree");
+        let m = shader::module_for(device, "voxels/octree/octree_update.wgsl", &KIND.shaders);
         let u = |entry: &str, args: bool| pipe(&m, "octree_update", entry, args);
         let update = UpdatePipelines {
             begin_clear: u("begin_clear", true),
@@ -393,7 +452,7 @@ impl OctreePipelines {
             ],
         });
         let filter_module =
-            shader::module_for(device, "voxels/octree/octree_filter.wgsl", "octree");
+            shader::module_for(device, "voxels/octree/octree_filter.wgsl", &KIND.shaders);
         let filter_pipeline_layout =
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("octree_filter"),
@@ -1029,8 +1088,12 @@ enum Run {
 }
 
 impl VoxelStructure for OctreeVolume {
-    fn kind(&self) -> &'static str {
-        "octree"
+    fn kind(&self) -> crate::voxel::VoxelKind {
+        crate::voxel::VoxelKind::OCTREE
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 
     fn grid(&self) -> Grid {

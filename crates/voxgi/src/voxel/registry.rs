@@ -1,0 +1,181 @@
+//! The registry of voxel structure kinds: everything the renderer, the command line, the
+//! viewer and the tests know about a kind comes from its `KindInfo` (name, limits, timing
+//! scopes, WGSL files, layouts, sampling constants, creation). A new kind is a folder under
+//! `voxel/` and `shaders/voxels/` that defines a `KindInfo`, plus one line in `VoxelKind::ALL`.
+
+use super::{Filtering, Grid, VoxelStructure, dense, octree};
+use crate::gpu::shader::StructureShaders;
+use crate::{Error, Result};
+
+/// What a structure is made from: where it lies and how it filters, the room its pools start
+/// with, and whether dynamic geometry will be merged into it.
+#[derive(Clone, Copy, Debug)]
+pub struct StructureDesc {
+    /// The grid of its finest voxels (the fragments' grid).
+    pub grid: Grid,
+    /// How it filters its levels.
+    pub filtering: Filtering,
+    /// Occupied voxels its pools start with room for (they grow when a build counts more).
+    pub leaves: u64,
+    /// Whether the scene has dynamic instances (their updates need the static build kept).
+    pub dynamic: bool,
+}
+
+/// A kind of voxel structure, as its own module declares it.
+pub struct KindInfo {
+    /// The name scene files, the command line and the viewer use; also its folders
+    /// `src/voxel/<name>/` and `shaders/voxels/<name>/`.
+    pub name: &'static str,
+    /// One line for help texts and the viewer.
+    pub summary: &'static str,
+    /// The largest voxel resolution it takes (a power of two).
+    pub max_resolution: u32,
+    /// Timing scopes of its own passes that build and update it from fragments, in the order
+    /// they run (they run before inject).
+    pub build_passes: &'static [&'static str],
+    /// Timing scopes of its own passes that filter its levels (after inject and each bounce).
+    pub filter_passes: &'static [&'static str],
+    /// Its WGSL files.
+    pub shaders: StructureShaders,
+    /// The layout of `@group(1)`, its sampling resources (`VoxelStructure::sampling`).
+    pub sampling_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
+    /// The layout of `@group(2)` of the lighting passes, its leaves.
+    pub leaves_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
+    /// The layout of `@group(3)` of the passes that store leaf radiance.
+    pub leaf_store_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
+    /// The layout of `@group(3)` of the gather, its irradiance lookup.
+    pub irradiance_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
+    /// Values for the `override` constants of its sample.wgsl: (anisotropic, gather axes).
+    pub sampling_constants: fn(bool, u32) -> [(&'static str, f64); 2],
+    /// Makes one. `previous`, the structure it replaces (of any kind), lends its pipelines
+    /// when it is of this kind. Errors name what does not fit the device.
+    pub create: CreateFn,
+}
+
+/// `KindInfo::create`.
+pub type CreateFn = fn(
+    &wgpu::Device,
+    &StructureDesc,
+    Option<&dyn VoxelStructure>,
+) -> Result<Box<dyn VoxelStructure>>;
+
+/// Which voxel structure a renderer builds: a handle to a kind in the registry.
+#[derive(Clone, Copy)]
+pub struct VoxelKind(&'static KindInfo);
+
+impl VoxelKind {
+    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
+    pub const DENSE: VoxelKind = VoxelKind(&dense::KIND);
+    /// The sparse voxel octree: memory in proportion to the occupied voxels.
+    pub const OCTREE: VoxelKind = VoxelKind(&octree::KIND);
+
+    /// The registry: every kind, in the order settings list them.
+    pub const ALL: &'static [VoxelKind] = &[VoxelKind::DENSE, VoxelKind::OCTREE];
+
+    /// A kind from its own declaration: how a kind outside the registry (an application's
+    /// own structure, a test's stand-in) is handed to `RendererOptions::voxels`. Settings and
+    /// the command line know only the registry's kinds.
+    pub const fn new(info: &'static KindInfo) -> Self {
+        VoxelKind(info)
+    }
+
+    /// The name settings and the command line use, also the WGSL folder `shaders/voxels/<name>/`.
+    pub fn name(self) -> &'static str {
+        self.0.name
+    }
+
+    /// Every kind's name, in the registry's order.
+    pub fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|k| k.name()).collect()
+    }
+
+    /// The kind named `s`.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                Error::Setting(format!(
+                    "voxel structure '{s}' is not one of {}",
+                    Self::names().join(", ")
+                ))
+            })
+    }
+
+    /// What the kind declares of itself.
+    pub fn info(self) -> &'static KindInfo {
+        self.0
+    }
+
+    /// The layout of @group(1), the structure's sampling resources.
+    pub fn sampling_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        (self.0.sampling_layout)(device)
+    }
+
+    /// The layout of @group(2) of the lighting passes, the structure's leaves.
+    pub fn leaves_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        (self.0.leaves_layout)(device)
+    }
+
+    /// The layout of @group(3) of the passes that store leaf radiance.
+    pub fn leaf_store_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        (self.0.leaf_store_layout)(device)
+    }
+
+    /// The layout of @group(3) of the gather, the structure's irradiance lookup.
+    pub fn irradiance_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        (self.0.irradiance_layout)(device)
+    }
+
+    /// Values for the `override` constants of the structure's sample.wgsl.
+    pub fn sampling_constants(self, anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
+        (self.0.sampling_constants)(anisotropic, axes)
+    }
+
+    /// Its WGSL files, for the shader composer.
+    pub fn shaders(self) -> &'static StructureShaders {
+        &self.0.shaders
+    }
+}
+
+impl Default for VoxelKind {
+    fn default() -> Self {
+        VoxelKind::DENSE
+    }
+}
+
+impl PartialEq for VoxelKind {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for VoxelKind {}
+
+impl std::fmt::Debug for VoxelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The timing scopes of the voxel update (what depends on the scene and its lights, not on
+/// the camera), in the order they run, with every kind's own passes; every other scope is the
+/// screen's.
+pub fn voxel_passes() -> Vec<&'static str> {
+    let mut v = vec!["shadow", "moments", "voxelize", "splat"];
+    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.0.build_passes));
+    v.push("inject");
+    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.0.filter_passes));
+    v.push("bounce");
+    v
+}
+
+/// The full WGSL of shader `name` with `voxels/` includes taken from the kind named `kind`
+/// (for tests and tools that name kinds by string).
+pub fn compose_for(name: &str, kind: &str) -> Result<String> {
+    Ok(crate::gpu::shader::compose_with(
+        name,
+        Some(VoxelKind::parse(kind)?.shaders()),
+    ))
+}
