@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 use voxgi::scene::glam::Vec3;
 use voxgi::scene::{Camera, Scene, builtin, io};
-use voxgi::{FrameParams, RendererOptions, SceneSettings, Tonemap, ViewMode};
+use voxgi::settings::{Domain, SETTINGS};
+use voxgi::{FrameParams, RendererOptions, SceneSettings};
 
 #[derive(Args)]
 pub struct SceneArg {
@@ -20,82 +21,71 @@ pub struct SceneArg {
     pub builtin: Option<String>,
 }
 
-/// Renderer settings shared by `render` and `bench`. Each flag overrides the scene file's
-/// `[settings]` table, which overrides the defaults.
-#[derive(Args)]
+/// Renderer settings shared by `render` and `bench`: one flag per setting of the library's
+/// table (`voxgi::settings::SETTINGS`), named as its key with dashes. Each flag overrides the
+/// scene file's `[settings]` table, which overrides the defaults.
 pub struct SettingsArgs {
-    /// Exposure in stops (EV): the image is scaled by 2^EV before tone mapping. Default 0.
-    #[arg(long, value_name = "EV", allow_hyphen_values = true)]
-    pub exposure: Option<f32>,
-    /// Tone-mapping curve for PNG output. Default aces.
-    #[arg(long, value_parser = names(Tonemap::ALL.map(Tonemap::name)))]
-    pub tonemap: Option<String>,
-    /// What to show; the voxel views ray-march the volume at --voxel-level and show the first
-    /// voxel with opacity > 0.5. Default final.
-    #[arg(long, value_parser = names(ViewMode::ALL.map(ViewMode::name)))]
-    pub view: Option<String>,
-    /// Shadow filter of point, spot and directional lights: pcf, or vsm-esm (the thesis'
-    /// prefiltered variance and exponential maps, the smaller visibility). Default pcf.
-    #[arg(long, value_parser = names(voxgi::ShadowFilter::ALL.map(voxgi::ShadowFilter::name)))]
-    pub shadow_filter: Option<String>,
-    /// Shadow map resolution per view, in texels. Default 1024.
-    #[arg(long, value_name = "N")]
-    pub shadow_map_size: Option<u32>,
-    /// Voxel structure: dense (the mip-mapped volume) or octree (the sparse voxel octree,
-    /// memory in proportion to the occupied voxels). Default dense.
-    #[arg(long, value_parser = names(voxgi::VoxelKind::names()))]
-    pub voxels: Option<String>,
-    /// Voxels per side of the volume (power of two, 16..=512; the octree 16..=1024). Default 128.
-    #[arg(long, value_name = "N")]
-    pub voxel_resolution: Option<u32>,
-    /// Indirect bounces: 0 ("direct": direct light only) to 8, or "unlimited". Default 2.
-    #[arg(long, value_name = "N", value_parser = lib(voxgi::parse_bounces))]
-    pub bounces: Option<u32>,
-    /// Diffuse cone set: 6x60, 7x45 or 9x45. Default 6x60.
-    #[arg(long, value_name = "SET", value_parser = lib(voxgi::parse_cones))]
-    pub cones: Option<voxgi::ConeSet>,
-    /// Diffuse indirect light per pixel: cones (a cone bundle per pixel) or leaves (the
-    /// thesis' fast shading: the leaves' stored irradiance, interpolated). Default cones.
-    #[arg(long, value_parser = names(voxgi::IndirectShading::ALL.map(voxgi::IndirectShading::name)))]
-    pub indirect: Option<String>,
-    /// Weigh each leaf's radiance and opacity per direction by its normals in the first
-    /// directional level (the point-cloud thesis' NDF), instead of counting leaves isotropic.
-    #[arg(long)]
-    pub ndf_mips: bool,
-    /// One radiance value per voxel above the finest level instead of six directional ones.
-    #[arg(long)]
-    pub isotropic: bool,
-    /// Directional blocks per cone sample in the per-pixel gather: 3 (default) or 2 (faster).
-    #[arg(long, value_name = "N")]
-    pub gather_axes: Option<u32>,
-    /// Gather indirect light at half resolution with an edge-aware upsample.
-    #[arg(long)]
-    pub half_res: bool,
-    /// Shadows of area lights by a cone traced through the voxels instead of the shadow map.
-    #[arg(long)]
-    pub cone_shadows: bool,
-    /// Ambient-occlusion radius in metres. Default: a quarter of the volume.
-    #[arg(long, value_name = "M")]
-    pub ao_radius: Option<f32>,
-    /// Ambient-occlusion falloff lambda in 1/(1 + lambda r), per metre. Default 0.
-    #[arg(long, value_name = "L")]
-    pub ao_lambda: Option<f32>,
-    /// Cone step as a fraction of the cone diameter. Default 0.5.
-    #[arg(long, value_name = "F")]
-    pub step_factor: Option<f32>,
-    /// Mip level the voxel views show (0 = finest).
-    #[arg(long, value_name = "N")]
-    pub voxel_level: Option<u32>,
-    /// Directional chain the voxel views read above the finest level: +x, -x, +y, -y, +z, -z.
-    #[arg(long, value_name = "DIR", value_parser = lib(voxgi::parse_direction), allow_hyphen_values = true)]
-    pub voxel_dir: Option<u32>,
-    /// Progressive bounces: one voxel bounce per frame on top of the last frame's light,
-    /// converging to unlimited bounces (sets --bounces unlimited).
-    #[arg(long)]
-    pub progressive: bool,
-    /// Voxel work on every K-th frame only (the voxels then trail moving meshes). Default 1.
-    #[arg(long, value_name = "K")]
-    pub update_interval: Option<u32>,
+    /// The flags given, as (key, text), checked against their setting's form.
+    given: Vec<(&'static str, String)>,
+}
+
+impl clap::FromArgMatches for SettingsArgs {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let given = SETTINGS
+            .iter()
+            .filter_map(|s| m.get_one::<String>(s.key).map(|v| (s.key, v.clone())))
+            .collect();
+        Ok(SettingsArgs { given })
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl clap::Args for SettingsArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        SETTINGS.iter().fold(cmd, |cmd, s| {
+            let mut arg = clap::Arg::new(s.key)
+                .long(s.flag())
+                .help(match s.domain {
+                    // clap lists the choices itself.
+                    Domain::Choice(_) => format!("{} (default {})", s.help, s.default_value()),
+                    _ => format!(
+                        "{} ({}; default {})",
+                        s.help,
+                        s.describe(),
+                        s.default_value()
+                    ),
+                })
+                .value_parser(move |v: &str| s.parse(v).map(|_| v.to_string()))
+                .help_heading(if s.per_frame() {
+                    "Frame settings"
+                } else {
+                    "Renderer settings"
+                });
+            arg = match s.domain {
+                // `--half-resolution` alone is true; `--anisotropic=false` turns one off.
+                Domain::Bool => arg
+                    .num_args(0..=1)
+                    .require_equals(true)
+                    .default_missing_value("true")
+                    .value_name("BOOL"),
+                Domain::Choice(names) => arg
+                    .value_name("NAME")
+                    .allow_hyphen_values(true)
+                    .ignore_case(true)
+                    .value_parser(clap::builder::PossibleValuesParser::new(names())),
+                _ => arg.value_name("VALUE").allow_hyphen_values(true),
+            };
+            cmd.arg(arg)
+        })
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 impl SettingsArgs {
@@ -110,78 +100,12 @@ impl SettingsArgs {
         if let Some(t) = file {
             SceneSettings::from_table(t)?.apply(&mut o, &mut f)?;
         }
-        macro_rules! set {
-            ($dst:expr, $src:expr) => {
-                if let Some(v) = $src {
-                    $dst = v;
-                }
-            };
-        }
-        set!(f.exposure, self.exposure);
-        if let Some(t) = &self.tonemap {
-            f.tonemap = Tonemap::parse(t)?;
-        }
-        if let Some(v) = &self.view {
-            f.view = ViewMode::parse(v)?;
-        }
-        set!(o.shadow_map_size, self.shadow_map_size);
-        if let Some(f) = &self.shadow_filter {
-            o.shadow_filter = voxgi::ShadowFilter::parse(f)?;
-        }
-        if let Some(v) = &self.voxels {
-            o.voxels = voxgi::VoxelKind::parse(v)?;
-        }
-        set!(o.voxel_resolution, self.voxel_resolution);
-        set!(o.bounces, self.bounces);
-        set!(o.cones, self.cones);
-        if let Some(i) = &self.indirect {
-            o.indirect = voxgi::IndirectShading::parse(i)?;
-        }
-        if self.isotropic {
-            o.anisotropic = false;
-        }
-        o.ndf_mips |= self.ndf_mips;
-        set!(o.gather_axes, self.gather_axes);
-        o.half_resolution |= self.half_res;
-        o.cone_shadows |= self.cone_shadows;
-        if self.ao_radius.is_some() {
-            o.ao_radius = self.ao_radius;
-        }
-        set!(o.ao_lambda, self.ao_lambda);
-        set!(o.step_factor, self.step_factor);
-        set!(f.debug_level, self.voxel_level);
-        set!(f.debug_direction, self.voxel_dir);
-        if self.progressive {
-            o.progressive = true;
-            o.bounces = voxgi::UNLIMITED_BOUNCES;
-        }
-        set!(o.voxel_update_interval, self.update_interval);
+        SceneSettings::from_pairs(self.given.iter().map(|(k, v)| (*k, v.as_str())))?
+            .apply(&mut o, &mut f)?;
         o.validate()?;
         f.validate(o.voxel_levels())?;
         Ok((o, f))
     }
-}
-
-/// The view when the scene gives none: as the renderer's (`Renderer::default_camera`), around
-/// everything the scene's animations sweep, so it is the same at every time.
-pub fn default_camera(scene: &Scene) -> Camera {
-    scene
-        .cameras
-        .first()
-        .cloned()
-        .unwrap_or_else(|| Camera::viewing(voxgi::swept_bounds(scene)))
-}
-
-/// A clap parser for one of the library's names.
-fn names(names: impl IntoIterator<Item = &'static str>) -> clap::builder::PossibleValuesParser {
-    clap::builder::PossibleValuesParser::new(names)
-}
-
-/// A clap parser from one of the library's parsers, so the CLI and scene files agree.
-fn lib<T: Clone + Send + Sync + 'static>(
-    f: fn(&str) -> voxgi::Result<T>,
-) -> impl Fn(&str) -> Result<T, String> + Clone {
-    move |s| f(s).map_err(|e| e.to_string())
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -58,7 +58,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         bail!("{label} has no animations to play (--animate)");
     }
     scene.set_time(args.time);
-    let camera = crate::args::default_camera(&scene);
+    let camera = scene.default_camera();
     let (settings, frame) = args
         .settings
         .resolve(table.as_ref(), camera)
@@ -246,23 +246,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "scene": label,
             "size": [w, h],
             "frames": args.frames,
-            "settings": {
-                "voxels": settings.voxels.name(),
-                "voxel_resolution": settings.voxel_resolution,
-                "anisotropic": settings.anisotropic,
-                "cones": settings.cones.name(),
-                "bounces": settings.bounces,
-                "gather_axes": settings.gather_axes,
-                "half_resolution": settings.half_resolution,
-                "cone_shadows": settings.cone_shadows,
-                "revoxelize_every_frame": args.revoxelize,
-                "animate": args.animate,
-                "fps": args.fps,
-                "progressive": settings.progressive,
-                "voxel_update_interval": settings.voxel_update_interval,
-                "shadow_map_size": settings.shadow_map_size,
-                "step_factor": settings.step_factor,
-            },
+            "settings": settings_json(&settings, &frame, args),
             "passes": rows,
             "sums": sums,
             "first_frame_ms": first_frame.iter().map(|(n, ms)| serde_json::json!({"name": n, "ms": ms})).collect::<Vec<_>>(),
@@ -283,4 +267,31 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// Every setting of the table with its value in this run (as the scene file writes it), and
+/// the bench's own choices.
+fn settings_json(
+    o: &voxgi::RendererOptions,
+    f: &voxgi::FrameParams,
+    args: &BenchArgs,
+) -> serde_json::Value {
+    use voxgi::settings::{SETTINGS, Value};
+    let mut m = serde_json::Map::new();
+    for s in SETTINGS {
+        let v = match s.value(o, f) {
+            Value::Bool(b) => serde_json::json!(b),
+            Value::Int(voxgi::UNLIMITED_BOUNCES) => serde_json::json!("unlimited"),
+            Value::Int(n) => serde_json::json!(n),
+            Value::Float(x) | Value::Auto(Some(x)) => serde_json::json!(x),
+            Value::Auto(None) => serde_json::json!("auto"),
+            Value::Name(n) => serde_json::json!(n),
+            Value::Rgb(c) => serde_json::json!(c),
+        };
+        m.insert(s.key.into(), v);
+    }
+    m.insert("revoxelize_every_frame".into(), args.revoxelize.into());
+    m.insert("animate".into(), args.animate.into());
+    m.insert("fps".into(), args.fps.into());
+    serde_json::Value::Object(m)
 }

@@ -136,7 +136,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let mut scene = scene;
     scene.set_time(times[0]);
-    let default = crate::args::default_camera(&scene);
+    let default = scene.default_camera();
     let camera = pick_camera(&scene, &default, args)?;
     let (options, frame) = args
         .settings
@@ -211,7 +211,7 @@ fn reference_options(
             ReferenceMode::Ao {
                 // The cone tracer's AO radius, so the two are comparable.
                 radius: options.ao_radius.unwrap_or_else(|| {
-                    let b = voxgi::swept_bounds(scene);
+                    let b = scene.swept_bounds();
                     voxgi::voxel::Grid::around(b.min, b.max, options.voxel_resolution).extent()
                         * 0.25
                 }),

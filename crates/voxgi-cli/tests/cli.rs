@@ -174,7 +174,7 @@ fn absurd_arguments_are_refused_by_the_parser() {
     ]);
     assert_eq!(o.status.code(), Some(1));
     assert!(
-        error_line(&o).contains("shadow map size 3"),
+        error_line(&o).contains("shadow_map_size 3"),
         "{}",
         error_line(&o)
     );
@@ -231,7 +231,7 @@ fn scene_file_settings_apply_and_typos_are_errors() {
     ]);
     assert_eq!(o.status.code(), Some(1));
     assert!(
-        error_line(&o).contains("voxel resolution 100"),
+        error_line(&o).contains("voxel_resolution 100"),
         "{}",
         error_line(&o)
     );
@@ -402,7 +402,7 @@ fn help_states_the_library_defaults() {
             .find(|l| l.trim_start().starts_with(&format!("{flag} ")))
             .unwrap_or_else(|| panic!("{flag} is not in the help"));
         assert!(
-            line.contains(&format!("Default {value}")),
+            line.contains(&format!("default {value})")),
             "{flag}: the help says `{}`, the library's default is {value}",
             line.trim()
         );
@@ -516,4 +516,55 @@ fn image_sequences_equal_renders_at_each_time() {
     ]);
     assert!(!o.status.success());
     assert!(error_line(&o).contains("%04d"), "{}", error_line(&o));
+}
+
+/// Every setting of the library's table is a flag of `render` and `bench`, named as its key,
+/// and a row of the scene-file documentation.
+#[test]
+fn every_setting_is_a_flag_and_documented() {
+    let docs = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/SCENE_FILES.md"),
+    )
+    .expect("docs/SCENE_FILES.md");
+    for command in ["render", "bench"] {
+        let o = voxgi(&[command, "--help"]);
+        assert!(o.status.success());
+        let help = String::from_utf8_lossy(&o.stdout).into_owned();
+        for s in voxgi::settings::SETTINGS {
+            let flag = format!("--{}", s.key.replace('_', "-"));
+            assert!(help.contains(&flag), "{command}: no {flag}");
+            assert!(
+                docs.contains(&format!("`{}`", s.key)),
+                "docs: no `{}`",
+                s.key
+            );
+        }
+    }
+    // A true-or-false flag alone turns it on; `=false` turns it off.
+    let out = tmp("flags.png");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        "16x16",
+        "--voxel-resolution",
+        "16",
+        "--half-resolution",
+        "--anisotropic=false",
+        "--voxel-dir",
+        "-Z",
+    ]);
+    assert!(o.status.success(), "{}", error_line(&o));
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "-o",
+        out.to_str().unwrap(),
+        "--anisotropic=maybe",
+    ]);
+    assert!(!o.status.success());
 }

@@ -23,6 +23,9 @@ use glam::{Mat4, Vec3};
 pub type Result<T, E = SceneError> = std::result::Result<T, E>;
 
 /// Hard limits that keep a hostile file from exhausting memory before we notice.
+/// Poses `Scene::swept_bounds` samples an animation at, past the first.
+pub const SWEEP_SAMPLES: u32 = 256;
+
 pub mod limits {
     /// Vertices or points in one mesh or cloud.
     pub const MAX_ELEMENTS: usize = 1 << 28;
@@ -398,10 +401,85 @@ impl Scene {
         Ok(())
     }
 
-    /// Camera used when neither the file nor the user gives one: in front of the bounds (+Z side,
-    /// slightly above), looking at their centre, far enough back to see the bounding sphere.
+    /// The camera every front end starts from: the scene's first camera, or else one in front
+    /// of everything it draws at any time of its animations (`swept_bounds`; +Z side, slightly
+    /// above), looking at their centre, far enough back to see the bounding sphere. The one
+    /// rule: the renderer, the command line, the viewer and point preparation all use it.
     pub fn default_camera(&self) -> Camera {
-        Camera::viewing(self.bounds())
+        self.cameras
+            .first()
+            .cloned()
+            .unwrap_or_else(|| Camera::viewing(self.swept_bounds()))
+    }
+
+    /// The bounds of everything the scene draws at any time of its animations: what never
+    /// moves where it is, and what animations move at every pose they pass through (sampled
+    /// at `SWEEP_SAMPLES` + 1 times over the longest animation, as the box around each
+    /// instance's mesh bounds). Renderers place their volume around it.
+    pub fn swept_bounds(&self) -> Aabb {
+        let animated = self.animated_instances();
+        let mut b = Aabb::EMPTY;
+        for (i, inst) in self.instances.iter().enumerate() {
+            if animated.binary_search(&i).is_ok() {
+                continue;
+            }
+            if let Some(mesh) = self.meshes.get(inst.mesh) {
+                for &p in &mesh.positions {
+                    b.grow(inst.transform.transform_point3(p));
+                }
+            }
+        }
+        for pc in &self.point_clouds {
+            for &p in &pc.positions {
+                b.grow(pc.transform.transform_point3(p));
+            }
+        }
+        if animated.is_empty() {
+            return b;
+        }
+        let local: Vec<Aabb> = animated
+            .iter()
+            .map(|&i| {
+                let mut l = Aabb::EMPTY;
+                for &p in &self.meshes[self.instances[i].mesh].positions {
+                    l.grow(p);
+                }
+                l
+            })
+            .collect();
+        let mut probe = Scene {
+            instances: self.instances.clone(),
+            lights: self.lights.clone(),
+            animations: self.animations.clone(),
+            ..Default::default()
+        };
+        let duration = self
+            .animations
+            .iter()
+            .map(animation::Animation::duration)
+            .fold(0.0f32, f32::max);
+        for k in 0..=SWEEP_SAMPLES {
+            probe.set_time(duration * k as f32 / SWEEP_SAMPLES as f32);
+            for (&i, l) in animated.iter().zip(&local) {
+                b = b.union(&l.transformed(probe.instances[i].transform));
+            }
+        }
+        b
+    }
+
+    /// The instances some animation moves, sorted, each once.
+    pub fn animated_instances(&self) -> Vec<usize> {
+        let mut v: Vec<usize> = self
+            .animations
+            .iter()
+            .flat_map(|a| match &a.target {
+                animation::AnimationTarget::Instances { instances, .. } => instances.clone(),
+                animation::AnimationTarget::Light { .. } => Vec::new(),
+            })
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
     }
 
     /// A sun for scenes that have no light at all, so they render as something other than black:

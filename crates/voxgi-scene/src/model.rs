@@ -314,6 +314,23 @@ impl Aabb {
         max: Vec3::splat(f32::NEG_INFINITY),
     };
 
+    /// The box around the corners of this one moved by `m`.
+    pub fn transformed(&self, m: glam::Mat4) -> Aabb {
+        let mut out = Aabb::EMPTY;
+        if self.is_empty() {
+            return out;
+        }
+        for i in 0..8 {
+            let p = Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            );
+            out.grow(m.transform_point3(p));
+        }
+        out
+    }
+
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }

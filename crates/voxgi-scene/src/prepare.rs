@@ -37,12 +37,7 @@ pub struct PointPreparation {
 /// cloud's bounds (scanners put the sensor there), else the default camera.
 pub fn prepare_points(scene: &mut Scene) -> PointPreparation {
     let mut timing = PointPreparation::default();
-    let camera = scene
-        .cameras
-        .first()
-        .cloned()
-        .unwrap_or_else(|| scene.default_camera())
-        .position;
+    let camera = scene.default_camera().position;
     for pc in &mut scene.point_clouds {
         if pc.positions.is_empty()
             || (!pc.normals.is_empty() && !pc.radii.is_empty() && !pc.regions.is_empty())

@@ -1,15 +1,12 @@
-//! The settings panel: per-frame parameters edited in place (they apply at once), creation-time
-//! options edited as a draft that "Apply" hands to `Renderer::set_options`. The widgets' own
-//! values (a resolution as a power of two, bounces as a count or unlimited) map to the options
-//! and back without loss.
+//! The settings panel, drawn from the library's one table of settings
+//! (`voxgi::settings::SETTINGS`): a widget per setting by its domain, with the table's label,
+//! range, choices and help. Per-frame parameters are edited in place (they apply at once);
+//! creation-time options are edited as a draft that "Apply" hands to `Renderer::set_options`.
+//! The widgets' own values (a resolution as a power of two, bounces as a count or unlimited)
+//! map to the settings and back without loss.
 
-use voxgi::{
-    ConeSet, DIRECTIONS, FrameParams, RendererOptions, Tonemap, UNLIMITED_BOUNCES, ViewMode,
-};
-
-/// Voxel resolutions the panel offers: 16..=512.
-pub const RESOLUTIONS: [u32; 6] = [16, 32, 64, 128, 256, 512];
-pub const CONE_SETS: [ConeSet; 3] = [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45];
+use voxgi::settings::{Changes, Domain, SETTINGS, Setting, Value};
+use voxgi::{FrameParams, MAX_BOUNCES, RendererOptions, UNLIMITED_BOUNCES};
 
 /// Bounces as the panel shows them: a count 0..=8 and an "unlimited" box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,84 +54,131 @@ pub struct PanelActions {
     pub display: Option<crate::ground_truth::Display>,
 }
 
-/// The panel's creation-time options section: widgets over the draft.
+/// One setting's widget over `o` and `f`; `levels` bounds the voxel views' level. Returns
+/// whether the user changed it.
+fn widget(
+    ui: &mut egui::Ui,
+    s: &'static Setting,
+    o: &mut RendererOptions,
+    f: &mut FrameParams,
+    levels: u32,
+) -> bool {
+    let old = s.value(o, f);
+    let mut v = old;
+    match (s.domain, &mut v) {
+        (Domain::Bool, Value::Bool(b)) => {
+            ui.checkbox(b, s.label);
+        }
+        (Domain::Int { min, max }, Value::Int(n)) => {
+            let max = if s.key == "voxel_level" {
+                levels.saturating_sub(1)
+            } else {
+                max
+            };
+            ui.add(egui::Slider::new(n, min..=max.max(min)).text(s.label));
+        }
+        (Domain::Resolution { min }, Value::Int(n)) => {
+            egui::ComboBox::from_label(s.label)
+                .selected_text(format!("{n}³"))
+                .show_ui(ui, |ui| {
+                    for r in resolutions(min, o.voxels) {
+                        ui.selectable_value(n, r, format!("{r}³"));
+                    }
+                });
+        }
+        (Domain::Float { min, max }, Value::Float(x)) => {
+            ui.add(egui::Slider::new(x, min..=max).text(s.label));
+        }
+        (Domain::Auto, Value::Auto(x)) => {
+            ui.horizontal(|ui| {
+                let mut auto = x.is_none();
+                ui.checkbox(&mut auto, format!("{}: auto", s.label));
+                if auto {
+                    *x = None;
+                } else {
+                    let mut m = x.unwrap_or(1.0);
+                    ui.add(
+                        egui::DragValue::new(&mut m)
+                            .speed(0.01)
+                            .range(0.001..=1.0e4),
+                    );
+                    *x = Some(m);
+                }
+            });
+        }
+        (Domain::Choice(names), Value::Name(n)) => {
+            egui::ComboBox::from_label(s.label)
+                .selected_text(*n)
+                .show_ui(ui, |ui| {
+                    for c in names() {
+                        ui.selectable_value(n, c, c);
+                    }
+                });
+        }
+        (Domain::Bounces, Value::Int(n)) => {
+            let mut b = BounceWidget::from_option(*n);
+            ui.horizontal(|ui| {
+                ui.add_enabled(
+                    !b.unlimited,
+                    egui::Slider::new(&mut b.count, 0..=MAX_BOUNCES).text(s.label),
+                );
+                ui.checkbox(&mut b.unlimited, "unlimited");
+            });
+            *n = b.to_option();
+        }
+        (Domain::Rgb, Value::Rgb(c)) => {
+            ui.horizontal(|ui| {
+                ui.color_edit_button_rgb(c);
+                ui.label(s.label);
+            });
+        }
+        (d, v) => unreachable!("{}: {d:?} holds {v:?}", s.key),
+    }
+    if v != old {
+        s.set(o, f, v);
+        true
+    } else {
+        false
+    }
+}
+
+/// The resolutions the panel offers for structure `voxels`: every power of two the options
+/// accept.
+pub fn resolutions(min: u32, voxels: voxgi::VoxelKind) -> Vec<u32> {
+    let top = voxels.info().max_resolution;
+    (min.ilog2()..=top.ilog2()).map(|k| 1u32 << k).collect()
+}
+
+/// The panel's creation-time options section: a widget per option of the table over the draft.
 pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -> PanelActions {
     let mut actions = PanelActions::default();
-    egui::ComboBox::from_label("voxel structure")
-        .selected_text(draft.voxels.name())
-        .show_ui(ui, |ui| {
-            for &k in voxgi::VoxelKind::ALL {
-                ui.selectable_value(&mut draft.voxels, k, k.name());
-            }
-        });
-    egui::ComboBox::from_label("voxels per side")
-        .selected_text(draft.voxel_resolution.to_string())
-        .show_ui(ui, |ui| {
-            for r in RESOLUTIONS {
-                ui.selectable_value(&mut draft.voxel_resolution, r, format!("{r}³"));
-            }
-        });
-    egui::ComboBox::from_label("diffuse cones")
-        .selected_text(draft.cones.name())
-        .show_ui(ui, |ui| {
-            for c in CONE_SETS {
-                ui.selectable_value(&mut draft.cones, c, c.name());
-            }
-        });
-    let mut b = BounceWidget::from_option(draft.bounces);
-    ui.horizontal(|ui| {
-        ui.add_enabled(
-            !b.unlimited,
-            egui::Slider::new(&mut b.count, 0..=8).text("bounces"),
-        );
-        ui.checkbox(&mut b.unlimited, "unlimited");
-    });
-    draft.bounces = b.to_option();
-    ui.add_enabled(
-        b.unlimited,
-        egui::Checkbox::new(&mut draft.progressive, "progressive (one bounce per frame)"),
-    );
-    if !b.unlimited {
-        draft.progressive = false;
+    // The frame parameters are not edited here; the widgets need somewhere to read them.
+    let mut unused = FrameParams::new(voxgi::scene::Camera::look_at(
+        glam::Vec3::Z,
+        glam::Vec3::ZERO,
+        45.0,
+    ));
+    for s in SETTINGS.iter().filter(|s| !s.per_frame()) {
+        let enabled = match s.key {
+            "ndf_mips" => draft.anisotropic,
+            "progressive" => draft.bounces == UNLIMITED_BOUNCES,
+            _ => true,
+        };
+        ui.add_enabled_ui(enabled, |ui| {
+            widget(ui, s, draft, &mut unused, 0);
+        })
+        .response
+        .on_hover_text(s.help);
     }
-    ui.checkbox(&mut draft.anisotropic, "anisotropic voxels");
-    ui.add_enabled(
-        draft.anisotropic,
-        egui::Checkbox::new(&mut draft.ndf_mips, "leaves weighed by their normals (NDF)"),
-    );
+    // The options that need another: what the library would refuse, the panel turns off.
     if !draft.anisotropic {
         draft.ndf_mips = false;
     }
-    egui::ComboBox::from_label("diffuse indirect")
-        .selected_text(match draft.indirect {
-            voxgi::IndirectShading::Cones => "cones per pixel",
-            voxgi::IndirectShading::Leaves => "leaves' irradiance (fast)",
-        })
-        .show_ui(ui, |ui| {
-            ui.selectable_value(
-                &mut draft.indirect,
-                voxgi::IndirectShading::Cones,
-                "cones per pixel",
-            );
-            ui.selectable_value(
-                &mut draft.indirect,
-                voxgi::IndirectShading::Leaves,
-                "leaves' irradiance (fast)",
-            );
-        });
-    ui.checkbox(&mut draft.half_resolution, "half-resolution gather");
-    ui.checkbox(&mut draft.cone_shadows, "cone-traced area-light shadows");
-    egui::ComboBox::from_label("point, spot and sun shadows")
-        .selected_text(draft.shadow_filter.name())
-        .show_ui(ui, |ui| {
-            for f in voxgi::ShadowFilter::ALL {
-                ui.selectable_value(&mut draft.shadow_filter, f, f.name());
-            }
-        });
-    ui.add(
-        egui::Slider::new(&mut draft.voxel_update_interval, 1..=16)
-            .text("voxel update every k frames"),
-    );
+    if draft.bounces != UNLIMITED_BOUNCES {
+        draft.progressive = false;
+    }
+    let top = draft.voxels.info().max_resolution;
+    draft.voxel_resolution = draft.voxel_resolution.min(top);
     ui.horizontal(|ui| {
         if ui.add_enabled(dirty, egui::Button::new("Apply")).clicked() {
             actions.apply = true;
@@ -144,49 +188,40 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
         }
     });
     if dirty {
-        ui.label("Apply builds a new renderer; the window goes on meanwhile.");
+        ui.label(
+            "Apply changes the renderer's options; the voxel structure, its resolution, the \
+             shadow maps and the uploaded scene's settings rebuild it.",
+        );
     }
     actions
 }
 
-/// The panel's per-frame section: edits `params` in place.
+/// Whether applying `draft` over `current` needs a new renderer (a setting that shapes the
+/// uploaded scene), rather than `Renderer::set_options`.
+pub fn needs_new_renderer(current: &RendererOptions, draft: &RendererOptions) -> bool {
+    voxgi::settings::changes_between(current, draft) == Some(Changes::Scene)
+}
+
+/// The panel's per-frame section: a widget per frame parameter of the table over `params`;
+/// the voxel level and direction only for the voxel views. `levels` is the volume's mip count.
 pub fn frame_ui(ui: &mut egui::Ui, params: &mut FrameParams, levels: u32) {
-    egui::ComboBox::from_label("view")
-        .selected_text(params.view.name())
-        .show_ui(ui, |ui| {
-            for v in ViewMode::ALL {
-                ui.selectable_value(&mut params.view, v, v.name());
-            }
-        });
-    if params.view.is_voxel() {
-        ui.add(
-            egui::Slider::new(&mut params.debug_level, 0..=levels.saturating_sub(1))
-                .text("voxel level"),
-        );
-        egui::ComboBox::from_label("voxel direction")
-            .selected_text(DIRECTIONS[params.debug_direction.min(5) as usize])
-            .show_ui(ui, |ui| {
-                for (i, d) in DIRECTIONS.iter().enumerate() {
-                    ui.selectable_value(&mut params.debug_direction, i as u32, *d);
-                }
-            });
+    let mut unused = RendererOptions::default();
+    for s in SETTINGS.iter().filter(|s| s.per_frame()) {
+        if matches!(s.key, "voxel_level" | "voxel_dir") && !params.view.is_voxel() {
+            continue;
+        }
+        ui.scope(|ui| {
+            widget(ui, s, &mut unused, params, levels);
+        })
+        .response
+        .on_hover_text(s.help);
     }
-    ui.add(egui::Slider::new(&mut params.exposure, -8.0..=8.0).text("exposure (EV)"));
-    egui::ComboBox::from_label("tone map")
-        .selected_text(params.tonemap.name())
-        .show_ui(ui, |ui| {
-            for t in Tonemap::ALL {
-                ui.selectable_value(&mut params.tonemap, t, t.name());
-            }
-        });
-    ui.add(
-        egui::Slider::new(&mut params.shadow_softness, 0.0..=16.0).text("shadow softness (texels)"),
-    );
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use voxgi::{ConeSet, Tonemap, ViewMode};
 
     #[test]
     fn bounce_widget_round_trips_every_setting() {
@@ -196,29 +231,23 @@ mod tests {
     }
 
     #[test]
-    fn the_panel_offers_every_valid_resolution_and_cone_set() {
-        for r in RESOLUTIONS {
-            let o = RendererOptions {
-                voxel_resolution: r,
-                ..RendererOptions::default()
-            };
-            assert!(o.validate().is_ok(), "{r}");
-        }
-        // Powers of two 16..=512 are exactly what the options accept.
-        let accepted: Vec<u32> = (4..=10)
-            .map(|k| 1u32 << k)
-            .filter(|&r| {
-                RendererOptions {
-                    voxel_resolution: r,
-                    ..RendererOptions::default()
-                }
-                .validate()
-                .is_ok()
-            })
-            .collect();
-        assert_eq!(accepted, RESOLUTIONS);
-        for c in CONE_SETS {
-            assert_eq!(ConeSet::parse(c.name()), Some(c));
+    fn the_panel_offers_every_valid_resolution() {
+        // Per structure, the powers of two the panel offers are exactly what the options
+        // accept (the octree's 1024 included).
+        for &voxels in voxgi::VoxelKind::ALL {
+            let accepted: Vec<u32> = (0..=12)
+                .map(|k| 1u32 << k)
+                .filter(|&r| {
+                    RendererOptions {
+                        voxels,
+                        voxel_resolution: r,
+                        ..RendererOptions::default()
+                    }
+                    .validate()
+                    .is_ok()
+                })
+                .collect();
+            assert_eq!(accepted, resolutions(16, voxels), "{voxels:?}");
         }
     }
 

@@ -272,11 +272,7 @@ impl Viewer {
         };
         let mut scene = scene;
         scene.set_time(0.0);
-        let default_camera = scene
-            .cameras
-            .first()
-            .cloned()
-            .unwrap_or_else(|| voxgi::scene::Camera::viewing(voxgi::swept_bounds(&scene)));
+        let default_camera = scene.default_camera();
         let mut params = FrameParams::new(default_camera.clone());
         if let Some(s) = &settings {
             s.apply(&mut options, &mut params)?;
@@ -289,7 +285,7 @@ impl Viewer {
             ground.paths_per_frame = n;
             ground.frame_target_ms = None;
         }
-        let bounds = voxgi::swept_bounds(&scene);
+        let bounds = scene.swept_bounds();
         let radius = if bounds.is_empty() {
             1.0
         } else {
@@ -526,7 +522,7 @@ impl Viewer {
         self.options = o.options;
         // The file's view settings (exposure, tone curve, view mode); the camera is framed below.
         self.params = o.settings_params;
-        let bounds = voxgi::swept_bounds(&o.scene);
+        let bounds = o.scene.swept_bounds();
         self.scene_radius = (bounds.size().length() * 0.5).max(1e-3);
         self.duration = o
             .scene
@@ -548,9 +544,23 @@ impl Viewer {
         self.status = format!("opened {}", o.path.display());
     }
 
-    /// Builds a renderer for the draft options in the background; the current one draws until
-    /// it is ready.
+    /// Applies the draft options: through `Renderer::set_options`, which rebuilds only what the
+    /// changed settings feed (a lighting change relights the voxels it has), or, for a setting
+    /// that shapes the uploaded scene, by building a new renderer in the background while the
+    /// current one draws.
     fn apply(&mut self) {
+        if !crate::settings::needs_new_renderer(&self.options, &self.draft) {
+            match self.renderer.set_options(&self.draft) {
+                Ok(()) => {
+                    self.options = self.draft.clone();
+                    self.pass_ms.clear();
+                    self.version += 1;
+                    self.status = "options applied".into();
+                }
+                Err(e) => self.status = format!("the new options failed: {e:#}"),
+            }
+            return;
+        }
         let (device, queue) = (self.device.clone(), self.queue.clone());
         let (scene, options) = (self.scene.clone(), self.draft.clone());
         self.rebuild = Some(Job::spawn("rebuilding for the new options", move || {

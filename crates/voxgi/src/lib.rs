@@ -50,7 +50,7 @@ pub mod reference;
 mod renderer;
 mod scene_state;
 pub mod screen;
-mod settings;
+pub mod settings;
 mod view;
 pub mod voxel;
 
@@ -65,8 +65,7 @@ pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
 pub use renderer::{Renderer, VoxelCounts};
-pub use scene_state::swept_bounds;
-pub use settings::{BouncesValue, SceneSettings, parse_bounces, parse_cones, parse_direction};
+pub use settings::{SceneSettings, Setting, parse_bounces};
 pub use voxel::{VoxelKind, voxel_passes};
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;

@@ -23,6 +23,9 @@ pub enum ConeSet {
 }
 
 impl ConeSet {
+    /// Every set, in the order settings list them.
+    pub const ALL: [ConeSet; 3] = [ConeSet::Six60, ConeSet::Seven45, ConeSet::Nine45];
+
     /// The set's name as settings and the command line spell it: "6x60", "7x45" or "9x45".
     pub fn name(&self) -> &'static str {
         match self {
@@ -363,86 +366,6 @@ impl Default for RendererOptions {
 }
 
 impl RendererOptions {
-    /// Checks every value against its documented range.
-    pub fn validate(&self) -> Result<()> {
-        let fail = |m: String| Err(Error::Setting(m));
-        if !(64..=8192).contains(&self.shadow_map_size) {
-            return fail(format!(
-                "shadow map size {} is outside 64..=8192",
-                self.shadow_map_size
-            ));
-        }
-        if !(1..=8192).contains(&self.max_texture_size) {
-            return fail(format!(
-                "max texture size {} is outside 1..=8192",
-                self.max_texture_size
-            ));
-        }
-        let r = self.voxel_resolution;
-        let top = self.voxels.info().max_resolution;
-        if !(16..=top).contains(&r) || !r.is_power_of_two() {
-            return fail(format!(
-                "voxel resolution {r} is not a power of two in 16..={top} (the {} structure)",
-                self.voxels.name()
-            ));
-        }
-        if self.bounces > MAX_BOUNCES && self.bounces != UNLIMITED_BOUNCES {
-            return fail(format!(
-                "{} bounces: use 0..={MAX_BOUNCES} or unlimited",
-                self.bounces
-            ));
-        }
-        if let Some(a) = self.ao_radius
-            && !(a.is_finite() && a > 0.0)
-        {
-            return fail(format!("AO radius {a} must be a positive number of metres"));
-        }
-        if !(self.ao_lambda.is_finite() && self.ao_lambda >= 0.0) {
-            return fail(format!("AO lambda {} must be >= 0", self.ao_lambda));
-        }
-        if self.ndf_mips && !self.anisotropic {
-            return fail(
-                "ndf_mips weighs six directional values: it needs the anisotropic volume".into(),
-            );
-        }
-        if !(2..=3).contains(&self.gather_axes) {
-            return fail(format!("gather axes {} must be 2 or 3", self.gather_axes));
-        }
-        if !(0.05..=2.0).contains(&self.step_factor) {
-            return fail(format!(
-                "step factor {} is outside 0.05..=2",
-                self.step_factor
-            ));
-        }
-        if !(0.0..=8.0).contains(&self.origin_offset) {
-            return fail(format!(
-                "cone origin offset {} is outside 0..=8 voxels",
-                self.origin_offset
-            ));
-        }
-        if let Some(d) = self.max_distance
-            && !(d.is_finite() && d > 0.0)
-        {
-            return fail(format!(
-                "max cone distance {d} must be a positive number of metres"
-            ));
-        }
-        if self.progressive && self.bounces != UNLIMITED_BOUNCES {
-            return fail(format!(
-                "progressive bounces converge to unlimited bounces: set bounces to unlimited \
-                 (not {})",
-                self.bounces
-            ));
-        }
-        if !(1..=64).contains(&self.voxel_update_interval) {
-            return fail(format!(
-                "voxel update interval {} is outside 1..=64 frames",
-                self.voxel_update_interval
-            ));
-        }
-        Ok(())
-    }
-
     /// Mip levels of the volume, the finest included.
     pub fn voxel_levels(&self) -> u32 {
         self.voxel_resolution.max(1).ilog2() + 1
@@ -488,40 +411,6 @@ impl FrameParams {
             debug_level: 0,
             debug_direction: 0,
         }
-    }
-
-    /// Checks every value against its documented range; `levels` is the volume's mip count.
-    pub fn validate(&self, levels: u32) -> Result<()> {
-        let fail = |m: String| Err(Error::Setting(m));
-        let c = &self.camera;
-        if !(c.position.is_finite() && c.forward.is_finite() && c.up.is_finite()) {
-            return fail("camera position and direction must be finite".into());
-        }
-        if !(0.0..=16.0).contains(&self.shadow_softness) {
-            return fail(format!(
-                "shadow softness {} is outside 0..=16 texels",
-                self.shadow_softness
-            ));
-        }
-        if !(-20.0..=20.0).contains(&self.exposure) {
-            return fail(format!("exposure {} EV is outside -20..=20", self.exposure));
-        }
-        if !self.background.iter().all(|c| c.is_finite() && *c >= 0.0) {
-            return fail("background must be finite and non-negative".into());
-        }
-        if self.debug_level >= levels {
-            return fail(format!(
-                "voxel debug level {} is outside 0..{levels}",
-                self.debug_level
-            ));
-        }
-        if self.debug_direction >= 6 {
-            return fail(format!(
-                "voxel debug direction {} is outside 0..6 (+X, -X, +Y, -Y, +Z, -Z)",
-                self.debug_direction
-            ));
-        }
-        Ok(())
     }
 }
 

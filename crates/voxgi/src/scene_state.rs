@@ -3,12 +3,9 @@
 //! everything animated sweeps (which the voxel grid and the shadow views must cover).
 
 use crate::{Error, Result};
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 use voxgi_scene::animation::{Animation, AnimationTarget};
 use voxgi_scene::{Aabb, Light, Scene};
-
-/// Poses sampled per animation to find the space it sweeps.
-const SWEEP_SAMPLES: u32 = 256;
 
 /// One instance as the renderer knows it.
 #[derive(Clone, Debug)]
@@ -29,24 +26,8 @@ impl InstanceState {
     /// The world bounds of the instance under `transform` (the box around the transformed
     /// corners of its mesh's bounds).
     pub fn world_bounds(&self, transform: Mat4) -> Aabb {
-        transformed(self.local, transform)
+        self.local.transformed(transform)
     }
-}
-
-fn transformed(b: Aabb, m: Mat4) -> Aabb {
-    let mut out = Aabb::EMPTY;
-    if b.is_empty() {
-        return out;
-    }
-    for i in 0..8 {
-        let p = Vec3::new(
-            if i & 1 == 0 { b.min.x } else { b.max.x },
-            if i & 2 == 0 { b.min.y } else { b.max.y },
-            if i & 4 == 0 { b.min.z } else { b.max.z },
-        );
-        out.grow(m.transform_point3(p));
-    }
-    out
 }
 
 /// The scene's mutable state: instances, lights and animations.
@@ -71,13 +52,6 @@ impl SceneState {
             .filter(|i| i.dynamic && i.draw.is_some())
             .fold(Aabb::EMPTY, |b, i| b.union(&i.world_bounds(i.transform)))
     }
-}
-
-/// The bounds of everything `scene` draws at any time of its animations (what the renderer's
-/// volume and default camera are placed around).
-pub fn swept_bounds(scene: &Scene) -> Aabb {
-    let draws: Vec<Option<u32>> = vec![None; scene.instances.len()];
-    SceneState::new(scene, &draws).swept_bounds(scene)
 }
 
 /// What `SceneState::set_time` changed.
@@ -143,45 +117,6 @@ impl SceneState {
     /// The animations.
     pub fn animations(&self) -> &[Animation] {
         &self.animated.animations
-    }
-
-    /// The bounds of everything the scene draws at any time: what never moves where it is,
-    /// and what animations move at every pose they pass through (sampled finely, plus the
-    /// current pose). `scene` is the uploaded scene, for the exact bounds of the still part.
-    pub fn swept_bounds(&self, scene: &Scene) -> Aabb {
-        let mut b = Aabb::EMPTY;
-        for (i, inst) in scene.instances.iter().enumerate() {
-            if self.animated_instances.binary_search(&i).is_ok() {
-                continue;
-            }
-            if let Some(mesh) = scene.meshes.get(inst.mesh) {
-                for &p in &mesh.positions {
-                    b.grow(inst.transform.transform_point3(p));
-                }
-            }
-        }
-        for pc in &scene.point_clouds {
-            for &p in &pc.positions {
-                b.grow(pc.transform.transform_point3(p));
-            }
-        }
-        if self.animated_instances.is_empty() {
-            return b;
-        }
-        let mut probe = self.animated.clone();
-        let duration = self
-            .animations()
-            .iter()
-            .map(Animation::duration)
-            .fold(0.0f32, f32::max);
-        for k in 0..=SWEEP_SAMPLES {
-            probe.set_time(duration * k as f32 / SWEEP_SAMPLES as f32);
-            for &i in &self.animated_instances {
-                let inst = &self.instances[i];
-                b = b.union(&inst.world_bounds(probe.instances[i].transform));
-            }
-        }
-        b
     }
 
     /// Samples the animations at time `t` and lists what changed since the last state set.

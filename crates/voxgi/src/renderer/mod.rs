@@ -36,6 +36,7 @@ use crate::screen::gather::{self, GatherPass};
 use crate::screen::gbuffer::GbufferPass;
 use crate::screen::tonemap::TonemapPass;
 use crate::screen::upsample::UpsamplePass;
+use crate::settings::{Changes, changes_between};
 use crate::view::lit_scene;
 use crate::voxel::{Filtering, Grid, POOL_COUNTERS, StructureDesc, VoxelStructure};
 use crate::{Error, Result};
@@ -187,7 +188,7 @@ impl Renderer {
             GpuScene::new(device, queue, scene, options)
         })??;
         let state = SceneState::new(scene, &gpu_scene.instance_draw);
-        let bounds = state.swept_bounds(scene);
+        let bounds = scene.swept_bounds();
         let (center, radius) = bounding_sphere(bounds);
         let facts = SceneFacts {
             bounds,
@@ -246,12 +247,7 @@ impl Renderer {
             contents: bytemuck::bytes_of(&cone_uniforms(options, &grid)),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        // From the swept bounds, so that it is the same at every time of an animation.
-        let default_camera = scene
-            .cameras
-            .first()
-            .cloned()
-            .unwrap_or_else(|| Camera::viewing(bounds));
+        let default_camera = scene.default_camera();
         let views = atlas.views.len();
         Ok(Renderer {
             device: device.clone(),
@@ -288,15 +284,18 @@ impl Renderer {
     /// Changes the options, rebuilding only what depends on the ones that changed: the fragments
     /// for the resolution, the volume for its resolution or anisotropy, the shadow atlas for
     /// its size or cone shadows, the gather, bounce and composite pipelines for what they are
-    /// specialised on; cone and AO parameters and the bounce count are uniform writes. Voxel
-    /// work is redone in the next frame only if something it depends on changed.
+    /// specialised on; cone and AO parameters and the bounce count are uniform writes. The next
+    /// frame's voxel work follows the settings table (`settings::Changes`): a structure or
+    /// shadow-map change voxelizes everything again, a lighting change (bounces, cones, AO,
+    /// indirect shading, progressive) relights the voxels it has, the others need none.
     /// `max_texture_size` and `default_light` shape the uploaded scene: changing them is an
     /// error (make a new renderer). `fragment_capacity` and `voxel_capacity` size a pool when
     /// it is made anew (here, for a new resolution or anisotropy), not the pools in use.
     pub fn set_options(&mut self, options: &RendererOptions) -> Result<()> {
         options.validate()?;
         let (old, new) = (&self.options, options);
-        if old.max_texture_size != new.max_texture_size || old.default_light != new.default_light {
+        let changes = changes_between(old, new);
+        if changes == Some(Changes::Scene) {
             return Err(Error::Setting(
                 "max_texture_size and default_light shape the uploaded scene: make a new \
                  Renderer to change them"
@@ -412,10 +411,12 @@ impl Renderer {
             self.voxel_bounces = voxel_bounce_count(self.facts.max_albedo, new);
         }
         // The gather's resolution needs no work here: the next frame makes targets to match.
-        let progressive = old.progressive != new.progressive;
         self.options = options.clone();
-        if volume || atlas || cones || progressive {
+        // A structure or an atlas made anew holds nothing yet, whatever the table says.
+        if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();
+        } else if changes == Some(Changes::Lighting) {
+            self.pending.lights = true;
         }
         Ok(())
     }

@@ -85,16 +85,62 @@ fn changed_options_render_like_a_fresh_renderer() {
                 ..base()
             },
         ),
+        // Lighting changes relight the voxels the renderer has instead of voxelizing again.
+        (
+            "longest cone",
+            RendererOptions {
+                max_distance: Some(0.1),
+                ..base()
+            },
+        ),
+        (
+            "cone origin",
+            RendererOptions {
+                origin_offset: 3.0,
+                ..base()
+            },
+        ),
+        (
+            "leaves",
+            RendererOptions {
+                indirect: voxgi::IndirectShading::Leaves,
+                ..base()
+            },
+        ),
+        (
+            "unlimited bounces",
+            RendererOptions {
+                bounces: voxgi::UNLIMITED_BOUNCES,
+                ..base()
+            },
+        ),
     ];
     let mut r = renderer(&scene, &base());
+    r.enable_timing(true);
     let params = FrameParams::new(r.default_camera().clone());
     let first = frame(&mut r, &params, SIZE, SIZE);
     for (what, options) in changes {
         r.set_options(&base()).expect("back to the base options");
         let again = frame(&mut r, &params, SIZE, SIZE);
         assert!(again.hdr == first.hdr, "{what}: back to the base options");
+        r.pass_times().expect("times");
         r.set_options(&options).expect(what);
         let changed = frame(&mut r, &params, SIZE, SIZE);
+        let passes: Vec<&str> = r
+            .pass_times()
+            .expect("times")
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect();
+        let lighting = voxgi::settings::changes_between(&base(), &options)
+            == Some(voxgi::settings::Changes::Lighting);
+        // Relit, not rebuilt (where the device times passes: lavapipe does).
+        if lighting && !passes.is_empty() {
+            assert!(
+                passes.contains(&"inject") && !passes.contains(&"voxelize"),
+                "{what}: {passes:?}"
+            );
+        }
         let fresh = render_with(&scene, &options, &params, SIZE, SIZE);
         assert!(
             changed.hdr == fresh.hdr,
