@@ -53,6 +53,8 @@ pub mod screen;
 pub mod settings;
 mod view;
 pub mod voxel;
+#[cfg(all(test, feature = "reference"))]
+mod wgsl_twins;
 
 pub use error::{Error, Result};
 pub use frame::targets::{FrameTargets, Target};

@@ -32,13 +32,13 @@ pub struct InjectPass {
 /// Mirrors `InjectParams` in shaders/lighting/inject.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct GpuInjectParams {
-    light_count: u32,
-    all: u32,
-    store_all: u32,
-    _pad: u32,
-    moved_min: [f32; 4],
-    moved_max: [f32; 4],
+pub(crate) struct GpuInjectParams {
+    pub(crate) light_count: u32,
+    pub(crate) all: u32,
+    pub(crate) store_all: u32,
+    pub(crate) _pad: u32,
+    pub(crate) moved_min: [f32; 4],
+    pub(crate) moved_max: [f32; 4],
 }
 
 impl InjectPass {

@@ -18,12 +18,12 @@ const STRIDE: u64 = 256;
 /// `MomentRect` in moments.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuMomentRect {
-    min: [u32; 2],
-    max: [u32; 2],
-    layer: u32,
-    far: f32,
-    _pad: [u32; 2],
+pub(crate) struct GpuMomentRect {
+    pub(crate) min: [u32; 2],
+    pub(crate) max: [u32; 2],
+    pub(crate) layer: u32,
+    pub(crate) far: f32,
+    pub(crate) _pad: [u32; 2],
 }
 
 /// The moments compute pass: its pipeline and layout.

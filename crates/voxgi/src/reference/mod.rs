@@ -20,7 +20,7 @@ use glam::{Mat3, Vec3};
 use voxgi_scene::{Light, Scene};
 use wgpu::util::DeviceExt;
 
-mod progressive;
+pub(crate) mod progressive;
 pub use progressive::{Accumulation, Region};
 
 /// How many indirect bounces the reference simulates (as the cone tracer counts them).
@@ -97,22 +97,22 @@ impl Default for ReferenceOptions {
 /// Mirrors `Params` in shaders/reference.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct GpuParams {
-    inv_view_proj: [[f32; 4]; 4],
-    background: [f32; 3],
-    light_count: u32,
-    width: u32,
-    height: u32,
-    x0: u32,
-    sample_count: u32,
-    seed: u32,
-    bounces: u32,
-    mode: u32,
-    ao_radius: f32,
-    rr_depth: u32,
-    x1: u32,
-    y0: u32,
-    y1: u32,
+pub(crate) struct GpuParams {
+    pub(crate) inv_view_proj: [[f32; 4]; 4],
+    pub(crate) background: [f32; 3],
+    pub(crate) light_count: u32,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) x0: u32,
+    pub(crate) sample_count: u32,
+    pub(crate) seed: u32,
+    pub(crate) bounces: u32,
+    pub(crate) mode: u32,
+    pub(crate) ao_radius: f32,
+    pub(crate) rr_depth: u32,
+    pub(crate) x1: u32,
+    pub(crate) y0: u32,
+    pub(crate) y1: u32,
 }
 
 /// Mirrors `Node` in shaders/reference.wgsl.

@@ -108,11 +108,11 @@ impl Accumulation {
 /// Mirrors `Display` in shaders/reference_display.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct GpuDisplay {
-    exposure: f32,
-    tonemap: u32,
-    width: u32,
-    _pad: u32,
+pub(crate) struct GpuDisplay {
+    pub(crate) exposure: f32,
+    pub(crate) tonemap: u32,
+    pub(crate) width: u32,
+    pub(crate) _pad: u32,
 }
 
 /// The `reference_display` pass: its layouts, and one pipeline per target format seen.

@@ -111,6 +111,19 @@ const LEVEL_STRIDE: u64 = 256;
 /// Texels per brick side.
 const BRICK: u32 = 3;
 
+/// The constants above that octree_update.wgsl (and tree.wgsl, which it includes) defines
+/// too, by their WGSL names: a test holds the two sides equal.
+#[cfg(test)]
+pub(crate) const SHARED_CONSTANTS: &[(&str, u64)] = &[
+    ("NODE_STRIDE", NODE_WORDS),
+    ("SLOT_STRIDE", SLOT_WORDS),
+    ("NODE_HEADER", NODE_HEADER),
+    ("TILE_WORDS", TILE_WORDS),
+    ("GRID_DEPTH", GRID_DEPTH as u64),
+    ("ARGS_NEW", ARGS_NEW),
+    ("ARGS_CLEAR", ARGS_CLEAR),
+];
+
 /// Mirrors `Octree` in shaders/voxels/octree/tree.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]

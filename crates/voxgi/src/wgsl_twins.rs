@@ -1,0 +1,313 @@
+//! Every `#[repr(C)]` struct shared with WGSL against its twin as naga lays it out: the size,
+//! and each field's offset by name (a field in the wrong place, or missing on one side, fails).
+//! Padding fields (`_…`) are left out of the comparison by name; the offsets around them and
+//! the size still pin them. The octree's layout constants are checked against tree.wgsl's.
+
+use crate::fragments::{GpuFragmentGrid, GpuRegion};
+use crate::frame::uniforms::GpuFrame;
+use crate::gpu::shader::compose;
+use crate::gpu_scene::{GpuDraw, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
+use crate::lighting::atlas::GpuShadowView;
+use crate::lighting::cones::GpuCones;
+use crate::lighting::inject::GpuInjectParams;
+use crate::lighting::moments::GpuMomentRect;
+use crate::reference::progressive::GpuDisplay;
+use crate::reference::{GpuNode, GpuParams, GpuTri, GpuTriShading};
+use crate::voxel::octree::{GpuAtlasShape, GpuOctree};
+use crate::voxel::{GpuVolume, VoxelKind};
+use std::mem::{offset_of, size_of};
+
+fn module(src: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)))
+}
+
+/// The modules that between them define every twin.
+fn modules() -> Vec<naga::Module> {
+    let octree = crate::gpu::shader::compose_with(
+        "voxels/octree/sample.wgsl",
+        Some(VoxelKind::OCTREE.shaders()),
+    );
+    let inject =
+        crate::gpu::shader::compose_with("lighting/inject.wgsl", Some(VoxelKind::DENSE.shaders()));
+    let gather =
+        crate::gpu::shader::compose_with("screen/gather.wgsl", Some(VoxelKind::DENSE.shaders()));
+    [
+        compose("screen/composite.wgsl"),
+        compose("screen/gbuffer.wgsl"),
+        compose("fragments/voxelize.wgsl"),
+        compose("lighting/moments.wgsl"),
+        compose("reference.wgsl"),
+        compose("reference_display.wgsl"),
+        gather,
+        inject,
+        octree,
+    ]
+    .iter()
+    .map(|s| module(s))
+    .collect()
+}
+
+/// (members by name and offset, size) of WGSL struct `name`.
+fn wgsl_struct(modules: &[naga::Module], name: &str) -> (Vec<(String, u32)>, u32) {
+    modules
+        .iter()
+        .flat_map(|m| m.types.iter())
+        .find_map(|(_, t)| match (&t.name, &t.inner) {
+            (Some(n), naga::TypeInner::Struct { members, span }) if n == name => Some((
+                members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                    .collect(),
+                *span,
+            )),
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("WGSL struct {name} not found"))
+}
+
+/// Checks Rust struct `$rust` against WGSL struct `$wgsl`: sizes, and for every listed field
+/// the WGSL member of the same name (`$field = "name"` where the names differ) at the same
+/// offset; every WGSL member that is not padding must be listed.
+macro_rules! twin {
+    ($m:expr, $rust:ty, $wgsl:literal, [$($field:ident $(= $name:literal)?),* $(,)?]) => {{
+        let (members, span) = wgsl_struct($m, $wgsl);
+        assert_eq!(
+            span as usize,
+            size_of::<$rust>(),
+            "{}: WGSL {} bytes, Rust {}",
+            $wgsl,
+            span,
+            size_of::<$rust>()
+        );
+        let mut listed: Vec<&str> = Vec::new();
+        $(
+            let name = twin!(@name $field $(= $name)?);
+            listed.push(name);
+            let (_, offset) = members
+                .iter()
+                .find(|(n, _)| n == name)
+                .unwrap_or_else(|| panic!("{}: no WGSL member {name}", $wgsl));
+            assert_eq!(
+                *offset as usize,
+                offset_of!($rust, $field),
+                "{}.{name}: WGSL offset {offset}, Rust {}",
+                $wgsl,
+                offset_of!($rust, $field)
+            );
+        )*
+        for (n, _) in &members {
+            assert!(
+                n.starts_with('_') || listed.contains(&n.as_str()),
+                "{}: WGSL member {n} has no Rust field listed",
+                $wgsl
+            );
+        }
+    }};
+    (@name $field:ident = $name:literal) => { $name };
+    (@name $field:ident) => { stringify!($field) };
+}
+
+#[test]
+fn every_twin_has_the_wgsl_layout() {
+    let m = &modules();
+    twin!(
+        m,
+        GpuFrame,
+        "Frame",
+        [
+            view_proj,
+            inv_view_proj,
+            camera_pos,
+            light_count,
+            size,
+            inv_size,
+            exposure,
+            tonemap,
+            shadow_softness,
+            view_mode,
+            background,
+            cone_shadows,
+            geometry_points,
+        ]
+    );
+    twin!(m, GpuVertex, "Vertex", [position, u, normal, v]);
+    twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
+    twin!(
+        m,
+        GpuMaterial,
+        "Material",
+        [
+            base_color,
+            emissive,
+            roughness,
+            metallic,
+            specular,
+            base_texture,
+            emissive_texture,
+            alpha_cutoff,
+            double_sided,
+        ]
+    );
+    twin!(
+        m,
+        GpuPoint,
+        "Point",
+        [
+            position,
+            radius,
+            normal,
+            albedo_rg,
+            albedo_b_emission_r,
+            emission_gb,
+        ]
+    );
+    twin!(
+        m,
+        GpuLight,
+        "Light",
+        [
+            position,
+            kind,
+            direction,
+            range,
+            radiance,
+            area,
+            axis_u,
+            cos_inner,
+            axis_v,
+            cos_outer,
+            shadow_first,
+            shadow_count,
+            size,
+        ]
+    );
+    twin!(
+        m,
+        GpuShadowView,
+        "ShadowView",
+        [
+            view_proj,
+            inv_view_proj,
+            origin,
+            kind,
+            dir,
+            texel,
+            near,
+            far,
+            resolution,
+            layer,
+            plane,
+        ]
+    );
+    twin!(
+        m,
+        GpuVolume,
+        "Volume",
+        [origin, resolution, voxel_size, levels, anisotropic]
+    );
+    twin!(
+        m,
+        GpuCones,
+        "Cones",
+        [
+            dirs,
+            count,
+            diffuse_tan,
+            step_factor,
+            max_distance,
+            ao_lambda,
+            ao_radius,
+            origin_offset,
+            indirect,
+        ]
+    );
+    twin!(
+        m,
+        GpuFragmentGrid,
+        "FragmentGrid",
+        [origin, resolution, voxel_size, inv_voxel_size]
+    );
+    twin!(m, GpuRegion, "FragmentRegion", [lo, hi]);
+    twin!(
+        m,
+        GpuInjectParams,
+        "InjectParams",
+        [light_count, all, store_all, moved_min, moved_max,]
+    );
+    twin!(m, GpuMomentRect, "MomentRect", [min, max, layer, far]);
+    twin!(
+        m,
+        GpuOctree,
+        "Octree",
+        [
+            origin,
+            resolution,
+            voxel_size,
+            depth,
+            anisotropic,
+            dirs,
+            base_v,
+            base_e,
+            base_o,
+            tiles,
+            slots,
+            ndf,
+            leaf_atlas,
+            even_atlas,
+            odd_atlas,
+        ]
+    );
+    twin!(m, GpuAtlasShape, "AtlasShape", [shift, block, z0, inv_size]);
+    twin!(
+        m,
+        GpuParams,
+        "Params",
+        [
+            inv_view_proj,
+            background,
+            light_count,
+            width,
+            height,
+            x0,
+            sample_count,
+            seed,
+            bounces,
+            mode,
+            ao_radius,
+            rr_depth,
+            x1,
+            y0,
+            y1,
+        ]
+    );
+    twin!(m, GpuNode, "Node", [lo, first, hi, count]);
+    twin!(m, GpuTri, "Tri", [p0, material, p1, light, p2, kind]);
+    twin!(m, GpuTriShading, "TriShading", [n0, n1, n2, uv]);
+    twin!(m, GpuDisplay, "Display", [exposure, tonemap, width]);
+}
+
+/// The octree's layout constants, which Rust and WGSL both define, agree.
+#[test]
+fn octree_constants_agree_with_the_wgsl() {
+    let src = crate::gpu::shader::compose_with(
+        "voxels/octree/octree_update.wgsl",
+        Some(VoxelKind::OCTREE.shaders()),
+    );
+    let m = module(&src);
+    let constant = |name: &str| -> u64 {
+        let (_, c) = m
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("octree_update.wgsl: no const {name}"));
+        match m.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v as u64,
+            naga::Expression::Literal(naga::Literal::I32(v)) => v as u64,
+            naga::Expression::Literal(naga::Literal::AbstractInt(v)) => v as u64,
+            ref e => panic!("octree_update.wgsl: {name} = {e:?}"),
+        }
+    };
+    for (name, rust) in crate::voxel::octree::SHARED_CONSTANTS {
+        assert_eq!(constant(name), *rust, "{name}: WGSL and Rust differ");
+    }
+}
