@@ -36,6 +36,10 @@ pub struct BenchArgs {
     /// Write the results as JSON here.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
+    /// Write the timed frames' pass scopes as a Chrome trace here (open it in chrome://tracing
+    /// or ui.perfetto.dev).
+    #[arg(long, value_name = "FILE")]
+    pub trace: Option<PathBuf>,
     #[command(flatten)]
     pub settings: SettingsArgs,
 }
@@ -118,6 +122,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
     let voxel_passes = voxgi::voxel_passes();
     for i in 0..args.warmup + args.frames {
+        if i == args.warmup && args.trace.is_some() {
+            renderer.keep_pass_trace();
+        }
         // Wall time from recording to the timestamps' readback: the whole frame, CPU included,
         // whatever a driver's timestamps miss (lavapipe's read about 0 for some passes).
         let start = std::time::Instant::now();
@@ -157,6 +164,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         eprint!("\rframe {}/{}", i + 1 - args.warmup, args.frames);
     }
     eprintln!();
+    if let Some(path) = &args.trace {
+        renderer
+            .write_pass_trace(path)
+            .with_context(|| format!("writing the trace {}", path.display()))?;
+        eprintln!("bench: pass trace in {}", path.display());
+    }
     let VoxelCounts {
         fragments,
         occupied,

@@ -1,51 +1,59 @@
-//! GPU timestamps per pass, for `voxgi bench`. Each pass asks for a scope by its name when it
-//! begins; scopes of the same name in a frame (one shadow pass per view, one filter pass per
-//! mip level) add up. Without timestamp support every request returns `None` and costs nothing.
+//! GPU timestamps per pass, for `voxgi bench`, through `wgpu-profiler`. Each pass asks for a
+//! scope by its name when it begins; scopes of the same name in a frame (one shadow pass per
+//! view, one filter pass per mip level) add up. Without timestamp support, or with timing off,
+//! every request returns `None` and costs nothing. The scopes of the frames read can be kept
+//! and written as a Chrome trace (`write_trace`).
 
 use crate::{Error, Result};
+use wgpu_profiler::{GpuProfiler, GpuProfilerQuery, GpuProfilerSettings, GpuTimerQueryResult};
 
-const MAX_SCOPES: u32 = 512;
-
-/// Timestamp queries for up to 512 pass scopes a frame, resolved into a buffer and read back
-/// after submission. Inert (all `None`) when disabled or when the device lacks `TIMESTAMP_QUERY`.
+/// Per-pass timestamp scopes: inert when disabled or when the device lacks
+/// `TIMESTAMP_QUERY`.
 pub struct GpuTimer {
-    query_set: Option<wgpu::QuerySet>,
-    resolve: Option<wgpu::Buffer>,
-    readback: Option<wgpu::Buffer>,
-    labels: Vec<&'static str>,
+    on: Option<Profiling>,
     period_ns: f32,
+}
+
+struct Profiling {
+    profiler: GpuProfiler,
+    /// `GpuProfiler::begin_pass_query` asks an encoder what it supports, and pass queries
+    /// record nothing into it: the passes' own encoders stay untouched until `resolve`.
+    scratch: wgpu::CommandEncoder,
+    /// This frame's pass queries: they are closed when the frame's queries are resolved.
+    open: Vec<GpuProfilerQuery>,
+    /// The names scopes were asked by (results come back as strings).
+    names: Vec<&'static str>,
+    /// A frame's queries were resolved into an encoder: the frame ends once that encoder has
+    /// been submitted (the next frame, or `read`).
+    resolved: bool,
+    /// The scopes of every frame read, for a trace, when kept.
+    trace: Option<Vec<GpuTimerQueryResult>>,
 }
 
 impl GpuTimer {
     /// A timer that records only if `enabled` and the device supports timestamps.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> Self {
         let on = enabled && device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let size = MAX_SCOPES as u64 * 2 * 8;
+        let settings = GpuProfilerSettings {
+            enable_timer_queries: true,
+            enable_debug_groups: false,
+            // Frames between reads: `headless::render` renders a few before it reads.
+            max_num_pending_frames: 16,
+        };
         GpuTimer {
-            query_set: on.then(|| {
-                device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("pass timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: MAX_SCOPES * 2,
-                })
-            }),
-            resolve: on.then(|| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("timestamp resolve"),
-                    size,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                })
-            }),
-            readback: on.then(|| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("timestamp readback"),
-                    size,
-                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                    mapped_at_creation: false,
-                })
-            }),
-            labels: Vec::new(),
+            on: on
+                .then(|| GpuProfiler::new(device, settings).ok())
+                .flatten()
+                .map(|profiler| Profiling {
+                    profiler,
+                    scratch: device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("timer scratch (never submitted)"),
+                    }),
+                    open: Vec::new(),
+                    names: Vec::new(),
+                    resolved: false,
+                    trace: None,
+                }),
             period_ns: queue.get_timestamp_period(),
         }
     }
@@ -53,88 +61,119 @@ impl GpuTimer {
     /// A timer that never records.
     pub fn disabled(queue: &wgpu::Queue) -> Self {
         GpuTimer {
-            query_set: None,
-            resolve: None,
-            readback: None,
-            labels: Vec::new(),
+            on: None,
             period_ns: queue.get_timestamp_period(),
         }
     }
 
-    fn next(&mut self, label: &'static str) -> Option<(&wgpu::QuerySet, u32)> {
-        let qs = self.query_set.as_ref()?;
-        if self.labels.len() as u32 >= MAX_SCOPES {
-            return None;
+    /// Keeps the scopes of every frame read from now on, for `write_trace`.
+    pub fn keep_trace(&mut self) {
+        if let Some(p) = &mut self.on {
+            p.trace.get_or_insert_with(Vec::new);
         }
-        let i = self.labels.len() as u32;
-        self.labels.push(label);
-        Some((qs, i * 2))
     }
 
-    /// Timestamp writes for a compute pass named `label`, or `None` when the timer is off or the
-    /// frame's scopes are used up.
+    /// Starts a frame: the last frame's encoder has been submitted (the renderer's contract),
+    /// so its profiler frame ends.
+    pub fn begin_frame(&mut self) {
+        if let Some(p) = &mut self.on
+            && std::mem::take(&mut p.resolved)
+            && let Err(e) = p.profiler.end_frame()
+        {
+            log::warn!("pass timing: {e}");
+        }
+    }
+
+    fn query(&mut self, label: &'static str) -> Option<&GpuProfilerQuery> {
+        let p = self.on.as_mut()?;
+        if !p.names.contains(&label) {
+            p.names.push(label);
+        }
+        let q = p.profiler.begin_pass_query(label, &mut p.scratch);
+        p.open.push(q);
+        p.open.last()
+    }
+
+    /// Timestamp writes for a compute pass named `label`, or `None` when the timer is off.
     pub fn compute(&mut self, label: &'static str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.next(label)
-            .map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(i),
-                end_of_pass_write_index: Some(i + 1),
-            })
+        self.query(label)?.compute_pass_timestamp_writes()
     }
 
-    /// Timestamp writes for a render pass named `label`, or `None` when the timer is off or the
-    /// frame's scopes are used up.
+    /// Timestamp writes for a render pass named `label`, or `None` when the timer is off.
     pub fn render(&mut self, label: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.next(label)
-            .map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(i),
-                end_of_pass_write_index: Some(i + 1),
-            })
+        self.query(label)?.render_pass_timestamp_writes()
     }
 
     /// Records the resolve of this frame's timestamps; call once after the last pass.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        let (Some(qs), Some(resolve), Some(readback)) =
-            (&self.query_set, &self.resolve, &self.readback)
-        else {
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let Some(p) = &mut self.on else {
             return;
         };
-        let n = self.labels.len() as u32 * 2;
-        if n == 0 {
-            return;
+        for q in p.open.drain(..) {
+            p.profiler.end_query(encoder, q);
         }
-        encoder.resolve_query_set(qs, 0..n, resolve, 0);
-        encoder.copy_buffer_to_buffer(resolve, 0, readback, 0, n as u64 * 8);
+        p.profiler.resolve_queries(encoder);
+        p.resolved = true;
     }
 
-    /// Milliseconds per pass name, in first-use order, after the frame was submitted; clears
-    /// the scopes for the next frame.
+    /// Milliseconds per pass name, in first-use order, of every frame since the last read,
+    /// once submitted. This waits for the GPU (for `voxgi bench`).
     pub fn read(&mut self, device: &wgpu::Device) -> Result<Vec<(&'static str, f64)>> {
-        let labels = std::mem::take(&mut self.labels);
-        let Some(readback) = &self.readback else {
+        self.begin_frame();
+        let period = self.period_ns;
+        let Some(p) = &mut self.on else {
             return Ok(Vec::new());
         };
-        if labels.is_empty() {
-            return Ok(Vec::new());
-        }
-        let bytes = crate::gpu::readback::read_buffer(device, readback)?;
-        let ticks: &[u64] = bytemuck::cast_slice(&bytes[..labels.len() * 16]);
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu {
+                context: "timestamps".into(),
+                reason: e.to_string(),
+            })?;
         let mut out: Vec<(&'static str, f64)> = Vec::new();
-        for (i, label) in labels.iter().enumerate() {
-            let (a, b) = (ticks[2 * i], ticks[2 * i + 1]);
-            let ms = b.saturating_sub(a) as f64 * self.period_ns as f64 * 1e-6;
-            match out.iter_mut().find(|(l, _)| l == label) {
-                Some(e) => e.1 += ms,
-                None => out.push((label, ms)),
+        while let Some(frame) = p.profiler.process_finished_frame(period) {
+            for scope in &frame {
+                let Some(name) = p.names.iter().find(|n| **n == scope.label) else {
+                    continue;
+                };
+                let ms = scope
+                    .time
+                    .as_ref()
+                    .map_or(0.0, |t| (t.end - t.start).max(0.0) * 1e3);
+                if !ms.is_finite() {
+                    return Err(Error::Gpu {
+                        context: "timestamps".into(),
+                        reason: "non-finite pass time".into(),
+                    });
+                }
+                match out.iter_mut().find(|(l, _)| l == name) {
+                    Some(e) => e.1 += ms,
+                    None => out.push((name, ms)),
+                }
+            }
+            if let Some(t) = &mut p.trace {
+                t.extend(frame);
             }
         }
-        if out.iter().any(|(_, ms)| !ms.is_finite()) {
-            return Err(Error::Gpu {
-                context: "timestamps".into(),
-                reason: "non-finite pass time".into(),
-            });
-        }
+        out.sort_by_key(|(n, _)| p.names.iter().position(|m| m == n));
         Ok(out)
+    }
+
+    /// Writes the scopes kept since `keep_trace` as a Chrome trace (chrome://tracing, Perfetto).
+    pub fn write_trace(&self, path: &std::path::Path) -> Result<()> {
+        let scopes = self
+            .on
+            .as_ref()
+            .and_then(|p| p.trace.as_deref())
+            .ok_or_else(|| {
+                Error::Setting(
+                    "no pass timings to trace: timing is off or this device has no timestamps"
+                        .into(),
+                )
+            })?;
+        wgpu_profiler::chrometrace::write_chrometrace(path, scopes).map_err(|e| Error::Output {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })
     }
 }

@@ -559,6 +559,17 @@ impl Renderer {
         self.timer = GpuTimer::new(&self.device, &self.queue, on);
     }
 
+    /// Keeps the pass scopes of every frame read by `pass_times` from now on, for
+    /// `write_pass_trace` (with timing on).
+    pub fn keep_pass_trace(&mut self) {
+        self.timer.keep_trace();
+    }
+
+    /// Writes the kept pass scopes as a Chrome trace (open it in chrome://tracing or Perfetto).
+    pub fn write_pass_trace(&self, path: &std::path::Path) -> Result<()> {
+        self.timer.write_trace(path)
+    }
+
     /// Milliseconds per pass of everything recorded since the last call, once it has been
     /// submitted. This waits for the GPU (for `voxgi bench`).
     pub fn pass_times(&mut self) -> Result<Vec<(&'static str, f64)>> {

@@ -54,6 +54,7 @@ impl Renderer {
     ) -> Result<()> {
         let (width, height) = (target.width, target.height);
         validate_size(width, height)?;
+        self.timer.begin_frame();
         params.validate(self.options.voxel_levels())?;
         self.receive_feedback()?;
         self.passes.tonemap.prepare(&self.device, target.format)?;
