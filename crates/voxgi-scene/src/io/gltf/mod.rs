@@ -1,0 +1,390 @@
+//! glTF 2.0 loader (`.gltf` with external or data-URI resources, and `.glb`).
+//!
+//! The `gltf` crate parses and validates the JSON; buffers and images are resolved here so that
+//! errors can name the resource that is wrong. Every accessor is checked against its buffer view
+//! and buffer before the `gltf` readers touch it, because those readers assume well-formed data
+//! (they `unreachable!()` on unexpected component types and slice with unchecked arithmetic).
+
+mod animation;
+mod buffers;
+mod meshes;
+
+use self::animation::load_animations;
+use self::buffers::{load_buffers, load_image};
+use self::meshes::load_primitive;
+use crate::{
+    AlphaMode, Camera, Instance, Light, LightKind, Material, Projection, Result, Scene, SceneError,
+};
+use glam::{Mat4, Quat, Vec3};
+use std::path::Path;
+
+/// Internal result: the reason string, turned into `SceneError::load(path, reason)` at the top.
+type R<T> = std::result::Result<T, String>;
+
+/// Loads a `.gltf` or `.glb` file into a validated [`Scene`].
+pub fn load(path: &Path) -> Result<Scene> {
+    let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, io_reason(&e)))?;
+    // The loader checks everything it hands to the `gltf` crate, but a panic in a dependency on
+    // a hostile file must still come back as an error, not abort the caller.
+    let outcome =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes)));
+    let scene = match outcome {
+        Ok(Ok(scene)) => scene,
+        Ok(Err(reason)) => return Err(SceneError::load(path, reason)),
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            return Err(SceneError::load(
+                path,
+                format!("malformed glTF (the glTF parser failed: {msg})"),
+            ));
+        }
+    };
+    scene.validate().map_err(|e| e.in_file(path))?;
+    Ok(scene)
+}
+
+fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        _ => e.to_string(),
+    }
+}
+
+fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
+    if bytes.is_empty() {
+        return Err("empty file".into());
+    }
+    let is_glb = bytes.starts_with(b"glTF");
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+        if is_glb {
+            format!("invalid binary glTF: {e}")
+        } else if path
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("glb"))
+        {
+            format!("not a binary glTF (no 'glTF' magic) and not glTF JSON either: {e}")
+        } else {
+            format!("invalid glTF: {e}")
+        }
+    })?;
+    let doc = &gltf.document;
+    validate_json(doc.as_json())?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = load_buffers(doc, base, gltf.blob.as_deref())?;
+
+    let mut scene = Scene {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        ..Default::default()
+    };
+
+    for image in doc.images() {
+        scene.textures.push(load_image(&image, base, &buffers)?);
+    }
+    let image_of = |t: gltf::texture::Texture| t.source().index();
+    for m in doc.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let e = m.emissive_factor();
+        scene.materials.push(Material {
+            name: m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
+            base_color: pbr.base_color_factor(),
+            base_color_texture: pbr.base_color_texture().map(|i| image_of(i.texture())),
+            emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
+            emissive_texture: m.emissive_texture().map(|i| image_of(i.texture())),
+            roughness: pbr.roughness_factor(),
+            metallic: pbr.metallic_factor(),
+            // KHR_materials_specular is not read: glTF's default specular factor is 1.
+            specular: 1.0,
+            alpha_mode: match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            },
+            double_sided: m.double_sided(),
+        });
+    }
+    let mut default_material = None;
+
+    // (glTF mesh, primitive) -> index into scene.meshes, None for skipped primitives.
+    let mut prim_map: Vec<Vec<Option<usize>>> = Vec::new();
+    for gmesh in doc.meshes() {
+        if gmesh
+            .primitives()
+            .any(|p| p.morph_targets().next().is_some())
+        {
+            log::warn!(
+                "{}: mesh {} '{}' has morph targets; it is drawn in its base shape (morph targets \
+                 are not supported)",
+                path.display(),
+                gmesh.index(),
+                gmesh.name().unwrap_or("")
+            );
+        }
+        let nprims = gmesh.primitives().len();
+        let mut row = Vec::with_capacity(nprims);
+        for prim in gmesh.primitives() {
+            let what = format!("mesh {} primitive {}", gmesh.index(), prim.index());
+            let Some(mut mesh) = load_primitive(&prim, &buffers, &what)? else {
+                row.push(None);
+                continue;
+            };
+            let base_name = gmesh
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("mesh {}", gmesh.index()));
+            mesh.name = if nprims > 1 {
+                format!("{base_name} primitive {}", prim.index())
+            } else {
+                base_name
+            };
+            mesh.material = match prim.material().index() {
+                Some(i) => i,
+                None => *default_material.get_or_insert_with(|| {
+                    scene.materials.push(Material::default());
+                    scene.materials.len() - 1
+                }),
+            };
+            scene.meshes.push(mesh);
+            row.push(Some(scene.meshes.len() - 1));
+        }
+        prim_map.push(row);
+    }
+
+    let Some(gscene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
+        log::warn!(
+            "{}: the file has no scenes; nothing is placed",
+            path.display()
+        );
+        return Ok(scene);
+    };
+
+    // Depth-first over the default scene with an explicit stack; a node reached twice means a
+    // cycle or a shared child, which glTF forbids (and which would otherwise never terminate).
+    let mut visited = vec![false; doc.nodes().len()];
+    // What each reached node holds, in the order reached (parents first), for the animations.
+    let mut placed: Vec<Option<Placed>> = vec![None; doc.nodes().len()];
+    let mut order = Vec::new();
+    let mut stack: Vec<(gltf::Node, Mat4, Option<usize>)> = gscene
+        .nodes()
+        .map(|n| (n, Mat4::IDENTITY, None))
+        .collect::<Vec<_>>();
+    stack.reverse();
+    let mut cameras: Vec<(usize, Camera)> = Vec::new();
+    while let Some((node, parent, parent_index)) = stack.pop() {
+        let ni = node.index();
+        if std::mem::replace(&mut visited[ni], true) {
+            return Err(format!(
+                "node {ni} is reached twice in scene {} (the node hierarchy must be a tree)",
+                gscene.index()
+            ));
+        }
+        let local = local_transform(&node);
+        let world = parent * local;
+        if !world.is_finite() {
+            return Err(format!("node {ni}: non-finite transform"));
+        }
+        let node_name = node
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("node {ni}"));
+        let mut here = Placed {
+            parent: parent_index,
+            local,
+            name: node_name.clone(),
+            instances: Vec::new(),
+            lights: Vec::new(),
+            camera: false,
+        };
+        if let Some(gmesh) = node.mesh() {
+            if doc.as_json().nodes[ni].skin.is_some() {
+                log::warn!(
+                    "{}: skinned mesh {} '{}' on node '{node_name}' is drawn in its bind pose; \
+                     skinning is not supported",
+                    path.display(),
+                    gmesh.index(),
+                    gmesh.name().unwrap_or("")
+                );
+            }
+            for &mesh in prim_map[gmesh.index()].iter().flatten() {
+                here.instances.push(scene.instances.len());
+                scene.instances.push(Instance {
+                    name: node_name.clone(),
+                    mesh,
+                    transform: world,
+                    dynamic: false,
+                    light: None,
+                });
+            }
+        }
+        let position = world.transform_point3(Vec3::ZERO);
+        let forward = world
+            .transform_vector3(Vec3::NEG_Z)
+            .try_normalize()
+            .unwrap_or(Vec3::NEG_Z);
+        if let Some(l) = node.light() {
+            let kind = match l.kind() {
+                gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
+                gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
+                gltf::khr_lights_punctual::Kind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                } => LightKind::Spot {
+                    inner_angle: inner_cone_angle,
+                    outer_angle: outer_cone_angle,
+                },
+            };
+            scene.lights.push(Light {
+                name: l
+                    .name()
+                    .map(str::to_string)
+                    .unwrap_or_else(|| node_name.clone()),
+                kind,
+                color: l.color(),
+                intensity: l.intensity(),
+                position,
+                direction: forward,
+                range: l.range(),
+                cast_shadows: true,
+            });
+            here.lights.push(scene.lights.len() - 1);
+        }
+        if let Some(c) = node.camera() {
+            here.camera = true;
+            let up = world.transform_vector3(Vec3::Y);
+            let up = (up - forward * up.dot(forward))
+                .try_normalize()
+                .unwrap_or_else(|| forward.any_orthonormal_vector());
+            let (projection, znear, zfar, aspect) = match c.projection() {
+                gltf::camera::Projection::Perspective(p) => (
+                    Projection::Perspective { yfov: p.yfov() },
+                    p.znear(),
+                    p.zfar(),
+                    p.aspect_ratio(),
+                ),
+                gltf::camera::Projection::Orthographic(o) => (
+                    Projection::Orthographic {
+                        xmag: o.xmag(),
+                        ymag: o.ymag(),
+                    },
+                    o.znear(),
+                    Some(o.zfar()),
+                    None,
+                ),
+            };
+            cameras.push((
+                ni,
+                Camera {
+                    name: c
+                        .name()
+                        .map(str::to_string)
+                        .unwrap_or_else(|| node_name.clone()),
+                    position,
+                    forward,
+                    up,
+                    projection,
+                    znear,
+                    zfar,
+                    aspect,
+                },
+            ));
+        }
+        placed[ni] = Some(here);
+        order.push(ni);
+        let children: Vec<_> = node.children().collect();
+        for child in children.into_iter().rev() {
+            stack.push((child, world, Some(ni)));
+        }
+    }
+    cameras.sort_by_key(|(ni, _)| *ni);
+    scene.cameras = cameras.into_iter().map(|(_, c)| c).collect();
+    load_animations(path, doc, &buffers, &mut scene, &placed, &order)?;
+    Ok(scene)
+}
+
+/// A node the walk of the default scene reached.
+#[derive(Clone)]
+struct Placed {
+    /// The parent node (glTF index); `None` for a root of the scene.
+    parent: Option<usize>,
+    /// The node's transform in its parent's frame.
+    local: Mat4,
+    name: String,
+    /// The instances of its mesh (`Scene::instances` indices).
+    instances: Vec<usize>,
+    /// Its punctual light (`Scene::lights` index).
+    lights: Vec<usize>,
+    camera: bool,
+}
+
+/// Runs the `gltf` crate's schema validation, after checking what its own validation indexes
+/// without a bounds check (a primitive's POSITION accessor). Missing POSITION `min`/`max`, which
+/// the spec requires but many exporters omit, is tolerated since the loader never uses them.
+fn validate_json(root: &gltf::json::Root) -> R<()> {
+    use gltf::json::validation::{Error as VError, Validate};
+    for (mi, m) in root.meshes.iter().enumerate() {
+        for (pi, p) in m.primitives.iter().enumerate() {
+            for (sem, acc) in &p.attributes {
+                if acc.value() >= root.accessors.len() {
+                    let sem = match sem {
+                        gltf::json::validation::Checked::Valid(s) => format!("{s:?}"),
+                        gltf::json::validation::Checked::Invalid => "?".into(),
+                    };
+                    return Err(format!(
+                        "meshes[{mi}].primitives[{pi}].attributes[{sem}]: accessor {} does not \
+                         exist ({} accessors)",
+                        acc.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, err| {
+        let path = path();
+        let p = path.as_str();
+        let min_max = p.ends_with(".min") || p.ends_with(".max");
+        if !(min_max && matches!(err, VError::Missing)) {
+            errors.push(format!("{p}: {err}"));
+        }
+    });
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("invalid glTF: {}", errors.join("; ")))
+    }
+}
+
+fn local_transform(node: &gltf::Node) -> Mat4 {
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => Mat4::from_cols_array_2d(&matrix),
+        gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            // glTF requires unit quaternions; files round them (0.383, 0.924), so normalise.
+            let q = unit_quat(Quat::from_array(rotation));
+            Mat4::from_scale_rotation_translation(scale.into(), q, translation.into())
+        }
+    }
+}
+
+/// `q` normalised, or the identity when it has no direction (zero or not finite).
+fn unit_quat(q: Quat) -> Quat {
+    if q.length_squared() > 0.0 && q.is_finite() {
+        q.normalize()
+    } else {
+        Quat::IDENTITY
+    }
+}

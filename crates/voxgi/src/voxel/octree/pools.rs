@@ -1,0 +1,127 @@
+//! The octree's pools: leaf slots and the three classes of tiles, sized from the scene's
+//! estimate and grown (or shrunk) to what a build counted.
+
+use super::*;
+
+/// How many of each pool an octree holds: leaf slots, and tiles of the three classes (leaf
+/// voxels, even levels above 0, odd levels).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OctreePools {
+    /// Occupied finest voxels.
+    pub slots: u32,
+    /// Tiles of eight leaf voxels (one level-0 brick each).
+    pub leaf_tiles: u32,
+    /// Tiles whose parents' bricks hold an even level above 0.
+    pub even_tiles: u32,
+    /// Tiles whose parents' bricks hold an odd level.
+    pub odd_tiles: u32,
+}
+
+impl OctreePools {
+    /// A first guess for `leaves` occupied voxels: surfaces fill about half of a 2³ group, and
+    /// each level above holds about a quarter of the one below; the dilation for the bricks'
+    /// borders roughly doubles each. The first build's counters correct it.
+    pub fn for_leaves(leaves: u64) -> Self {
+        let c = |n: u64| n.clamp(64, u32::MAX as u64 / 8) as u32;
+        OctreePools {
+            slots: c(leaves),
+            leaf_tiles: c(leaves / 2),
+            even_tiles: c(leaves / 16),
+            odd_tiles: c(leaves / 8),
+        }
+    }
+
+    /// These pools, shrunk where a buffer would exceed `max_binding` bytes: a first guess
+    /// must not fail where the scene itself would fit (growth then reports a real excess).
+    pub fn within(self, max_binding: u64) -> Self {
+        let mut p = self;
+        p.slots = p
+            .slots
+            .min((max_binding / (SLOT_WORDS * 4)).min(u32::MAX as u64) as u32);
+        let node_bytes = |p: &OctreePools| {
+            let interior = 1 + p.even_tiles as u64 + p.odd_tiles as u64;
+            (NODE_HEADER + 8 * interior * NODE_WORDS + 8 * p.leaf_tiles as u64) * 4
+        };
+        while node_bytes(&p) > max_binding && p.leaf_tiles > 64 {
+            p.leaf_tiles /= 2;
+            p.even_tiles = (p.even_tiles / 2).max(64);
+            p.odd_tiles = (p.odd_tiles / 2).max(64);
+        }
+        p
+    }
+
+    /// Bytes these pools take on the GPU (bricks with six directions above level 0).
+    pub fn bytes(&self) -> u64 {
+        let brick = 27 * 8;
+        self.slots as u64 * SLOT_BYTES
+            + self.leaf_tiles as u64 * (brick + 8 * 4 + 8)
+            + (self.even_tiles as u64 + self.odd_tiles as u64) * (6 * brick + 8 * 16 + 8)
+    }
+
+    /// The pools to make after a build that counted `counted` (`OctreeVolume::pool_counter`'s
+    /// first four words), or None to keep these. A pool that overflowed hides what the levels
+    /// below it would have needed, so every pool grows at least by half once one overflows.
+    /// Pools more than twice what the build needed (the first guess comes from an upper bound
+    /// on the fragments) shrink to the counts and an eighth: the octree's point is its memory.
+    pub fn resized_for(&self, counted: &[u32]) -> Option<Self> {
+        let have = [self.slots, self.leaf_tiles, self.even_tiles, self.odd_tiles];
+        if counted.iter().zip(have).all(|(&n, h)| n <= h) {
+            let need = |n: u32| n.saturating_add(n / 8).max(64);
+            let fit = OctreePools {
+                slots: need(counted[0]),
+                leaf_tiles: need(counted[1]),
+                even_tiles: need(counted[2]),
+                odd_tiles: need(counted[3]),
+            };
+            // Below a few MiB a shrink is not worth a rebuild.
+            let oversized = self.bytes() > 2 * fit.bytes() && self.bytes() > 8 << 20;
+            return oversized.then_some(fit);
+        }
+        let grow = |n: u32, h: u32| -> u32 {
+            let half = h.saturating_add(h / 2);
+            n.max(half).max(64)
+        };
+        Some(OctreePools {
+            slots: grow(counted[0], self.slots),
+            leaf_tiles: grow(counted[1], self.leaf_tiles),
+            even_tiles: grow(counted[2], self.even_tiles),
+            odd_tiles: grow(counted[3], self.odd_tiles),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pools_grow_to_what_was_counted_and_by_half_at_least() {
+        let p = OctreePools {
+            slots: 1000,
+            leaf_tiles: 100,
+            even_tiles: 10,
+            odd_tiles: 10,
+        };
+        assert_eq!(p.resized_for(&[1000, 100, 10, 10]), None);
+        let g = p.resized_for(&[5000, 100, 10, 11]).unwrap();
+        assert_eq!(
+            (g.slots, g.leaf_tiles, g.even_tiles, g.odd_tiles),
+            (5000, 150, 64, 64)
+        );
+    }
+
+    #[test]
+    fn pools_far_larger_than_needed_shrink_to_the_counts() {
+        let big = OctreePools::for_leaves(4_000_000);
+        let counted = [400_000, 150_000, 6_000, 25_000];
+        let fit = big
+            .resized_for(&counted)
+            .expect("a tenth of the pools is used");
+        assert_eq!(
+            (fit.slots, fit.leaf_tiles, fit.even_tiles, fit.odd_tiles),
+            (450_000, 168_750, 6_750, 28_125)
+        );
+        // Sized so, the next build keeps them.
+        assert_eq!(fit.resized_for(&counted), None);
+    }
+}
