@@ -1,0 +1,327 @@
+//! A frame and the split view: the frame's steps (`redraw`), the scene drawn into the window
+//! right of the panel (cone tracing, with the path tracer over its columns, or the last image
+//! again when nothing changed), the UI laid out and drawn over it, and presenting.
+
+use super::Viewer;
+use crate::ground_truth::Display;
+use crate::settings::PanelActions;
+use anyhow::Result;
+use voxgi::{Target, wgpu};
+
+/// The frame's UI, laid out and its textures and buffers uploaded: what the egui passes draw,
+/// and what is left to hand over once they are recorded.
+pub(super) struct UiFrame {
+    pub(super) jobs: Vec<egui::ClippedPrimitive>,
+    pub(super) screen: egui_wgpu::ScreenDescriptor,
+    /// Command buffers from egui's `update_buffers`, submitted before the frame's encoder.
+    extra: Vec<wgpu::CommandBuffer>,
+    /// The frame's texture changes: the new ones uploaded, the ones egui is done with freed
+    /// after the passes are recorded.
+    textures: egui::TexturesDelta,
+}
+
+impl Viewer {
+    /// Draws one frame; returns true when the viewer should close (a screenshot was taken).
+    pub(super) fn redraw(&mut self) -> Result<bool> {
+        self.poll_jobs();
+        let dt = self.time_frame();
+        self.move_camera(dt);
+        self.update_scene(dt)?;
+
+        let Some(frame) = self.surface_texture()? else {
+            return Ok(false);
+        };
+        let view = frame.texture.create_view(&Default::default());
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.draw_frame(&mut encoder, &frame.texture, true)?;
+
+        // The UI, drawn over the image.
+        let (ui, actions) = self.run_ui(&mut encoder);
+        egui_pass(
+            &self.egui_renderer,
+            &mut encoder,
+            &view,
+            &ui.jobs,
+            &ui.screen,
+        );
+        let ui_capture = self.capture_with_ui(&mut encoder, &ui)?;
+        self.present(encoder, frame, ui);
+        self.record_pass_times()?;
+        self.count_frame();
+
+        self.act(actions);
+        self.follow_vsync();
+        self.take_screenshots(ui_capture)
+    }
+
+    /// Times the frame (for the stats and the path tracer's budget); returns the time step
+    /// for the camera and the animation.
+    fn time_frame(&mut self) -> f32 {
+        let elapsed = self.stats.frame_started();
+        let tracing_only = self.reused || !self.ground.needs_cone_tracing();
+        self.ground.frame_time(elapsed * 1e3, tracing_only);
+        // Slow frames do not make the animation or the fly camera jump.
+        elapsed.min(0.25)
+    }
+
+    /// The scene's state for this frame: the animation played `dt` seconds on, the renderer
+    /// at its time, the controller's camera, and the path tracer following them.
+    fn update_scene(&mut self, dt: f32) -> Result<()> {
+        if self.playing && self.duration > 0.0 {
+            self.time = (self.time + dt) % self.duration.max(1e-3);
+        }
+        self.renderer.set_time(self.time)?;
+        if self.time != self.last_time {
+            self.last_time = self.time;
+            self.version += 1;
+            self.ground.scene_changed();
+        }
+        self.params.camera = self.controller_camera();
+        self.ground.update(
+            &self.device,
+            &self.queue,
+            &self.scene,
+            self.time,
+            self.renderer.lights(),
+            &self.options,
+            self.version,
+        );
+        Ok(())
+    }
+
+    /// Runs the panel for this frame's input and uploads what egui needs to draw it (texture
+    /// updates, and buffers recorded into `encoder`); returns that and what the panel asked for.
+    fn run_ui(&mut self, encoder: &mut wgpu::CommandEncoder) -> (UiFrame, PanelActions) {
+        let (w, h) = (self.config.width, self.config.height);
+        let raw = self.egui_state.take_egui_input(&self.window);
+        let ctx = self.egui_ctx.clone();
+        let mut actions = PanelActions::default();
+        let full = ctx.run_ui(raw, |ui| actions = self.ui(ui));
+        self.egui_state
+            .handle_platform_output(&self.window, full.platform_output);
+        let jobs = ctx.tessellate(full.shapes, full.pixels_per_point);
+        for (id, deltas) in &full.textures_delta.set {
+            for delta in deltas {
+                self.egui_renderer
+                    .update_texture(&self.device, &self.queue, *id, delta);
+            }
+        }
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [w, h],
+            pixels_per_point: full.pixels_per_point,
+        };
+        let extra =
+            self.egui_renderer
+                .update_buffers(&self.device, &self.queue, encoder, &jobs, &screen);
+        let ui = UiFrame {
+            jobs,
+            screen,
+            extra,
+            textures: full.textures_delta,
+        };
+        (ui, actions)
+    }
+
+    /// Frees the textures the UI is done with, submits the frame's work and presents it.
+    fn present(&mut self, encoder: wgpu::CommandEncoder, frame: wgpu::SurfaceTexture, ui: UiFrame) {
+        for id in &ui.textures.free {
+            self.egui_renderer.free_texture(id);
+        }
+        self.queue
+            .submit(ui.extra.into_iter().chain([encoder.finish()]));
+        self.window.pre_present_notify();
+        self.queue.present(frame);
+    }
+
+    /// Counts the frame, and as ready when nothing ran in the background.
+    fn count_frame(&mut self) {
+        self.frames += 1;
+        let busy = self.rebuild.is_some()
+            || self.opening.is_some()
+            || (self.ground.display != Display::ConeTraced && self.ground.building());
+        if !busy {
+            self.ready_frames += 1;
+        }
+    }
+
+    pub(super) fn set_display(&mut self, display: Display) {
+        if display != Display::ConeTraced && self.playing {
+            self.playing = false;
+            self.status = "paused: the path tracer shows a still scene".into();
+        }
+        self.ground.display = display;
+    }
+
+    /// The 3D view's columns of the window: right of the panel, or all of the window when the
+    /// panel is hidden, leaves less than a quarter, or the view cannot be copied beside it.
+    pub(super) fn view_columns(&self) -> (u32, u32) {
+        let w = self.config.width;
+        let x0 = if self.images.is_some() && self.panel_px * 4 <= w * 3 {
+            self.panel_px
+        } else {
+            0
+        };
+        (x0, w - x0)
+    }
+
+    /// The frame's scene into `surface` (the window's texture, or a capture of it) right of
+    /// the panel: cone tracing, with the path tracer over its columns. A cone-traced image that
+    /// would come out as the last one (same parameters, same scene, the renderer idle) is
+    /// copied from the last instead of drawn, so a still view costs next to nothing. With
+    /// `accumulate` false the path tracer only shows what it has (the frame drawn again).
+    pub(super) fn draw_frame(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        surface: &wgpu::Texture,
+        accumulate: bool,
+    ) -> Result<()> {
+        let (w, h, format) = (self.config.width, self.config.height, self.config.format);
+        let surface_view = surface.create_view(&Default::default());
+        if accumulate {
+            self.reused = false;
+        }
+        if self.images.is_none() {
+            return self.draw_scene(
+                encoder,
+                &Target::new(&surface_view, format, w, h),
+                accumulate,
+            );
+        }
+        let (x0, vw) = self.view_columns();
+        let stale = self
+            .images
+            .as_ref()
+            .and_then(|i| i.view.as_ref())
+            .is_none_or(|t| (t.width(), t.height()) != (vw, h));
+        let fresh = stale.then(|| {
+            (
+                self.image_texture("cone-traced view", format, vw, h),
+                self.image_texture("view", format, vw, h),
+            )
+        });
+        if stale {
+            log::debug!("view images: {vw}x{h} at column {x0}");
+        }
+        let images = self.images.as_mut().expect("checked above");
+        if let Some((cone, view)) = fresh {
+            images.cone = Some(cone);
+            images.view = Some(view);
+            images.shows = None;
+        }
+        let cone = images.cone.clone().expect("made above");
+        let view = images.view.clone().expect("made above");
+        let extent = wgpu::Extent3d {
+            width: vw,
+            height: h,
+            depth_or_array_layers: 1,
+        };
+        if self.ground.needs_cone_tracing() {
+            // Counters that came back may ask for a rebuild: then the renderer is not idle.
+            self.renderer.receive_feedback()?;
+            let shows = Some((self.params.clone(), self.version));
+            let images = self.images.as_mut().expect("checked above");
+            if images.shows == shows && self.renderer.is_idle() {
+                self.reused |= accumulate;
+            } else {
+                let v = cone.create_view(&Default::default());
+                self.renderer
+                    .render(encoder, &Target::new(&v, format, vw, h), &self.params)?;
+                images.shows = shows;
+            }
+            encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
+        }
+        let v = view.create_view(&Default::default());
+        let r = self.ground.record(
+            encoder,
+            &Target::new(&v, format, vw, h),
+            &self.params,
+            self.options.bounces,
+            accumulate,
+        );
+        if let Err(e) = r {
+            self.ground.error = Some(format!("{e:#}"));
+        }
+        if x0 > 0 {
+            // Under the panel: black, not whatever the surface held.
+            color_pass(
+                encoder,
+                "clear",
+                &surface_view,
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            );
+        }
+        encoder.copy_texture_to_texture(
+            view.as_image_copy(),
+            wgpu::TexelCopyTextureInfo {
+                texture: surface,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: x0, y: 0, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
+            extent,
+        );
+        Ok(())
+    }
+
+    /// The scene into `target`: cone tracing, then the path tracer over its columns. With
+    /// `accumulate` false the path tracer only shows what it has (a second drawing of the same
+    /// frame, for a screenshot).
+    pub(super) fn draw_scene(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        accumulate: bool,
+    ) -> Result<()> {
+        if self.ground.needs_cone_tracing() {
+            self.renderer.render(encoder, target, &self.params)?;
+        }
+        let r = self.ground.record(
+            encoder,
+            target,
+            &self.params,
+            self.options.bounces,
+            accumulate,
+        );
+        if let Err(e) = r {
+            self.ground.error = Some(format!("{e:#}"));
+        }
+        Ok(())
+    }
+}
+
+/// Draws the UI over what `view` holds.
+pub(super) fn egui_pass(
+    renderer: &egui_wgpu::Renderer,
+    encoder: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    jobs: &[egui::ClippedPrimitive],
+    screen: &egui_wgpu::ScreenDescriptor,
+) {
+    let pass = color_pass(encoder, "egui", view, wgpu::LoadOp::Load);
+    renderer.render(&mut pass.forget_lifetime(), jobs, screen);
+}
+
+/// A render pass into `view` alone, loading or clearing it.
+fn color_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    view: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load,
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

@@ -1,0 +1,161 @@
+//! Input: the window's events dispatched (keys, mouse buttons, cursor, wheel, dropped files),
+//! raw mouse motion, the key bindings, and the camera controllers (orbit and fly) they drive.
+
+use super::Viewer;
+use crate::camera::{Fly, Movement, Orbit};
+use crate::ground_truth::Display;
+use anyhow::Result;
+use std::collections::HashSet;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+use winit::keyboard::{KeyCode, PhysicalKey};
+
+pub(super) enum Controller {
+    Orbit(Orbit),
+    Fly(Fly),
+}
+
+/// What the keyboard and the mouse hold.
+#[derive(Default)]
+pub(super) struct Input {
+    keys: HashSet<KeyCode>,
+    left_down: bool,
+    right_down: bool,
+    cursor: Option<(f32, f32)>,
+}
+
+impl Viewer {
+    pub(super) fn window_event(
+        &mut self,
+        event_loop: &ActiveEventLoop,
+        event: WindowEvent,
+    ) -> Result<()> {
+        let response = self.egui_state.on_window_event(&self.window, &event);
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => self.resize(size),
+            WindowEvent::RedrawRequested if self.redraw()? => event_loop.exit(),
+            WindowEvent::DroppedFile(path) => self.open(&path),
+            // A release always ends a drag or a held key, even over the panel: swallowed, it
+            // would leave the camera turning or flying.
+            WindowEvent::MouseInput {
+                state: ElementState::Released,
+                button,
+                ..
+            } => match button {
+                MouseButton::Left => self.input.left_down = false,
+                MouseButton::Right | MouseButton::Middle => self.input.right_down = false,
+                _ => {}
+            },
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Released => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    self.input.keys.remove(&code);
+                }
+            }
+            _ if response.consumed => {}
+            // Presses only: releases were taken above.
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    if !event.repeat {
+                        self.key_pressed(code);
+                    }
+                    self.input.keys.insert(code);
+                }
+            }
+            WindowEvent::MouseInput { button, .. } => match button {
+                MouseButton::Left => self.input.left_down = true,
+                MouseButton::Right | MouseButton::Middle => self.input.right_down = true,
+                _ => {}
+            },
+            WindowEvent::CursorMoved { position, .. } => {
+                let p = (position.x as f32, position.y as f32);
+                if let Some(last) = self.input.cursor
+                    && let Controller::Orbit(o) = &mut self.controller
+                {
+                    let (dx, dy) = (p.0 - last.0, p.1 - last.1);
+                    if self.input.left_down {
+                        o.rotate(dx, dy);
+                    } else if self.input.right_down {
+                        o.pan(dx, dy, self.config.height as f32);
+                    }
+                }
+                self.input.cursor = Some(p);
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                match &mut self.controller {
+                    Controller::Orbit(o) => o.zoom(steps),
+                    Controller::Fly(f) => f.speed = (f.speed * 1.2f32.powf(steps)).max(1e-3),
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Raw mouse motion: mouse look while flying with the left button held.
+    pub(super) fn mouse_motion(&mut self, dx: f32, dy: f32) {
+        if let Controller::Fly(f) = &mut self.controller
+            && self.input.left_down
+        {
+            f.look(dx, dy);
+        }
+    }
+
+    fn key_pressed(&mut self, code: KeyCode) {
+        match code {
+            KeyCode::KeyF => {
+                let cam = self.params.camera.clone();
+                self.controller = match &self.controller {
+                    Controller::Orbit(_) => {
+                        Controller::Fly(Fly::from_camera(&cam, self.scene_radius * 0.5))
+                    }
+                    Controller::Fly(_) => {
+                        Controller::Orbit(Orbit::from_camera(&cam, self.scene_radius))
+                    }
+                };
+            }
+            KeyCode::KeyH => self.frame_scene(),
+            KeyCode::KeyG => {
+                let i = Display::ALL.iter().position(|d| *d == self.ground.display);
+                self.set_display(Display::ALL[(i.unwrap_or(0) + 1) % Display::ALL.len()]);
+            }
+            KeyCode::Space => self.playing = !self.playing,
+            KeyCode::Tab => self.show_panel = !self.show_panel,
+            KeyCode::F12 | KeyCode::KeyP => self.screenshot_key = true,
+            _ => {}
+        }
+    }
+
+    /// The frame's camera motion, `dt` seconds of it: flying with the held keys, or the
+    /// orbit's turntable turn.
+    pub(super) fn move_camera(&mut self, dt: f32) {
+        if let Controller::Fly(f) = &mut self.controller {
+            let k = |c: KeyCode| self.input.keys.contains(&c) as i32 as f32;
+            f.step(
+                Movement {
+                    right: k(KeyCode::KeyD) - k(KeyCode::KeyA),
+                    up: k(KeyCode::KeyE) - k(KeyCode::KeyQ),
+                    forward: k(KeyCode::KeyW) - k(KeyCode::KeyS),
+                },
+                dt,
+            );
+        }
+        if let Controller::Orbit(o) = &mut self.controller
+            && self.turntable != 0.0
+        {
+            o.turn(self.turntable.to_radians());
+        }
+    }
+
+    /// The controller's camera.
+    pub(super) fn controller_camera(&self) -> voxgi::scene::Camera {
+        match &self.controller {
+            Controller::Orbit(o) => o.camera(),
+            Controller::Fly(f) => f.camera(),
+        }
+    }
+}

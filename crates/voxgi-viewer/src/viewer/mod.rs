@@ -1,0 +1,306 @@
+//! The window: the winit application (`App`), and the `Viewer` it hands events to, with its
+//! fields and its creation. The viewer's work is spread over the child modules by job:
+//! `surface` (the device, the surface's configuration, resizing), `input` (keys and mouse to the
+//! camera controllers), `frame` (a frame's steps, the scene and the split view drawn into the
+//! window), `screenshot`, `panel` (the egui panel and the overlays), `stats` (frame and per-pass
+//! times) and `open` (opening scenes, applying options, and the background work for both).
+
+mod frame;
+mod input;
+mod open;
+mod panel;
+mod screenshot;
+mod stats;
+mod surface;
+
+use crate::Args;
+use crate::camera::Orbit;
+use crate::ground_truth::{Display, GroundTruth};
+use crate::jobs::Job;
+use anyhow::Result;
+use input::{Controller, Input};
+use open::Opened;
+use stats::Stats;
+use std::path::PathBuf;
+use std::sync::Arc;
+use voxgi::scene::Scene;
+use voxgi::{FrameParams, Renderer, RendererOptions, SceneSettings, wgpu};
+use winit::application::ApplicationHandler;
+use winit::event::{DeviceEvent, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+use winit::window::{Window, WindowId};
+
+/// The winit application: opens the window on `resumed`, then hands events to the `Viewer`.
+pub struct App {
+    args: Args,
+    scene: Option<(Scene, Option<SceneSettings>)>,
+    viewer: Option<Viewer>,
+    error: Option<anyhow::Error>,
+}
+
+impl App {
+    pub fn new(args: Args, scene: (Scene, Option<SceneSettings>)) -> Self {
+        App {
+            args,
+            scene: Some(scene),
+            viewer: None,
+            error: None,
+        }
+    }
+
+    /// The error that closed the window, if one did.
+    pub fn finish(self) -> Result<()> {
+        match self.error {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        self.error = Some(e);
+        event_loop.exit();
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.viewer.is_some() {
+            return;
+        }
+        let Some(scene) = self.scene.take() else {
+            return;
+        };
+        match Viewer::new(event_loop, &self.args, scene) {
+            Ok(v) => self.viewer = Some(v),
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(v) = self.viewer.as_mut() else {
+            return;
+        };
+        match v.window_event(event_loop, event) {
+            Ok(()) => {}
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn device_event(&mut self, _: &ActiveEventLoop, _: winit::event::DeviceId, event: DeviceEvent) {
+        if let (Some(v), DeviceEvent::MouseMotion { delta }) = (self.viewer.as_mut(), event) {
+            v.mouse_motion(delta.0 as f32, delta.1 as f32);
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let Some(v) = &self.viewer {
+            v.window.request_redraw();
+        }
+    }
+}
+
+/// The 3D view's images, the size of the part of the window right of the panel: what cone
+/// tracing drew last (kept to show again while nothing changes) and the frame's view (cone
+/// tracing with the path tracer over its columns), copied into the window beside the panel.
+struct ViewImages {
+    cone: Option<wgpu::Texture>,
+    view: Option<wgpu::Texture>,
+    /// The frame parameters and scene state (`Viewer::version`) `cone` shows.
+    shows: Option<(FrameParams, u64)>,
+}
+
+struct Viewer {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    adapter: wgpu::AdapterInfo,
+    timestamps: bool,
+    renderer: Renderer,
+    /// The scene as loaded (at time 0): what new options and the path tracer build from.
+    scene: Arc<Scene>,
+    /// Counts changes of the scene's state (time, lights): the path tracer follows it.
+    version: u64,
+    last_time: f32,
+    ground: GroundTruth,
+    // Background work, each shown in the window while it runs.
+    rebuild: Option<Job<(Renderer, RendererOptions)>>,
+    opening: Option<Job<Opened>>,
+    dialog: Option<Job<Option<PathBuf>>>,
+    open_path: String,
+    vsync: bool,
+    /// The view's images; `None` when the surface cannot be copied into (then every frame
+    /// draws the whole window, under the panel too).
+    images: Option<ViewImages>,
+    /// Where the panel ends, physical pixels from the window's left (0 without the panel):
+    /// the 3D view starts there.
+    panel_px: u32,
+    /// Whether this frame showed the last image again instead of drawing.
+    reused: bool,
+    /// Degrees the orbit turns each frame (`--turntable`).
+    turntable: f32,
+    /// The adapter is a CPU driver (lavapipe, WARP): smaller defaults.
+    cpu: bool,
+    scene_name: String,
+    scene_radius: f32,
+    /// The scene's own cameras, to pick from.
+    cameras: Vec<voxgi::scene::Camera>,
+    options: RendererOptions,
+    draft: RendererOptions,
+    params: FrameParams,
+    controller: Controller,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    input: Input,
+    // Animation.
+    duration: f32,
+    time: f32,
+    playing: bool,
+    // Stats.
+    stats: Stats,
+    frames: u32,
+    /// Frames drawn with nothing in the background (the path tracer built): what
+    /// `--after-frames` counts, so a screenshot does not race a build.
+    ready_frames: u32,
+    status: String,
+    show_panel: bool,
+    // Screenshots.
+    screenshot: Option<(PathBuf, u32)>,
+    screenshot_ui: bool,
+    screenshot_key: bool,
+}
+
+impl Viewer {
+    fn new(
+        event_loop: &ActiveEventLoop,
+        args: &Args,
+        (scene, settings): (Scene, Option<SceneSettings>),
+    ) -> Result<Self> {
+        let surface::Gpu {
+            window,
+            surface,
+            config,
+            device,
+            queue,
+            info,
+            cpu,
+            timestamps,
+            keeps_image,
+        } = surface::open_window(event_loop, args, &scene_label(&scene))?;
+
+        let mut options = RendererOptions {
+            // A CPU driver stays usable at half resolution.
+            half_resolution: cpu,
+            voxel_resolution: if cpu { 64 } else { 128 },
+            ..RendererOptions::default()
+        };
+        let mut scene = scene;
+        scene.set_time(0.0);
+        let default_camera = scene.default_camera();
+        let mut params = FrameParams::new(default_camera.clone());
+        if let Some(s) = &settings {
+            s.apply(&mut options, &mut params)?;
+        }
+        let mut renderer = Renderer::new(&device, &queue, &scene, &options)?;
+        renderer.enable_timing(timestamps);
+        let mut ground = GroundTruth::new(args.display, cpu, timestamps);
+        ground.divider = args.divider;
+        if let Some(n) = args.paths_per_frame {
+            ground.paths_per_frame = n;
+            ground.frame_target_ms = None;
+        }
+        let bounds = scene.swept_bounds();
+        let radius = if bounds.is_empty() {
+            1.0
+        } else {
+            (bounds.size().length() * 0.5).max(1e-3)
+        };
+        let duration = scene
+            .animations
+            .iter()
+            .map(|a| a.duration())
+            .fold(0.0f32, f32::max);
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(
+            &device,
+            config.format,
+            egui_wgpu::RendererOptions::default(),
+        );
+        let orbit_distance = (bounds.center() - default_camera.position)
+            .length()
+            .max(radius * 0.1);
+        Ok(Viewer {
+            window,
+            surface,
+            config,
+            device,
+            queue,
+            adapter: info,
+            timestamps,
+            scene_name: scene_label(&scene),
+            scene_radius: radius,
+            cameras: scene.cameras.clone(),
+            // The path tracer shows a still scene: play with G's cone tracing.
+            playing: duration > 0.0 && args.display == Display::ConeTraced,
+            draft: options.clone(),
+            options,
+            controller: Controller::Orbit(Orbit::from_camera(&default_camera, orbit_distance)),
+            params,
+            renderer,
+            scene: Arc::new(scene),
+            version: 0,
+            last_time: 0.0,
+            ground,
+            rebuild: None,
+            opening: None,
+            dialog: None,
+            open_path: String::new(),
+            vsync: !args.no_vsync,
+            images: keeps_image.then_some(ViewImages {
+                cone: None,
+                view: None,
+                shows: None,
+            }),
+            panel_px: 0,
+            reused: false,
+            turntable: args.turntable,
+            cpu,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            input: Input::default(),
+            duration,
+            time: 0.0,
+            stats: Stats::new(),
+            frames: 0,
+            ready_frames: 0,
+            status: String::new(),
+            // A screenshot without the UI is of the whole window.
+            show_panel: args.screenshot.is_none() || args.with_ui,
+            screenshot: args
+                .screenshot
+                .clone()
+                .map(|p| (p, args.after_frames.max(1))),
+            screenshot_ui: args.with_ui,
+            screenshot_key: false,
+        })
+    }
+}
+
+fn scene_label(scene: &Scene) -> String {
+    if scene.name.is_empty() {
+        "scene".into()
+    } else {
+        scene.name.clone()
+    }
+}

@@ -1,0 +1,172 @@
+//! Opening scenes and the background work: a file loaded and its renderer built off the
+//! window's thread, new options applied (or a renderer rebuilt for them), the file dialog, and
+//! taking what finished; framing the scene's camera.
+
+use super::input::Controller;
+use super::{Viewer, scene_label};
+use crate::camera::Orbit;
+use crate::ground_truth::Display;
+use crate::jobs::{Job, take};
+use crate::load;
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use voxgi::scene::Scene;
+use voxgi::{FrameParams, Renderer, RendererOptions};
+
+/// A file loaded and its renderer built, off the window's thread.
+pub(super) struct Opened {
+    path: PathBuf,
+    scene: Scene,
+    settings_params: FrameParams,
+    options: RendererOptions,
+    renderer: Renderer,
+}
+
+impl Viewer {
+    /// Back to the scene's own camera (or the view of its bounds).
+    pub(super) fn frame_scene(&mut self) {
+        let cam = self.renderer.default_camera().clone();
+        self.controller = Controller::Orbit(Orbit::from_camera(&cam, self.scene_radius * 2.0));
+    }
+
+    /// Starts loading the file at `path` (and building its renderer) in the background; when it
+    /// is done it replaces the scene. On failure the error shows and the scene stays.
+    pub(super) fn open(&mut self, path: &Path) {
+        let path = path.to_path_buf();
+        let (device, queue) = (self.device.clone(), self.queue.clone());
+        let (options, camera) = (self.options.clone(), self.params.camera.clone());
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        self.opening = Some(Job::spawn(format!("opening {name}"), move || {
+            let (mut scene, settings) = load(Some(&path), None)?;
+            scene.set_time(0.0);
+            let mut options = options;
+            let mut params = FrameParams::new(camera);
+            if let Some(s) = &settings {
+                s.apply(&mut options, &mut params)?;
+            }
+            let renderer = Renderer::new(&device, &queue, &scene, &options)
+                .with_context(|| path.display().to_string())?;
+            Ok(Opened {
+                path,
+                scene,
+                settings_params: params,
+                options,
+                renderer,
+            })
+        }));
+    }
+
+    /// The loaded file replaces the scene.
+    fn opened(&mut self, o: Opened) {
+        let mut renderer = o.renderer;
+        renderer.enable_timing(self.timestamps);
+        self.renderer = renderer;
+        self.draft = o.options.clone();
+        self.options = o.options;
+        // The file's view settings (exposure, tone curve, view mode); the camera is framed below.
+        self.params = o.settings_params;
+        let bounds = o.scene.swept_bounds();
+        self.scene_radius = (bounds.size().length() * 0.5).max(1e-3);
+        self.duration = o
+            .scene
+            .animations
+            .iter()
+            .map(|a| a.duration())
+            .fold(0.0f32, f32::max);
+        self.time = 0.0;
+        self.playing = self.duration > 0.0 && self.ground.display == Display::ConeTraced;
+        self.scene_name = scene_label(&o.scene);
+        self.cameras = o.scene.cameras.clone();
+        self.window
+            .set_title(&format!("voxgi — {}", self.scene_name));
+        self.scene = Arc::new(o.scene);
+        self.version += 1;
+        self.ground.clear();
+        self.stats.clear_passes();
+        self.frame_scene();
+        self.status = format!("opened {}", o.path.display());
+    }
+
+    /// Applies the draft options: through `Renderer::set_options`, which rebuilds only what the
+    /// changed settings feed (a lighting change relights the voxels it has), or, for a setting
+    /// that shapes the uploaded scene, by building a new renderer in the background while the
+    /// current one draws.
+    pub(super) fn apply(&mut self) {
+        if !crate::settings::needs_new_renderer(&self.options, &self.draft) {
+            match self.renderer.set_options(&self.draft) {
+                Ok(()) => {
+                    self.options = self.draft.clone();
+                    self.stats.clear_passes();
+                    self.version += 1;
+                    self.status = "options applied".into();
+                }
+                Err(e) => self.status = format!("the new options failed: {e:#}"),
+            }
+            return;
+        }
+        let (device, queue) = (self.device.clone(), self.queue.clone());
+        let (scene, options) = (self.scene.clone(), self.draft.clone());
+        self.rebuild = Some(Job::spawn("rebuilding for the new options", move || {
+            Ok((Renderer::new(&device, &queue, &scene, &options)?, options))
+        }));
+    }
+
+    /// The new options' renderer takes over, with the scene's time and the lights as edited.
+    fn rebuilt(&mut self, mut renderer: Renderer, options: RendererOptions) {
+        renderer.enable_timing(self.timestamps);
+        let lights = self.renderer.lights().to_vec();
+        if renderer.lights().len() == lights.len() {
+            for (i, l) in lights.iter().enumerate() {
+                // A light whose kind differs (the default sun switched) keeps the new one's.
+                let _ = renderer.set_light(i, l);
+            }
+        }
+        self.renderer = renderer;
+        // The path tracer sees the scene's lights, and the default sun when there are none.
+        if options.default_light != self.options.default_light {
+            self.ground.clear();
+        }
+        self.options = options;
+        self.stats.clear_passes();
+        self.version += 1;
+        self.status = "options applied".into();
+    }
+
+    /// Opens the system's file dialog on its own thread.
+    pub(super) fn open_dialog(&mut self) {
+        self.dialog = Some(Job::spawn("waiting for the file dialog", || {
+            Ok(rfd::FileDialog::new()
+                .set_title("Open a scene")
+                .add_filter("scenes", voxgi::scene::io::EXTENSIONS)
+                .pick_file())
+        }));
+    }
+
+    /// Takes the results of finished background work.
+    pub(super) fn poll_jobs(&mut self) {
+        match take(&mut self.rebuild) {
+            Some(Ok((r, options))) => self.rebuilt(r, options),
+            Some(Err(e)) => self.status = format!("the new options failed: {e:#}"),
+            None => {}
+        }
+        match take(&mut self.opening) {
+            Some(Ok(o)) => self.opened(o),
+            Some(Err(e)) => self.status = format!("{e:#}"),
+            None => {}
+        }
+        match take(&mut self.dialog) {
+            Some(Ok(Some(path))) => self.open(&path),
+            Some(Ok(None)) => {
+                self.status = "no file chosen (the dialog needs xdg-desktop-portal or zenity; \
+                               a file dropped onto the window or a path typed above opens too)"
+                    .into()
+            }
+            Some(Err(e)) => self.status = format!("{e:#}"),
+            None => {}
+        }
+    }
+}

@@ -1,0 +1,351 @@
+//! The egui panel: the settings panel's sections (the scene and how to open another, the view,
+//! the scene's cameras, the path tracer, the lights, the renderer's options, the animation, the
+//! stats section from `stats`), what its buttons ask for, and the overlays over the image (the
+//! background work running, the split view's divider and captions). The settings widgets
+//! themselves are in `crate::settings`.
+
+use super::Viewer;
+use super::input::Controller;
+use crate::camera::{Orbit, render_flags};
+use crate::ground_truth::Display;
+use crate::settings::{PanelActions, frame_ui, options_ui};
+use std::path::PathBuf;
+
+/// The settings panel's width, points.
+const PANEL_WIDTH: f32 = 370.0;
+
+impl Viewer {
+    pub(super) fn ui(&mut self, ui: &mut egui::Ui) -> PanelActions {
+        let mut actions = PanelActions::default();
+        self.overlays_ui(ui);
+        if !self.show_panel {
+            self.panel_px = 0;
+            return actions;
+        }
+        // A fixed width: a panel that followed its content would resize the 3D view (and
+        // restart the path tracer) whenever a label grew.
+        let panel = egui::Panel::left("settings")
+            .exact_size(PANEL_WIDTH)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    ui.heading(&self.scene_name);
+                    ui.label(format!(
+                        "{} ({:?})",
+                        self.adapter.name, self.adapter.backend
+                    ));
+                    ui.label(
+                        "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
+                         to look) · H: frame · G: path tracer / split · Space: play · \
+                         P: screenshot · Tab: panel",
+                    );
+                    ui.horizontal(|ui| {
+                        if ui.button("Open…").clicked() {
+                            actions.open_dialog = true;
+                        }
+                        let edit = ui.add(
+                            egui::TextEdit::singleline(&mut self.open_path)
+                                .hint_text("or a path, then Enter")
+                                .desired_width(150.0),
+                        );
+                        let enter =
+                            edit.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                        if enter && !self.open_path.trim().is_empty() {
+                            actions.open = Some(PathBuf::from(self.open_path.trim()));
+                        }
+                    });
+                    if !self.status.is_empty() {
+                        ui.colored_label(egui::Color32::YELLOW, &self.status);
+                    }
+                    ui.separator();
+                    egui::CollapsingHeader::new("view")
+                        .default_open(true)
+                        .show(ui, |ui| {
+                            frame_ui(ui, &mut self.params, self.options.voxel_levels());
+                            let flags = render_flags(&self.params.camera);
+                            ui.horizontal(|ui| {
+                                if ui.button("copy view as voxgi render flags").clicked() {
+                                    ui.ctx().copy_text(flags.clone());
+                                }
+                            });
+                            ui.label(egui::RichText::new(flags).monospace().small());
+                        });
+                    if !self.cameras.is_empty() {
+                        ui.horizontal(|ui| {
+                            ui.label("scene camera:");
+                            let mut pick = None;
+                            for (i, c) in self.cameras.iter().enumerate() {
+                                let name = if c.name.is_empty() {
+                                    format!("{i}")
+                                } else {
+                                    c.name.clone()
+                                };
+                                if ui.button(name).clicked() {
+                                    pick = Some(c.clone());
+                                }
+                            }
+                            if let Some(c) = pick {
+                                self.controller =
+                                    Controller::Orbit(Orbit::from_camera(&c, self.scene_radius));
+                            }
+                        });
+                    }
+                    egui::CollapsingHeader::new("ground truth")
+                        .default_open(true)
+                        .show(ui, |ui| {
+                            if let Some(d) = self.ground_ui(ui) {
+                                actions.display = Some(d);
+                            }
+                        });
+                    ui.collapsing("lights", |ui| self.lights_ui(ui));
+                    ui.collapsing("renderer", |ui| {
+                        let dirty = self.draft != self.options;
+                        let a = options_ui(ui, &mut self.draft, dirty);
+                        actions.apply |= a.apply;
+                        actions.revert |= a.revert;
+                    });
+                    if self.duration > 0.0 {
+                        ui.collapsing("animation", |ui| {
+                            ui.horizontal(|ui| {
+                                let label = if self.playing { "pause" } else { "play" };
+                                if ui.button(label).clicked() {
+                                    self.playing = !self.playing;
+                                }
+                                ui.add(
+                                    egui::Slider::new(&mut self.time, 0.0..=self.duration)
+                                        .text("s"),
+                                );
+                            });
+                        });
+                    }
+                    egui::CollapsingHeader::new("stats")
+                        .default_open(true)
+                        .show(ui, |ui| self.stats_ui(ui));
+                });
+            });
+        let ppp = ui.ctx().pixels_per_point();
+        let right = panel.response.rect.right() - ui.ctx().content_rect().left();
+        self.panel_px = ((right * ppp).round().max(0.0) as u32).min(self.config.width);
+        actions
+    }
+
+    /// The path tracer's controls: what the window shows, the divider, samples per frame.
+    fn ground_ui(&mut self, ui: &mut egui::Ui) -> Option<Display> {
+        let mut pick = None;
+        ui.horizontal(|ui| {
+            for d in Display::ALL {
+                if ui
+                    .selectable_label(self.ground.display == d, d.name())
+                    .clicked()
+                {
+                    pick = Some(d);
+                }
+            }
+        });
+        if self.ground.display == Display::Split {
+            ui.add(egui::Slider::new(&mut self.ground.divider, 0.0..=1.0).text("divider"));
+        }
+        ui.add(
+            egui::Slider::new(&mut self.ground.samples_per_frame, 1..=64)
+                .logarithmic(true)
+                .text("samples per frame"),
+        );
+        let mut auto = self.ground.frame_target_ms.is_some();
+        ui.horizontal(|ui| {
+            ui.add_enabled(
+                !auto,
+                egui::Slider::new(&mut self.ground.paths_per_frame, 1 << 10..=1 << 26)
+                    .logarithmic(true)
+                    .text("paths a frame"),
+            );
+            ui.checkbox(&mut auto, "auto");
+        });
+        match (auto, self.ground.frame_target_ms) {
+            (true, None) => {
+                self.ground.frame_target_ms = Some(crate::ground_truth::default_target_ms(self.cpu))
+            }
+            (false, Some(_)) => self.ground.frame_target_ms = None,
+            _ => {}
+        }
+        if let Some(t) = &mut self.ground.frame_target_ms {
+            ui.add(
+                egui::Slider::new(t, 1.0..=2000.0)
+                    .logarithmic(true)
+                    .text("ms of tracing a frame"),
+            );
+        }
+        ui.add(
+            egui::Slider::new(&mut self.ground.max_samples, 16..=65536)
+                .logarithmic(true)
+                .text("stop at spp"),
+        );
+        if self.ground.display != Display::ConeTraced {
+            ui.label(self.ground.label());
+            if self.params.view != voxgi::ViewMode::Final {
+                ui.label("(the path tracer shows the final image in every view mode)");
+            }
+        }
+        pick
+    }
+
+    /// Over the image: what runs in the background, the split view's divider and the names of
+    /// its sides.
+    fn overlays_ui(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let mut running: Vec<String> = Vec::new();
+        if let Some(job) = &self.rebuild {
+            running.push(job.label());
+        }
+        if let Some(job) = &self.opening {
+            running.push(job.label());
+        }
+        if let Some(job) = &self.dialog {
+            running.push(job.label());
+        }
+        if self.ground.display != Display::ConeTraced
+            && let Some(l) = self.ground.job_label()
+        {
+            running.push(l);
+        }
+        if !running.is_empty() {
+            egui::Area::new(egui::Id::unique("jobs"))
+                .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        for r in &running {
+                            ui.horizontal(|ui| {
+                                ui.spinner();
+                                ui.label(r);
+                            });
+                        }
+                    });
+                });
+        }
+        let screen = ctx.content_rect();
+        let caption = |ui: &mut egui::Ui, text: String| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(text));
+        };
+        match self.ground.display {
+            Display::ConeTraced => {}
+            Display::PathTraced => {
+                let text = self.ground.label();
+                egui::Area::new(egui::Id::unique("path traced"))
+                    .anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0])
+                    .show(&ctx, |ui| caption(ui, text));
+            }
+            Display::Split => {
+                let ppp = ctx.pixels_per_point();
+                let (x0, vw) = self.view_columns();
+                let (left, width) = (screen.left() + x0 as f32 / ppp, vw as f32 / ppp);
+                let x = left + width * self.ground.divider;
+                let text = self.ground.label();
+                egui::Area::new(egui::Id::unique("path traced"))
+                    .anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0])
+                    .show(&ctx, |ui| caption(ui, text));
+                egui::Area::new(egui::Id::unique("cone traced"))
+                    .pivot(egui::Align2::RIGHT_BOTTOM)
+                    .fixed_pos(egui::pos2(x - 12.0, screen.bottom() - 8.0))
+                    .show(&ctx, |ui| caption(ui, "cone traced".into()));
+                // The divider: a line with a handle, dragged sideways.
+                let response = egui::Area::new(egui::Id::unique("divider"))
+                    .fixed_pos(egui::pos2(x - 6.0, screen.top()))
+                    .movable(false)
+                    .show(&ctx, |ui| {
+                        let (rect, response) = ui.allocate_exact_size(
+                            egui::vec2(12.0, screen.height()),
+                            egui::Sense::drag(),
+                        );
+                        let painter = ui.painter();
+                        let stroke = egui::Stroke::new(2.0, egui::Color32::WHITE);
+                        painter.line_segment([rect.center_top(), rect.center_bottom()], stroke);
+                        painter.circle(rect.center(), 7.0, egui::Color32::from_gray(40), stroke);
+                        response.on_hover_cursor(egui::CursorIcon::ResizeHorizontal)
+                    })
+                    .inner;
+                if response.dragged() {
+                    let moved = response.drag_delta().x / width.max(1.0);
+                    self.ground.divider = (self.ground.divider + moved).clamp(0.0, 1.0);
+                }
+            }
+        }
+    }
+
+    /// Each light's colour, intensity and placement; a change goes to `Renderer::set_light`,
+    /// which re-renders its shadow views and re-lights the voxels.
+    fn lights_ui(&mut self, ui: &mut egui::Ui) {
+        let lights: Vec<voxgi::scene::Light> = self.renderer.lights().to_vec();
+        for (i, light) in lights.iter().enumerate() {
+            let mut l = light.clone();
+            let kind = match l.kind {
+                voxgi::scene::LightKind::Directional => "directional",
+                voxgi::scene::LightKind::Point => "point",
+                voxgi::scene::LightKind::Spot { .. } => "spot",
+                voxgi::scene::LightKind::Area { .. } => "area",
+            };
+            ui.label(egui::RichText::new(format!("{} ({kind})", l.name)).strong());
+            let speed = 0.01 * l.intensity.max(0.1);
+            // Only what the user changed counts: the colour button rounds its value through
+            // HSV when first shown, which is not an edit.
+            let mut changed = false;
+            ui.horizontal(|ui| {
+                changed |= ui.color_edit_button_rgb(&mut l.color).changed();
+                changed |= ui
+                    .add(
+                        egui::DragValue::new(&mut l.intensity)
+                            .speed(speed)
+                            .range(0.0..=1e6)
+                            .prefix("intensity "),
+                    )
+                    .changed();
+            });
+            let step = self.scene_radius * 0.005;
+            if l.kind == voxgi::scene::LightKind::Directional {
+                ui.horizontal(|ui| {
+                    ui.label("direction");
+                    for c in 0..3 {
+                        changed |= ui
+                            .add(egui::DragValue::new(&mut l.direction[c]).speed(0.01))
+                            .changed();
+                    }
+                });
+            } else {
+                ui.horizontal(|ui| {
+                    ui.label("position");
+                    for c in 0..3 {
+                        changed |= ui
+                            .add(egui::DragValue::new(&mut l.position[c]).speed(step))
+                            .changed();
+                    }
+                });
+            }
+            if changed && l != *light {
+                if l.direction.length_squared() < 1e-8 {
+                    l.direction = light.direction;
+                }
+                // The path tracer takes the edit from `renderer.lights()` in its next update.
+                match self.renderer.set_light(i, &l) {
+                    Ok(()) => self.ground.scene_changed(),
+                    Err(e) => self.status = format!("{e}"),
+                }
+            }
+        }
+    }
+
+    /// Does what the panel's buttons asked for this frame.
+    pub(super) fn act(&mut self, mut actions: PanelActions) {
+        if actions.revert {
+            self.draft = self.options.clone();
+        }
+        if actions.apply {
+            self.apply();
+        }
+        if actions.open_dialog {
+            self.open_dialog();
+        }
+        if let Some(path) = actions.open.take() {
+            self.open(&path);
+        }
+        if let Some(d) = actions.display {
+            self.set_display(d);
+        }
+    }
+}

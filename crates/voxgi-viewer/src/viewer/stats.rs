@@ -1,0 +1,155 @@
+//! Statistics: the times of recent frames and the per-pass GPU milliseconds kept for the rolling
+//! graphs, gathered each frame, and the panel's stats section that shows them with the
+//! renderer's voxel counts and GPU memory.
+
+use super::Viewer;
+use anyhow::Result;
+use std::collections::VecDeque;
+use std::time::Instant;
+
+/// Per-pass GPU milliseconds of recent frames, for the rolling graph.
+const HISTORY: usize = 120;
+
+/// Frame times and per-pass GPU times of the last `HISTORY` frames.
+pub(super) struct Stats {
+    last_frame: Instant,
+    frame_ms: VecDeque<f32>,
+    pass_ms: Vec<(&'static str, VecDeque<f32>)>,
+}
+
+impl Stats {
+    pub(super) fn new() -> Self {
+        Stats {
+            last_frame: Instant::now(),
+            frame_ms: Default::default(),
+            pass_ms: Vec::new(),
+        }
+    }
+
+    /// A frame starts: the seconds since the last one started, kept in the frame times.
+    pub(super) fn frame_started(&mut self) -> f32 {
+        let now = Instant::now();
+        let elapsed = (now - self.last_frame).as_secs_f32();
+        self.last_frame = now;
+        push(&mut self.frame_ms, elapsed * 1e3);
+        elapsed
+    }
+
+    /// Forgets the passes and their times: the renderer or its options changed.
+    pub(super) fn clear_passes(&mut self) {
+        self.pass_ms.clear();
+    }
+
+    /// The mean milliseconds per frame over the recent frames but the first two, and how many
+    /// frames that is.
+    pub(super) fn steady_frame_ms(&self) -> (f32, usize) {
+        // The steady state: the frames after the first, which builds the voxels.
+        let recent: Vec<f32> = self.frame_ms.iter().skip(2).copied().collect();
+        let mean = recent.iter().sum::<f32>() / recent.len().max(1) as f32;
+        (mean, recent.len())
+    }
+}
+
+impl Viewer {
+    /// The frame's GPU times per pass (the renderer's and the path tracer's), when the adapter
+    /// has timestamps; the path tracer's frame is done either way.
+    pub(super) fn record_pass_times(&mut self) -> Result<()> {
+        let reference = self.ground.frame_done();
+        if self.timestamps {
+            let times: Vec<_> = self
+                .renderer
+                .pass_times()?
+                .into_iter()
+                .chain(reference)
+                .collect();
+            let pass_ms = &mut self.stats.pass_ms;
+            for (name, _) in &times {
+                if !pass_ms.iter().any(|(n, _)| n == name) {
+                    pass_ms.push((name, Default::default()));
+                }
+            }
+            // A pass that did not run this frame (the voxel passes of a still scene) took 0 ms
+            // of it: the means are per frame, not per run.
+            for (name, v) in pass_ms {
+                let ms = times
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map_or(0.0, |(_, ms)| *ms);
+                push(v, ms as f32);
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn stats_ui(&mut self, ui: &mut egui::Ui) {
+        let mean = |v: &VecDeque<f32>| v.iter().sum::<f32>() / v.len().max(1) as f32;
+        let frame = mean(&self.stats.frame_ms);
+        ui.label(format!(
+            "frame {frame:.1} ms ({:.1} fps)",
+            1e3 / frame.max(1e-3)
+        ));
+        if self.reused {
+            ui.label("cone tracing: nothing changed, the last image is shown again");
+        }
+        if let Some(c) = self.renderer.last_voxel_counts() {
+            ui.label(format!("{} fragments, {} voxels", c.fragments, c.occupied));
+        }
+        if self.stats.pass_ms.is_empty() {
+            ui.label("no GPU timestamps on this adapter");
+        }
+        // A bar per pass: the mean of the recent frames, and a sparkline of them.
+        let max = self
+            .stats
+            .pass_ms
+            .iter()
+            .flat_map(|(_, v)| v.iter().copied())
+            .fold(1e-3f32, f32::max);
+        for (name, v) in &self.stats.pass_ms {
+            ui.horizontal(|ui| {
+                ui.label(
+                    egui::RichText::new(format!("{name:<12} {:>7.2} ms", mean(v))).monospace(),
+                );
+                let (rect, _) =
+                    ui.allocate_exact_size(egui::vec2(120.0, 14.0), egui::Sense::hover());
+                let painter = ui.painter_at(rect);
+                let n = v.len().max(2) as f32;
+                let points: Vec<egui::Pos2> = v
+                    .iter()
+                    .enumerate()
+                    .map(|(i, ms)| {
+                        egui::pos2(
+                            rect.left() + rect.width() * i as f32 / (n - 1.0),
+                            rect.bottom() - rect.height() * (ms / max).min(1.0),
+                        )
+                    })
+                    .collect();
+                painter.add(egui::Shape::line(
+                    points,
+                    egui::Stroke::new(1.0, egui::Color32::LIGHT_GREEN),
+                ));
+            });
+        }
+        ui.checkbox(&mut self.vsync, "vsync");
+        ui.separator();
+        let memory = self.renderer.memory();
+        let total: u64 = memory.iter().map(|(_, b)| b).sum();
+        ui.label(format!("GPU memory {:.1} MiB", total as f64 / 1048576.0));
+        for (name, bytes) in memory.iter().filter(|(_, b)| *b >= 1 << 16) {
+            ui.label(
+                egui::RichText::new(format!(
+                    "  {name:<28} {:>8.2} MiB",
+                    *bytes as f64 / 1048576.0
+                ))
+                .monospace()
+                .small(),
+            );
+        }
+    }
+}
+
+fn push(v: &mut VecDeque<f32>, x: f32) {
+    if v.len() == HISTORY {
+        v.pop_front();
+    }
+    v.push_back(x);
+}

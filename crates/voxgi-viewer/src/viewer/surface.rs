@@ -1,0 +1,156 @@
+//! The device and the window's surface: opening the window, the adapter and the device, the
+//! surface's configuration (format, usages, present mode), resizing, and taking each frame's
+//! surface texture.
+
+use super::Viewer;
+use crate::Args;
+use anyhow::{Context, Result, anyhow};
+use std::sync::Arc;
+use voxgi::wgpu;
+use winit::event_loop::ActiveEventLoop;
+use winit::window::Window;
+
+/// The window, the device and the surface configured for it, as `Viewer::new` opens them.
+pub(super) struct Gpu {
+    pub(super) window: Arc<Window>,
+    pub(super) surface: wgpu::Surface<'static>,
+    pub(super) config: wgpu::SurfaceConfiguration,
+    pub(super) device: wgpu::Device,
+    pub(super) queue: wgpu::Queue,
+    pub(super) info: wgpu::AdapterInfo,
+    /// The adapter is a CPU driver (lavapipe, WARP).
+    pub(super) cpu: bool,
+    /// The device has timestamp queries: GPU times per pass.
+    pub(super) timestamps: bool,
+    /// The surface can be copied into: a still view is drawn once and copied after that.
+    pub(super) keeps_image: bool,
+}
+
+/// Opens the window titled after `scene_name`, a device that can draw into it, and the
+/// surface, configured at the size `args` asks for.
+pub(super) fn open_window(
+    event_loop: &ActiveEventLoop,
+    args: &Args,
+    scene_name: &str,
+) -> Result<Gpu> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+        Box::new(event_loop.owned_display_handle()),
+    ));
+    // Open small first: the size depends on whether the adapter is a CPU.
+    let attrs = Window::default_attributes()
+        .with_title(format!("voxgi — {scene_name}"))
+        .with_inner_size(winit::dpi::PhysicalSize::new(640, 360));
+    let window = Arc::new(
+        event_loop
+            .create_window(attrs)
+            .context("cannot open a window")?,
+    );
+    let surface = instance
+        .create_surface(window.clone())
+        .context("cannot draw into the window")?;
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: Some(&surface),
+        apply_limit_buckets: false,
+    }))
+    .map_err(|e| anyhow!("no GPU adapter can draw into this window: {e}"))?;
+    let info = adapter.get_info();
+    let cpu = info.device_type == wgpu::DeviceType::Cpu;
+    let features = voxgi::required_features(&adapter);
+    let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("voxgi-viewer"),
+        required_features: features,
+        required_limits: voxgi::required_limits(&adapter),
+        ..Default::default()
+    }))
+    .with_context(|| format!("cannot open {}", info.name))?;
+    let (w, h) = args
+        .size
+        .unwrap_or(if cpu { (960, 480) } else { (1280, 720) });
+    let _ = window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
+    let size = window.inner_size();
+    let caps = surface.get_capabilities(&adapter);
+    // 8-bit without an sRGB view: voxgi applies the sRGB curve itself, and egui, which
+    // blends in gamma space, wants exactly that.
+    let format = caps
+        .formats
+        .iter()
+        .copied()
+        .find(|f| {
+            matches!(
+                f,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
+            )
+        })
+        .or_else(|| caps.formats.first().copied())
+        .ok_or_else(|| anyhow!("the window offers no surface format"))?;
+    let mut config = surface
+        .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+        .ok_or_else(|| anyhow!("{} cannot draw into this window", info.name))?;
+    config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    // A still view is drawn once into an image and copied into each frame after that.
+    let keeps_image = caps.usages.contains(wgpu::TextureUsages::COPY_DST);
+    if keeps_image {
+        config.usage |= wgpu::TextureUsages::COPY_DST;
+    }
+    config.format = format;
+    config.present_mode = if args.no_vsync {
+        wgpu::PresentMode::AutoNoVsync
+    } else {
+        wgpu::PresentMode::AutoVsync
+    };
+    surface.configure(&device, &config);
+    Ok(Gpu {
+        window,
+        surface,
+        config,
+        device,
+        queue,
+        info,
+        cpu,
+        timestamps,
+        keeps_image,
+    })
+}
+
+impl Viewer {
+    /// The window's new size: the surface follows it.
+    pub(super) fn resize(&mut self, size: winit::dpi::PhysicalSize<u32>) {
+        self.config.width = size.width.max(1);
+        self.config.height = size.height.max(1);
+        self.surface.configure(&self.device, &self.config);
+    }
+
+    /// The surface texture to draw this frame into, or `None` when there is none this time
+    /// (the surface is configured again when it went out of date).
+    pub(super) fn surface_texture(&mut self) -> Result<Option<wgpu::SurfaceTexture>> {
+        match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => Ok(Some(t)),
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                Ok(None)
+            }
+            // Minimised or slow to hand out a frame: try again on the next redraw.
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                Ok(None)
+            }
+            other => Err(anyhow!("the window's surface: {other:?}")),
+        }
+    }
+
+    /// Configures the surface again when the panel's vsync box changed.
+    pub(super) fn follow_vsync(&mut self) {
+        let present_mode = if self.vsync {
+            wgpu::PresentMode::AutoVsync
+        } else {
+            wgpu::PresentMode::AutoNoVsync
+        };
+        if present_mode != self.config.present_mode {
+            self.config.present_mode = present_mode;
+            self.surface.configure(&self.device, &self.config);
+        }
+    }
+}
