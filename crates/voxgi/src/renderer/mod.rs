@@ -83,9 +83,9 @@ pub struct Renderer {
     brdf_tables: BrdfTables,
     /// The layout of the screen passes' `@group(0)` (`globals`).
     globals_layout: wgpu::BindGroupLayout,
-    /// The globals' bind group, made on the first frame after the targets or the atlas were
+    /// The screen passes' bind groups, made on the first frame after what they bind was
     /// replaced.
-    globals: Option<wgpu::BindGroup>,
+    binds: Option<order::FrameBinds>,
     fragments: Fragments,
     /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
     /// names its kind.
@@ -258,7 +258,7 @@ impl Renderer {
             passes,
             brdf_tables,
             globals_layout: crate::frame::globals::layout(device),
-            globals: None,
+            binds: None,
             fragments,
             volume,
             static_triangles,
@@ -381,7 +381,6 @@ impl Renderer {
             })?;
         if let Some(a) = atlas_new {
             self.atlas = a;
-            self.globals = None;
         }
         if let Some(f) = fragments_new {
             self.fragments = f;
@@ -412,6 +411,8 @@ impl Renderer {
         }
         // The gather's resolution needs no work here: the next frame makes targets to match.
         self.options = options.clone();
+        // The screen passes and the atlas may be new: their bind groups are made again.
+        self.binds = None;
         // A structure or an atlas made anew holds nothing yet, whatever the table says.
         if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();

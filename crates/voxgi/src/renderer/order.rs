@@ -68,7 +68,7 @@ impl Renderer {
             self.targets = Some(checked(&self.device, "render targets", || {
                 FrameTargets::new(&self.device, width, height, half)
             })?);
-            self.globals = None;
+            self.binds = None;
         }
         self.record_shadows(encoder);
         let interval = self.options.voxel_update_interval.max(1) as u64;
@@ -91,9 +91,11 @@ impl Renderer {
         let t = self.targets.as_ref().expect("targets were just created");
         self.queue
             .write_buffer(&t.frame, 0, bytemuck::bytes_of(&frame));
-        // Made again only when a resource it binds was replaced (new targets, a new atlas).
-        let globals = self.globals.get_or_insert_with(|| {
-            globals::bind_group(
+        // Made again only when a resource they bind was replaced (new targets, a new atlas, a
+        // pass made anew by `set_options`).
+        let p = &self.passes;
+        let b = self.binds.get_or_insert_with(|| FrameBinds {
+            globals: globals::bind_group(
                 &self.device,
                 &self.globals_layout,
                 &GlobalsSources {
@@ -102,16 +104,20 @@ impl Renderer {
                     lighting: self.atlas.lighting_resources(&self.scene),
                     tables: &self.brdf_tables,
                 },
-            )
+            ),
+            gbuffer: p.gbuffer.bind(&self.device, t, &self.scene),
+            gather: p.gather.bind(&self.device, t),
+            upsample: p.upsample.bind(&self.device, t),
+            composite: p.composite.bind(&self.device, t),
+            tonemap: p.tonemap.bind(&self.device, t),
         });
+        let globals = &b.globals;
         let timer = &mut self.timer;
-        let p = &self.passes;
-        p.gbuffer
-            .record(&self.device, encoder, t, &self.scene, timer);
+        p.gbuffer.record(encoder, t, &self.scene, &b.gbuffer, timer);
         p.gather
-            .record(&self.device, encoder, t, globals, &*self.volume, timer);
-        p.upsample.record(&self.device, encoder, t, globals, timer);
-        p.composite.record(&self.device, encoder, t, globals, timer);
+            .record(encoder, t, globals, &*self.volume, &b.gather, timer);
+        p.upsample.record(encoder, t, globals, &b.upsample, timer);
+        p.composite.record(encoder, t, globals, &b.composite, timer);
         // Only for the voxel views: replaces the composite's output.
         if let Some(mode) = params.view.voxel_view() {
             self.volume.record_debug(
@@ -127,7 +133,7 @@ impl Renderer {
             );
         }
         p.tonemap
-            .record(&self.device, encoder, t, globals, target, timer);
+            .record(encoder, globals, target, &b.tonemap, timer);
         timer.resolve(encoder);
         Ok(())
     }
@@ -326,4 +332,15 @@ impl Renderer {
         self.pending.views = pending.views;
         self.pending.inject_views = vec![ViewDirt::Clean; self.atlas.views.len()];
     }
+}
+
+/// The bind groups of the screen passes that stay the same from frame to frame: made on the
+/// first frame after the targets, the shadow atlas or a screen pass were made anew.
+pub(super) struct FrameBinds {
+    globals: wgpu::BindGroup,
+    gbuffer: wgpu::BindGroup,
+    gather: wgpu::BindGroup,
+    upsample: wgpu::BindGroup,
+    composite: wgpu::BindGroup,
+    tonemap: wgpu::BindGroup,
 }

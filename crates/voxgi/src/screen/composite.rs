@@ -57,17 +57,8 @@ impl CompositePass {
         CompositePass { pipeline, layout }
     }
 
-    /// Records the composite over the whole frame (8x8-pixel workgroups) into `t.hdr`, reading the
-    /// G-buffer, the upsampled gather results and the frame's `globals` (lights, shadow atlas,
-    /// BRDF tables). Timed as "composite".
-    pub fn record(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        t: &FrameTargets,
-        globals: &wgpu::BindGroup,
-        timer: &mut GpuTimer,
-    ) {
+    /// The pass's own bind group for these targets (made once per targets).
+    pub fn bind(&self, device: &wgpu::Device, t: &FrameTargets) -> wgpu::BindGroup {
         let mut resources = t.gbuffer_resources().to_vec();
         resources.extend([
             wgpu::BindingResource::TextureView(&t.hdr),
@@ -75,18 +66,31 @@ impl CompositePass {
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),
         ]);
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),
             layout: &self.layout,
             entries: &layout::entries(resources),
-        });
+        })
+    }
+
+    /// Records the composite over the whole frame (8x8-pixel workgroups) into `t.hdr`, reading the
+    /// G-buffer, the upsampled gather results and the frame's `globals` (lights, shadow atlas,
+    /// BRDF tables). Timed as "composite".
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        globals: &wgpu::BindGroup,
+        bind: &wgpu::BindGroup,
+        timer: &mut GpuTimer,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("composite"),
             timestamp_writes: timer.compute("composite"),
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, globals, &[]);
-        pass.set_bind_group(2, &bind, &[]);
+        pass.set_bind_group(2, bind, &[]);
         pass.dispatch_workgroups(t.width.div_ceil(8), t.height.div_ceil(8), 1);
     }
 }

@@ -74,29 +74,33 @@ impl GatherPass {
         }
     }
 
-    /// Records the gather at `t.gather_size()` (8x8-pixel workgroups) into the low-resolution
-    /// indirect, visibility and guide targets, sampling `voxels` with the cones of the frame's
-    /// `globals`. Timed as "gather".
-    pub fn record(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        t: &FrameTargets,
-        globals: &wgpu::BindGroup,
-        voxels: &dyn VoxelStructure,
-        timer: &mut GpuTimer,
-    ) {
+    /// The pass's own bind group for these targets (made once per targets).
+    pub fn bind(&self, device: &wgpu::Device, t: &FrameTargets) -> wgpu::BindGroup {
         let mut res = t.gbuffer_resources().to_vec();
         res.extend([
             wgpu::BindingResource::TextureView(&t.indirect_low),
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),
         ]);
-        let own = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather"),
             layout: &self.layout,
             entries: &layout::entries(res),
-        });
+        })
+    }
+
+    /// Records the gather at `t.gather_size()` (8x8-pixel workgroups) into the low-resolution
+    /// indirect, visibility and guide targets, sampling `voxels` with the cones of the frame's
+    /// `globals`. Timed as "gather".
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        globals: &wgpu::BindGroup,
+        voxels: &dyn VoxelStructure,
+        own: &wgpu::BindGroup,
+        timer: &mut GpuTimer,
+    ) {
         let (w, h) = t.gather_size();
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("gather"),
@@ -105,7 +109,7 @@ impl GatherPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, globals, &[]);
         pass.set_bind_group(1, voxels.sampling(), &[]);
-        pass.set_bind_group(2, &own, &[]);
+        pass.set_bind_group(2, own, &[]);
         pass.set_bind_group(3, voxels.irradiance(), &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }

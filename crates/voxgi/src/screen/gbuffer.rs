@@ -88,17 +88,14 @@ impl GbufferPass {
         }
     }
 
-    /// Records the pass: clears the G-buffer targets of `t`, draws every mesh draw call of `scene`,
-    /// then its points as surfels. Timed as "gbuffer".
-    pub fn record(
+    /// The pass's bind group for these targets and this scene (made once per targets).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
         scene: &GpuScene,
-        timer: &mut GpuTimer,
-    ) {
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
             layout: &self.layout,
             entries: &layout::entries(vec![
@@ -111,7 +108,19 @@ impl GbufferPass {
                 scene.points.as_entire_binding(),
                 scene.point_spread.as_entire_binding(),
             ]),
-        });
+        })
+    }
+
+    /// Records the pass: clears the G-buffer targets of `t`, draws every mesh draw call of `scene`,
+    /// then its points as surfels. Timed as "gbuffer".
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        scene: &GpuScene,
+        bind: &wgpu::BindGroup,
+        timer: &mut GpuTimer,
+    ) {
         let clear = |view| {
             Some(wgpu::RenderPassColorAttachment {
                 view,
@@ -139,7 +148,7 @@ impl GbufferPass {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, bind, &[]);
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
         for call in &scene.calls {
             pass.draw_indexed(

@@ -76,14 +76,22 @@ impl TonemapPass {
         Ok(())
     }
 
+    /// The pass's own bind group for these targets (made once per targets).
+    pub fn bind(&self, device: &wgpu::Device, t: &FrameTargets) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tonemap"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&t.hdr)]),
+        })
+    }
+
     /// Draws into `target`, whose format `prepare` has seen.
     pub fn record(
         &self,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        t: &FrameTargets,
         globals: &wgpu::BindGroup,
         target: &Target,
+        bind: &wgpu::BindGroup,
         timer: &mut GpuTimer,
     ) {
         let format = target.format;
@@ -91,11 +99,6 @@ impl TonemapPass {
             debug_assert!(false, "tonemap: no pipeline prepared for {format:?}");
             return;
         };
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tonemap"),
-            layout: &self.layout,
-            entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&t.hdr)]),
-        });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tonemap"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -114,7 +117,7 @@ impl TonemapPass {
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, globals, &[]);
-        pass.set_bind_group(2, &bind, &[]);
+        pass.set_bind_group(2, bind, &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -41,17 +41,9 @@ impl UpsamplePass {
         }
     }
 
-    /// Records the edge-aware 4x4 filter of `t.indirect_low` (guided by `t.guide_low`) into
-    /// `t.indirect`, at the gather's resolution. Timed as "upsample".
-    pub fn record(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        t: &FrameTargets,
-        globals: &wgpu::BindGroup,
-        timer: &mut GpuTimer,
-    ) {
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    /// The pass's own bind group for these targets (made once per targets).
+    pub fn bind(&self, device: &wgpu::Device, t: &FrameTargets) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("upsample"),
             layout: &self.layout,
             entries: &layout::entries(vec![
@@ -59,14 +51,26 @@ impl UpsamplePass {
                 wgpu::BindingResource::TextureView(&t.guide_low),
                 wgpu::BindingResource::TextureView(&t.indirect),
             ]),
-        });
+        })
+    }
+
+    /// Records the edge-aware 4x4 filter of `t.indirect_low` (guided by `t.guide_low`) into
+    /// `t.indirect`, at the gather's resolution. Timed as "upsample".
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &FrameTargets,
+        globals: &wgpu::BindGroup,
+        bind: &wgpu::BindGroup,
+        timer: &mut GpuTimer,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("upsample"),
             timestamp_writes: timer.compute("upsample"),
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, globals, &[]);
-        pass.set_bind_group(2, &bind, &[]);
+        pass.set_bind_group(2, bind, &[]);
         let (w, h) = t.gather_size();
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
