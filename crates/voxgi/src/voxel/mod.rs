@@ -12,11 +12,12 @@ pub mod octree;
 pub mod registry;
 
 pub use crate::fragments::{Grid, Region};
-pub use registry::{KindInfo, StructureDesc, VoxelKind, voxel_passes};
+pub use registry::{KindInfo, StructureDesc, VoxelKind};
 
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
+use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use voxgi_scene::Aabb;
@@ -184,6 +185,64 @@ impl VoxelWork {
     pub fn is_empty(&self) -> bool {
         self.build.is_none() && self.update.is_none()
     }
+}
+
+/// The registry: every kind voxgi has, in the order settings list them, with names for the two
+/// that code names.
+impl VoxelKind {
+    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
+    pub const DENSE: VoxelKind = VoxelKind::new(&dense::KIND);
+    /// The sparse voxel octree: memory in proportion to the occupied voxels.
+    pub const OCTREE: VoxelKind = VoxelKind::new(&octree::KIND);
+
+    /// Every kind, in the order settings list them. A new kind is one entry here.
+    pub const ALL: &'static [VoxelKind] = &[VoxelKind::DENSE, VoxelKind::OCTREE];
+
+    /// Every kind's name, in the registry's order.
+    pub fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|k| k.name()).collect()
+    }
+
+    /// The kind named `s`.
+    pub fn parse(s: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                Error::Setting(format!(
+                    "voxel structure '{s}' is not one of {}",
+                    Self::names().join(", ")
+                ))
+            })
+    }
+}
+
+impl Default for VoxelKind {
+    fn default() -> Self {
+        VoxelKind::DENSE
+    }
+}
+
+/// The timing scopes of the voxel update (what depends on the scene and its lights, not on
+/// the camera), in the order they run, with every kind's own passes; every other scope is the
+/// screen's.
+pub fn voxel_passes() -> Vec<&'static str> {
+    let mut v = vec!["shadow", "moments", "voxelize", "splat"];
+    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.info().build_passes));
+    v.push("inject");
+    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.info().filter_passes));
+    v.push("bounce");
+    v
+}
+
+/// The full WGSL of shader `name` with `voxels/` includes taken from the kind named `kind`
+/// (for tests and tools that name kinds by string).
+pub fn compose_for(name: &str, kind: &str) -> Result<String> {
+    Ok(crate::gpu::shader::compose_with(
+        name,
+        Some(VoxelKind::parse(kind)?.shaders()),
+    ))
 }
 
 /// How a structure filters its levels above the finest.

@@ -1,11 +1,13 @@
-//! The registry of voxel structure kinds: everything the renderer, the command line, the
-//! viewer and the tests know about a kind comes from its `KindInfo` (name, limits, timing
-//! scopes, WGSL files, layouts, sampling constants, creation). A new kind is a folder under
-//! `voxel/` and `shaders/voxels/` that defines a `KindInfo`, plus one line in `VoxelKind::ALL`.
+//! What a kind of voxel structure declares of itself (`KindInfo`: name, limits, timing
+//! scopes, WGSL files, layouts, sampling constants, creation), and `VoxelKind`, a handle to
+//! one. Everything the renderer, the command line, the viewer and the tests know about a kind
+//! comes from here. The registry itself, `VoxelKind::ALL`, is in `voxel/mod.rs`, beside the
+//! kinds' modules: a new kind is a folder under `voxel/` and `shaders/voxels/` that defines a
+//! `KindInfo`, plus its `mod` line and one entry in `VoxelKind::ALL`.
 
-use super::{Filtering, Grid, VoxelStructure, dense, octree};
+use super::{Filtering, Grid, VoxelStructure};
+use crate::Result;
 use crate::gpu::shader::StructureShaders;
-use crate::{Error, Result};
 
 /// What a structure is made from: where it lies and how it filters, the room its pools start
 /// with, and whether dynamic geometry will be merged into it.
@@ -64,14 +66,6 @@ pub type CreateFn = fn(
 pub struct VoxelKind(&'static KindInfo);
 
 impl VoxelKind {
-    /// The dense mip-mapped volume: every voxel stored, fastest to sample and to update.
-    pub const DENSE: VoxelKind = VoxelKind(&dense::KIND);
-    /// The sparse voxel octree: memory in proportion to the occupied voxels.
-    pub const OCTREE: VoxelKind = VoxelKind(&octree::KIND);
-
-    /// The registry: every kind, in the order settings list them.
-    pub const ALL: &'static [VoxelKind] = &[VoxelKind::DENSE, VoxelKind::OCTREE];
-
     /// A kind from its own declaration: how a kind outside the registry (an application's
     /// own structure, a test's stand-in) is handed to `RendererOptions::voxels`. Settings and
     /// the command line know only the registry's kinds.
@@ -82,25 +76,6 @@ impl VoxelKind {
     /// The name settings and the command line use, also the WGSL folder `shaders/voxels/<name>/`.
     pub fn name(self) -> &'static str {
         self.0.name
-    }
-
-    /// Every kind's name, in the registry's order.
-    pub fn names() -> Vec<&'static str> {
-        Self::ALL.iter().map(|k| k.name()).collect()
-    }
-
-    /// The kind named `s`.
-    pub fn parse(s: &str) -> Result<Self> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                Error::Setting(format!(
-                    "voxel structure '{s}' is not one of {}",
-                    Self::names().join(", ")
-                ))
-            })
     }
 
     /// What the kind declares of itself.
@@ -139,12 +114,6 @@ impl VoxelKind {
     }
 }
 
-impl Default for VoxelKind {
-    fn default() -> Self {
-        VoxelKind::DENSE
-    }
-}
-
 impl PartialEq for VoxelKind {
     fn eq(&self, other: &Self) -> bool {
         self.name() == other.name()
@@ -157,25 +126,4 @@ impl std::fmt::Debug for VoxelKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
-}
-
-/// The timing scopes of the voxel update (what depends on the scene and its lights, not on
-/// the camera), in the order they run, with every kind's own passes; every other scope is the
-/// screen's.
-pub fn voxel_passes() -> Vec<&'static str> {
-    let mut v = vec!["shadow", "moments", "voxelize", "splat"];
-    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.0.build_passes));
-    v.push("inject");
-    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.0.filter_passes));
-    v.push("bounce");
-    v
-}
-
-/// The full WGSL of shader `name` with `voxels/` includes taken from the kind named `kind`
-/// (for tests and tools that name kinds by string).
-pub fn compose_for(name: &str, kind: &str) -> Result<String> {
-    Ok(crate::gpu::shader::compose_with(
-        name,
-        Some(VoxelKind::parse(kind)?.shaders()),
-    ))
 }

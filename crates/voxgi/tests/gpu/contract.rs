@@ -9,9 +9,9 @@ use voxgi::scene::builtin;
 use voxgi::scene::glam::{UVec3, Vec3, Vec4};
 use voxgi::voxel::VoxelKind;
 
-/// `voxel::registry::compose_for` of a registered kind.
+/// `voxel::compose_for` of a registered kind.
 fn compose_for(name: &str, kind: &str) -> String {
-    voxgi::voxel::registry::compose_for(name, kind).expect("a registered kind")
+    voxgi::voxel::compose_for(name, kind).expect("a registered kind")
 }
 use voxgi::voxel::cpu::{DenseSampler, Texture3d};
 use voxgi::{FrameParams, RendererOptions, wgpu};

@@ -8,7 +8,7 @@ fn parse(name: &str) -> naga::Module {
 }
 
 fn parse_for(name: &str, kind: &str) -> naga::Module {
-    let src = voxgi::voxel::registry::compose_for(name, kind).expect("a kind");
+    let src = voxgi::voxel::compose_for(name, kind).expect("a kind");
     naga::front::wgsl::parse_str(&src)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)))
 }
