@@ -84,15 +84,16 @@ impl BouncePass {
         steps: BounceSteps,
         timer: &mut GpuTimer,
     ) {
+        let bound = voxels.bindings();
         let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bounce globals"),
             layout: &self.globals,
             entries: &layout::entries(vec![
                 cones.as_entire_binding(),
-                voxels.leaf_irradiance().as_entire_binding(),
+                bound.leaf_irradiance.as_entire_binding(),
             ]),
         });
-        let (args, offset) = voxels.leaf_dispatch();
+        let (args, offset) = bound.leaf_dispatch;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("bounce"),
             timestamp_writes: timer.compute("bounce"),
@@ -104,14 +105,14 @@ impl BouncePass {
         };
         pass.set_pipeline(gather);
         pass.set_bind_group(0, &globals, &[]);
-        pass.set_bind_group(1, voxels.sampling(), &[]);
-        pass.set_bind_group(2, voxels.leaves(), &[]);
+        pass.set_bind_group(1, bound.sampling, &[]);
+        pass.set_bind_group(2, bound.leaves, &[]);
         pass.dispatch_workgroups_indirect(args, offset);
         if !steps.store {
             return;
         }
         pass.set_pipeline(&self.store);
-        pass.set_bind_group(3, voxels.leaf_store(), &[]);
+        pass.set_bind_group(3, bound.leaf_store, &[]);
         pass.dispatch_workgroups_indirect(args, offset);
     }
 }

@@ -218,7 +218,8 @@ impl InjectPass {
             entries: &layout::entries(vec![self.args.as_entire_binding()]),
         });
         let (mark, main) = &self.pipelines[which];
-        let (leaf_args, offset) = voxels.leaf_dispatch();
+        let bound = voxels.bindings();
+        let (leaf_args, offset) = bound.leaf_dispatch;
         // Three passes: each reads what the one before wrote (the list, its dispatch size).
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -227,8 +228,8 @@ impl InjectPass {
             });
             pass.set_pipeline(mark);
             pass.set_bind_group(0, &globals, &[]);
-            pass.set_bind_group(2, voxels.leaves(), &[]);
-            pass.set_bind_group(3, voxels.leaf_store(), &[]);
+            pass.set_bind_group(2, bound.leaves, &[]);
+            pass.set_bind_group(3, bound.leaf_store, &[]);
             pass.dispatch_workgroups_indirect(leaf_args, offset);
         }
         {
@@ -247,8 +248,8 @@ impl InjectPass {
         });
         pass.set_pipeline(main);
         pass.set_bind_group(0, &globals, &[]);
-        pass.set_bind_group(2, voxels.leaves(), &[]);
-        pass.set_bind_group(3, voxels.leaf_store(), &[]);
+        pass.set_bind_group(2, bound.leaves, &[]);
+        pass.set_bind_group(3, bound.leaf_store, &[]);
         pass.dispatch_workgroups_indirect(&self.args, 0);
     }
 }

@@ -101,6 +101,7 @@ impl GatherPass {
         own: &wgpu::BindGroup,
         timer: &mut GpuTimer,
     ) {
+        let bound = voxels.bindings();
         let (w, h) = t.gather_size();
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("gather"),
@@ -108,9 +109,9 @@ impl GatherPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, globals, &[]);
-        pass.set_bind_group(1, voxels.sampling(), &[]);
+        pass.set_bind_group(1, bound.sampling, &[]);
         pass.set_bind_group(2, own, &[]);
-        pass.set_bind_group(3, voxels.irradiance(), &[]);
+        pass.set_bind_group(3, bound.irradiance, &[]);
         pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
     }
 }

@@ -131,22 +131,9 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()>;
     /// Bytes per GPU resource.
     fn memory(&self) -> Vec<(&'static str, u64)>;
-    /// The bind group of the WGSL contract's resources, `@group(1)`.
-    fn sampling(&self) -> &wgpu::BindGroup;
-    /// The leaves' bind group (`voxels/<kind>/leaves.wgsl`), `@group(2)` of the lighting
-    /// passes: what each leaf is, and its direct and bounced light.
-    fn leaves(&self) -> &wgpu::BindGroup;
-    /// The leaves' radiance for writing (`voxels/<kind>/leaf_store.wgsl`), `@group(3)`.
-    fn leaf_store(&self) -> &wgpu::BindGroup;
-    /// Per leaf slot, what the last bounce kept for the fast shading (`IndirectShading::Leaves`):
-    /// a `vec4<u32>` record of irradiance, occlusion and normal (shaders/lighting/bounce.wgsl).
-    fn leaf_irradiance(&self) -> &wgpu::Buffer;
-    /// The bind group of `voxels/<kind>/irradiance.wgsl`, `@group(3)` of the gather: the
-    /// record of the leaf at a voxel coordinate.
-    fn irradiance(&self) -> &wgpu::BindGroup;
-    /// An indirect dispatch of one 64-wide workgroup per 64 leaves (2D past 65535 groups:
-    /// threads index leaves as `gid.x + gid.y * num_workgroups.x * 64`).
-    fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64);
+    /// What the passes bind of the structure: its sampling group, its leaves, their radiance
+    /// store, the irradiance lookup, the leaves' records and the leaves' dispatch size.
+    fn bindings(&self) -> StructureBindings<'_>;
     /// Records a debug view into the HDR target, replacing the lit image.
     fn record_debug(
         &self,
@@ -243,6 +230,30 @@ pub fn compose_for(name: &str, kind: &str) -> Result<String> {
         name,
         Some(VoxelKind::parse(kind)?.shaders()),
     ))
+}
+
+/// What the passes bind of a structure (`VoxelStructure::bindings`), by owner: group 1 of
+/// every pipeline that traces cones, and the groups of the lighting passes and the gather.
+#[derive(Clone, Copy)]
+pub struct StructureBindings<'a> {
+    /// The WGSL contract's resources (`voxels/<kind>/sample.wgsl`), `@group(1)`.
+    pub sampling: &'a wgpu::BindGroup,
+    /// The leaves (`voxels/<kind>/leaves.wgsl`), `@group(2)` of the lighting passes: what each
+    /// leaf is, and its direct and bounced light.
+    pub leaves: &'a wgpu::BindGroup,
+    /// The leaves' radiance for writing (`voxels/<kind>/leaf_store.wgsl`), `@group(3)`.
+    pub leaf_store: &'a wgpu::BindGroup,
+    /// The irradiance lookup (`voxels/<kind>/irradiance.wgsl`), `@group(3)` of the gather:
+    /// the record of the leaf at a voxel coordinate.
+    pub irradiance: &'a wgpu::BindGroup,
+    /// Per leaf slot, what the last bounce kept for the fast shading
+    /// (`IndirectShading::Leaves`): a `vec4<u32>` record of irradiance, occlusion and normal
+    /// (shaders/lighting/bounce.wgsl).
+    pub leaf_irradiance: &'a wgpu::Buffer,
+    /// An indirect dispatch of one 64-wide workgroup per 64 leaves (2D past 65535 groups:
+    /// threads index leaves as `gid.x + gid.y * num_workgroups.x * 64`): the buffer and the
+    /// byte offset.
+    pub leaf_dispatch: (&'a wgpu::Buffer, u64),
 }
 
 /// How a structure filters its levels above the finest.

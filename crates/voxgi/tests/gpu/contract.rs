@@ -349,7 +349,7 @@ pub fn run_probes(r: &voxgi::Renderer, probes: &[[f32; 8]]) -> Vec<Vec4> {
         let mut pass = encoder.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.set_bind_group(1, r.volume().sampling(), &[]);
+        pass.set_bind_group(1, r.volume().bindings().sampling, &[]);
         pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
     }
     queue.submit([encoder.finish()]);

@@ -11,8 +11,8 @@ use voxgi::scene::builtin;
 use voxgi::scene::glam::Vec3;
 use voxgi::voxel::dense::{self, DenseVolume};
 use voxgi::voxel::{
-    DebugView, FrameChanges, Grid, KindInfo, POOL_COUNTERS, StructureDesc, VoxelKind,
-    VoxelStructure, VoxelWork,
+    DebugView, FrameChanges, Grid, KindInfo, POOL_COUNTERS, StructureBindings, StructureDesc,
+    VoxelKind, VoxelStructure, VoxelWork,
 };
 use voxgi::{RendererOptions, Result};
 
@@ -113,23 +113,8 @@ impl VoxelStructure for StandIn {
     fn memory(&self) -> Vec<(&'static str, u64)> {
         self.inner.memory()
     }
-    fn sampling(&self) -> &voxgi::wgpu::BindGroup {
-        self.inner.sampling()
-    }
-    fn leaves(&self) -> &voxgi::wgpu::BindGroup {
-        self.inner.leaves()
-    }
-    fn leaf_store(&self) -> &voxgi::wgpu::BindGroup {
-        self.inner.leaf_store()
-    }
-    fn leaf_irradiance(&self) -> &voxgi::wgpu::Buffer {
-        self.inner.leaf_irradiance()
-    }
-    fn irradiance(&self) -> &voxgi::wgpu::BindGroup {
-        self.inner.irradiance()
-    }
-    fn leaf_dispatch(&self) -> (&voxgi::wgpu::Buffer, u64) {
-        self.inner.leaf_dispatch()
+    fn bindings(&self) -> StructureBindings<'_> {
+        self.inner.bindings()
     }
     fn record_debug(
         &self,

@@ -22,7 +22,7 @@ use crate::gpu::shader::StructureShaders;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::voxel::registry::{KindInfo, StructureDesc};
-use crate::voxel::{DebugView, Filtering, POOL_COUNTERS, VoxelStructure};
+use crate::voxel::{DebugView, Filtering, POOL_COUNTERS, StructureBindings, VoxelStructure};
 use crate::{Error, Result};
 use debug::DebugPass;
 use filter::FilterPass;
@@ -823,29 +823,16 @@ impl VoxelStructure for DenseVolume {
         self.memory_report()
     }
 
-    fn sampling(&self) -> &wgpu::BindGroup {
-        &self.sampling
-    }
-
-    fn leaves(&self) -> &wgpu::BindGroup {
-        &self.leaves
-    }
-
-    fn leaf_store(&self) -> &wgpu::BindGroup {
-        &self.leaf_store
-    }
-
-    fn leaf_irradiance(&self) -> &wgpu::Buffer {
-        &self.slot_irradiance
-    }
-
-    fn irradiance(&self) -> &wgpu::BindGroup {
-        &self.irradiance
-    }
-
-    fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64) {
-        // The build's prepare_slots writes one thread per slot at offset 0.
-        (&self.args, 0)
+    fn bindings(&self) -> StructureBindings<'_> {
+        StructureBindings {
+            sampling: &self.sampling,
+            leaves: &self.leaves,
+            leaf_store: &self.leaf_store,
+            irradiance: &self.irradiance,
+            leaf_irradiance: &self.slot_irradiance,
+            // The build's prepare_slots writes one thread per slot at offset 0.
+            leaf_dispatch: (&self.args, 0),
+        }
     }
 
     fn record_debug(

@@ -30,7 +30,7 @@ use tree::{ARGS_WORDS, GRID_DEPTH, LEVEL_STRIDE, NODE_HEADER, TILE_WORDS, atlas,
 pub use tree::{ATLAS_FORMAT, GpuAtlasShape, GpuOctree, NODE_WORDS, SLOT_BYTES, SLOT_WORDS};
 
 use super::registry::{KindInfo, StructureDesc};
-use super::{DebugView, Filtering, Grid, POOL_COUNTERS, VoxelStructure};
+use super::{DebugView, Filtering, Grid, POOL_COUNTERS, StructureBindings, VoxelStructure};
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
 use crate::gpu::checked;
@@ -537,28 +537,15 @@ impl VoxelStructure for OctreeVolume {
         self.memory_report()
     }
 
-    fn sampling(&self) -> &wgpu::BindGroup {
-        &self.sampling
-    }
-
-    fn leaves(&self) -> &wgpu::BindGroup {
-        &self.leaves
-    }
-
-    fn leaf_store(&self) -> &wgpu::BindGroup {
-        &self.leaf_store
-    }
-
-    fn leaf_irradiance(&self) -> &wgpu::Buffer {
-        &self.leaf_irradiance
-    }
-
-    fn irradiance(&self) -> &wgpu::BindGroup {
-        &self.irradiance
-    }
-
-    fn leaf_dispatch(&self) -> (&wgpu::Buffer, u64) {
-        (&self.args, 12)
+    fn bindings(&self) -> StructureBindings<'_> {
+        StructureBindings {
+            sampling: &self.sampling,
+            leaves: &self.leaves,
+            leaf_store: &self.leaf_store,
+            irradiance: &self.irradiance,
+            leaf_irradiance: &self.leaf_irradiance,
+            leaf_dispatch: (&self.args, 12),
+        }
     }
 
     fn record_debug(
