@@ -1,12 +1,102 @@
-//! Accessors and primitives: the bounds and type checks every accessor passes before the `gltf`
-//! readers touch it, and a primitive's attributes and indices read into a [`Mesh`].
+//! Materials, meshes, accessors and primitives: the document's materials and mesh primitives
+//! into the scene, the bounds and type checks every accessor passes before the `gltf` readers
+//! touch it, and a primitive's attributes and indices read into a [`Mesh`].
 
 use super::R;
 use super::buffers::view_bytes;
-use crate::{Mesh, compute_normals, limits};
+use crate::{AlphaMode, Material, Mesh, Scene, compute_normals, limits};
 use glam::{Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
+use std::path::Path;
+
+/// The document's materials into `scene.materials`, in the document's order (so a
+/// primitive's material index is the scene's).
+pub(super) fn load_materials(doc: &gltf::Document, scene: &mut Scene) {
+    let image_of = |t: gltf::texture::Texture| t.source().index();
+    for m in doc.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let e = m.emissive_factor();
+        scene.materials.push(Material {
+            name: m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
+            base_color: pbr.base_color_factor(),
+            base_color_texture: pbr.base_color_texture().map(|i| image_of(i.texture())),
+            emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
+            emissive_texture: m.emissive_texture().map(|i| image_of(i.texture())),
+            roughness: pbr.roughness_factor(),
+            metallic: pbr.metallic_factor(),
+            // KHR_materials_specular is not read: glTF's default specular factor is 1.
+            specular: 1.0,
+            alpha_mode: match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            },
+            double_sided: m.double_sided(),
+        });
+    }
+}
+
+/// Every mesh primitive into `scene.meshes` (a primitive without a material gets one default
+/// material, added on first use); returns, per glTF mesh and primitive, the index into
+/// `scene.meshes`, `None` for skipped primitives. `path` names the file in warnings.
+pub(super) fn load_meshes(
+    doc: &gltf::Document,
+    buffers: &[Vec<u8>],
+    path: &Path,
+    scene: &mut Scene,
+) -> R<Vec<Vec<Option<usize>>>> {
+    let mut default_material = None;
+
+    let mut prim_map: Vec<Vec<Option<usize>>> = Vec::new();
+    for gmesh in doc.meshes() {
+        if gmesh
+            .primitives()
+            .any(|p| p.morph_targets().next().is_some())
+        {
+            log::warn!(
+                "{}: mesh {} '{}' has morph targets; it is drawn in its base shape (morph targets \
+                 are not supported)",
+                path.display(),
+                gmesh.index(),
+                gmesh.name().unwrap_or("")
+            );
+        }
+        let nprims = gmesh.primitives().len();
+        let mut row = Vec::with_capacity(nprims);
+        for prim in gmesh.primitives() {
+            let what = format!("mesh {} primitive {}", gmesh.index(), prim.index());
+            let Some(mut mesh) = load_primitive(&prim, buffers, &what)? else {
+                row.push(None);
+                continue;
+            };
+            let base_name = gmesh
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("mesh {}", gmesh.index()));
+            mesh.name = if nprims > 1 {
+                format!("{base_name} primitive {}", prim.index())
+            } else {
+                base_name
+            };
+            mesh.material = match prim.material().index() {
+                Some(i) => i,
+                None => *default_material.get_or_insert_with(|| {
+                    scene.materials.push(Material::default());
+                    scene.materials.len() - 1
+                }),
+            };
+            scene.meshes.push(mesh);
+            row.push(Some(scene.meshes.len() - 1));
+        }
+        prim_map.push(row);
+    }
+    Ok(prim_map)
+}
 
 /// Checks that reading `count` elements of `acc` stays inside its buffer view and buffer, and
 /// that its type is one of `allowed`, so the `gltf` readers can neither panic nor read short.
@@ -109,11 +199,7 @@ pub(super) fn collect<T: Default + Clone, I: Iterator<Item = T>>(
     Ok(v)
 }
 
-pub(super) fn load_primitive(
-    prim: &gltf::Primitive,
-    buffers: &[Vec<u8>],
-    what: &str,
-) -> R<Option<Mesh>> {
+fn load_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>], what: &str) -> R<Option<Mesh>> {
     let mode = prim.mode();
     if !matches!(
         mode,

@@ -11,10 +11,8 @@ mod meshes;
 
 use self::animation::load_animations;
 use self::buffers::{load_buffers, load_image};
-use self::meshes::load_primitive;
-use crate::{
-    AlphaMode, Camera, Instance, Light, LightKind, Material, Projection, Result, Scene, SceneError,
-};
+use self::meshes::{load_materials, load_meshes};
+use crate::{Camera, Instance, Light, LightKind, Projection, Result, Scene, SceneError};
 use glam::{Mat4, Quat, Vec3};
 use std::path::Path;
 
@@ -87,78 +85,9 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
     for image in doc.images() {
         scene.textures.push(load_image(&image, base, &buffers)?);
     }
-    let image_of = |t: gltf::texture::Texture| t.source().index();
-    for m in doc.materials() {
-        let pbr = m.pbr_metallic_roughness();
-        let strength = m.emissive_strength().unwrap_or(1.0);
-        let e = m.emissive_factor();
-        scene.materials.push(Material {
-            name: m
-                .name()
-                .map(str::to_string)
-                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
-            base_color: pbr.base_color_factor(),
-            base_color_texture: pbr.base_color_texture().map(|i| image_of(i.texture())),
-            emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
-            emissive_texture: m.emissive_texture().map(|i| image_of(i.texture())),
-            roughness: pbr.roughness_factor(),
-            metallic: pbr.metallic_factor(),
-            // KHR_materials_specular is not read: glTF's default specular factor is 1.
-            specular: 1.0,
-            alpha_mode: match m.alpha_mode() {
-                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
-                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
-            },
-            double_sided: m.double_sided(),
-        });
-    }
-    let mut default_material = None;
-
+    load_materials(doc, &mut scene);
     // (glTF mesh, primitive) -> index into scene.meshes, None for skipped primitives.
-    let mut prim_map: Vec<Vec<Option<usize>>> = Vec::new();
-    for gmesh in doc.meshes() {
-        if gmesh
-            .primitives()
-            .any(|p| p.morph_targets().next().is_some())
-        {
-            log::warn!(
-                "{}: mesh {} '{}' has morph targets; it is drawn in its base shape (morph targets \
-                 are not supported)",
-                path.display(),
-                gmesh.index(),
-                gmesh.name().unwrap_or("")
-            );
-        }
-        let nprims = gmesh.primitives().len();
-        let mut row = Vec::with_capacity(nprims);
-        for prim in gmesh.primitives() {
-            let what = format!("mesh {} primitive {}", gmesh.index(), prim.index());
-            let Some(mut mesh) = load_primitive(&prim, &buffers, &what)? else {
-                row.push(None);
-                continue;
-            };
-            let base_name = gmesh
-                .name()
-                .map(str::to_string)
-                .unwrap_or_else(|| format!("mesh {}", gmesh.index()));
-            mesh.name = if nprims > 1 {
-                format!("{base_name} primitive {}", prim.index())
-            } else {
-                base_name
-            };
-            mesh.material = match prim.material().index() {
-                Some(i) => i,
-                None => *default_material.get_or_insert_with(|| {
-                    scene.materials.push(Material::default());
-                    scene.materials.len() - 1
-                }),
-            };
-            scene.meshes.push(mesh);
-            row.push(Some(scene.meshes.len() - 1));
-        }
-        prim_map.push(row);
-    }
+    let prim_map = load_meshes(doc, &buffers, path, &mut scene)?;
 
     let Some(gscene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
         log::warn!(
