@@ -11,6 +11,7 @@ mod embed;
 mod errors;
 mod fast_shading;
 mod golden;
+mod layering;
 mod ndf_mips;
 mod options;
 mod point_gi;
