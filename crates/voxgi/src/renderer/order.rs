@@ -277,7 +277,7 @@ impl Renderer {
                 p.bounce
                     .record(&self.device, encoder, volume, &self.cones, steps, timer);
                 if steps.store {
-                    volume.record_filter(&self.device, encoder, timer);
+                    volume.record_filter(encoder, timer);
                 }
             };
         if geometry || pending.lights {
@@ -301,7 +301,7 @@ impl Renderer {
                 // a cleared volume only reproduces the direct light).
                 self.progressive_left = self.voxel_bounces + 1;
             } else {
-                self.volume.record_filter(&self.device, encoder, timer);
+                self.volume.record_filter(encoder, timer);
                 let n = self.voxel_bounces;
                 for i in 0..n {
                     // With leaves the last bounce's light is what the pixels read: it keeps

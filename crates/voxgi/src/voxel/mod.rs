@@ -111,12 +111,7 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
         timer: &mut GpuTimer,
     );
     /// Records the filtering of the leaves' radiance into every coarser level.
-    fn record_filter(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-    );
+    fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer);
     /// A buffer whose first `POOL_COUNTERS` u32 count what the last build asked of each of the
     /// structure's pools, past their capacity (read back asynchronously to grow them). Word 0
     /// is always the leaves (occupied finest voxels); the others are the structure's own (zero

@@ -90,13 +90,8 @@ impl VoxelStructure for StandIn {
     ) {
         self.inner.record_update(d, e, f, t)
     }
-    fn record_filter(
-        &self,
-        d: &voxgi::wgpu::Device,
-        e: &mut voxgi::wgpu::CommandEncoder,
-        t: &mut GpuTimer,
-    ) {
-        self.inner.record_filter(d, e, t)
+    fn record_filter(&self, e: &mut voxgi::wgpu::CommandEncoder, t: &mut GpuTimer) {
+        self.inner.record_filter(e, t)
     }
     fn pool_counter(&self) -> &voxgi::wgpu::Buffer {
         self.inner.pool_counter()

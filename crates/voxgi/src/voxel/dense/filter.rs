@@ -4,6 +4,7 @@ use super::{DenseVolume, RADIANCE_FORMAT, mip_view};
 use crate::gpu::layout;
 use crate::gpu::shader::voxel_pipeline;
 use crate::gpu::timer::GpuTimer;
+use crate::voxel::{Filtering, Grid};
 use wgpu::util::DeviceExt;
 
 const STRIDE: u64 = 256;
@@ -48,16 +49,16 @@ impl FilterPass {
         }
     }
 
-    fn steps(vol: &DenseVolume) -> Vec<Step> {
-        let res = vol.grid.resolution;
-        let levels = vol.grid.levels();
-        let mode = if vol.anisotropic { 1 } else { 0 };
+    fn steps(grid: Grid, filtering: Filtering) -> Vec<Step> {
+        let res = grid.resolution;
+        let levels = grid.levels();
+        let mode = if filtering.anisotropic { 1 } else { 0 };
         (1..levels)
             .map(|level| {
                 // Level 1 reads the finest (isotropic) level, one block; later ones their own
                 // blocks.
                 let src = (level > 1).then(|| level - 2);
-                let ndf = vol.ndf && vol.anisotropic && src.is_none();
+                let ndf = filtering.ndf && filtering.anisotropic && src.is_none();
                 Step {
                     src,
                     dst: level - 1,
@@ -67,17 +68,17 @@ impl FilterPass {
             .collect()
     }
 
-    /// Records the filtering of every level above the finest, coarsest last: one dispatch per
-    /// level, each reading the level below it (the finest level's `radiance` for the first) and
-    /// writing every block of `chains`. Timed as "filter" (summed over the levels).
-    pub fn record(
+    /// The bind groups of every level's step for a volume on `grid` with these textures (the
+    /// finest level's `radiance` and `normal`, the `chains` above), with their parameters:
+    /// made once per volume (they bind only its own textures).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        vol: &DenseVolume,
-        timer: &mut GpuTimer,
-    ) {
-        let steps = Self::steps(vol);
+        grid: Grid,
+        filtering: Filtering,
+        [radiance, chains, normal]: [&wgpu::Texture; 3],
+    ) -> FilterBinds {
+        let steps = Self::steps(grid, filtering);
         let mut bytes = vec![0u8; steps.len() * STRIDE as usize];
         for (i, s) in steps.iter().enumerate() {
             bytes[i * STRIDE as usize..i * STRIDE as usize + 16]
@@ -92,11 +93,11 @@ impl FilterPass {
             .iter()
             .map(|s| {
                 let src = match s.src {
-                    None => mip_view(&vol.radiance, 0),
-                    Some(m) => mip_view(&vol.chains, m),
+                    None => mip_view(radiance, 0),
+                    Some(m) => mip_view(chains, m),
                 };
-                let dst = mip_view(&vol.chains, s.dst);
-                let normals = mip_view(&vol.normal, 0);
+                let dst = mip_view(chains, s.dst);
+                let normals = mip_view(normal, 0);
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("filter"),
                     layout: &self.layout,
@@ -113,16 +114,43 @@ impl FilterPass {
                 })
             })
             .collect();
+        FilterBinds {
+            _params: params,
+            binds,
+            steps,
+        }
+    }
+
+    /// Records the filtering of every level above the finest, coarsest last: one dispatch per
+    /// level, each reading the level below it (the finest level's `radiance` for the first) and
+    /// writing every block of `chains` (`binds`, from `bind`). Timed as "filter" (summed over
+    /// the levels).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        vol: &DenseVolume,
+        binds: &FilterBinds,
+        timer: &mut GpuTimer,
+    ) {
+        let (steps, binds) = (&binds.steps, &binds.binds);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("filter"),
             timestamp_writes: timer.compute("filter"),
         });
         pass.set_pipeline(&self.pipeline);
-        for (i, (s, b)) in steps.iter().zip(&binds).enumerate() {
+        for (i, (s, b)) in steps.iter().zip(binds).enumerate() {
             pass.set_bind_group(0, b, &[(i as u64 * STRIDE) as u32]);
             let n = s.params[1].div_ceil(4);
             let depth = (s.params[1] * vol.chain_blocks()).div_ceil(4);
             pass.dispatch_workgroups(n, n, depth);
         }
     }
+}
+
+/// The dense filter's bind groups for one volume (`FilterPass::bind`).
+pub struct FilterBinds {
+    /// Every step's parameters at its dynamic offset; bound by `binds`.
+    _params: wgpu::Buffer,
+    binds: Vec<wgpu::BindGroup>,
+    steps: Vec<Step>,
 }

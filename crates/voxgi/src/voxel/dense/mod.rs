@@ -188,6 +188,8 @@ pub struct DenseVolume {
     leaves: wgpu::BindGroup,
     leaf_store: wgpu::BindGroup,
     irradiance: wgpu::BindGroup,
+    /// The filter's bind groups for this volume's textures.
+    filter_binds: filter::FilterBinds,
     pipelines: Arc<DensePipelines>,
 }
 
@@ -471,6 +473,10 @@ impl DenseVolume {
             layout: &Self::leaf_store_layout(device),
             entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&view(&radiance))]),
         });
+        let filter_binds =
+            pipelines
+                .filter
+                .bind(device, grid, filtering, [&radiance, &chains, &normal]);
         DenseVolume {
             grid,
             anisotropic,
@@ -501,6 +507,7 @@ impl DenseVolume {
             leaves,
             leaf_store,
             irradiance,
+            filter_binds,
             pipelines: pipelines.clone(),
         }
     }
@@ -777,13 +784,10 @@ impl VoxelStructure for DenseVolume {
         self.update(device, encoder, fragments, timer);
     }
 
-    fn record_filter(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-    ) {
-        self.pipelines.filter.record(device, encoder, self, timer);
+    fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
+        self.pipelines
+            .filter
+            .record(encoder, self, &self.filter_binds, timer);
     }
 
     fn pool_counter(&self) -> &wgpu::Buffer {

@@ -491,12 +491,7 @@ impl VoxelStructure for OctreeVolume {
         self.update(device, encoder, fragments, timer);
     }
 
-    fn record_filter(
-        &self,
-        _device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        timer: &mut GpuTimer,
-    ) {
+    fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
         self.filter(encoder, timer);
     }
 
