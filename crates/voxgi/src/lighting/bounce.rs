@@ -71,28 +71,37 @@ impl BouncePass {
         }
     }
 
-    /// Records one bounce over the leaves of `voxels` with the diffuse cones in `cones` (`Cones` in
-    /// shared/volume.wgsl), then, with `steps.store`, the store into the finest level, both as
-    /// indirect dispatches timed as "bounce". After a store the volume must be filtered again
-    /// before it is sampled.
-    pub fn record(
+    /// The pass's `@group(0)`: the diffuse cones in `cones` (`Cones` in shared/volume.wgsl) and
+    /// the leaves' records of `voxels`; made once per structure.
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         voxels: &dyn VoxelStructure,
         cones: &wgpu::Buffer,
-        steps: BounceSteps,
-        timer: &mut GpuTimer,
-    ) {
-        let bound = voxels.bindings();
-        let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bounce globals"),
             layout: &self.globals,
             entries: &layout::entries(vec![
                 cones.as_entire_binding(),
-                bound.leaf_irradiance.as_entire_binding(),
+                voxels.bindings().leaf_irradiance.as_entire_binding(),
             ]),
-        });
+        })
+    }
+
+    /// Records one bounce over the leaves of `voxels` with the cones `globals` binds (`bind`),
+    /// then, with `steps.store`, the store into the finest level, both as
+    /// indirect dispatches timed as "bounce". After a store the volume must be filtered again
+    /// before it is sampled.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        voxels: &dyn VoxelStructure,
+        globals: &wgpu::BindGroup,
+        steps: BounceSteps,
+        timer: &mut GpuTimer,
+    ) {
+        let bound = voxels.bindings();
         let (args, offset) = bound.leaf_dispatch;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("bounce"),
@@ -104,7 +113,7 @@ impl BouncePass {
             (_, false) => &self.gather,
         };
         pass.set_pipeline(gather);
-        pass.set_bind_group(0, &globals, &[]);
+        pass.set_bind_group(0, globals, &[]);
         pass.set_bind_group(1, bound.sampling, &[]);
         pass.set_bind_group(2, bound.leaves, &[]);
         pass.dispatch_workgroups_indirect(args, offset);

@@ -16,13 +16,18 @@ pub struct InjectPass {
     pipelines: [(wgpu::ComputePipeline, wgpu::ComputePipeline); 2],
     prepare: wgpu::ComputePipeline,
     globals: wgpu::BindGroupLayout,
-    args_layout: wgpu::BindGroupLayout,
     /// `main`'s dispatch size (written by `prepare`).
     args: wgpu::Buffer,
     /// The leaves to recompute (`todo` in the WGSL), grown by `prepare` to the structure's
     /// leaves.
     todo: wgpu::Buffer,
     light_count: u32,
+    /// `globals` bound: the params, the lights and the shadow atlas, the views' dirt and the
+    /// list; made by `prepare` when first needed and again when the atlas or the list is new
+    /// (the atlas it was made for is kept to tell).
+    bound: Option<(wgpu::Texture, wgpu::BindGroup)>,
+    /// `args_layout` bound to `args`.
+    args_bind: wgpu::BindGroup,
     /// `InjectParams`: the light count, whether every leaf is recomputed, where geometry moved.
     params: wgpu::Buffer,
     /// Per shadow view, the rectangle of its map that changed.
@@ -91,17 +96,24 @@ impl InjectPass {
         };
         let layouts = [Some(&globals), None, Some(&leaves), Some(&store)];
         let both = |store| (pipe("mark", &layouts, store), pipe("main", &layouts, store));
+        let args = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("inject dispatch size"),
+            size: 12,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+            mapped_at_creation: false,
+        });
+        let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("inject args"),
+            layout: &args_layout,
+            entries: &layout::entries(vec![args.as_entire_binding()]),
+        });
         InjectPass {
             pipelines: [both(true), both(false)],
             prepare: pipe("prepare", &[Some(&globals), Some(&args_layout)], true),
-            args: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("inject dispatch size"),
-                size: 12,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-                mapped_at_creation: false,
-            }),
+            args,
+            args_bind,
+            bound: None,
             todo: todo_buffer(device, 4),
-            args_layout,
             globals,
             light_count,
             params: device.create_buffer(&wgpu::BufferDescriptor {
@@ -128,6 +140,8 @@ impl InjectPass {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
+        scene: &GpuScene,
+        atlas: &ShadowAtlas,
         voxels: &dyn VoxelStructure,
         all: bool,
         store_all: bool,
@@ -150,6 +164,19 @@ impl InjectPass {
         let needed = todo_bytes(voxels);
         if self.todo.size() < needed {
             self.todo = todo_buffer(device, needed);
+            self.bound = None;
+        }
+        if self.bound.as_ref().is_none_or(|(t, _)| *t != atlas.texture) {
+            let mut resources = vec![self.params.as_entire_binding()];
+            resources.extend(atlas.lighting_resources(scene));
+            resources.push(self.dirt.as_entire_binding());
+            resources.push(self.todo.as_entire_binding());
+            let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("inject globals"),
+                layout: &self.globals,
+                entries: &layout::entries(resources),
+            });
+            self.bound = Some((atlas.texture.clone(), globals));
         }
         let dirt: Vec<[f32; 4]> = views.iter().map(|v| v.to_gpu(res)).collect();
         if !dirt.is_empty() {
@@ -162,38 +189,28 @@ impl InjectPass {
     /// "inject".
     pub fn record(
         &self,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        atlas: &ShadowAtlas,
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
-        self.record_with(0, device, encoder, scene, atlas, voxels, timer);
+        self.record_with(0, encoder, voxels, timer);
     }
 
     /// `record`, but the leaves' radiance is kept: only their direct light is renewed (for
     /// progressive bounces, which build on the last update's radiance).
     pub fn record_direct_only(
         &self,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        atlas: &ShadowAtlas,
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
-        self.record_with(1, device, encoder, scene, atlas, voxels, timer);
+        self.record_with(1, encoder, voxels, timer);
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn record_with(
         &self,
         which: usize,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        atlas: &ShadowAtlas,
         voxels: &dyn VoxelStructure,
         timer: &mut GpuTimer,
     ) {
@@ -203,20 +220,11 @@ impl InjectPass {
         );
         let todo = &self.todo;
         encoder.clear_buffer(todo, 0, Some(4));
-        let mut resources = vec![self.params.as_entire_binding()];
-        resources.extend(atlas.lighting_resources(scene));
-        resources.push(self.dirt.as_entire_binding());
-        resources.push(todo.as_entire_binding());
-        let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("inject globals"),
-            layout: &self.globals,
-            entries: &layout::entries(resources),
-        });
-        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("inject args"),
-            layout: &self.args_layout,
-            entries: &layout::entries(vec![self.args.as_entire_binding()]),
-        });
+        let Some((_, globals)) = &self.bound else {
+            debug_assert!(false, "inject: `prepare` makes the bind group");
+            return;
+        };
+        let args = &self.args_bind;
         let (mark, main) = &self.pipelines[which];
         let bound = voxels.bindings();
         let (leaf_args, offset) = bound.leaf_dispatch;
@@ -227,7 +235,7 @@ impl InjectPass {
                 timestamp_writes: timer.compute("inject"),
             });
             pass.set_pipeline(mark);
-            pass.set_bind_group(0, &globals, &[]);
+            pass.set_bind_group(0, globals, &[]);
             pass.set_bind_group(2, bound.leaves, &[]);
             pass.set_bind_group(3, bound.leaf_store, &[]);
             pass.dispatch_workgroups_indirect(leaf_args, offset);
@@ -238,8 +246,8 @@ impl InjectPass {
                 timestamp_writes: timer.compute("inject"),
             });
             pass.set_pipeline(&self.prepare);
-            pass.set_bind_group(0, &globals, &[]);
-            pass.set_bind_group(1, &args, &[]);
+            pass.set_bind_group(0, globals, &[]);
+            pass.set_bind_group(1, args, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -247,7 +255,7 @@ impl InjectPass {
             timestamp_writes: timer.compute("inject"),
         });
         pass.set_pipeline(main);
-        pass.set_bind_group(0, &globals, &[]);
+        pass.set_bind_group(0, globals, &[]);
         pass.set_bind_group(2, bound.leaves, &[]);
         pass.set_bind_group(3, bound.leaf_store, &[]);
         pass.dispatch_workgroups_indirect(&self.args, 0);

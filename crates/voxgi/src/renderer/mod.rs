@@ -86,6 +86,9 @@ pub struct Renderer {
     /// The screen passes' bind groups, made on the first frame after what they bind was
     /// replaced.
     binds: Option<order::FrameBinds>,
+    /// The bounce pass's bind group, made on the first bounce after the structure or the pass
+    /// was made anew.
+    bounce_globals: Option<wgpu::BindGroup>,
     fragments: Fragments,
     /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
     /// names its kind.
@@ -259,6 +262,7 @@ impl Renderer {
             brdf_tables,
             globals_layout: crate::frame::globals::layout(device),
             binds: None,
+            bounce_globals: None,
             fragments,
             volume,
             static_triangles,
@@ -411,8 +415,9 @@ impl Renderer {
         }
         // The gather's resolution needs no work here: the next frame makes targets to match.
         self.options = options.clone();
-        // The screen passes and the atlas may be new: their bind groups are made again.
+        // The passes, the structure and the atlas may be new: their bind groups are made again.
         self.binds = None;
+        self.bounce_globals = None;
         // A structure or an atlas made anew holds nothing yet, whatever the table says.
         if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();
@@ -504,6 +509,7 @@ impl Renderer {
             };
             if grow_volume {
                 self.volume.grow(&self.device, &pools)?;
+                self.bounce_globals = None;
             }
             if let Some(f) = fragments {
                 self.fragments = f;

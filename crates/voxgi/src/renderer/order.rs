@@ -208,6 +208,8 @@ impl Renderer {
             self.passes.inject.prepare(
                 &self.device,
                 &self.queue,
+                &self.scene,
+                &self.atlas,
                 &*self.volume,
                 pending.rebuild || pending.lights,
                 // Stored bounces overwrite the radiance: it must start from the direct light
@@ -270,12 +272,16 @@ impl Renderer {
             }
         }
         let progressive = self.options.progressive;
+        // Made once per structure and set of passes (cleared where either is made anew).
+        let bounce_globals = self
+            .bounce_globals
+            .get_or_insert_with(|| p.bounce.bind(&self.device, &*self.volume, &self.cones));
         // One bounce, and the filtering its stored light needs.
         let bounce =
             |encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer, steps: BounceSteps| {
                 let volume = &*self.volume;
                 p.bounce
-                    .record(&self.device, encoder, volume, &self.cones, steps, timer);
+                    .record(encoder, volume, bounce_globals, steps, timer);
                 if steps.store {
                     volume.record_filter(encoder, timer);
                 }
@@ -286,15 +292,7 @@ impl Renderer {
             } else {
                 InjectPass::record
             };
-            inject(
-                &p.inject,
-                &self.device,
-                encoder,
-                &self.scene,
-                &self.atlas,
-                &*self.volume,
-                timer,
-            );
+            inject(&p.inject, encoder, &*self.volume, timer);
             if progressive {
                 // One bounce per update from the previous update's light; after a change
                 // this many updates make every leaf's light converge again (the first from
