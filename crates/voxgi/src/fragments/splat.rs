@@ -37,26 +37,15 @@ impl SplatPass {
         SplatPass { pipeline, layout }
     }
 
-    /// Records the pass over every point of `scene`, one thread per point, appending to
-    /// `fragments` and its count (after `voxelize`, into the same build). Timed as "splat".
-    pub fn record(
+    /// The pass's bind group over `scene`'s geometry points into `fragments` (made once per
+    /// fragment buffer).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         fragments: &Fragments,
-        timer: &mut GpuTimer,
-    ) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("splat"),
-            timestamp_writes: timer.compute("splat"),
-        });
-        // Area lights' surfaces are not voxelized (see `triangle_table`); they follow the
-        // geometry's points.
-        if scene.geometry_points == 0 {
-            return;
-        }
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat"),
             layout: &self.layout,
             entries: &layout::entries(vec![
@@ -72,9 +61,29 @@ impl SplatPass {
                 fragments.count.as_entire_binding(),
                 fragments.region(Geometry::Static),
             ]),
+        })
+    }
+
+    /// Records the pass over every point of `scene`, one thread per point, appending to
+    /// `fragments` and its count (after `voxelize`, into the same build). Timed as "splat".
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        bind: Option<&wgpu::BindGroup>,
+        timer: &mut GpuTimer,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("splat"),
+            timestamp_writes: timer.compute("splat"),
         });
+        // Area lights' surfaces are not voxelized (see `triangle_table`); they follow the
+        // geometry's points.
+        let (Some(bind), true) = (bind, scene.geometry_points > 0) else {
+            return;
+        };
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, bind, &[]);
         let (x, y) = layout::groups_2d(scene.geometry_points, 64);
         pass.dispatch_workgroups(x, y, 1);
     }

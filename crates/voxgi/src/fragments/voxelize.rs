@@ -56,19 +56,15 @@ impl VoxelizePass {
         }
     }
 
-    /// Records the pass over `triangles`, one workgroup per triangle, appending to `fragments` and
-    /// its count; clear the count first (`Fragments::record_clear`). A dynamic table's fragments
-    /// carry coverage. Timed as "voxelize".
-    pub fn record(
+    /// The pass's bind group over `triangles` into `fragments` (made once per fragment buffer).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         triangles: &TriangleTable,
         fragments: &Fragments,
-        timer: &mut GpuTimer,
-    ) {
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxelize"),
             layout: &self.layout,
             entries: &layout::entries(vec![
@@ -88,7 +84,19 @@ impl VoxelizePass {
                     Geometry::Static
                 }),
             ]),
-        });
+        })
+    }
+
+    /// Records the pass over `triangles`, one workgroup per triangle, appending to `fragments` and
+    /// its count; clear the count first (`Fragments::record_clear`). A dynamic table's fragments
+    /// carry coverage. Timed as "voxelize".
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        triangles: &TriangleTable,
+        bind: &wgpu::BindGroup,
+        timer: &mut GpuTimer,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("voxelize"),
             timestamp_writes: timer.compute("voxelize"),
@@ -101,7 +109,7 @@ impl VoxelizePass {
         } else {
             &self.pipeline
         });
-        pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(0, bind, &[]);
         let (x, y) = layout::groups_2d(triangles.count, 1);
         pass.dispatch_workgroups(x, y, 1);
     }

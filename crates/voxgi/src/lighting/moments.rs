@@ -7,7 +7,6 @@ use crate::gpu::shader::grouped_pipeline;
 use crate::gpu::timer::GpuTimer;
 use crate::lighting::atlas::{MOMENTS_FORMAT, ShadowAtlas, ViewDirt, behind_emitter};
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 /// How far the prefilter's disc reaches from its centre, in texels (`MOMENT_RADIUS` in
 /// shaders/shared/lights.wgsl).
@@ -68,14 +67,40 @@ impl MomentsPass {
         MomentsPass { pipeline, layout }
     }
 
+    /// The pass's bind group over `atlas`, with room for a rectangle per view (made once per
+    /// atlas).
+    pub fn bind(&self, device: &wgpu::Device, atlas: &ShadowAtlas) -> MomentsBind {
+        let rects = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("moments rects"),
+            size: atlas.views.len().max(1) as u64 * STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("moments"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                wgpu::BindingResource::TextureView(&atlas.array_view),
+                wgpu::BindingResource::TextureView(&atlas.moments_view),
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &rects,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<GpuMomentRect>() as u64),
+                }),
+            ]),
+        });
+        MomentsBind { rects, bind }
+    }
+
     /// Records the moments of every part of `atlas`'s maps that `views` marks re-rendered
     /// (grown by the disc's radius: texels there average changed ones). Timed as "moments".
     pub fn record(
         &self,
-        device: &wgpu::Device,
+        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         views: &[ViewDirt],
+        bound: &MomentsBind,
         timer: &mut GpuTimer,
     ) {
         let res = atlas.texture.width();
@@ -109,31 +134,16 @@ impl MomentsPass {
             let o = i * STRIDE as usize;
             bytes[o..o + size_of::<GpuMomentRect>()].copy_from_slice(bytemuck::bytes_of(r));
         }
-        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("moments rects"),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("moments"),
-            layout: &self.layout,
-            entries: &layout::entries(vec![
-                wgpu::BindingResource::TextureView(&atlas.array_view),
-                wgpu::BindingResource::TextureView(&atlas.moments_view),
-                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &uniforms,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(size_of::<GpuMomentRect>() as u64),
-                }),
-            ]),
-        });
+        // Written before the submission runs, as the frame's other uniforms are.
+        queue.write_buffer(&bound.rects, 0, &bytes);
+        let bind = &bound.bind;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("moments"),
             timestamp_writes: timer.compute("moments"),
         });
         pass.set_pipeline(&self.pipeline);
         for (i, r) in rects.iter().enumerate() {
-            pass.set_bind_group(0, &bind, &[(i as u64 * STRIDE) as u32]);
+            pass.set_bind_group(0, bind, &[(i as u64 * STRIDE) as u32]);
             pass.dispatch_workgroups(
                 (r.max[0] - r.min[0]).div_ceil(8),
                 (r.max[1] - r.min[1]).div_ceil(8),
@@ -141,4 +151,10 @@ impl MomentsPass {
             );
         }
     }
+}
+
+/// The moments pass's bind group for one atlas, and the rectangles it reads (`MomentsPass::bind`).
+pub struct MomentsBind {
+    rects: wgpu::Buffer,
+    bind: wgpu::BindGroup,
 }

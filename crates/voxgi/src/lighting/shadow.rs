@@ -84,21 +84,14 @@ impl ShadowPass {
         }
     }
 
-    /// Records one render pass per shadow view of `atlas` into its layer (skipping views that only
-    /// see the back of their emitter), drawing every mesh except the light's own emitter, and the
-    /// points. Only what `views` marks out of date is rendered: a whole view, or a rectangle of
-    /// it (scissored: the rest keeps its texels, which are what a full render would give since
-    /// nothing there changed). Timed as "shadow" (summed over the views).
-    pub fn record(
+    /// The pass's bind group over `atlas`'s views and `scene`'s geometry (made once per atlas).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         scene: &GpuScene,
-        views: &[ViewDirt],
-        timer: &mut GpuTimer,
-    ) {
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow"),
             layout: &self.layout,
             entries: &layout::entries(vec![
@@ -112,7 +105,23 @@ impl ShadowPass {
                 scene.points.as_entire_binding(),
                 scene.point_spread.as_entire_binding(),
             ]),
-        });
+        })
+    }
+
+    /// Records one render pass per shadow view of `atlas` into its layer (skipping views that only
+    /// see the back of their emitter), drawing every mesh except the light's own emitter, and the
+    /// points. Only what `views` marks out of date is rendered: a whole view, or a rectangle of
+    /// it (scissored: the rest keeps its texels, which are what a full render would give since
+    /// nothing there changed). Timed as "shadow" (summed over the views).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        scene: &GpuScene,
+        views: &[ViewDirt],
+        bind: &wgpu::BindGroup,
+        timer: &mut GpuTimer,
+    ) {
         for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
             let dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
             let res = atlas.texture.width();
@@ -156,7 +165,7 @@ impl ShadowPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, &bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
+            pass.set_bind_group(0, bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
             if !whole {
                 let (x, y, w, h) = scissor;
                 pass.set_scissor_rect(x, y, w, h);

@@ -89,6 +89,12 @@ pub struct Renderer {
     /// The bounce pass's bind group, made on the first bounce after the structure or the pass
     /// was made anew.
     bounce_globals: Option<wgpu::BindGroup>,
+    /// The bind groups of voxelize and splat, made on the first voxel update after the
+    /// fragments were made anew.
+    fragment_binds: Option<order::FragmentBinds>,
+    /// The shadow and moments passes' bind groups, made on the first shadow render after the
+    /// atlas was made anew.
+    shadow_binds: Option<order::ShadowBinds>,
     fragments: Fragments,
     /// The voxel structure: every pass reaches it through `VoxelStructure`; only its creation
     /// names its kind.
@@ -263,6 +269,8 @@ impl Renderer {
             globals_layout: crate::frame::globals::layout(device),
             binds: None,
             bounce_globals: None,
+            fragment_binds: None,
+            shadow_binds: None,
             fragments,
             volume,
             static_triangles,
@@ -418,6 +426,8 @@ impl Renderer {
         // The passes, the structure and the atlas may be new: their bind groups are made again.
         self.binds = None;
         self.bounce_globals = None;
+        self.fragment_binds = None;
+        self.shadow_binds = None;
         // A structure or an atlas made anew holds nothing yet, whatever the table says.
         if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();
@@ -513,6 +523,7 @@ impl Renderer {
             }
             if let Some(f) = fragments {
                 self.fragments = f;
+                self.fragment_binds = None;
             }
             self.pools += 1;
             log::info!(

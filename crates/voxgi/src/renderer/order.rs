@@ -164,20 +164,28 @@ impl Renderer {
     fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder) {
         let views = std::mem::take(&mut self.pending.views);
         if views.iter().any(|&v| v != ViewDirt::Clean) {
-            self.passes.shadow.record(
-                &self.device,
+            let p = &self.passes;
+            let vsm = self.options.shadow_filter == ShadowFilter::VsmEsm;
+            // Made once per atlas (cleared where the atlas is made anew).
+            let b = self.shadow_binds.get_or_insert_with(|| ShadowBinds {
+                shadow: p.shadow.bind(&self.device, &self.atlas, &self.scene),
+                moments: vsm.then(|| p.moments.bind(&self.device, &self.atlas)),
+            });
+            p.shadow.record(
                 encoder,
                 &self.atlas,
                 &self.scene,
                 &views,
+                &b.shadow,
                 &mut self.timer,
             );
-            if self.options.shadow_filter == ShadowFilter::VsmEsm {
-                self.passes.moments.record(
-                    &self.device,
+            if let Some(m) = &b.moments {
+                p.moments.record(
+                    &self.queue,
                     encoder,
                     &self.atlas,
                     &views,
+                    m,
                     &mut self.timer,
                 );
             }
@@ -222,33 +230,40 @@ impl Renderer {
         }
         let timer = &mut self.timer;
         let p = &self.passes;
+        // Made once per fragment buffer (cleared where the fragments are made anew).
+        let fb = self.fragment_binds.get_or_insert_with(|| FragmentBinds {
+            voxelize_static: p.voxelize.bind(
+                &self.device,
+                &self.scene,
+                &self.static_triangles,
+                &self.fragments,
+            ),
+            voxelize_dynamic: p.voxelize.bind(
+                &self.device,
+                &self.scene,
+                &self.dynamic_triangles,
+                &self.fragments,
+            ),
+            splat: (self.scene.geometry_points > 0)
+                .then(|| p.splat.bind(&self.device, &self.scene, &self.fragments)),
+        });
         if work.build.is_some() {
             self.fragments.record_clear(encoder);
-            let t = &self.static_triangles;
-            p.voxelize.record(
-                &self.device,
-                encoder,
-                &self.scene,
-                t,
-                &self.fragments,
-                timer,
-            );
+            p.voxelize
+                .record(encoder, &self.static_triangles, &fb.voxelize_static, timer);
             // Point clouds are static: the renderer places them once.
             p.splat
-                .record(&self.device, encoder, &self.scene, &self.fragments, timer);
+                .record(encoder, &self.scene, fb.splat.as_ref(), timer);
             self.fragments.record_mark(encoder);
             self.volume
                 .record_build(&self.device, encoder, &self.fragments, timer);
         }
         if work.update.is_some() {
             self.fragments.record_truncate(encoder);
-            let t = &self.dynamic_triangles;
             p.voxelize.record(
-                &self.device,
                 encoder,
-                &self.scene,
-                t,
-                &self.fragments,
+                &self.dynamic_triangles,
+                &fb.voxelize_dynamic,
                 timer,
             );
             self.volume
@@ -341,4 +356,20 @@ pub(super) struct FrameBinds {
     upsample: wgpu::BindGroup,
     composite: wgpu::BindGroup,
     tonemap: wgpu::BindGroup,
+}
+
+/// The bind groups of the passes that make fragments: made on the first voxel update after
+/// the fragment buffer was made anew.
+pub(super) struct FragmentBinds {
+    voxelize_static: wgpu::BindGroup,
+    voxelize_dynamic: wgpu::BindGroup,
+    /// None without geometry points (the pass then records an empty scope).
+    splat: Option<wgpu::BindGroup>,
+}
+
+/// The shadow pass's bind group and the moments pass's (with VSM/ESM): made on the first
+/// shadow render after the atlas was made anew.
+pub(super) struct ShadowBinds {
+    shadow: wgpu::BindGroup,
+    moments: Option<crate::lighting::moments::MomentsBind>,
 }
