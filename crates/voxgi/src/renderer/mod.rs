@@ -222,8 +222,9 @@ impl Renderer {
         )?;
         let grid = grid(&facts, options);
         let fragments = fragments::allocate(device, grid, facts.fragments_wanted(options, &grid))?;
-        let volume =
+        let mut volume =
             (options.voxels.info().create)(device, &facts.structure_desc(options, grid), None)?;
+        volume.bind_fragments(device, &fragments);
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
             moments: MomentsPass::new(device),
@@ -394,12 +395,16 @@ impl Renderer {
         if let Some(a) = atlas_new {
             self.atlas = a;
         }
+        let rebind = volume_new.is_some() || fragments_new.is_some();
         if let Some(f) = fragments_new {
             self.fragments = f;
         }
         if let Some(v) = volume_new {
             self.volume = v;
             self.pools += 1;
+        }
+        if rebind {
+            self.volume.bind_fragments(&self.device, &self.fragments);
         }
         if let Some(p) = gather_new {
             self.passes.gather = p;
@@ -525,6 +530,7 @@ impl Renderer {
                 self.fragments = f;
                 self.fragment_binds = None;
             }
+            self.volume.bind_fragments(&self.device, &self.fragments);
             self.pools += 1;
             log::info!(
                 "voxels: {} fragments, {} occupied voxels: growing the pools to {} fragments \

@@ -110,6 +110,10 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     );
+    /// Makes the bind groups of its build and update over `fragments`, which the renderer
+    /// hands it whenever the fragments or the structure are made anew; `record_build` and
+    /// `record_update` given other fragments make theirs on the spot.
+    fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments);
     /// Records the filtering of the leaves' radiance into every coarser level.
     fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer);
     /// A buffer whose first `POOL_COUNTERS` u32 count what the last build asked of each of the
@@ -249,6 +253,30 @@ pub struct StructureBindings<'a> {
     /// threads index leaves as `gid.x + gid.y * num_workgroups.x * 64`): the buffer and the
     /// byte offset.
     pub leaf_dispatch: (&'a wgpu::Buffer, u64),
+}
+
+/// A structure's bind group over one fragment buffer (`VoxelStructure::bind_fragments`), kept
+/// with the buffer it binds so that it is used for those fragments only.
+#[derive(Default)]
+pub struct FragmentBind(Option<(wgpu::Buffer, wgpu::BindGroup)>);
+
+impl FragmentBind {
+    /// Keeps `bind`, made over `fragments`.
+    pub fn set(&mut self, fragments: &Fragments, bind: wgpu::BindGroup) {
+        self.0 = Some((fragments.buffer.clone(), bind));
+    }
+
+    /// The bind group over `fragments`: the kept one if it binds them, else `make`'s.
+    pub fn get(
+        &self,
+        fragments: &Fragments,
+        make: impl FnOnce() -> wgpu::BindGroup,
+    ) -> wgpu::BindGroup {
+        match &self.0 {
+            Some((buffer, bind)) if *buffer == fragments.buffer => bind.clone(),
+            _ => make(),
+        }
+    }
 }
 
 /// How a structure filters its levels above the finest.

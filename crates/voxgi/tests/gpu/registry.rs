@@ -90,6 +90,9 @@ impl VoxelStructure for StandIn {
     ) {
         self.inner.record_update(d, e, f, t)
     }
+    fn bind_fragments(&mut self, d: &voxgi::wgpu::Device, f: &Fragments) {
+        self.inner.bind_fragments(d, f)
+    }
     fn record_filter(&self, e: &mut voxgi::wgpu::CommandEncoder, t: &mut GpuTimer) {
         self.inner.record_filter(e, t)
     }

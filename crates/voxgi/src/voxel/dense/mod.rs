@@ -22,7 +22,9 @@ use crate::gpu::shader::StructureShaders;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::voxel::registry::{KindInfo, StructureDesc};
-use crate::voxel::{DebugView, Filtering, POOL_COUNTERS, StructureBindings, VoxelStructure};
+use crate::voxel::{
+    DebugView, Filtering, FragmentBind, POOL_COUNTERS, StructureBindings, VoxelStructure,
+};
 use crate::{Error, Result};
 use debug::DebugPass;
 use filter::FilterPass;
@@ -190,6 +192,10 @@ pub struct DenseVolume {
     irradiance: wgpu::BindGroup,
     /// The filter's bind groups for this volume's textures.
     filter_binds: filter::FilterBinds,
+    /// dense_build's and dense_update's bind group over the fragments (`bind_fragments`).
+    fragment_bind: FragmentBind,
+    /// The build steps' dispatch sizes, bound for the steps that write them.
+    args_bind: wgpu::BindGroup,
     pipelines: Arc<DensePipelines>,
 }
 
@@ -473,6 +479,12 @@ impl DenseVolume {
             layout: &Self::leaf_store_layout(device),
             entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&view(&radiance))]),
         });
+        let args = storage_buffer(
+            device,
+            "voxel dispatch sizes",
+            9 * 4,
+            wgpu::BufferUsages::INDIRECT,
+        );
         let filter_binds =
             pipelines
                 .filter
@@ -492,12 +504,13 @@ impl DenseVolume {
             slot_direct,
             slot_next,
             slot_irradiance,
-            args: storage_buffer(
-                device,
-                "voxel dispatch sizes",
-                9 * 4,
-                wgpu::BufferUsages::INDIRECT,
-            ),
+            fragment_bind: FragmentBind::default(),
+            args_bind: device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("dense args"),
+                layout: &pipelines.args_layout,
+                entries: &layout::entries(vec![args.as_entire_binding()]),
+            }),
+            args,
             albedo,
             normal,
             emission,
@@ -626,11 +639,13 @@ impl DenseVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let bind = self.build_bind_group(device, fragments);
+        let bind = self
+            .fragment_bind
+            .get(fragments, || self.build_bind_group(device, fragments));
         let b = &self.pipelines.build;
         // The previous build's slots, from its own dispatch size over them.
         let forget = [(&b.begin, Run::One), (&b.clear_previous, Run::Indirect(0))];
-        self.run_steps(device, encoder, "dense_build", &bind, &forget, timer);
+        self.run_steps(encoder, "dense_build", &bind, &forget, timer);
         encoder.clear_buffer(&self.occupancy, 0, None);
         encoder.clear_buffer(&self.accum, 0, None);
         encoder.clear_buffer(&self.dyn_accum, 0, None);
@@ -641,7 +656,7 @@ impl DenseVolume {
             (&b.prepare_slots, Run::Prepare),
             (&b.resolve, Run::Indirect(0)),
         ];
-        self.run_steps(device, encoder, "dense_build", &bind, &steps, timer);
+        self.run_steps(encoder, "dense_build", &bind, &steps, timer);
     }
 
     /// Records an update by the dynamic fragments (those past the build's): undo the
@@ -653,7 +668,9 @@ impl DenseVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let bind = self.build_bind_group(device, fragments);
+        let bind = self
+            .fragment_bind
+            .get(fragments, || self.build_bind_group(device, fragments));
         let u = &self.pipelines.update;
         let steps = [
             (&u.begin, Run::Prepare),
@@ -664,25 +681,20 @@ impl DenseVolume {
             (&u.prepare, Run::Prepare),
             (&u.resolve, Run::Indirect(24)),
         ];
-        self.run_steps(device, encoder, "dense_update", &bind, &steps, timer);
+        self.run_steps(encoder, "dense_update", &bind, &steps, timer);
     }
 
     /// Records `steps` of dense_build or dense_update, one compute pass each: each step reads
     /// what the one before wrote (dispatch sizes, slots). Timed as `label`.
     fn run_steps(
         &self,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         label: &'static str,
         bind: &wgpu::BindGroup,
         steps: &[(&wgpu::ComputePipeline, Run)],
         timer: &mut GpuTimer,
     ) {
-        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dense args"),
-            layout: &self.pipelines.args_layout,
-            entries: &layout::entries(vec![self.args.as_entire_binding()]),
-        });
+        let args = &self.args_bind;
         for (pipeline, run) in steps {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
@@ -692,7 +704,7 @@ impl DenseVolume {
             pass.set_bind_group(0, bind, &[]);
             match run {
                 Run::Prepare => {
-                    pass.set_bind_group(1, &args, &[]);
+                    pass.set_bind_group(1, args, &[]);
                     pass.dispatch_workgroups(1, 1, 1);
                 }
                 Run::One => pass.dispatch_workgroups(1, 1, 1),
@@ -762,6 +774,11 @@ impl VoxelStructure for DenseVolume {
 
     fn grid(&self) -> Grid {
         self.grid
+    }
+
+    fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments) {
+        let bind = self.build_bind_group(device, fragments);
+        self.fragment_bind.set(fragments, bind);
     }
 
     fn record_build(

@@ -5,7 +5,11 @@ use super::*;
 use tree::{ARGS_CLEAR, ARGS_NEW};
 
 impl OctreeVolume {
-    fn build_bind_group(&self, device: &wgpu::Device, fragments: &Fragments) -> wgpu::BindGroup {
+    pub(super) fn build_bind_group(
+        &self,
+        device: &wgpu::Device,
+        fragments: &Fragments,
+    ) -> wgpu::BindGroup {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("octree_build"),
@@ -38,12 +42,10 @@ impl OctreeVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let bind = self.build_bind_group(device, fragments);
-        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("octree_build args"),
-            layout: &self.pipelines.args_layout,
-            entries: &layout::entries(vec![self.args.as_entire_binding()]),
-        });
+        let bind = self
+            .fragment_bind
+            .get(fragments, || self.build_bind_group(device, fragments));
+        let args = &self.args_bind;
         let b = &self.pipelines.build;
         let depth = self.depth();
         let over_nodes = |t: u32| Run::Indirect((6 + 3 * t as u64) * 4);
@@ -72,7 +74,7 @@ impl OctreeVolume {
         ]);
         // Positions the previous build filled and this one may not.
         encoder.clear_buffer(&self.top_grid, 0, None);
-        self.run_steps(encoder, "octree_build", &bind, &args, &steps, timer);
+        self.run_steps(encoder, "octree_build", &bind, args, &steps, timer);
         if let Some(snapshot) = &self.snapshot {
             for (live, copy) in self.snapshotted().iter().zip(snapshot) {
                 encoder.copy_buffer_to_buffer(live, 0, copy, 0, live.size());
@@ -130,12 +132,10 @@ impl OctreeVolume {
             self.build(device, encoder, fragments, timer);
             return;
         };
-        let bind = self.build_bind_group(device, fragments);
-        let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("octree_update args"),
-            layout: &self.pipelines.args_layout,
-            entries: &layout::entries(vec![self.args.as_entire_binding()]),
-        });
+        let bind = self
+            .fragment_bind
+            .get(fragments, || self.build_bind_group(device, fragments));
+        let args = &self.args_bind;
         let u = &self.pipelines.update;
         let depth = self.depth();
         let over_nodes = |t: u32| Run::Indirect((6 + 3 * t as u64) * 4);
@@ -147,7 +147,7 @@ impl OctreeVolume {
         for t in 1..depth {
             clear.push((&u.clear_nodes, t, over_new(t)));
         }
-        self.run_steps(encoder, "octree_update", &bind, &args, &clear, timer);
+        self.run_steps(encoder, "octree_update", &bind, args, &clear, timer);
         for (live, copy) in self.snapshotted().iter().zip(snapshot) {
             encoder.copy_buffer_to_buffer(copy, 0, live, 0, live.size());
         }
@@ -182,7 +182,7 @@ impl OctreeVolume {
             (&u.resolve, depth, over_nodes(depth)),
             (&u.end_update, depth, Run::Prepare),
         ]);
-        self.run_steps(encoder, "octree_update", &bind, &args, &steps, timer);
+        self.run_steps(encoder, "octree_update", &bind, args, &steps, timer);
     }
 }
 

@@ -30,7 +30,9 @@ use tree::{ARGS_WORDS, GRID_DEPTH, LEVEL_STRIDE, NODE_HEADER, TILE_WORDS, atlas,
 pub use tree::{ATLAS_FORMAT, GpuAtlasShape, GpuOctree, NODE_WORDS, SLOT_BYTES, SLOT_WORDS};
 
 use super::registry::{KindInfo, StructureDesc};
-use super::{DebugView, Filtering, Grid, POOL_COUNTERS, StructureBindings, VoxelStructure};
+use super::{
+    DebugView, Filtering, FragmentBind, Grid, POOL_COUNTERS, StructureBindings, VoxelStructure,
+};
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
 use crate::gpu::checked;
@@ -146,6 +148,10 @@ pub struct OctreeVolume {
     /// The static build's nodes, tiles, leaves and top grid, which every update starts from;
     /// None for a scene without dynamic instances.
     snapshot: Option<[wgpu::Buffer; 4]>,
+    /// octree_build's and octree_update's bind group over the fragments (`bind_fragments`).
+    fragment_bind: FragmentBind,
+    /// The build steps' dispatch sizes, bound for the steps that write them.
+    args_bind: wgpu::BindGroup,
     pipelines: Arc<OctreePipelines>,
 }
 
@@ -329,6 +335,11 @@ impl OctreeVolume {
             [&nodes, &tile_buf, &slot_buf, &top_grid]
                 .map(|b| storage_buffer(device, "octree static snapshot", b.size()))
         });
+        let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("octree_build args"),
+            layout: &pipelines.args_layout,
+            entries: &layout::entries(vec![args.as_entire_binding()]),
+        });
         Ok(OctreeVolume {
             grid,
             anisotropic,
@@ -353,6 +364,8 @@ impl OctreeVolume {
             irradiance,
             filter,
             snapshot,
+            fragment_bind: FragmentBind::default(),
+            args_bind,
             pipelines: pipelines.clone(),
         })
     }
@@ -469,6 +482,11 @@ impl VoxelStructure for OctreeVolume {
 
     fn grid(&self) -> Grid {
         self.grid
+    }
+
+    fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments) {
+        let bind = self.build_bind_group(device, fragments);
+        self.fragment_bind.set(fragments, bind);
     }
 
     fn record_build(
