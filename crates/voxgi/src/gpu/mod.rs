@@ -49,11 +49,10 @@ pub fn checked<T>(device: &wgpu::Device, context: &str, f: impl FnOnce() -> T) -
     let out = f();
     let mut open = Vec::new();
     // The validation scope first: it is the innermost, and its error is the more specific.
-    for scope in [
+    for mut scope in [
         Box::pin(scope_val.pop()) as Scope,
         Box::pin(scope_oom.pop()),
     ] {
-        let mut scope = scope;
         match poll_now(scope.as_mut()) {
             Poll::Ready(Some(e)) => return Err(gpu_error(context, &e)),
             Poll::Ready(None) => {}
