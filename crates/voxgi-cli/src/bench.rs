@@ -14,7 +14,8 @@ pub struct BenchArgs {
     /// Image size in pixels.
     #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Frames timed (after the warm-up).
+    /// Frames timed (after the warm-up). With temporal accumulation a still view stops
+    /// rendering after 256 still frames (it has converged): time a still with fewer, or animate.
     #[arg(long, value_name = "N", default_value_t = 20)]
     pub frames: u32,
     /// Frames rendered before timing starts.

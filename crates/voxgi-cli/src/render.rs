@@ -57,6 +57,12 @@ pub struct RenderArgs {
     /// Frames per second of scene time in a sequence.
     #[arg(long, value_name = "F", default_value_t = 30.0, requires = "frames")]
     pub fps: f32,
+    /// With temporal accumulation (the default): the still is the mean of N frames of the
+    /// same instant, jittered within the pixel and with the cones turned (default 16). 1
+    /// renders a single frame. A sequence (--frames) instead renders one frame per step, the
+    /// history carried from frame to frame as in the viewer.
+    #[arg(long, value_name = "N", conflicts_with = "frames")]
+    pub accumulate: Option<u32>,
 }
 
 /// The path of frame `k` of an output pattern: its one `%d` or `%0Nd` replaced by `k`.
@@ -131,6 +137,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let (scene, table) = p.stage(&format!("loading {label}"), || {
         load_scene_and_settings(&args.scene)
     })?;
+    if args.accumulate == Some(0) {
+        bail!("--accumulate 0: a still needs at least one frame");
+    }
     if !args.time.is_finite() {
         bail!("--time {} is not a finite number of seconds", args.time);
     }
@@ -152,14 +161,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let mut renderer = p
             .stage("uploading scene", || ctx.renderer(&scene, &options))
             .with_context(|| label.clone())?;
-        p.stage(&format!("rendering {w}x{h}"), || {
-            // One image of a still scene: progressive bounces run to convergence (a sequence
-            // shows them building up frame by frame instead, as an application would).
-            let mut out = headless::render(&ctx, &mut renderer, &frame, w, h)?;
-            while !renderer.voxels_settled() {
-                out = headless::render(&ctx, &mut renderer, &frame, w, h)?;
-            }
-            Ok::<_, voxgi::Error>(out)
+        let accumulate = args.accumulate.unwrap_or(headless::DEFAULT_ACCUMULATE);
+        let what = if options.temporal && accumulate > 1 {
+            format!("rendering {w}x{h}, {accumulate} frames accumulated")
+        } else {
+            format!("rendering {w}x{h}")
+        };
+        // One image of a still scene: progressive bounces run to convergence (a sequence
+        // shows them building up frame by frame instead, as an application would).
+        p.stage(&what, || {
+            headless::render_still(&ctx, &mut renderer, &frame, w, h, accumulate)
         })?
     } else {
         let opts = reference_options(args, &scene, &options);

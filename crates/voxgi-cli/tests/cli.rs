@@ -339,6 +339,9 @@ fn embed_example_pixels_equal_voxgi_render() {
         png.to_str().unwrap(),
         "--size",
         "64x48",
+        // The example renders one frame: the first of a history, the still without jitter.
+        "--accumulate",
+        "1",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let cli = image::open(&png).expect("a PNG was written").to_rgba8();
@@ -461,10 +464,12 @@ fn render_time_samples_the_scene_file_animations() {
     assert!(error_line(&bad).contains("--time"), "{}", error_line(&bad));
 }
 
-/// An image sequence (one renderer moved from frame to frame, only the moving block
-/// re-voxelized) equals `--time` renders of the same instants made from scratch, to the byte:
-/// incremental updates reproduce fresh builds exactly. A pattern without a frame number is
-/// refused before anything renders.
+/// Without temporal accumulation an image sequence (one renderer moved from frame to frame,
+/// only the moving block re-voxelized) equals `--time` renders of the same instants made from
+/// scratch, to the byte: incremental updates reproduce fresh builds exactly. With it, the
+/// sequence's first frame is the single-frame still and later frames carry the history (they
+/// differ from the stills). A pattern without a frame number is refused before anything
+/// renders.
 #[test]
 fn image_sequences_equal_renders_at_each_time() {
     let scene = concat!(
@@ -473,7 +478,13 @@ fn image_sequences_equal_renders_at_each_time() {
     );
     let dir = tmp("sequence");
     std::fs::create_dir_all(&dir).unwrap();
-    let common = ["--size", "32x24", "--voxel-resolution", "32"];
+    let common = [
+        "--size",
+        "32x24",
+        "--voxel-resolution",
+        "32",
+        "--temporal=false",
+    ];
     let pattern = dir.join("seq_%03d.png");
     let mut args = vec![
         "render",
@@ -505,6 +516,32 @@ fn image_sequences_equal_renders_at_each_time() {
             "frame {k} (t = {t}) differs from a fresh render at that time"
         );
     }
+    let temporal = dir.join("temporal_%03d.png");
+    let o = voxgi(&[
+        "render",
+        scene,
+        "--frames",
+        "2",
+        "--fps",
+        "2",
+        "--time",
+        "0.5",
+        "--size",
+        "32x24",
+        "--voxel-resolution",
+        "32",
+        "-o",
+        temporal.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let still = |k: usize| image::open(dir.join(format!("seq_{k:03}.png"))).unwrap();
+    let carried = |k: usize| image::open(dir.join(format!("temporal_{k:03}.png"))).unwrap();
+    assert_eq!(still(0).as_bytes(), carried(0).as_bytes(), "first frame");
+    assert_ne!(
+        still(1).as_bytes(),
+        carried(1).as_bytes(),
+        "no history carried"
+    );
     let flat = dir.join("flat.png");
     let o = voxgi(&[
         "render",

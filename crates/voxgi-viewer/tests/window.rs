@@ -135,17 +135,29 @@ fn the_split_view_shows_cone_tracing_left_and_the_path_tracer_right() {
         return;
     };
     // Left of the divider (the middle) the split view is the cone tracer's image, untouched.
+    // Both accumulate their frames (temporal accumulation), the split view over more of them
+    // (its cone tracer also draws while the path tracer is being built): they differ at edges
+    // and in penumbrae by what a few more jittered frames change (measured on lavapipe: 0.42
+    // of 255 on average), far less than the path tracer's noise (its roughness below: 10.7).
     let w = cone.width();
-    let mut left = 0u8;
+    let (mut sum, mut n, mut worst) = (0.0f64, 0.0f64, 0u8);
     for (x, y, p) in split.enumerate_pixels() {
         if x < w / 2 {
             let q = cone.get_pixel(x, y).0;
-            left = left.max((0..3).map(|c| p.0[c].abs_diff(q[c])).max().unwrap());
+            for (a, b) in p.0.iter().zip(q) {
+                sum += a.abs_diff(b) as f64;
+                worst = worst.max(a.abs_diff(b));
+            }
+            n += 3.0;
         }
     }
-    assert_eq!(
-        left, 0,
-        "the split view's left half differs from cone tracing"
+    let left = sum / n;
+    eprintln!(
+        "split view's left half against cone tracing: mean {left:.3}, largest {worst} of 255"
+    );
+    assert!(
+        left < 1.0,
+        "the split view's left half differs from cone tracing by {left} on average"
     );
     // Right of it, the path tracer: a few samples a pixel are noisy (measured on lavapipe:
     // 10.7 against cone tracing's 2.5 on the green wall), so twice as rough means it is there.

@@ -217,8 +217,9 @@ pub struct GpuLight {
     pub shadow_count: u32,
     /// Radius of a disc with the light's area, metres: sets the penumbra size.
     pub size: f32,
-    /// Padding to a multiple of 16 bytes; zero.
-    pub _pad: f32,
+    /// Index of the light's first sample view (`SAMPLE_POINTS` cubes of six faces, for area
+    /// shadows sampled over frames), or `NO_INDEX`.
+    pub sample_first: u32,
 }
 
 /// `GpuLight::kind` of a directional light (a sun).
@@ -270,6 +271,13 @@ pub struct GpuScene {
     pub indices: wgpu::Buffer,
     /// One `GpuDraw` per drawn instance.
     pub draws: wgpu::Buffer,
+    /// Per draw, its model matrix in the previous frame (column-major mat4): the G-buffer's
+    /// motion vectors. Brought up to date by `advance_motion`.
+    pub prev_models: wgpu::Buffer,
+    /// What `prev_models` holds now.
+    prev_written: Vec<[[f32; 4]; 4]>,
+    /// The model matrices the last frame drew with.
+    last_models: Vec<[[f32; 4]; 4]>,
     /// One `GpuMaterial` per scene material.
     pub materials: wgpu::Buffer,
     /// One `GpuLight` per scene light; its shadow fields are written when the shadow views are
@@ -368,6 +376,7 @@ pub fn gpu_light(l: &Light) -> GpuLight {
         radiance: l.radiometric().to_array(),
         area: l.area(),
         size: (l.area() / std::f32::consts::PI).sqrt(),
+        sample_first: NO_INDEX,
         ..Default::default()
     };
     match l.kind {
@@ -503,6 +512,7 @@ impl GpuScene {
         fits("points", points.len(), size_of_val(points.as_slice()))?;
         fits("instances", draws.len(), size_of_val(draws.as_slice()))?;
         fits("indices", indices.len(), size_of_val(indices.as_slice()))?;
+        let models: Vec<[[f32; 4]; 4]> = draws.iter().map(|d| d.model).collect();
         Ok(GpuScene {
             vertices: storage("vertices", bytemuck::cast_slice(&vertices), 32),
             indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -515,6 +525,9 @@ impl GpuScene {
                 usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
             }),
             draws: storage("draws", bytemuck::cast_slice(&draws), 144),
+            prev_models: storage("previous models", bytemuck::cast_slice(&models), 64),
+            prev_written: models.clone(),
+            last_models: models,
             materials: storage("materials", bytemuck::cast_slice(&materials), 64),
             lights: storage("lights", bytemuck::cast_slice(&lights), 96),
             points: storage("points", bytemuck::cast_slice(&points), 32),
@@ -561,6 +574,21 @@ impl GpuScene {
         );
     }
 
+    /// Called once per frame before the G-buffer: `prev_models` takes the models the last
+    /// frame drew with, written only when they differ from what it holds, so a still scene
+    /// writes nothing. Returns whether any model differs from the last frame's.
+    pub fn advance_motion(&mut self, queue: &wgpu::Queue) -> bool {
+        let current: Vec<[[f32; 4]; 4]> = self.gpu_draws.iter().map(|d| d.model).collect();
+        let prev = &self.last_models;
+        if *prev != self.prev_written && !prev.is_empty() {
+            queue.write_buffer(&self.prev_models, 0, bytemuck::cast_slice(prev));
+            self.prev_written = prev.clone();
+        }
+        let moved = current != self.last_models;
+        self.last_models = current;
+        moved
+    }
+
     /// Bytes of GPU memory per resource, for `voxgi bench` and `info`.
     pub fn memory(&self) -> Vec<(&'static str, u64)> {
         let t = &self.textures;
@@ -573,7 +601,7 @@ impl GpuScene {
         vec![
             ("vertices", self.vertices.size()),
             ("indices", self.indices.size()),
-            ("draws", self.draws.size()),
+            ("draws", self.draws.size() + self.prev_models.size()),
             ("materials", self.materials.size()),
             ("lights", self.lights.size()),
             ("points", self.points.size()),

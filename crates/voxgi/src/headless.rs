@@ -167,6 +167,8 @@ const MAX_FRAMES: u32 = 4;
 /// (`OUTPUT_FORMAT`) and the linear HDR radiance. Waits for the GPU, unlike
 /// `Renderer::render`. When the frame's voxel build overflowed a pool, the frame is rendered
 /// again once the pools have grown, so the image is always that of a renderer sized right.
+/// With temporal accumulation this is the next frame of the renderer's stream (the first
+/// one is the unjittered still); `render_still` renders a converged still.
 pub fn render(
     ctx: &GpuContext,
     renderer: &mut Renderer,
@@ -174,74 +176,144 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Result<RenderOutput> {
-    crate::validate_size(width, height)?;
-    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("headless output"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: OUTPUT_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    let target = Target::new(&view, OUTPUT_FORMAT, width, height);
-    for frame in 0..MAX_FRAMES {
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("headless frame"),
-            });
-        renderer.render(&mut encoder, &target, params)?;
-        ctx.queue.submit([encoder.finish()]);
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| Error::Gpu {
-                context: "frame".into(),
-                reason: e.to_string(),
-            })?;
-        ctx.take_error("frame")?;
-        // The counters' map callback runs in whichever thread polls the device; on a device
-        // shared between threads that may be another one, a moment after this thread's wait
-        // returned. Until it has run, a build that overflowed looks finished (a flaky golden
-        // test showed such an image: voxels missing from one corner).
-        let waiting = std::time::Instant::now();
-        while renderer.feedback_in_flight() {
-            if waiting.elapsed() > std::time::Duration::from_secs(30) {
-                return Err(Error::Gpu {
-                    context: "voxel counters".into(),
-                    reason: "their readback did not complete within 30 s".into(),
-                });
-            }
-            let _ = ctx.device.poll(wgpu::PollType::Poll);
-            std::thread::yield_now();
-        }
-        if !renderer.receive_feedback()? {
-            break;
-        }
-        if frame + 1 == MAX_FRAMES {
-            return Err(Error::Gpu {
-                context: "voxelize".into(),
-                reason: "the voxel pools still overflow after growing".into(),
-            });
+    let output = Output::new(ctx, width, height)?;
+    output.frame(ctx, renderer, params)?;
+    output.read(ctx, renderer)
+}
+
+/// Frames `render_still` accumulates unless told otherwise: past 16 the Cornell box's
+/// error against the path tracer no longer falls measurably (docs/QUALITY.md).
+pub const DEFAULT_ACCUMULATE: u32 = 16;
+
+/// Renders a still of the scene as it is: frames until the voxels have settled (progressive
+/// bounces converged), then, with temporal accumulation on, `accumulate` frames of the same
+/// instant into a fresh history (jittered, the cones turned) and reads back their mean.
+/// Without temporal accumulation, or with `accumulate` at most 1, the settled frame itself.
+/// More than `TEMPORAL_STILL_FRAMES` is an error: the renderer stops accumulating there.
+pub fn render_still(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    params: &FrameParams,
+    width: u32,
+    height: u32,
+    accumulate: u32,
+) -> Result<RenderOutput> {
+    if accumulate > crate::TEMPORAL_STILL_FRAMES {
+        return Err(crate::Error::Setting(format!(
+            "{accumulate} frames to accumulate: at most {} (a still has converged there)",
+            crate::TEMPORAL_STILL_FRAMES
+        )));
+    }
+    let output = Output::new(ctx, width, height)?;
+    output.frame(ctx, renderer, params)?;
+    while !renderer.voxels_settled() {
+        output.frame(ctx, renderer, params)?;
+    }
+    if renderer.options().temporal && accumulate > 1 {
+        renderer.reset_history();
+        for _ in 0..accumulate {
+            output.frame(ctx, renderer, params)?;
         }
     }
-    let hdr = renderer.hdr_texture().ok_or_else(|| Error::Gpu {
-        context: "frame".into(),
-        reason: "no HDR target after rendering".into(),
-    })?;
-    let hdr_bytes = readback::read_texture(&ctx.device, &ctx.queue, hdr)?;
-    let ldr = readback::read_texture(&ctx.device, &ctx.queue, &texture)?;
-    ctx.take_error("readback")?;
-    Ok(RenderOutput {
-        width,
-        height,
-        hdr: bytemuck::cast_slice(&hdr_bytes).to_vec(),
-        ldr,
-    })
+    output.read(ctx, renderer)
+}
+
+/// The texture headless frames are written to.
+struct Output {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    width: u32,
+    height: u32,
+}
+
+impl Output {
+    fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<Self> {
+        crate::validate_size(width, height)?;
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("headless output"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: OUTPUT_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Ok(Output {
+            texture,
+            view,
+            width,
+            height,
+        })
+    }
+
+    /// Renders one frame into the texture and waits for it: again after a voxel build that
+    /// overflowed, once the pools have grown.
+    fn frame(&self, ctx: &GpuContext, renderer: &mut Renderer, params: &FrameParams) -> Result<()> {
+        let target = Target::new(&self.view, OUTPUT_FORMAT, self.width, self.height);
+        for frame in 0..MAX_FRAMES {
+            let mut encoder = ctx
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("headless frame"),
+                });
+            renderer.render(&mut encoder, &target, params)?;
+            ctx.queue.submit([encoder.finish()]);
+            ctx.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| Error::Gpu {
+                    context: "frame".into(),
+                    reason: e.to_string(),
+                })?;
+            ctx.take_error("frame")?;
+            // The counters' map callback runs in whichever thread polls the device; on a device
+            // shared between threads that may be another one, a moment after this thread's wait
+            // returned. Until it has run, a build that overflowed looks finished (a flaky golden
+            // test showed such an image: voxels missing from one corner).
+            let waiting = std::time::Instant::now();
+            while renderer.feedback_in_flight() {
+                if waiting.elapsed() > std::time::Duration::from_secs(30) {
+                    return Err(Error::Gpu {
+                        context: "voxel counters".into(),
+                        reason: "their readback did not complete within 30 s".into(),
+                    });
+                }
+                let _ = ctx.device.poll(wgpu::PollType::Poll);
+                std::thread::yield_now();
+            }
+            if !renderer.receive_feedback()? {
+                break;
+            }
+            if frame + 1 == MAX_FRAMES {
+                return Err(Error::Gpu {
+                    context: "voxelize".into(),
+                    reason: "the voxel pools still overflow after growing".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads back the last frame: the tone-mapped image and the HDR radiance it showed.
+    fn read(&self, ctx: &GpuContext, renderer: &Renderer) -> Result<RenderOutput> {
+        let (width, height, texture) = (self.width, self.height, &self.texture);
+        let hdr = renderer.hdr_texture().ok_or_else(|| Error::Gpu {
+            context: "frame".into(),
+            reason: "no HDR target after rendering".into(),
+        })?;
+        let hdr_bytes = readback::read_texture(&ctx.device, &ctx.queue, hdr)?;
+        let ldr = readback::read_texture(&ctx.device, &ctx.queue, texture)?;
+        ctx.take_error("readback")?;
+        Ok(RenderOutput {
+            width,
+            height,
+            hdr: bytemuck::cast_slice(&hdr_bytes).to_vec(),
+            ldr,
+        })
+    }
 }

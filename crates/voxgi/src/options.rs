@@ -82,6 +82,10 @@ pub enum ViewMode {
     /// have children (at level 0 its occupied leaves), the dense volume's cells with any
     /// opacity; coloured by level, shaded by face, edges darkened.
     VoxelNodes,
+    /// Motion vectors: red and green the screen motion since the last frame in pixels (x
+    /// right, y down), blue the surface's distance from the last frame's camera in metres.
+    /// Raw values: read them from an EXR.
+    Motion,
 }
 
 impl Tonemap {
@@ -113,7 +117,7 @@ impl Tonemap {
 
 impl ViewMode {
     /// Every view, in the order of their ids.
-    pub const ALL: [ViewMode; 10] = [
+    pub const ALL: [ViewMode; 11] = [
         ViewMode::Final,
         ViewMode::Albedo,
         ViewMode::Normal,
@@ -124,6 +128,7 @@ impl ViewMode {
         ViewMode::VoxelOpacity,
         ViewMode::VoxelRadiance,
         ViewMode::VoxelNodes,
+        ViewMode::Motion,
     ];
 
     /// The name scene files and the CLI use.
@@ -139,6 +144,7 @@ impl ViewMode {
             ViewMode::VoxelOpacity => "voxel-opacity",
             ViewMode::VoxelRadiance => "voxel-radiance",
             ViewMode::VoxelNodes => "voxel-nodes",
+            ViewMode::Motion => "motion",
         }
     }
 
@@ -333,6 +339,12 @@ pub struct RendererOptions {
     /// only (1..=64); the frames between reuse the voxels, which then trail the meshes by up
     /// to k - 1 frames. Shadow maps follow every frame. Default 1.
     pub voxel_update_interval: u32,
+    /// Temporal accumulation: each frame's camera is jittered within the pixel and its cone
+    /// bundle turned, and the frames are accumulated into a history reprojected by motion
+    /// vectors (anti-aliased edges, many more cone directions than one frame traces; a still
+    /// converges over frames). Off, every frame is a still of its own, the same from frame to
+    /// frame. Default true.
+    pub temporal: bool,
 }
 
 impl Default for RendererOptions {
@@ -361,6 +373,7 @@ impl Default for RendererOptions {
             voxel_capacity: None,
             progressive: false,
             voxel_update_interval: 1,
+            temporal: true,
         }
     }
 }

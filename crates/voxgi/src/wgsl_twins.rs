@@ -128,6 +128,13 @@ fn every_twin_has_the_wgsl_layout() {
             background,
             cone_shadows,
             geometry_points,
+            jitter,
+            prev_view_proj,
+            view_proj_unjittered,
+            prev_camera_pos,
+            history,
+            cone_turn,
+            light_sample,
         ]
     );
     twin!(m, GpuVertex, "Vertex", [position, u, normal, v]);
@@ -179,6 +186,7 @@ fn every_twin_has_the_wgsl_layout() {
             shadow_first,
             shadow_count,
             size,
+            sample_first,
         ]
     );
     twin!(
@@ -197,6 +205,7 @@ fn every_twin_has_the_wgsl_layout() {
             resolution,
             layer,
             plane,
+            offset,
         ]
     );
     twin!(

@@ -224,8 +224,13 @@ impl Viewer {
                 self.reused |= accumulate;
             } else {
                 let v = cone.create_view(&Default::default());
-                self.renderer
-                    .render(encoder, &Target::new(&v, format, vw, h), &self.params)?;
+                let target = Target::new(&v, format, vw, h);
+                if accumulate {
+                    self.renderer.render(encoder, &target, &self.params)?;
+                } else {
+                    // The frame shown, again: another would accumulate into the history.
+                    self.renderer.redraw(encoder, &target, &self.params)?;
+                }
                 images.shows = shows;
             }
             encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
@@ -273,7 +278,12 @@ impl Viewer {
         accumulate: bool,
     ) -> Result<()> {
         if self.ground.needs_cone_tracing() {
-            self.renderer.render(encoder, target, &self.params)?;
+            if accumulate {
+                self.renderer.render(encoder, target, &self.params)?;
+            } else {
+                // The frame shown, again: another would accumulate into the history.
+                self.renderer.redraw(encoder, target, &self.params)?;
+            }
         }
         let r = self.ground.record(
             encoder,

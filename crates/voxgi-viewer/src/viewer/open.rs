@@ -28,6 +28,8 @@ impl Viewer {
     pub(super) fn frame_scene(&mut self) {
         let cam = self.renderer.default_camera().clone();
         self.controller = Controller::Orbit(Orbit::from_camera(&cam, self.scene_radius * 2.0));
+        // A cut to another view: nothing of the last view's history belongs in it.
+        self.renderer.reset_history();
     }
 
     /// Starts loading the file at `path` (and building its renderer) in the background; when it

@@ -20,6 +20,8 @@
 @group(2) @binding(6) var visibility: texture_2d<f32>;
 // Each gather sample's normal and camera distance.
 @group(2) @binding(7) var guide: texture_2d<f32>;
+// The G-buffer's motion vectors (the motion view).
+@group(2) @binding(8) var gb_motion: texture_2d<f32>;
 
 // False when every light's visibility is cone-traced: the shadow-map code is then compiled
 // out. CPU drivers run a branch's code even when no lane takes it, and the shadow-map lookup
@@ -135,7 +137,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = id.xy;
     let depth = textureLoad(gb_depth, px, 0);
     if depth >= 1.0 {
-        textureStore(hdr, px, frame.background);
+        var background = frame.background;
+        if frame.view_mode == VIEW_MOTION {
+            background = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        }
+        textureStore(hdr, px, background);
         return;
     }
     let am = textureLoad(gb_albedo, px, 0);
@@ -164,6 +170,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         var w = 1.0;
         if cone {
             w = vis[channel];
+        } else if SHADOW_MAPS && light.sample_first != NO_INDEX && frame.history != HISTORY_NONE {
+            // Accumulating frames: one of this frame's points on the light, a different one
+            // for each pixel of a 2x2 block (the temporal pass's neighbourhood then spans
+            // the penumbra) and for each frame.
+            let s = (px.x & 1u) + 2u * (px.y & 1u) + frame.light_sample;
+            w = sampled_visibility(light, p, n, s & 3u);
         } else if SHADOW_MAPS {
             w = light_visibility(light, p, n, frame.shadow_softness);
         }
@@ -186,6 +198,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         case VIEW_INDIRECT: {
             out = ind.rgb;
+        }
+        case VIEW_MOTION: {
+            out = textureLoad(gb_motion, px, 0).xyz;
         }
         default: {}
     }

@@ -97,7 +97,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(guide_out, gid.xy, vec4<f32>(nr.xyz, length(frame.camera_pos - p)));
     // The ring of tilted cones repeats every 2 pi / (count - 1).
     let period = 2.0 * PI / f32(max(cones.count, 2u) - 1u);
-    let angle = (f32(bayer4(gid.xy)) + 0.5) / 16.0 * period;
+    // With temporal accumulation each frame turns the whole pattern a little further
+    // (frame.cone_turn, 0 in frame 0), so the frames between them trace many more rotations.
+    let angle = (f32(bayer4(gid.xy)) + 0.5 + frame.cone_turn) / 16.0 * period;
     // Even and odd Bayer ranks trace the two halves of the ring: each half then meets eight
     // rotations spread over the whole period.
     var g: Gathered;

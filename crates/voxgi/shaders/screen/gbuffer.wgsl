@@ -1,5 +1,8 @@
-// gbuffer: rasterizes every mesh instance into albedo/metallic, normal/roughness, emission and
-// depth, then every point-cloud sample as a surfel (an oriented disc, see shared/surfel.wgsl).
+// gbuffer: rasterizes every mesh instance into albedo/metallic, normal/roughness, emission,
+// motion and depth, then every point-cloud sample as a surfel (an oriented disc, see
+// shared/surfel.wgsl). Motion: how far the surface under a pixel moved on screen since the
+// last frame (pixels, without the jitter), and its distance from the last frame's camera
+// (the temporal pass's disocclusion test).
 
 //!include shared/scene.wgsl
 //!include shared/surfel.wgsl
@@ -13,12 +16,18 @@
 @group(0) @binding(6) var<storage, read> points: array<Point>;
 // Per point: how far its neighbours stray from its tangent plane, metres (scan noise).
 @group(0) @binding(7) var<storage, read> point_spread: array<f32>;
+// Per draw, its model matrix in the previous frame.
+@group(0) @binding(8) var<storage, read> prev_models: array<mat4x4<f32>>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) @interpolate(flat) draw: u32,
+    // Clip positions without the jitter, now and in the last frame; world position then.
+    @location(3) now: vec4<f32>,
+    @location(4) then: vec4<f32>,
+    @location(5) then_world: vec3<f32>,
 }
 
 @vertex
@@ -26,7 +35,12 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
     let v = vertices[vi];
     let d = draws[di];
     var out: VsOut;
-    out.clip = frame.view_proj * (d.model * vec4<f32>(v.position, 1.0));
+    let world = d.model * vec4<f32>(v.position, 1.0);
+    let then_world = prev_models[di] * vec4<f32>(v.position, 1.0);
+    out.clip = frame.view_proj * world;
+    out.now = frame.view_proj_unjittered * world;
+    out.then = frame.prev_view_proj * then_world;
+    out.then_world = then_world.xyz;
     out.normal = (d.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
     out.uv = vec2<f32>(v.u, v.v);
     out.draw = di;
@@ -37,6 +51,15 @@ struct GBuffer {
     @location(0) albedo_metallic: vec4<f32>,
     @location(1) normal_roughness: vec4<f32>,
     @location(2) emission: vec4<f32>,
+    @location(3) motion: vec4<f32>,
+}
+
+// Screen motion in pixels from the last frame to this one, the surface's distance from the
+// last frame's camera, and 1 (background stays cleared to 0).
+fn motion(now: vec4<f32>, then: vec4<f32>, then_world: vec3<f32>) -> vec4<f32> {
+    let ndc = now.xy / now.w - then.xy / then.w;
+    let px = ndc * vec2<f32>(0.5, -0.5) * frame.size;
+    return vec4<f32>(px, length(then_world - frame.prev_camera_pos), 1.0);
 }
 
 @fragment
@@ -69,6 +92,7 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> GBuffer {
     out.albedo_metallic = vec4<f32>(base.rgb, m.metallic);
     out.normal_roughness = vec4<f32>(n, m.roughness);
     out.emission = vec4<f32>(emission, m.specular);
+    out.motion = motion(in.now, in.then, in.then_world);
     return out;
 }
 
@@ -80,6 +104,9 @@ struct PointOut {
     @location(1) @interpolate(flat) normal: vec3<f32>,
     @location(2) @interpolate(flat) albedo: vec3<f32>,
     @location(3) @interpolate(flat) emission: vec3<f32>,
+    @location(4) now: vec4<f32>,
+    @location(5) then: vec4<f32>,
+    @location(6) world: vec3<f32>,
 }
 
 @vertex
@@ -110,7 +137,12 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
     var q = p;
     q.position += point_normal(p) * min(point_spread[vi / 6u], p.radius);
     var out: PointOut;
-    out.clip = frame.view_proj * vec4<f32>(surfel_world(q, n, corner), 1.0);
+    // Point clouds do not move (yet): only the camera's motion.
+    let world = vec4<f32>(surfel_world(q, n, corner), 1.0);
+    out.clip = frame.view_proj * world;
+    out.now = frame.view_proj_unjittered * world;
+    out.then = frame.prev_view_proj * world;
+    out.world = world.xyz;
     out.disc = corner;
     out.normal = n;
     out.albedo = point_albedo(p);
@@ -128,5 +160,6 @@ fn fs_points(in: PointOut) -> GBuffer {
     out.normal_roughness = vec4<f32>(in.normal, 1.0);
     // Specular 0.5: scans are mostly matte; half the dielectric default keeps a faint sheen.
     out.emission = vec4<f32>(in.emission, 0.5);
+    out.motion = motion(in.now, in.then, in.world);
     return out;
 }

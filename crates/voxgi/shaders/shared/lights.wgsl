@@ -19,7 +19,12 @@ fn shadow_view_index(light: Light, p: vec3<f32>) -> u32 {
     if light.shadow_count < 6u {
         return light.shadow_first;
     }
-    let d = p - shadow_views[light.shadow_first].origin;
+    return cube_face(light.shadow_first, p);
+}
+
+// Which face of the cube of views from `first` to `first + 5` sees p.
+fn cube_face(first: u32, p: vec3<f32>) -> u32 {
+    let d = p - shadow_views[first].origin;
     let a = abs(d);
     var face = 0u;
     if a.x >= a.y && a.x >= a.z {
@@ -29,7 +34,7 @@ fn shadow_view_index(light: Light, p: vec3<f32>) -> u32 {
     } else {
         face = select(5u, 4u, d.z > 0.0);
     }
-    return light.shadow_first + face;
+    return first + face;
 }
 
 fn shadow_uv(view: ShadowView, p: vec3<f32>) -> vec3<f32> {
@@ -55,7 +60,7 @@ fn shadow_texel_world(view: ShadowView, dist: f32) -> f32 {
 
 fn shadow_texel(view: ShadowView, t: vec2<i32>) -> f32 {
     let r = i32(view.resolution);
-    let c = clamp(t, vec2<i32>(0), vec2<i32>(r - 1));
+    let c = clamp(t, vec2<i32>(0), vec2<i32>(r - 1)) + vec2<i32>(view.offset);
     return textureLoad(shadow_maps, c, i32(view.layer), 0).r;
 }
 
@@ -189,7 +194,10 @@ struct ShadowSetup {
 }
 
 fn shadow_setup(light: Light, p: vec3<f32>, n: vec3<f32>) -> ShadowSetup {
-    let view = shadow_views[shadow_view_index(light, p)];
+    return view_setup(shadow_views[shadow_view_index(light, p)], p, n);
+}
+
+fn view_setup(view: ShadowView, p: vec3<f32>, n: vec3<f32>) -> ShadowSetup {
     let d0 = shadow_distance(view, p);
     let texel = shadow_texel_world(view, max(d0, view.near));
     // Light direction at p, for the slope of the receiver as the light sees it.
@@ -266,6 +274,34 @@ fn light_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
         lit += shadow_tap(s.view, s.uv + vogel(i, PCF_TAPS) * radius, s.rp, s.bias);
     }
     return lit / f32(PCF_TAPS);
+}
+
+// One frame's estimate of the fraction of an area light's unshadowed irradiance at p (normal
+// n) that arrives, from the point of the light the sample view cube `s` (of the light's
+// SAMPLE_POINTS) looks out of, whose hard shadow gives its visibility V. With G the point's
+// geometry term (the two cosines over the squared distance) and E = the integral of G over
+// the light (`polygon_irradiance`), the point uniform over the light's area A:
+//     1 - (1 - V) G A / E,
+// whose mean is exactly the integral of V G over that of G, the path tracer's shadowed share.
+// Written so, a point that sees the light (or lies behind p's horizon, G = 0) counts as 1: lit
+// surfaces carry no noise, only shadows do.
+fn sampled_visibility(light: Light, p: vec3<f32>, n: vec3<f32>, s: u32) -> f32 {
+    let e = polygon_irradiance(light, p, n);
+    if e <= 0.0 {
+        return 1.0;
+    }
+    let first = light.sample_first + 6u * s;
+    let view = shadow_views[cube_face(first, p)];
+    let to = shadow_views[first].origin - p;
+    let r2 = max(dot(to, to), 1e-8);
+    let l = to * inverseSqrt(r2);
+    let g = max(dot(n, l), 0.0) * max(dot(light.direction, -l), 0.0) / r2;
+    if g <= 0.0 {
+        return 1.0;
+    }
+    let setup = view_setup(view, p, n);
+    let v = shadow_tap(view, setup.uv, setup.rp, setup.bias);
+    return 1.0 - (1.0 - v) * g * light.area / e;
 }
 
 // Whether `light_visibility(light, p, n, softness)` reads a texel of the shadow view

@@ -15,6 +15,7 @@ const VIEW_VOXEL_ALBEDO: u32 = 6u;
 const VIEW_VOXEL_OPACITY: u32 = 7u;
 const VIEW_VOXEL_RADIANCE: u32 = 8u;
 const VIEW_VOXEL_NODES: u32 = 9u;
+const VIEW_MOTION: u32 = 10u;
 
 // Frame.tonemap: Tonemap::id() in src/options.rs.
 const TONEMAP_ACES: u32 = 0u;
@@ -42,9 +43,26 @@ struct Frame {
     cone_shadows: u32,
     // The points from this index on show area lights (GpuScene::geometry_points).
     geometry_points: u32,
-    _pad1: u32,
+    // This frame's sub-pixel camera offset, pixels (view_proj includes it).
+    jitter: vec2<f32>,
+    // The previous frame's world-to-clip matrix without its jitter.
+    prev_view_proj: mat4x4<f32>,
+    // This frame's world-to-clip matrix without the jitter.
+    view_proj_unjittered: mat4x4<f32>,
+    prev_camera_pos: vec3<f32>,
+    // HISTORY_*: what the temporal pass may do with the history.
+    history: u32,
+    // How far this frame turns the diffuse cone bundle, in interleaving steps.
+    cone_turn: f32,
+    // Which frame of the area lights' sample points the sample views show.
+    light_sample: u32,
     _pad2: u32,
+    _pad3: u32,
 }
+
+const HISTORY_NONE: u32 = 0u;
+const HISTORY_MOVING: u32 = 1u;
+const HISTORY_STILL: u32 = 2u;
 
 // One vertex, pulled from a storage buffer (no vertex buffers: every pass reads the same data).
 struct Vertex {
@@ -135,7 +153,8 @@ struct Light {
     shadow_count: u32,
     // Radius of a disc with the light's area: sets the penumbra size.
     size: f32,
-    _pad: f32,
+    // The first of the light's SAMPLE_POINTS cubes of sample views, or NO_INDEX.
+    sample_first: u32,
 }
 
 const SHADOW_ORTHO: u32 = 0u;
@@ -160,4 +179,7 @@ struct ShadowView {
     // Geometry behind this plane (dot(plane.xyz, x) + plane.w < 0) casts no shadow: nothing
     // behind a one-sided emitter can block it. Zero for other lights.
     plane: vec4<f32>,
+    // Where the view's texels start in its layer (sample views share layers).
+    offset: vec2<f32>,
+    _pad: vec2<f32>,
 }

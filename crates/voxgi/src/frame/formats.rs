@@ -7,6 +7,10 @@ pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// G-buffer emission target: rgb emitted radiance, a specular reflectance.
 pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// G-buffer motion target: xy the screen motion since the last frame in pixels (without the
+/// jitter), z the surface's distance from the last frame's camera, w 1 (0: background).
+/// Half floats: the four G-buffer colour targets fit the 32 bytes a sample may have.
+pub const MOTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// G-buffer depth target (cleared to 1, less-than test).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -22,3 +26,10 @@ pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Uno
 /// The gather pixels' geometry for the upsample's edge weights: normal (rgb) and distance to
 /// the camera (a; 0 for background).
 pub const GUIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The temporal history's colour: rgb the accumulated linear radiance, a how many frames it
+/// holds (its weight in the running mean).
+pub const HISTORY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The temporal history's geometry: rgb the surface normal, a its distance from the camera
+/// (0: background), for the next frame's disocclusion test.
+pub const HISTORY_GEOMETRY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

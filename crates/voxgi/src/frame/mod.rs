@@ -4,5 +4,7 @@
 
 pub mod formats;
 pub mod globals;
+pub mod history;
+pub mod sequence;
 pub mod targets;
 pub mod uniforms;

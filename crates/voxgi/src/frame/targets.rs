@@ -3,8 +3,9 @@
 
 use super::formats::{
     ALBEDO_FORMAT, DEPTH_FORMAT, EMISSION_FORMAT, GUIDE_FORMAT, HDR_FORMAT, INDIRECT_FORMAT,
-    NORMAL_FORMAT, VISIBILITY_FORMAT,
+    MOTION_FORMAT, NORMAL_FORMAT, VISIBILITY_FORMAT,
 };
+use super::history::History;
 use super::uniforms::GpuFrame;
 use crate::gpu::layout;
 
@@ -22,6 +23,9 @@ pub struct FrameTargets {
     pub normal: wgpu::TextureView,
     /// G-buffer emission (`EMISSION_FORMAT`: rgb emitted radiance, a specular).
     pub emission: wgpu::TextureView,
+    /// G-buffer motion (`MOTION_FORMAT`: screen motion since the last frame, distance from
+    /// the last frame's camera).
+    pub motion: wgpu::TextureView,
     /// G-buffer depth (`DEPTH_FORMAT`).
     pub depth: wgpu::TextureView,
     /// Linear radiance (the composite's output, the debug views' too); `tonemap` reads it.
@@ -40,12 +44,14 @@ pub struct FrameTargets {
     pub half: bool,
     /// The texture behind `hdr`, for reading the frame back.
     pub hdr_texture: wgpu::Texture,
+    /// The temporal history, with temporal accumulation on.
+    pub history: Option<History>,
 }
 
 impl FrameTargets {
     /// Targets for a `width` x `height` output; the gather's targets at half that (rounded up) when
-    /// `half`.
-    pub fn new(device: &wgpu::Device, width: u32, height: u32, half: bool) -> Self {
+    /// `half`; with a temporal history when `temporal`.
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, half: bool, temporal: bool) -> Self {
         let (lw, lh) = gather_size(width, height, half);
         let sized = |label: &str,
                      format: wgpu::TextureFormat,
@@ -86,6 +92,7 @@ impl FrameTargets {
             albedo: view(make("gbuffer albedo", ALBEDO_FORMAT, rt)),
             normal: view(make("gbuffer normal", NORMAL_FORMAT, rt)),
             emission: view(make("gbuffer emission", EMISSION_FORMAT, rt)),
+            motion: view(make("gbuffer motion", MOTION_FORMAT, rt)),
             depth: view(make("gbuffer depth", DEPTH_FORMAT, rt)),
             indirect: view(low("indirect", INDIRECT_FORMAT)),
             indirect_low: view(low("indirect gather", INDIRECT_FORMAT)),
@@ -94,18 +101,25 @@ impl FrameTargets {
             half,
             hdr: hdr_texture.create_view(&Default::default()),
             hdr_texture,
+            history: temporal.then(|| History::new(device, width, height)),
         }
     }
 
     /// Bytes per pixel of the full-resolution targets (g-buffer, HDR) and of those at the
     /// gather's resolution (gathered and filtered indirect light, visibility, guide).
-    const FULL_BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 4 + 16;
+    const FULL_BYTES_PER_PIXEL: u64 = 8 + 8 + 8 + 8 + 4 + 16;
     const LOW_BYTES_PER_PIXEL: u64 = 8 + 8 + 4 + 8;
 
     /// GPU memory of the targets in bytes.
     pub fn bytes(&self) -> u64 {
         let (lw, lh) = self.gather_size();
-        self.width as u64 * self.height as u64 * Self::FULL_BYTES_PER_PIXEL
+        let full = Self::FULL_BYTES_PER_PIXEL
+            + if self.history.is_some() {
+                History::BYTES_PER_PIXEL
+            } else {
+                0
+            };
+        self.width as u64 * self.height as u64 * full
             + lw as u64 * lh as u64 * Self::LOW_BYTES_PER_PIXEL
     }
 

@@ -35,6 +35,35 @@ pub struct GpuFrame {
     pub cone_shadows: u32,
     /// `GpuScene::geometry_points`: the points from this index on show area lights.
     pub geometry_points: u32,
+    /// This frame's sub-pixel camera offset in pixels (`sequence::jitter`; zero without
+    /// temporal accumulation). `view_proj` includes it.
+    pub jitter: [f32; 2],
+    /// The previous frame's world-to-clip matrix, without its jitter (this frame's own when
+    /// there is no history): motion vectors point back through it.
+    pub prev_view_proj: [[f32; 4]; 4],
+    /// This frame's world-to-clip matrix without the jitter: motion vectors compare it with
+    /// `prev_view_proj`, so they hold the motion of the scene, not of the samples.
+    pub view_proj_unjittered: [[f32; 4]; 4],
+    /// The previous frame's camera position (the disocclusion test's distances).
+    pub prev_camera_pos: [f32; 3],
+    /// What the temporal pass may do with the history: `HISTORY_*` in the WGSL (none, a
+    /// moving view that is clamped to the frame, or a still that is averaged).
+    pub history: u32,
+    /// How far this frame turns the diffuse cone bundle, as a fraction of one interleaving
+    /// step (`sequence::cone_turn`; zero without temporal accumulation).
+    pub cone_turn: f32,
+    /// The frame's index in the sequence of area-light sample points: its sample views show
+    /// points `4 light_sample` to `4 light_sample + 3` (`sequence::light_points`).
+    pub light_sample: u32,
     /// Padding to a multiple of 16 bytes; zero.
     pub _pad: [u32; 2],
 }
+
+/// `GpuFrame::history`: no history to use (the first frame, a cut, accumulation off).
+pub const HISTORY_NONE: u32 = 0;
+/// `GpuFrame::history`: the view or the scene changed since the last frame: the history is
+/// reprojected and clamped to this frame's neighbourhood.
+pub const HISTORY_MOVING: u32 = 1;
+/// `GpuFrame::history`: nothing changed since the last frame: the history is averaged with
+/// this frame as it is, converging to the mean of every frame since the last change.
+pub const HISTORY_STILL: u32 = 2;

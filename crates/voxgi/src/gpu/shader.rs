@@ -56,6 +56,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "screen/gather.wgsl",
     "screen/upsample.wgsl",
     "screen/composite.wgsl",
+    "screen/temporal.wgsl",
     "screen/tonemap.wgsl",
     "reference.wgsl",
     "reference_display.wgsl",

@@ -6,7 +6,7 @@ use crate::Result;
 use crate::gpu::layout;
 use crate::gpu_scene::{
     CONE_SHADOW_LIGHTS, GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT,
-    LIGHT_SPOT,
+    LIGHT_SPOT, NO_INDEX,
 };
 use crate::options::{RendererOptions, ShadowFilter};
 use bytemuck::{Pod, Zeroable};
@@ -41,6 +41,11 @@ pub struct GpuShadowView {
     /// Emitter plane (xyz normal, w offset): geometry with dot(plane.xyz, x) + plane.w < 0 casts no
     /// shadow. Zero for lights other than area lights.
     pub plane: [f32; 4],
+    /// Where the view's texels start in its layer, texels: zero, or the corner of a sample
+    /// view's quarter.
+    pub offset: [f32; 2],
+    /// Padding to a multiple of 16 bytes; zero.
+    pub _pad: [f32; 2],
 }
 
 pub(crate) const SHADOW_ORTHO: u32 = 0;
@@ -77,26 +82,36 @@ pub struct ShadowAtlas {
     /// Each view's `GpuShadowView` at a `UNIFORM_STRIDE` offset (the shadow pass's dynamic
     /// uniform).
     pub(crate) uniforms: wgpu::Buffer,
+    /// Whether area lights have sample views (`plan_views`' `samples`).
+    pub samples: bool,
 }
 
 fn up_for(dir: Vec3) -> Vec3 {
     if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y }
 }
 
+/// Points on an area light whose shadows are sampled per frame (temporal accumulation): each
+/// a cube of views, the four sharing six layers of the atlas, a quarter of each layer apiece.
+pub const SAMPLE_POINTS: usize = 4;
+
 /// Lays out shadow views for every shadow-casting light and records in `lights` where each
-/// light's views are.
+/// light's views are. With `samples`, each shadow-casting area light also gets
+/// `SAMPLE_POINTS` cubes of sample views (after all the other views), placed at its centre
+/// until `sample_views` moves them.
 pub fn plan_views(
     lights: &mut [GpuLight],
     casts: &[bool],
     center: Vec3,
     radius: f32,
     res: u32,
+    samples: bool,
 ) -> (Vec<GpuShadowView>, Vec<usize>) {
     let mut views = Vec::new();
     let mut owner = Vec::new();
     let near = (radius * 1e-4).max(1e-5);
     let res_f = res as f32;
     for (li, light) in lights.iter_mut().enumerate() {
+        light.sample_first = NO_INDEX;
         if !casts[li] {
             continue;
         }
@@ -129,6 +144,8 @@ pub fn plan_views(
                 resolution: res_f,
                 layer: 0,
                 plane,
+                offset: [0.0; 2],
+                _pad: [0.0; 2],
             });
             owner.push(li);
         };
@@ -174,29 +191,9 @@ pub fn plan_views(
                 } else {
                     pos + dir * near * 2.0
                 };
-                // A guard band of a few texels lets filter taps near a face's edge stay inside it.
-                let tan_half = 1.0 + 4.0 / res_f;
-                let far = far_from(origin);
-                let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, far);
-                for axis in [
-                    Vec3::X,
-                    Vec3::NEG_X,
-                    Vec3::Y,
-                    Vec3::NEG_Y,
-                    Vec3::Z,
-                    Vec3::NEG_Z,
-                ] {
-                    let view = Mat4::look_at_rh(origin, origin + axis, up_for(axis));
-                    push(
-                        view,
-                        proj,
-                        origin,
-                        SHADOW_PERSPECTIVE,
-                        axis,
-                        2.0 * tan_half / res_f,
-                        near,
-                        far,
-                    );
+                for v in cube_views(origin, plane, near, far_from(origin), res_f) {
+                    views.push(v);
+                    owner.push(li);
                 }
             }
             _ => {}
@@ -207,7 +204,103 @@ pub fn plan_views(
     for (i, v) in views.iter_mut().enumerate() {
         v.layer = i as u32;
     }
+    if samples {
+        let mut layer = views.len() as u32;
+        for (li, light) in lights.iter_mut().enumerate() {
+            if !casts[li] || !light.is_area() {
+                continue;
+            }
+            light.sample_first = views.len() as u32;
+            let centre = [Vec2::splat(0.5); SAMPLE_POINTS];
+            views.extend(sample_views(light, layer, centre, center, radius, res));
+            owner.extend([li; 6 * SAMPLE_POINTS]);
+            layer += 6;
+        }
+    }
     (views, owner)
+}
+
+/// The six perspective views of a cube around `origin` (a point or area light's shadow
+/// views), each `res` texels square with its layer and offset left zero.
+fn cube_views(origin: Vec3, plane: [f32; 4], near: f32, far: f32, res: f32) -> Vec<GpuShadowView> {
+    // A guard band of a few texels lets filter taps near a face's edge stay inside it.
+    let tan_half = 1.0 + 4.0 / res;
+    let proj = Mat4::perspective_rh(2.0 * tan_half.atan(), 1.0, near, far);
+    [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+    ]
+    .into_iter()
+    .map(|axis| {
+        let view_proj = proj * Mat4::look_at_rh(origin, origin + axis, up_for(axis));
+        GpuShadowView {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            origin: origin.to_array(),
+            kind: SHADOW_PERSPECTIVE,
+            dir: axis.to_array(),
+            texel: 2.0 * tan_half / res,
+            near,
+            far,
+            resolution: res,
+            layer: 0,
+            plane,
+            offset: [0.0; 2],
+            _pad: [0.0; 2],
+        }
+    })
+    .collect()
+}
+
+/// The point of an area light at `u` in the unit square: a rectangle's point at those
+/// fractions of its edges, or a disc's at radius fraction sqrt(u.x) and angle 2 pi u.y (equal
+/// areas to equal squares).
+pub fn light_point(light: &GpuLight, u: Vec2) -> Vec3 {
+    let (c, a, b) = (
+        Vec3::from(light.position),
+        Vec3::from(light.axis_u),
+        Vec3::from(light.axis_v),
+    );
+    if light.kind == LIGHT_RECT {
+        return c + (2.0 * u.x - 1.0) * a + (2.0 * u.y - 1.0) * b;
+    }
+    let (r, t) = (u.x.sqrt(), std::f32::consts::TAU * u.y);
+    c + r * (t.cos() * a + t.sin() * b)
+}
+
+/// The `SAMPLE_POINTS` cubes of an area light's sample views, one at each of `points` (unit
+/// square coordinates, `light_point`), in layers `layer..layer + 6` (face by face) of an
+/// atlas of `res`-texel layers: point i in the quarter (i % 2, i / 2) of each.
+pub fn sample_views(
+    light: &GpuLight,
+    layer: u32,
+    points: [Vec2; SAMPLE_POINTS],
+    center: Vec3,
+    radius: f32,
+    res: u32,
+) -> Vec<GpuShadowView> {
+    let near = (radius * 1e-4).max(1e-5);
+    let dir = Vec3::from(light.direction).normalize();
+    let plane = [dir.x, dir.y, dir.z, -dir.dot(Vec3::from(light.position))];
+    let half = (res / 2) as f32;
+    let mut out = Vec::with_capacity(6 * SAMPLE_POINTS);
+    for (i, u) in points.iter().enumerate() {
+        let origin = light_point(light, *u) + dir * near * 2.0;
+        let far = (origin - center).length() + radius * 1.01;
+        for (face, mut v) in cube_views(origin, plane, near, far, half)
+            .into_iter()
+            .enumerate()
+        {
+            v.layer = layer + face as u32;
+            v.offset = [(i % 2) as f32 * half, (i / 2) as f32 * half];
+            out.push(v);
+        }
+    }
+    out
 }
 
 /// What of a shadow view's map is out of date.
@@ -360,8 +453,9 @@ impl ShadowAtlas {
         view_light: Vec<usize>,
         res: u32,
         moments: bool,
+        samples: bool,
     ) -> Self {
-        let layers = views.len().max(1) as u32;
+        let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
         let (mres, mlayers) = if moments { (res, layers) } else { (1, 1) };
         let moments = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow moments"),
@@ -450,7 +544,44 @@ impl ShadowAtlas {
             moments,
             moments_view,
             depth_view: depth.create_view(&Default::default()),
+            samples,
         }
+    }
+
+    /// Moves the sample views of every area light that has them to `points` (unit square
+    /// coordinates on the light, `light_point`), writing them where the passes read them, and
+    /// returns the views' indices (to be rendered).
+    pub fn move_samples(
+        &mut self,
+        queue: &wgpu::Queue,
+        lights: &[GpuLight],
+        points: [Vec2; SAMPLE_POINTS],
+        center: Vec3,
+        radius: f32,
+    ) -> std::ops::Range<usize> {
+        let mut moved: Option<(usize, usize)> = None;
+        let res = self.texture.width();
+        for light in lights.iter().filter(|l| l.sample_first != NO_INDEX) {
+            let first = light.sample_first as usize;
+            let layer = self.views[first].layer;
+            let views = sample_views(light, layer, points, center, radius, res);
+            for (i, v) in views.iter().enumerate() {
+                queue.write_buffer(
+                    &self.uniforms,
+                    (first + i) as u64 * UNIFORM_STRIDE,
+                    bytemuck::bytes_of(v),
+                );
+            }
+            queue.write_buffer(
+                &self.views_buffer,
+                (first * size_of::<GpuShadowView>()) as u64,
+                bytemuck::cast_slice(&views),
+            );
+            let end = first + views.len();
+            moved = Some(moved.map_or((first, end), |(a, b)| (a.min(first), b.max(end))));
+            self.views[first..first + views.len()].copy_from_slice(&views);
+        }
+        moved.map_or(0..0, |(a, b)| a..b)
     }
 
     /// Replaces the views by `views` (re-planned after lights moved: the same number, owned by
@@ -524,10 +655,13 @@ pub fn plan_atlas(
 ) -> Result<ShadowAtlas> {
     crate::gpu::checked(device, "shadow atlas", || {
         let res = atlas_resolution(options, &scene.gpu_lights);
-        let (views, owners) = plan_views(&mut scene.gpu_lights, casts, center, radius, res);
+        // Area-light shadows sampled over frames need the frames' accumulation.
+        let samples = options.temporal;
+        let (views, owners) =
+            plan_views(&mut scene.gpu_lights, casts, center, radius, res, samples);
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
         let moments = options.shadow_filter == ShadowFilter::VsmEsm;
-        ShadowAtlas::new(device, views, owners, res, moments)
+        ShadowAtlas::new(device, views, owners, res, moments, samples)
     })
 }
 
@@ -571,7 +705,7 @@ mod tests {
     #[test]
     fn a_down_facing_emitter_skips_only_its_upward_cube_face() {
         let mut lights = [light(LIGHT_RECT, [0.0, -1.0, 0.0])];
-        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256, false);
         let skipped: Vec<[f32; 3]> = views
             .iter()
             .filter(|v| behind_emitter(v))
@@ -580,12 +714,12 @@ mod tests {
         assert_eq!(skipped, vec![[0.0, 1.0, 0.0]]);
         // A point light sees all round: no face is skipped.
         let mut lights = [light(LIGHT_POINT, [0.0, -1.0, 0.0])];
-        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256, false);
         assert!(views.iter().all(|v| !behind_emitter(v)));
         // A tilted emitter sees a little of every side face, so none is skipped but the back.
         let d = Vec3::new(0.3, -1.0, 0.2).normalize();
         let mut lights = [light(LIGHT_RECT, d.to_array())];
-        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256);
+        let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256, false);
         assert_eq!(views.iter().filter(|v| behind_emitter(v)).count(), 1);
     }
 }

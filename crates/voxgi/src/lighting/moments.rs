@@ -110,7 +110,8 @@ impl MomentsPass {
             let Some((x, y, w, h)) = dirt.scissor(res) else {
                 continue;
             };
-            if behind_emitter(view) {
+            // Sample views (a quarter of a layer each) are read by single hard taps only.
+            if behind_emitter(view) || view.resolution as u32 != res {
                 continue;
             }
             let grow = |lo: u32| lo.saturating_sub(MOMENT_RADIUS);
@@ -120,7 +121,7 @@ impl MomentsPass {
                     (x + w + MOMENT_RADIUS).min(res),
                     (y + h + MOMENT_RADIUS).min(res),
                 ],
-                layer: i as u32,
+                layer: view.layer,
                 far: view.far,
                 _pad: [0; 2],
             };

@@ -112,7 +112,9 @@ impl ShadowPass {
     /// see the back of their emitter), drawing every mesh except the light's own emitter, and the
     /// points. Only what `views` marks out of date is rendered: a whole view, or a rectangle of
     /// it (scissored: the rest keeps its texels, which are what a full render would give since
-    /// nothing there changed). Timed as "shadow" (summed over the views).
+    /// nothing there changed). A view that fills only part of its layer (a sample view's
+    /// quarter) is rendered through a viewport onto that part. Timed as "shadow" (summed over
+    /// the views), and the area lights' sample views as "shadow_samples".
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -122,18 +124,32 @@ impl ShadowPass {
         bind: &wgpu::BindGroup,
         timer: &mut GpuTimer,
     ) {
-        for (i, layer) in atlas.layer_views.iter().enumerate().take(atlas.views.len()) {
+        let sampled = atlas
+            .views
+            .iter()
+            .position(|v| v.offset != [0.0; 2] || v.resolution as u32 != atlas.texture.width())
+            .unwrap_or(atlas.views.len());
+        for (i, view) in atlas.views.iter().enumerate() {
             let dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
-            let res = atlas.texture.width();
+            let res = view.resolution as u32;
             let Some(scissor) = dirt.scissor(res) else {
                 continue;
             };
-            if behind_emitter(&atlas.views[i]) {
+            if behind_emitter(view) {
                 continue;
             }
-            let whole = dirt == ViewDirt::All;
+            let layer = &atlas.layer_views[view.layer as usize];
+            let [ox, oy] = view.offset;
+            // A part of a layer is never cleared whole: the rest belongs to other views.
+            let part = view.offset != [0.0; 2] || res != atlas.texture.width();
+            let whole = dirt == ViewDirt::All && !part;
+            let label = if i >= sampled {
+                "shadow_samples"
+            } else {
+                "shadow"
+            };
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow"),
+                label: Some(label),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: layer,
                     depth_slice: None,
@@ -161,14 +177,17 @@ impl ShadowPass {
                     }),
                     stencil_ops: None,
                 }),
-                timestamp_writes: timer.render("shadow"),
+                timestamp_writes: timer.render(label),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
             pass.set_bind_group(0, bind, &[(i as u64 * UNIFORM_STRIDE) as u32]);
+            if part {
+                pass.set_viewport(ox, oy, res as f32, res as f32, 0.0, 1.0);
+            }
             if !whole {
                 let (x, y, w, h) = scissor;
-                pass.set_scissor_rect(x, y, w, h);
+                pass.set_scissor_rect(x + ox as u32, y + oy as u32, w, h);
                 pass.set_pipeline(&self.clear);
                 pass.draw(0..3, 0..1);
             }

@@ -11,6 +11,9 @@
 //! for everything, and no frame waits for the GPU.
 
 mod order;
+mod temporal;
+
+pub use temporal::STILL_FRAMES as TEMPORAL_STILL_FRAMES;
 mod updates;
 
 use crate::brdf::BrdfTables;
@@ -34,6 +37,7 @@ use crate::scene_state::SceneState;
 use crate::screen::composite::CompositePass;
 use crate::screen::gather::{self, GatherPass};
 use crate::screen::gbuffer::GbufferPass;
+use crate::screen::temporal::TemporalPass;
 use crate::screen::tonemap::TonemapPass;
 use crate::screen::upsample::UpsamplePass;
 use crate::settings::{Changes, changes_between};
@@ -57,6 +61,7 @@ struct Passes {
     gather: GatherPass,
     upsample: UpsamplePass,
     composite: CompositePass,
+    temporal: TemporalPass,
     tonemap: TonemapPass,
 }
 
@@ -121,6 +126,8 @@ pub struct Renderer {
     last_counts: Option<VoxelCounts>,
     timer: GpuTimer,
     targets: Option<FrameTargets>,
+    /// The temporal history's bookkeeping between frames.
+    temporal: temporal::TemporalState,
     center: Vec3,
     radius: f32,
     default_camera: Camera,
@@ -242,6 +249,7 @@ impl Renderer {
             gather: GatherPass::new(device, options, facts.glossy),
             upsample: UpsamplePass::new(device),
             composite: composite_pass(device, &gpu_scene, &facts, options),
+            temporal: TemporalPass::new(device),
             tonemap: TonemapPass::new(device),
         })?;
         let (static_triangles, dynamic_triangles) = checked(device, "voxelization table", || {
@@ -287,6 +295,7 @@ impl Renderer {
             last_counts: None,
             timer: GpuTimer::disabled(queue),
             targets: None,
+            temporal: Default::default(),
             center,
             radius,
             default_camera,
@@ -324,6 +333,8 @@ impl Renderer {
         let atlas = old.shadow_map_size != new.shadow_map_size
             || old.cone_shadows != new.cone_shadows
             || old.shadow_filter != new.shadow_filter
+            // Area lights' sample views come and go with temporal accumulation.
+            || (old.temporal != new.temporal && self.scene.gpu_lights.iter().any(|l| l.is_area()))
             || shadow::atlas_resolution(old, &self.scene.gpu_lights)
                 != shadow::atlas_resolution(new, &self.scene.gpu_lights);
         let cones = volume
@@ -433,6 +444,8 @@ impl Renderer {
         self.bounce_globals = None;
         self.fragment_binds = None;
         self.shadow_binds = None;
+        // What the history holds was rendered with the old options.
+        self.temporal.reset();
         // A structure or an atlas made anew holds nothing yet, whatever the table says.
         if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();
@@ -449,11 +462,14 @@ impl Renderer {
     }
 
     /// Whether rendering again with the same frame parameters and target would give the same
-    /// image: the voxels are settled and no voxel counter is still on its way back (one that
-    /// overflowed would make the next frame rebuild). An application may then show its last
-    /// image instead of rendering.
+    /// image: the voxels are settled, no voxel counter is still on its way back (one that
+    /// overflowed would make the next frame rebuild) and, with temporal accumulation, the
+    /// still view has accumulated `TEMPORAL_STILL_FRAMES` frames. An application may then
+    /// show its last image instead of rendering.
     pub fn is_idle(&self) -> bool {
-        self.voxels_settled() && !self.counters.pending()
+        self.voxels_settled()
+            && !self.counters.pending()
+            && (!self.options.temporal || self.temporal.converged())
     }
 
     /// Whether a voxel counter read back is submitted but has not completed (`headless::render`
@@ -606,10 +622,24 @@ impl Renderer {
         self.pending = Pending::everything(self.atlas.views.len());
     }
 
-    /// The linear HDR radiance of the last frame (before exposure and tone mapping),
-    /// `Rgba32Float` at the last target's size, with `COPY_SRC` and `TEXTURE_BINDING` usage.
+    /// The linear HDR radiance of the last frame (before exposure and tone mapping; with
+    /// temporal accumulation, the accumulated image the frame showed), `Rgba32Float` at the
+    /// last target's size, with `COPY_SRC` and `TEXTURE_BINDING` usage. Its alpha is not
+    /// the image's (the history keeps its frame count there).
     pub fn hdr_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.hdr_texture)
+        let t = self.targets.as_ref()?;
+        Some(match &t.history {
+            Some(h) => &h.color[self.temporal.written()],
+            None => &t.hdr_texture,
+        })
+    }
+
+    /// Forgets the temporal history: the next frame shows only itself. Call it on a camera
+    /// cut (a jump to an unrelated view); reprojection already discards what a moving camera
+    /// uncovers, but a cut would otherwise show the old view's light for a frame or two where
+    /// surfaces happen to line up.
+    pub fn reset_history(&mut self) {
+        self.temporal.reset();
     }
 }
 

@@ -4,7 +4,7 @@
 //! ```text
 //! shadow → [moments] → [voxelize (static) → splat → <kind>_build] → [voxelize (dynamic) → <kind>_update]
 //!        → inject → filter → (bounce → filter) × (bounces − 1) → [bounce (records)]
-//!        → gbuffer → gather → upsample → composite → [debug] → tonemap
+//!        → gbuffer → gather → upsample → composite → [debug] → [temporal] → tonemap
 //! ```
 //!
 //! The voxel passes (up to the last `filter` or `bounce`) run only for what changed since the
@@ -12,15 +12,19 @@
 //! never waits. With progressive bounces one bounce runs per frame until the light converges.
 //! With the fast shading (`IndirectShading::Leaves`) one more bounce keeps every leaf's
 //! irradiance and is neither stored nor filtered. `debug` runs only for the voxel views and
-//! replaces the composite's output; `tonemap` writes the caller's target. Passes depend on
+//! replaces the composite's output; `temporal` (with temporal accumulation on) accumulates it
+//! into the history; `tonemap` writes the caller's target. Passes depend on
 //! shared resources (the GPU scene, the shadow atlas, the fragments, the structure, the
 //! frame's targets), never on each other. Nothing here waits for the GPU.
 
 use super::Renderer;
+use super::temporal::FrameHistory;
 use crate::Result;
 use crate::frame::globals::{self, GlobalsSources};
+use crate::frame::sequence;
 use crate::frame::targets::{FrameTargets, Target};
 use crate::frame::uniforms::GpuFrame;
+use crate::frame::uniforms::HISTORY_NONE;
 use crate::gpu::checked;
 use crate::gpu::timer::GpuTimer;
 use crate::lighting::atlas::ViewDirt;
@@ -30,6 +34,8 @@ use crate::lighting::inject::InjectPass;
 use crate::options::{FrameParams, ShadowFilter, validate_size};
 use crate::view::camera_view_proj;
 use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, Region, VoxelWork};
+use glam::{Mat4, Vec3};
+use std::ops::Range;
 
 impl Renderer {
     /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
@@ -59,18 +65,42 @@ impl Renderer {
         self.receive_feedback()?;
         self.passes.tonemap.prepare(&self.device, target.format)?;
         let half = self.options.half_resolution;
-        if self
-            .targets
-            .as_ref()
-            .is_none_or(|t| t.width != width || t.height != height || t.half != half)
-        {
+        let temporal = self.options.temporal;
+        if self.targets.as_ref().is_none_or(|t| {
+            t.width != width || t.height != height || t.half != half || {
+                t.history.is_some() != temporal
+            }
+        }) {
             // Out of memory for large sizes is an error here, not the device's handler's.
             self.targets = Some(checked(&self.device, "render targets", || {
-                FrameTargets::new(&self.device, width, height, half)
+                FrameTargets::new(&self.device, width, height, half, temporal)
             })?);
             self.binds = None;
+            self.temporal.reset();
         }
-        self.record_shadows(encoder);
+        // A new scene or structure: what the history holds is of another.
+        if self.pending.rebuild {
+            self.temporal.reset();
+        }
+        // Whether the light or the geometry may differ from the last frame's.
+        let changed = self.voxel_work_pending() | self.scene.advance_motion(&self.queue);
+        let view_proj = camera_view_proj(&params.camera, width, height, self.center, self.radius);
+        let history = self.temporal.begin(temporal, params, view_proj, changed);
+        // Area lights' sample views move to this frame's points on their lights: every frame
+        // that accumulates (not the first of a history, which shows PCSS, nor a held one).
+        let sampled = if self.atlas.samples && history.mode != HISTORY_NONE && !history.hold {
+            let points = sequence::light_points(history.sample);
+            self.atlas.move_samples(
+                &self.queue,
+                &self.scene.gpu_lights,
+                points,
+                self.center,
+                self.radius,
+            )
+        } else {
+            0..0
+        };
+        self.record_shadows(encoder, sampled);
         let interval = self.options.voxel_update_interval.max(1) as u64;
         // A rebuild (the first frame among them) never waits for its turn.
         let due = self.voxel_work_pending()
@@ -87,7 +117,7 @@ impl Renderer {
             self.record_voxels(encoder, work);
         }
         self.frame_index += 1;
-        let frame = self.frame_uniforms(params, width, height);
+        let frame = self.frame_uniforms(params, width, height, view_proj, &history);
         let t = self.targets.as_ref().expect("targets were just created");
         self.queue
             .write_buffer(&t.frame, 0, bytemuck::bytes_of(&frame));
@@ -109,10 +139,18 @@ impl Renderer {
             gather: p.gather.bind(&self.device, t),
             upsample: p.upsample.bind(&self.device, t),
             composite: p.composite.bind(&self.device, t),
+            temporal: p.temporal.bind(&self.device, t),
             tonemap: p.tonemap.bind(&self.device, t),
         });
         let globals = &b.globals;
         let timer = &mut self.timer;
+        // A converged still: the last accumulated image again, nothing rendered.
+        if history.hold {
+            let shown = &b.tonemap[1 + self.temporal.written()];
+            p.tonemap.record(encoder, globals, target, shown, timer);
+            timer.resolve(encoder);
+            return Ok(());
+        }
         p.gbuffer.record(encoder, t, &self.scene, &b.gbuffer, timer);
         p.gather
             .record(encoder, t, globals, &*self.volume, &b.gather, timer);
@@ -132,15 +170,70 @@ impl Renderer {
                 timer,
             );
         }
-        p.tonemap
-            .record(encoder, globals, target, &b.tonemap, timer);
+        // The tone-mapped image: the HDR target's, or the history the temporal pass wrote.
+        let shown = match &b.temporal {
+            Some(pair) => {
+                p.temporal
+                    .record(encoder, t, globals, &pair[history.read], timer);
+                &b.tonemap[2 - history.read]
+            }
+            None => &b.tonemap[0],
+        };
+        p.tonemap.record(encoder, globals, target, shown, timer);
         timer.resolve(encoder);
         Ok(())
     }
 
-    /// The frame uniform for a `width` x `height` frame of `p`.
-    fn frame_uniforms(&self, p: &FrameParams, width: u32, height: u32) -> GpuFrame {
-        let view_proj = camera_view_proj(&p.camera, width, height, self.center, self.radius);
+    /// Writes the last frame's image into `target` again, tone-mapped as it was, without
+    /// rendering a frame: with temporal accumulation another frame would add to the history
+    /// and show a different image (a screenshot of what a window shows, say). When there is
+    /// no last frame of `target`'s size, renders one with `params`.
+    pub fn redraw(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        params: &FrameParams,
+    ) -> Result<()> {
+        let same = self
+            .targets
+            .as_ref()
+            .is_some_and(|t| (t.width, t.height) == (target.width, target.height));
+        let Some(b) = self.binds.as_ref().filter(|_| same) else {
+            return self.render(encoder, target, params);
+        };
+        self.passes.tonemap.prepare(&self.device, target.format)?;
+        self.timer.begin_frame();
+        let shown = match &b.temporal {
+            Some(_) => &b.tonemap[1 + self.temporal.written()],
+            None => &b.tonemap[0],
+        };
+        self.passes
+            .tonemap
+            .record(encoder, &b.globals, target, shown, &mut self.timer);
+        self.timer.resolve(encoder);
+        Ok(())
+    }
+
+    /// The frame uniform for a `width` x `height` frame of `p` seen through `unjittered`, with
+    /// `history`'s jitter, cone turn and previous view.
+    fn frame_uniforms(
+        &self,
+        p: &FrameParams,
+        width: u32,
+        height: u32,
+        unjittered: Mat4,
+        history: &FrameHistory,
+    ) -> GpuFrame {
+        let [jx, jy] = history.jitter;
+        // The jitter moves the image by (jx, jy) pixels: a translation in normalised device
+        // coordinates (y up there, down in pixels). None at all for frame 0, so that frame is
+        // the unjittered still to the bit.
+        let view_proj = if history.jitter == [0.0; 2] {
+            unjittered
+        } else {
+            let ndc = Vec3::new(2.0 * jx / width as f32, -2.0 * jy / height as f32, 0.0);
+            Mat4::from_translation(ndc) * unjittered
+        };
         GpuFrame {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
@@ -156,13 +249,30 @@ impl Renderer {
             background: [p.background[0], p.background[1], p.background[2], 1.0],
             cone_shadows: self.options.cone_shadows as u32,
             geometry_points: self.scene.geometry_points,
+            jitter: history.jitter,
+            prev_view_proj: history.prev_view_proj.to_cols_array_2d(),
+            view_proj_unjittered: unjittered.to_cols_array_2d(),
+            prev_camera_pos: history.prev_camera.to_array(),
+            history: history.mode,
+            cone_turn: history.cone_turn,
+            light_sample: history.sample,
             _pad: [0; 2],
         }
     }
 
-    /// Records the shadow views that must be re-rendered (all after a rebuild).
-    fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder) {
-        let views = std::mem::take(&mut self.pending.views);
+    /// Records the shadow views that must be re-rendered (all after a rebuild), and the sample
+    /// views in `sampled` (no others: a frame that does not sample does not read them).
+    fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder, sampled: Range<usize>) {
+        let mut views = std::mem::take(&mut self.pending.views);
+        for (i, v) in views.iter_mut().enumerate() {
+            if self.atlas.views[i].resolution as u32 != self.atlas.texture.width() {
+                *v = if sampled.contains(&i) {
+                    ViewDirt::All
+                } else {
+                    ViewDirt::Clean
+                };
+            }
+        }
         if views.iter().any(|&v| v != ViewDirt::Clean) {
             let p = &self.passes;
             let vsm = self.options.shadow_filter == ShadowFilter::VsmEsm;
@@ -355,7 +465,10 @@ pub(super) struct FrameBinds {
     gather: wgpu::BindGroup,
     upsample: wgpu::BindGroup,
     composite: wgpu::BindGroup,
-    tonemap: wgpu::BindGroup,
+    /// With temporal accumulation: `[i]` reads history `i` and writes the other.
+    temporal: Option<[wgpu::BindGroup; 2]>,
+    /// Reading the HDR target, then each history.
+    tonemap: Vec<wgpu::BindGroup>,
 }
 
 /// The bind groups of the passes that make fragments: made on the first voxel update after

@@ -123,6 +123,7 @@ impl Renderer {
         }
         g.shadow_first = was.shadow_first;
         g.shadow_count = was.shadow_count;
+        g.sample_first = was.sample_first;
         self.scene.gpu_lights[index] = g;
         self.state.lights[index] = light.clone();
         // Re-plan every view (a light's views follow its position and direction) and re-render
@@ -134,6 +135,7 @@ impl Renderer {
             self.center,
             self.radius,
             res,
+            self.atlas.samples,
         );
         for (i, (new, old)) in views.iter().zip(&self.atlas.views).enumerate() {
             if bytemuck::bytes_of(new) != bytemuck::bytes_of(old) {

@@ -33,6 +33,7 @@ impl CompositePass {
             layout::texture_2d_load(5, c),
             layout::texture_2d_load(6, c),
             layout::texture_2d_load(7, c),
+            layout::texture_2d_load(8, c),
         ]);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
@@ -65,6 +66,7 @@ impl CompositePass {
             wgpu::BindingResource::TextureView(&t.indirect),
             wgpu::BindingResource::TextureView(&t.visibility_low),
             wgpu::BindingResource::TextureView(&t.guide_low),
+            wgpu::BindingResource::TextureView(&t.motion),
         ]);
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite"),

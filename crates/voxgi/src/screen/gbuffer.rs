@@ -1,7 +1,9 @@
-//! gbuffer: rasterizes all mesh instances into the G-buffer, then every point-cloud sample as a
+//! gbuffer: rasterizes all mesh instances into the G-buffer (motion vectors included), then every point-cloud sample as a
 //! surfel (an oriented disc) into the same targets, depth-tested against the meshes.
 
-use crate::frame::formats::{ALBEDO_FORMAT, DEPTH_FORMAT, EMISSION_FORMAT, NORMAL_FORMAT};
+use crate::frame::formats::{
+    ALBEDO_FORMAT, DEPTH_FORMAT, EMISSION_FORMAT, MOTION_FORMAT, NORMAL_FORMAT,
+};
 use crate::frame::targets::FrameTargets;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
@@ -36,6 +38,7 @@ impl GbufferPass {
                 layout::sampler(5, wgpu::ShaderStages::FRAGMENT),
                 layout::storage(6, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(7, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(8, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let module = shader::module(device, "screen/gbuffer.wgsl");
@@ -75,6 +78,7 @@ impl GbufferPass {
                         Some(ALBEDO_FORMAT.into()),
                         Some(NORMAL_FORMAT.into()),
                         Some(EMISSION_FORMAT.into()),
+                        Some(MOTION_FORMAT.into()),
                     ],
                 }),
                 multiview_mask: None,
@@ -107,6 +111,7 @@ impl GbufferPass {
                 wgpu::BindingResource::Sampler(&scene.sampler),
                 scene.points.as_entire_binding(),
                 scene.point_spread.as_entire_binding(),
+                scene.prev_models.as_entire_binding(),
             ]),
         })
     }
@@ -134,7 +139,12 @@ impl GbufferPass {
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
-            color_attachments: &[clear(&t.albedo), clear(&t.normal), clear(&t.emission)],
+            color_attachments: &[
+                clear(&t.albedo),
+                clear(&t.normal),
+                clear(&t.emission),
+                clear(&t.motion),
+            ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &t.depth,
                 depth_ops: Some(wgpu::Operations {

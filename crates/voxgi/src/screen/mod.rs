@@ -1,4 +1,5 @@
-//! The passes over the screen: `gbuffer`, `gather`, `upsample`, `composite` and `tonemap`
+//! The passes over the screen: `gbuffer`, `gather`, `upsample`, `composite`, `temporal` and
+//! `tonemap`
 //! (the only one that touches the caller's texture). A pass's module, WGSL file
 //! (`shaders/screen/`), pipeline label and timing scope share one name; `renderer.rs` calls
 //! them in order.
@@ -6,5 +7,6 @@
 pub mod composite;
 pub mod gather;
 pub mod gbuffer;
+pub mod temporal;
 pub mod tonemap;
 pub mod upsample;

@@ -76,13 +76,21 @@ impl TonemapPass {
         Ok(())
     }
 
-    /// The pass's own bind group for these targets (made once per targets).
-    pub fn bind(&self, device: &wgpu::Device, t: &FrameTargets) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tonemap"),
-            layout: &self.layout,
-            entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&t.hdr)]),
-        })
+    /// The pass's own bind groups for these targets (made once per targets): the first reads
+    /// the HDR target, the others each history (the temporal pass's output, when there is one).
+    pub fn bind(&self, device: &wgpu::Device, t: &FrameTargets) -> Vec<wgpu::BindGroup> {
+        let read = |view: &wgpu::TextureView| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("tonemap"),
+                layout: &self.layout,
+                entries: &layout::entries(vec![wgpu::BindingResource::TextureView(view)]),
+            })
+        };
+        let mut binds = vec![read(&t.hdr)];
+        if let Some(h) = &t.history {
+            binds.extend(h.color_views.iter().map(read));
+        }
+        binds
     }
 
     /// Draws into `target`, whose format `prepare` has seen.

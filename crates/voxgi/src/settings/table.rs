@@ -203,6 +203,17 @@ pub static SETTINGS: &[Setting] = &[
         access: access!(options bool half_resolution),
     },
     Setting {
+        key: "temporal",
+        label: "temporal accumulation",
+        help: "Jitter the camera and turn the cones every frame and accumulate the frames \
+               (anti-aliasing, converged stills); off, every frame is a still of its own. \
+               Area lights' shadows then sample points on the light, frame by frame (their \
+               shadow maps are made anew).",
+        domain: Domain::Bool,
+        changes: Changes::Voxels,
+        access: access!(options bool temporal),
+    },
+    Setting {
         key: "step_factor",
         label: "cone step",
         help: "Cone sample step as a fraction of the cone's diameter.",

@@ -29,6 +29,8 @@ fn options() -> RendererOptions {
         // One voxel bounce, so the bounce pass is part of what must match.
         bounces: 2,
         shadow_map_size: 256,
+        // These tests compare voxel updates frame by frame; accumulation would blend frames.
+        temporal: false,
         ..RendererOptions::default()
     }
 }
@@ -335,6 +337,7 @@ fn furnace_options(progressive: bool) -> RendererOptions {
         voxel_resolution: 64,
         bounces: UNLIMITED_BOUNCES,
         progressive,
+        temporal: false,
         ..RendererOptions::default()
     }
 }
@@ -407,6 +410,7 @@ fn a_slowly_sliding_block_does_not_make_distant_light_jump() {
     let options = RendererOptions {
         voxel_resolution: 64,
         bounces: 1,
+        temporal: false,
         ..RendererOptions::default()
     };
     let mut r = renderer(&scene, &options);
@@ -509,6 +513,7 @@ fn catch_up_after_a_change(voxels: voxgi::VoxelKind) {
         voxels,
         voxel_resolution: 32,
         shadow_map_size: 256,
+        temporal: false,
         ..RendererOptions::default()
     };
     let progressive = RendererOptions {

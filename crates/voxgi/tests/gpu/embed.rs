@@ -98,6 +98,8 @@ fn every_target_format_gets_the_same_image() {
         (wgpu::TextureFormat::Bgra8UnormSrgb, 1),
     ] {
         let t = texture(format, w, h);
+        // Each image a first frame: without jitter or accumulation.
+        r.reset_history();
         draw(&mut r, &params, &t);
         let d = max_diff(&rgba8(&t));
         assert!(d <= tolerance, "{format:?}: differs by {d} steps");
@@ -105,6 +107,7 @@ fn every_target_format_gets_the_same_image() {
     // A 10-bit swapchain format without sRGB gets voxgi's sRGB curve too: within one 8-bit
     // step once its 1023 levels are scaled to 255.
     let t = texture(wgpu::TextureFormat::Rgb10a2Unorm, w, h);
+    r.reset_history();
     draw(&mut r, &params, &t);
     let bytes = read_texture(&ctx().device, &ctx().queue, &t).expect("readback");
     let ten: Vec<u8> = bytemuck::cast_slice::<u8, u32>(&bytes)
@@ -117,6 +120,7 @@ fn every_target_format_gets_the_same_image() {
     let d = max_diff(&ten);
     assert!(d <= 1, "Rgb10a2Unorm: differs by {d} steps");
     let t = texture(wgpu::TextureFormat::Rgba16Float, w, h);
+    r.reset_history();
     draw(&mut r, &params, &t);
     let bytes = read_texture(&ctx().device, &ctx().queue, &t).expect("readback");
     let halves: &[u16] = bytemuck::cast_slice(&bytes);
@@ -144,6 +148,8 @@ fn tiny_pools() -> RendererOptions {
         voxel_resolution: 32,
         fragment_capacity: Some(1),
         voxel_capacity: Some(1),
+        // Growth is judged frame by frame against a fresh renderer's single frame.
+        temporal: false,
         ..RendererOptions::default()
     }
 }
@@ -260,6 +266,51 @@ fn an_idle_renderer_draws_its_last_image_again() {
     light.intensity *= 0.5;
     r.set_light(0, &light).unwrap();
     assert!(!r.is_idle(), "idle with a light change waiting");
+}
+
+/// With temporal accumulation a still view keeps changing while it accumulates, so the
+/// renderer is not idle; after `TEMPORAL_STILL_FRAMES` still frames it is, and from then on
+/// draws the same image to the bit. Moving the camera ends it.
+#[test]
+fn a_temporal_still_becomes_idle_once_converged() {
+    let scene = builtin::cornell_box();
+    let (w, h) = (16, 16);
+    let options = RendererOptions {
+        voxel_resolution: 16,
+        ..RendererOptions::default()
+    };
+    let mut r = renderer(&scene, &options);
+    let mut params = FrameParams::new(r.default_camera().clone());
+    let t = texture(wgpu::TextureFormat::Rgba8Unorm, w, h);
+    let mut idle_at = None;
+    let mut last = Vec::new();
+    let limit = voxgi::TEMPORAL_STILL_FRAMES;
+    for i in 0..limit + 8 {
+        r.receive_feedback().unwrap();
+        if r.is_idle() {
+            idle_at.get_or_insert(i);
+        }
+        draw(&mut r, &params, &t);
+        let now = rgba8(&t);
+        if idle_at.is_some() {
+            assert!(
+                now == last,
+                "frame {i} changed although the renderer was idle"
+            );
+        }
+        last = now;
+    }
+    // The first frame starts the history (a build settles within it); then `limit` still
+    // frames accumulate.
+    let idle_at = idle_at.expect("never idle");
+    assert!(
+        (limit..=limit + 3).contains(&idle_at),
+        "idle at frame {idle_at}, expected just after {limit} still frames"
+    );
+    params.camera.position += voxgi::scene::glam::Vec3::new(0.01, 0.0, 0.0);
+    assert!(r.is_idle(), "is_idle says nothing about parameters to come");
+    draw(&mut r, &params, &t);
+    assert!(!r.is_idle(), "idle right after the camera moved");
 }
 
 /// A target format the tone mapping cannot write is an error naming it, every time it is

@@ -20,5 +20,6 @@ mod reference;
 mod registry;
 mod shaders;
 mod shadow_filter;
+mod temporal;
 mod vct;
 mod voxels;
