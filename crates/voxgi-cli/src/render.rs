@@ -58,9 +58,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "F", default_value_t = 30.0, requires = "frames")]
     pub fps: f32,
     /// With temporal accumulation (the default): the still is the mean of N frames of the
-    /// same instant, jittered within the pixel and with the cones turned (default 16). 1
-    /// renders a single frame. A sequence (--frames) instead renders one frame per step, the
-    /// history carried from frame to frame as in the viewer.
+    /// same instant, jittered within the pixel, with the cones turned and new points on area
+    /// lights (default 64, at most 256). 1 renders a single frame. A sequence (--frames)
+    /// instead renders one frame per step, the history carried from frame to frame as in the
+    /// viewer.
     #[arg(long, value_name = "N", conflicts_with = "frames")]
     pub accumulate: Option<u32>,
 }
@@ -139,6 +140,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     })?;
     if args.accumulate == Some(0) {
         bail!("--accumulate 0: a still needs at least one frame");
+    }
+    if let Some(n) = args
+        .accumulate
+        .filter(|&n| n > voxgi::TEMPORAL_STILL_FRAMES)
+    {
+        bail!(
+            "--accumulate {n}: at most {} (a still has converged there)",
+            voxgi::TEMPORAL_STILL_FRAMES
+        );
     }
     if !args.time.is_finite() {
         bail!("--time {} is not a finite number of seconds", args.time);

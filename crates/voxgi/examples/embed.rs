@@ -1,5 +1,8 @@
 //! voxgi inside an application that owns its device: open an adapter and a device, make a
 //! texture, render the built-in Cornell box into it, read it back and write `embed.png`.
+//! It renders one frame with the default options: the first frame of a temporal history,
+//! which is the unjittered single frame (`voxgi render --accumulate 1`). An application that
+//! keeps rendering gets the accumulated image from the second frame on.
 //!
 //! ```sh
 //! cargo run --release -p voxgi --example embed -- [WIDTHxHEIGHT] [OUT.png]

@@ -181,13 +181,16 @@ pub fn render(
     output.read(ctx, renderer)
 }
 
-/// Frames `render_still` accumulates unless told otherwise: past 16 the Cornell box's
-/// error against the path tracer no longer falls measurably (docs/QUALITY.md).
-pub const DEFAULT_ACCUMULATE: u32 = 16;
+/// Frames `render_still` accumulates unless told otherwise: enough for the area light's
+/// sampled shadows to agree with the path tracer's (the Cornell box's direct light, whose
+/// error falls only slowly beyond, docs/QUALITY.md); the indirect light has converged long
+/// before.
+pub const DEFAULT_ACCUMULATE: u32 = 64;
 
 /// Renders a still of the scene as it is: frames until the voxels have settled (progressive
 /// bounces converged), then, with temporal accumulation on, `accumulate` frames of the same
-/// instant into a fresh history (jittered, the cones turned) and reads back their mean.
+/// instant into a fresh history (jittered, the cones turned, new points on area lights) and
+/// reads back their mean.
 /// Without temporal accumulation, or with `accumulate` at most 1, the settled frame itself.
 /// More than `TEMPORAL_STILL_FRAMES` is an error: the renderer stops accumulating there.
 pub fn render_still(
@@ -211,7 +214,9 @@ pub fn render_still(
     }
     if renderer.options().temporal && accumulate > 1 {
         renderer.reset_history();
-        for _ in 0..accumulate {
+        // The history's first frame (the still a single frame shows) counts for nothing: the
+        // mean is of the `accumulate` frames after it.
+        for _ in 0..=accumulate {
             output.frame(ctx, renderer, params)?;
         }
     }

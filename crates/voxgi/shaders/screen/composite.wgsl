@@ -129,6 +129,13 @@ fn shade_light(light: Light, s: Surface, p: vec3<f32>, n: vec3<f32>, v: vec3<f32
     return (brdf_diffuse(s) + brdf_specular(s, n, v, l)) * e * n_dot_l;
 }
 
+// An integer hash of a 2x2 block's coordinates (a multiply-xorshift mix).
+fn block_hash(b: vec2<u32>) -> u32 {
+    var h = (b.x * 0x8da6b343u) ^ (b.y * 0xd8163841u);
+    h = (h ^ (h >> 16u)) * 0x7feb352du;
+    return h ^ (h >> 15u);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if f32(id.x) >= frame.size.x || f32(id.y) >= frame.size.y {
@@ -173,8 +180,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         } else if SHADOW_MAPS && light.sample_first != NO_INDEX && frame.history != HISTORY_NONE {
             // Accumulating frames: one of this frame's points on the light, a different one
             // for each pixel of a 2x2 block (the temporal pass's neighbourhood then spans
-            // the penumbra) and for each frame.
-            let s = (px.x & 1u) + 2u * (px.y & 1u) + frame.light_sample;
+            // the penumbra) and for each frame, the blocks' order scrambled so that their
+            // pixels' sequences (and their leftover errors) do not repeat in a grid.
+            let s = (px.x & 1u) + 2u * (px.y & 1u) + frame.light_sample + block_hash(px >> vec2<u32>(1u));
             w = sampled_visibility(light, p, n, s & 3u);
         } else if SHADOW_MAPS {
             w = light_visibility(light, p, n, frame.shadow_softness);

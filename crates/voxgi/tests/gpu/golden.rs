@@ -1,5 +1,7 @@
 //! Golden images, compared with FLIP. `VOXGI_BLESS=1` rewrites them on purpose; a failing test
-//! writes the new image and the FLIP error map to `target/test-output/`.
+//! writes the new image and the FLIP error map to `target/test-output/`. Each is one frame
+//! with temporal accumulation on (the default): a history's first frame, the unjittered still
+//! (the temporal tests cover accumulation).
 
 use crate::common::*;
 use std::path::{Path, PathBuf};
