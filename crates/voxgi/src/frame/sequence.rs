@@ -100,4 +100,29 @@ mod tests {
             assert!((v - i as f32 / 25.0).abs() < 1e-6, "{t:?}");
         }
     }
+
+    #[test]
+    fn light_points_cover_the_light_evenly() {
+        // 64 frames, 256 points: each cell of an 8x8 grid over the unit square expects 4. The
+        // R2 sequence's discrepancy keeps every cell within 4 ± 3 (random points would leave
+        // about one cell in ten empty).
+        let mut cells = [0u32; 64];
+        for k in 0..64 {
+            for p in light_points(k) {
+                assert!(
+                    (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y),
+                    "{p}"
+                );
+                cells[(p.y * 8.0) as usize * 8 + (p.x * 8.0) as usize] += 1;
+            }
+        }
+        assert!(cells.iter().all(|&c| (1..=7).contains(&c)), "{cells:?}");
+        // Each frame's four points are four different points of the light.
+        let f = light_points(5);
+        for i in 0..4 {
+            for j in i + 1..4 {
+                assert!(f[i].distance(f[j]) > 0.05, "{f:?}");
+            }
+        }
+    }
 }

@@ -722,4 +722,51 @@ mod tests {
         let (views, _) = plan_views(&mut lights, &[true], Vec3::ZERO, 2.0, 256, false);
         assert_eq!(views.iter().filter(|v| behind_emitter(v)).count(), 1);
     }
+
+    #[test]
+    fn sample_views_follow_the_regular_views_in_quarters_of_six_layers() {
+        let mut rect = light(LIGHT_RECT, [0.0, -1.0, 0.0]);
+        rect.axis_u = [0.2, 0.0, 0.0];
+        rect.axis_v = [0.0, 0.0, 0.1];
+        let mut lights = [light(LIGHT_POINT, [0.0, -1.0, 0.0]), rect];
+        let (views, owners) = plan_views(&mut lights, &[true, true], Vec3::ZERO, 2.0, 256, true);
+        // Two cubes of regular views, then the rectangle's four sample cubes.
+        assert_eq!(views.len(), 12 + 6 * SAMPLE_POINTS);
+        assert_eq!(lights[0].sample_first, NO_INDEX);
+        assert_eq!(lights[1].sample_first, 12);
+        assert!(owners[12..].iter().all(|&o| o == 1));
+        for (i, v) in views[12..].iter().enumerate() {
+            let (point, face) = (i / 6, i % 6);
+            assert_eq!(v.layer, 12 + face as u32);
+            assert_eq!(v.resolution, 128.0);
+            assert_eq!(
+                v.offset,
+                [(point % 2) as f32 * 128.0, (point / 2) as f32 * 128.0]
+            );
+        }
+        // Without samples, nothing follows the regular views.
+        let (views, _) = plan_views(&mut lights, &[true, true], Vec3::ZERO, 2.0, 256, false);
+        assert_eq!((views.len(), lights[1].sample_first), (12, NO_INDEX));
+    }
+
+    #[test]
+    fn light_points_span_the_emitter() {
+        let mut rect = light(LIGHT_RECT, [0.0, -1.0, 0.0]);
+        rect.axis_u = [0.2, 0.0, 0.0];
+        rect.axis_v = [0.0, 0.0, 0.1];
+        // The unit square's corners are the rectangle's corners, its centre the light's.
+        assert!(light_point(&rect, Vec2::ZERO).distance(Vec3::new(-0.2, 1.0, -0.1)) < 1e-6);
+        assert!(light_point(&rect, Vec2::ONE).distance(Vec3::new(0.2, 1.0, 0.1)) < 1e-6);
+        assert!(light_point(&rect, Vec2::splat(0.5)).distance(Vec3::Y) < 1e-6);
+        // A disc's points lie within its radius, on its plane, the rim at u.x = 1.
+        let mut disc = rect;
+        disc.kind = LIGHT_DISC;
+        disc.axis_u = [0.3, 0.0, 0.0];
+        disc.axis_v = [0.0, 0.0, 0.3];
+        for (x, y) in [(0.0, 0.0), (0.25, 0.3), (0.99, 0.7), (1.0, 0.5)] {
+            let d = light_point(&disc, Vec2::new(x, y)) - Vec3::Y;
+            assert!(d.y.abs() < 1e-6 && d.length() <= 0.3 + 1e-6, "{d}");
+            assert!((d.length() - 0.3 * x.sqrt()).abs() < 1e-5);
+        }
+    }
 }
