@@ -214,9 +214,7 @@ pub fn render_still(
     }
     if renderer.options().temporal && accumulate > 1 {
         renderer.reset_history();
-        // The history's first frame (the still a single frame shows) counts for nothing: the
-        // mean is of the `accumulate` frames after it.
-        for _ in 0..=accumulate {
+        for _ in 0..accumulate {
             output.frame(ctx, renderer, params)?;
         }
     }
