@@ -8,6 +8,7 @@ use crate::frame::uniforms::GpuFrame;
 use crate::gpu::shader::compose;
 use crate::gpu_scene::{GpuDraw, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
 use crate::lighting::atlas::GpuShadowView;
+use crate::lighting::blend::GpuBlend;
 use crate::lighting::cones::GpuCones;
 use crate::lighting::inject::GpuInjectParams;
 use crate::lighting::moments::GpuMomentRect;
@@ -31,6 +32,8 @@ fn modules() -> Vec<naga::Module> {
         crate::gpu::shader::compose_with("lighting/inject.wgsl", Some(VoxelKind::DENSE.shaders()));
     let gather =
         crate::gpu::shader::compose_with("screen/gather.wgsl", Some(VoxelKind::DENSE.shaders()));
+    let blend =
+        crate::gpu::shader::compose_with("lighting/blend.wgsl", Some(VoxelKind::DENSE.shaders()));
     [
         compose("screen/composite.wgsl"),
         compose("screen/gbuffer.wgsl"),
@@ -39,6 +42,7 @@ fn modules() -> Vec<naga::Module> {
         compose("reference.wgsl"),
         compose("reference_display.wgsl"),
         gather,
+        blend,
         inject,
         octree,
     ]
@@ -138,6 +142,7 @@ fn every_twin_has_the_wgsl_layout() {
         ]
     );
     twin!(m, GpuVertex, "Vertex", [position, u, normal, v]);
+    twin!(m, GpuBlend, "Blend", [weight, restart, from_bounce]);
     twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
     twin!(
         m,

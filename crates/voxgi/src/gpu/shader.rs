@@ -53,6 +53,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "lighting/inject.wgsl",
     "lighting/bounce.wgsl",
     "lighting/bounce_store.wgsl",
+    "lighting/blend.wgsl",
     "screen/gather.wgsl",
     "screen/upsample.wgsl",
     "screen/composite.wgsl",

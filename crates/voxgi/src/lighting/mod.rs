@@ -5,6 +5,7 @@
 //! share one name; `renderer.rs` calls them in order.
 
 pub mod atlas;
+pub mod blend;
 pub mod bounce;
 pub mod bounces;
 pub mod cones;

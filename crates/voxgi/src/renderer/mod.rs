@@ -26,6 +26,7 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, readback, requirements};
 use crate::gpu_scene::{GpuScene, bounding_sphere};
 use crate::lighting::atlas::{self as shadow, ShadowAtlas, plan_atlas};
+use crate::lighting::blend::{BlendPass, BlendState};
 use crate::lighting::bounce::BouncePass;
 use crate::lighting::bounces::{leaves, voxel_bounce_count};
 use crate::lighting::cones::cone_uniforms;
@@ -57,6 +58,7 @@ struct Passes {
     splat: SplatPass,
     inject: InjectPass,
     bounce: BouncePass,
+    blend: BlendPass,
     gbuffer: GbufferPass,
     gather: GatherPass,
     upsample: UpsamplePass,
@@ -115,6 +117,10 @@ pub struct Renderer {
     pending: Pending,
     /// Progressive bounces still to run before the voxel light has converged.
     progressive_left: u32,
+    /// The leaves' shown light (`lighting::blend`); `None` until a blend step needs it.
+    blend: Option<BlendState>,
+    /// Blend steps left before the shown light is the last update's.
+    blend_left: u32,
     /// Frames rendered, for `voxel_update_interval`.
     frame_index: u64,
     /// Instances, lights and animations as last set.
@@ -245,6 +251,7 @@ impl Renderer {
                 options.shadow_filter,
             ),
             bounce: BouncePass::new(device, options.voxels, options.anisotropic, leaves(options)),
+            blend: BlendPass::new(device, options.voxels),
             gbuffer: GbufferPass::new(device),
             gather: GatherPass::new(device, options, facts.glossy),
             upsample: UpsamplePass::new(device),
@@ -288,6 +295,8 @@ impl Renderer {
             voxel_bounces,
             pending: Pending::everything(views),
             progressive_left: 0,
+            blend: None,
+            blend_left: 0,
             frame_index: 0,
             state,
             counters: CounterReadback::new("voxel counters readback", 1 + POOL_COUNTERS),
@@ -413,6 +422,13 @@ impl Renderer {
         if let Some(v) = volume_new {
             self.volume = v;
             self.pools += 1;
+            // Its leaves are others: blending starts afresh (and a new kind needs its pass).
+            self.blend = None;
+            if kind {
+                self.passes.blend = checked(device, "pipeline creation", || {
+                    BlendPass::new(device, new.voxels)
+                })?;
+            }
         }
         if rebind {
             self.volume.bind_fragments(&self.device, &self.fragments);
@@ -444,8 +460,10 @@ impl Renderer {
         self.bounce_globals = None;
         self.fragment_binds = None;
         self.shadow_binds = None;
-        // What the history holds was rendered with the old options.
+        // What the history holds was rendered with the old options, and the voxels' light
+        // under them is no state to blend from: the new options' light shows at once.
         self.temporal.reset();
+        self.blend = None;
         // A structure or an atlas made anew holds nothing yet, whatever the table says.
         if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();
@@ -495,6 +513,9 @@ impl Renderer {
         m.push(("shadow atlas", self.atlas.bytes()));
         m.extend(self.fragments.memory());
         m.extend(self.volume.memory());
+        if let Some(b) = &self.blend {
+            m.push(("voxel blend", b.bytes()));
+        }
         if let Some(t) = &self.targets {
             m.push(("render targets", t.bytes()));
         }

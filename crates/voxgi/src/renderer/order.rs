@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! shadow → [moments] → [voxelize (static) → splat → <kind>_build] → [voxelize (dynamic) → <kind>_update]
-//!        → inject → filter → (bounce → filter) × (bounces − 1) → [bounce (records)]
+//!        → inject → filter → (bounce → filter) × (bounces − 1) → [bounce (records)] → [blend → filter]
 //!        → gbuffer → gather → upsample → composite → [debug] → [temporal] → tonemap
 //! ```
 //!
@@ -11,7 +11,9 @@
 //! last voxel update (`updates::Pending`), every `voxel_update_interval` frames; a rebuild
 //! never waits. With progressive bounces one bounce runs per frame until the light converges.
 //! With the fast shading (`IndirectShading::Leaves`) one more bounce keeps every leaf's
-//! irradiance and is neither stored nor filtered. `debug` runs only for the voxel views and
+//! irradiance and is neither stored nor filtered. With temporal accumulation `blend` moves the
+//! light the structure shows towards the update's over a few frames (every frame, whatever
+//! the update interval). `debug` runs only for the voxel views and
 //! replaces the composite's output; `temporal` (with temporal accumulation on) accumulates it
 //! into the history; `tonemap` writes the caller's target. Passes depend on
 //! shared resources (the GPU scene, the shadow atlas, the fragments, the structure, the
@@ -28,10 +30,11 @@ use crate::frame::uniforms::HISTORY_NONE;
 use crate::gpu::checked;
 use crate::gpu::timer::GpuTimer;
 use crate::lighting::atlas::ViewDirt;
+use crate::lighting::blend::{GpuBlend, VOXEL_BLEND_FRAMES};
 use crate::lighting::bounce::BounceSteps;
 use crate::lighting::bounces;
 use crate::lighting::inject::InjectPass;
-use crate::options::{FrameParams, ShadowFilter, validate_size};
+use crate::options::{FrameParams, IndirectShading, ShadowFilter, validate_size};
 use crate::view::camera_view_proj;
 use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, Region, VoxelWork};
 use glam::{Mat4, Vec3};
@@ -113,9 +116,12 @@ impl Renderer {
             rebuild: due && self.pending.rebuild,
             dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
         });
-        if due || !work.is_empty() {
-            self.record_voxels(encoder, work);
-        }
+        let relit = if due || !work.is_empty() {
+            self.record_voxels(encoder, work)
+        } else {
+            None
+        };
+        self.record_blend(encoder, relit);
         self.frame_index += 1;
         let frame = self.frame_uniforms(params, width, height, view_proj, &history);
         let t = self.targets.as_ref().expect("targets were just created");
@@ -307,16 +313,24 @@ impl Renderer {
     /// have not converged.
     pub(super) fn voxel_work_pending(&self) -> bool {
         let p = &self.pending;
-        p.rebuild || p.geometry || p.lights || self.progressive_left > 0
+        p.rebuild || p.geometry || p.lights || self.progressive_left > 0 || self.blend_left > 0
     }
 
     /// Records what the changes since the last voxel update need, in the fixed order:
     /// voxelize the static geometry and build (after a rebuild), voxelize the dynamic geometry
     /// and update (after it moved), inject, then filter and bounce; with progressive bounces,
     /// one bounce per update until converged.
-    fn record_voxels(&mut self, encoder: &mut wgpu::CommandEncoder, work: VoxelWork) {
+    ///
+    /// Returns what the leaves' light did: `Some(rebuilt)` when it was computed anew (every
+    /// leaf new with `rebuilt`), `None` when it stayed.
+    fn record_voxels(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        work: VoxelWork,
+    ) -> Option<bool> {
         let pending = std::mem::take(&mut self.pending);
         let geometry = !work.is_empty();
+        let relit = (geometry || pending.lights).then_some(pending.rebuild);
         self.fragments.set_regions(
             &self.queue,
             work.build.unwrap_or(Region::EMPTY),
@@ -454,6 +468,59 @@ impl Renderer {
         // The shadow views were consumed by `record_shadows` this frame; injection's start over.
         self.pending.views = pending.views;
         self.pending.inject_views = vec![ViewDirt::Clean; self.atlas.views.len()];
+        relit
+    }
+
+    /// Records a step of `blend` (and the filter after it) when the leaves' light changed
+    /// this frame (`relit`, from `record_voxels`) or is still moving towards the last change.
+    /// Only with temporal accumulation and the per-pixel cones from stored bounces (progressive
+    /// bounces converge over frames already; the fast shading's last bounce is not stored);
+    /// turned off mid-way, one last step lands on the light.
+    fn record_blend(&mut self, encoder: &mut wgpu::CommandEncoder, relit: Option<bool>) {
+        let o = &self.options;
+        let on = o.temporal && !o.progressive && o.indirect == IndirectShading::Cones;
+        if !on && self.blend_left == 0 {
+            // What the structure shows is the update's light: the next blend starts afresh.
+            self.blend = None;
+            return;
+        }
+        if relit.is_some() {
+            self.blend_left = if on { VOXEL_BLEND_FRAMES } else { 1 };
+        } else if !on {
+            self.blend_left = 1;
+        }
+        if self.blend_left == 0 {
+            return;
+        }
+        // Shown light made now (or dropped by `set_options`, or of a structure that grew)
+        // holds nothing to blend from: this step shows the update's light.
+        let capacity = self.volume.leaf_capacity().max(1);
+        let fresh = self.blend.as_ref().is_none_or(|b| b.capacity != capacity);
+        if fresh {
+            self.blend = Some(self.passes.blend.state(&self.device, &*self.volume));
+        }
+        let restart = fresh || relit == Some(true);
+        let step = GpuBlend {
+            weight: if restart {
+                1.0
+            } else {
+                1.0 / self.blend_left as f32
+            },
+            restart: restart as u32,
+            from_bounce: (bounces::stored_bounces(o, self.voxel_bounces) > 0) as u32,
+            _pad: 0,
+        };
+        let state = self.blend.as_ref().expect("made above");
+        self.passes.blend.record(
+            &self.queue,
+            encoder,
+            &*self.volume,
+            state,
+            step,
+            &mut self.timer,
+        );
+        self.volume.record_filter(encoder, &mut self.timer);
+        self.blend_left = if restart { 0 } else { self.blend_left - 1 };
     }
 }
 

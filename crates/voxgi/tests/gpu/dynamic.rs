@@ -87,7 +87,12 @@ fn volume_bytes(r: &Renderer) -> Vec<(&'static str, Vec<u8>)> {
         ("radiance", &v.radiance),
     ]
     .into_iter()
-    .map(|(n, t)| (n, readback::read_texture(&c.device, &c.queue, t).expect(n)))
+    .map(|(n, t)| {
+        (
+            n,
+            readback::read_texture_3d(&c.device, &c.queue, t, 0).expect(n),
+        )
+    })
     .collect()
 }
 
@@ -554,4 +559,78 @@ fn catch_up_after_a_change(voxels: voxgi::VoxelKind) {
     assert!(results[0].1 <= 6, "{voxels:?}: {:?}", results[0]);
     // Every 4th frame: the indirect light waits for the next update, at most 4 frames away.
     assert!(results[1].1 <= 4, "{voxels:?}: {:?}", results[1]);
+}
+
+/// With temporal accumulation the voxels' light follows a change over `VOXEL_BLEND_FRAMES`
+/// frames: each frame after the Cornell box's light moves, the dense volume's radiance has
+/// gone that share of the way from the old light to the new (it is stored as optical depth,
+/// linear in radiance where the opacity stays), and the last step lands on the new light to
+/// the bit: the light a fresh renderer computes for the moved lamp.
+#[test]
+fn voxel_light_follows_a_change_over_a_few_frames() {
+    use voxgi::lighting::blend::VOXEL_BLEND_FRAMES;
+    let radiance = |r: &Renderer| -> Vec<f32> {
+        let v = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
+        let bytes = readback::read_texture_3d(&ctx().device, &ctx().queue, &v.radiance, 0).unwrap();
+        bytemuck::cast_slice::<u8, u16>(&bytes)
+            .iter()
+            .map(|&h| readback::f16_to_f32(h))
+            .collect()
+    };
+    let mut scene = builtin::cornell_box();
+    let light = scene.lights.len() - 1;
+    // Two bounces: the blend starts from the last stored bounce's light.
+    let options = RendererOptions {
+        voxel_resolution: 32,
+        shadow_map_size: 256,
+        ..RendererOptions::default()
+    };
+    assert!(options.temporal);
+    let mut r = renderer(&scene, &options);
+    let p = params(&r);
+    while !r.voxels_settled() {
+        frame(&mut r, &p, 16, 16);
+    }
+    let before = radiance(&r);
+    let mut moved = scene.lights[light].clone();
+    moved.position += Vec3::new(0.15, 0.0, -0.1);
+    r.set_light(light, &moved).unwrap();
+    let mut steps = Vec::new();
+    for _ in 0..VOXEL_BLEND_FRAMES {
+        assert!(!r.voxels_settled(), "settled with blend steps left");
+        frame(&mut r, &p, 16, 16);
+        steps.push(radiance(&r));
+    }
+    assert!(
+        r.voxels_settled(),
+        "still blending after {VOXEL_BLEND_FRAMES} frames"
+    );
+    scene.lights[light] = moved;
+    let fresh = renderer(&scene, &options);
+    let mut fresh = fresh;
+    frame(&mut fresh, &p, 16, 16);
+    let after = radiance(&fresh);
+    let distance =
+        |a: &[f32], b: &[f32]| -> f64 { a.iter().zip(b).map(|(x, y)| (x - y).abs() as f64).sum() };
+    let change = distance(&before, &after);
+    assert!(change > 0.0, "moving the light changed no voxel");
+    for (j, s) in steps.iter().enumerate() {
+        let share = distance(&before, s) / change;
+        let want = (j + 1) as f64 / VOXEL_BLEND_FRAMES as f64;
+        eprintln!(
+            "blend step {}: {share:.4} of the way (a linear ramp: {want:.4})",
+            j + 1
+        );
+        // Half-float storage rounds each texel by up to 2^-11 of its value: the sums agree
+        // within 1 % of the change.
+        assert!(
+            (share - want).abs() < 0.01,
+            "step {}: {share} of the way",
+            j + 1
+        );
+    }
+    assert!(
+        steps.last().unwrap() == &after,
+        "the last step is not the fresh renderer's light"
+    );
 }

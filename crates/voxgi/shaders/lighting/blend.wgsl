@@ -1,0 +1,40 @@
+// blend: moves every leaf's shown radiance (what the structure holds for the cones) a step
+// towards the light the last voxel update computed for it, so that bounced light changes over
+// a few frames instead of at once. Runs after the update, before the filter.
+
+//!include shared/volume.wgsl
+//!include voxels/leaf_store.wgsl
+
+struct Blend {
+    // The share of the remaining way this step goes: 1 / (steps left, this one included).
+    weight: f32,
+    // 1: every leaf starts at its new light (a rebuild: slots hold other leaves now).
+    restart: u32,
+    // 1: the update's light is the last bounce's (`leaf_next`); 0: the direct light.
+    from_bounce: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> blend: Blend;
+// Per leaf slot: the radiance the structure shows (premultiplied rgb, opacity).
+@group(0) @binding(1) var<storage, read_write> shown: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = gid.x + gid.y * nwg.x * 64u;
+    if s >= leaf_count() {
+        return;
+    }
+    var goal = leaf_direct[s];
+    if blend.from_bounce != 0u {
+        goal = leaf_next[s];
+    }
+    // A leaf the last update made (a moved instance's) has no light of its own to come from.
+    var now = goal;
+    if blend.restart == 0u && !leaf_is_new(s) {
+        // mix(a, b, 1) is b exactly: the last step lands on the update's light to the bit.
+        now = mix(shown[s], goal, blend.weight);
+    }
+    shown[s] = now;
+    store_leaf_radiance(s, now);
+}
