@@ -176,7 +176,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // Without history the frame itself, exactly.
     var out = now;
     if count > 1.0 {
-        out = history.rgb + (now - history.rgb) / count;
+        var w = 1.0 / count;
+        if frame.history == HISTORY_MOVING {
+            // While things move, a sample far from the pixel's centre counts less (a Gaussian
+            // fit of the Blackman-Harris window): an edge's pixel then swings less with the
+            // jitter (docs/QUALITY.md, in motion). A still's mean stays the plain average
+            // over the pixel.
+            w *= exp(-2.29 * dot(frame.jitter, frame.jitter));
+        }
+        out = history.rgb + (now - history.rgb) * w;
     }
     textureStore(history_out, px, vec4<f32>(out, count));
 }
