@@ -3,6 +3,7 @@
 //! writes the other; the renderer flips which is which.
 
 use super::formats::{HISTORY_FORMAT, HISTORY_GEOMETRY_FORMAT};
+use super::targets::{STORAGE_TARGET, texture_2d};
 
 /// The history's two pairs of textures, at the output size.
 pub struct History {
@@ -23,22 +24,7 @@ impl History {
     /// Textures for a `width` x `height` output.
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let make = |label: &str, format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::STORAGE_BINDING
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+            texture_2d(device, label, format, STORAGE_TARGET, (width, height))
         };
         let color = [
             make("history 0", HISTORY_FORMAT),

@@ -53,29 +53,10 @@ impl FrameTargets {
     /// `half`; with a temporal history when `temporal`.
     pub fn new(device: &wgpu::Device, width: u32, height: u32, half: bool, temporal: bool) -> Self {
         let (lw, lh) = gather_size(width, height, half);
-        let sized = |label: &str,
-                     format: wgpu::TextureFormat,
-                     usage: wgpu::TextureUsages,
-                     (width, height): (u32, u32)| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let sized =
+            |label: &str, format, usage, size| texture_2d(device, label, format, usage, size);
         let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let st = wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC;
+        let st = STORAGE_TARGET;
         let view = |t: wgpu::Texture| t.create_view(&Default::default());
         let make = |label: &str, format, usage| sized(label, format, usage, (width, height));
         let low = |label: &str, format| sized(label, format, st, (lw, lh));
@@ -199,4 +180,33 @@ impl<'a> Target<'a> {
             height,
         }
     }
+}
+
+/// What a compute pass writes and a later one reads (or the frame's reader copies out).
+pub(super) const STORAGE_TARGET: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC);
+
+/// A single-level 2D texture of `width` x `height`.
+pub(super) fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    (width, height): (u32, u32),
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
 }

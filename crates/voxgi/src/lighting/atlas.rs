@@ -84,6 +84,8 @@ pub struct ShadowAtlas {
     pub(crate) uniforms: wgpu::Buffer,
     /// Whether area lights have sample views (`plan_views`' `samples`).
     pub samples: bool,
+    /// Index of the first sample view: they follow all the other views.
+    first_sample: usize,
 }
 
 fn up_for(dir: Vec3) -> Vec3 {
@@ -456,6 +458,11 @@ impl ShadowAtlas {
         samples: bool,
     ) -> Self {
         let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
+        // Sample views are the quarter-size ones, after all the others (`plan_views`).
+        let first_sample = views
+            .iter()
+            .position(|v| v.resolution as u32 != res)
+            .unwrap_or(views.len());
         let (mres, mlayers) = if moments { (res, layers) } else { (1, 1) };
         let moments = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow moments"),
@@ -545,12 +552,17 @@ impl ShadowAtlas {
             moments_view,
             depth_view: depth.create_view(&Default::default()),
             samples,
+            first_sample,
         }
     }
 
+    /// The indices of the area lights' sample views (empty without them).
+    pub fn sample_views(&self) -> std::ops::Range<usize> {
+        self.first_sample..self.views.len()
+    }
+
     /// Moves the sample views of every area light that has them to `points` (unit square
-    /// coordinates on the light, `light_point`), writing them where the passes read them, and
-    /// returns the views' indices (to be rendered).
+    /// coordinates on the light, `light_point`), writing them where the passes read them.
     pub fn move_samples(
         &mut self,
         queue: &wgpu::Queue,
@@ -558,8 +570,7 @@ impl ShadowAtlas {
         points: [Vec2; SAMPLE_POINTS],
         center: Vec3,
         radius: f32,
-    ) -> std::ops::Range<usize> {
-        let mut moved: Option<(usize, usize)> = None;
+    ) {
         let res = self.texture.width();
         for light in lights.iter().filter(|l| l.sample_first != NO_INDEX) {
             let first = light.sample_first as usize;
@@ -577,11 +588,8 @@ impl ShadowAtlas {
                 (first * size_of::<GpuShadowView>()) as u64,
                 bytemuck::cast_slice(&views),
             );
-            let end = first + views.len();
-            moved = Some(moved.map_or((first, end), |(a, b)| (a.min(first), b.max(end))));
             self.views[first..first + views.len()].copy_from_slice(&views);
         }
-        moved.map_or(0..0, |(a, b)| a..b)
     }
 
     /// Replaces the views by `views` (re-planned after lights moved: the same number, owned by

@@ -105,13 +105,14 @@ impl MomentsPass {
     ) {
         let res = atlas.texture.width();
         let mut rects = Vec::new();
-        for (i, view) in atlas.views.iter().enumerate() {
+        // Sample views are read by single hard taps only.
+        let regular = atlas.sample_views().start;
+        for (i, view) in atlas.views.iter().enumerate().take(regular) {
             let dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
             let Some((x, y, w, h)) = dirt.scissor(res) else {
                 continue;
             };
-            // Sample views (a quarter of a layer each) are read by single hard taps only.
-            if behind_emitter(view) || view.resolution as u32 != res {
+            if behind_emitter(view) {
                 continue;
             }
             let grow = |lo: u32| lo.saturating_sub(MOMENT_RADIUS);

@@ -124,11 +124,6 @@ impl ShadowPass {
         bind: &wgpu::BindGroup,
         timer: &mut GpuTimer,
     ) {
-        let sampled = atlas
-            .views
-            .iter()
-            .position(|v| v.offset != [0.0; 2] || v.resolution as u32 != atlas.texture.width())
-            .unwrap_or(atlas.views.len());
         for (i, view) in atlas.views.iter().enumerate() {
             let dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
             let res = view.resolution as u32;
@@ -143,7 +138,7 @@ impl ShadowPass {
             // A part of a layer is never cleared whole: the rest belongs to other views.
             let part = view.offset != [0.0; 2] || res != atlas.texture.width();
             let whole = dirt == ViewDirt::All && !part;
-            let label = if i >= sampled {
+            let label = if atlas.sample_views().contains(&i) {
                 "shadow_samples"
             } else {
                 "shadow"

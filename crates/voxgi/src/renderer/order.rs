@@ -38,7 +38,6 @@ use crate::options::{FrameParams, IndirectShading, ShadowFilter, validate_size};
 use crate::view::camera_view_proj;
 use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, Region, VoxelWork};
 use glam::{Mat4, Vec3};
-use std::ops::Range;
 
 impl Renderer {
     /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
@@ -91,19 +90,17 @@ impl Renderer {
         let history = self.temporal.begin(temporal, params, view_proj, changed);
         // Area lights' sample views move to this frame's points on their lights: every frame
         // that accumulates (not the first of a history, which shows PCSS, nor a held one).
-        let sampled = if self.atlas.samples && history.mode != HISTORY_NONE && !history.hold {
-            let points = sequence::light_points(history.sample);
+        let sampling = self.atlas.samples && history.mode != HISTORY_NONE && !history.hold;
+        if sampling {
             self.atlas.move_samples(
                 &self.queue,
                 &self.scene.gpu_lights,
-                points,
+                sequence::light_points(history.sample),
                 self.center,
                 self.radius,
-            )
-        } else {
-            0..0
-        };
-        self.record_shadows(encoder, sampled);
+            );
+        }
+        self.record_shadows(encoder, sampling);
         let interval = self.options.voxel_update_interval.max(1) as u64;
         // A rebuild (the first frame among them) never waits for its turn.
         let due = self.voxel_work_pending()
@@ -266,18 +263,18 @@ impl Renderer {
         }
     }
 
-    /// Records the shadow views that must be re-rendered (all after a rebuild), and the sample
-    /// views in `sampled` (no others: a frame that does not sample does not read them).
-    fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder, sampled: Range<usize>) {
+    /// Records the shadow views that must be re-rendered (all after a rebuild), and with
+    /// `sampling` the sample views (not otherwise: a frame that does not sample does not read
+    /// them).
+    fn record_shadows(&mut self, encoder: &mut wgpu::CommandEncoder, sampling: bool) {
         let mut views = std::mem::take(&mut self.pending.views);
-        for (i, v) in views.iter_mut().enumerate() {
-            if self.atlas.views[i].resolution as u32 != self.atlas.texture.width() {
-                *v = if sampled.contains(&i) {
-                    ViewDirt::All
-                } else {
-                    ViewDirt::Clean
-                };
-            }
+        let dirt = if sampling {
+            ViewDirt::All
+        } else {
+            ViewDirt::Clean
+        };
+        if let Some(samples) = views.get_mut(self.atlas.sample_views()) {
+            samples.fill(dirt);
         }
         if views.iter().any(|&v| v != ViewDirt::Clean) {
             let p = &self.passes;
