@@ -2,8 +2,7 @@
 //! geometry it was accumulated on, twice over. Each frame the temporal pass reads one pair and
 //! writes the other; the renderer flips which is which.
 
-use super::formats::{HISTORY_FORMAT, HISTORY_GEOMETRY_FORMAT};
-use super::targets::{STORAGE_TARGET, texture_2d};
+use super::formats::{HISTORY_FORMAT, HISTORY_GEOMETRY_FORMAT, STORAGE_TARGET, texture_2d};
 
 /// The history's two pairs of textures, at the output size.
 pub struct History {

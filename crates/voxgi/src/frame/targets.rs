@@ -3,7 +3,7 @@
 
 use super::formats::{
     ALBEDO_FORMAT, DEPTH_FORMAT, EMISSION_FORMAT, GUIDE_FORMAT, HDR_FORMAT, INDIRECT_FORMAT,
-    MOTION_FORMAT, NORMAL_FORMAT, VISIBILITY_FORMAT,
+    MOTION_FORMAT, NORMAL_FORMAT, STORAGE_TARGET, VISIBILITY_FORMAT, texture_2d,
 };
 use super::history::History;
 use super::uniforms::GpuFrame;
@@ -180,33 +180,4 @@ impl<'a> Target<'a> {
             height,
         }
     }
-}
-
-/// What a compute pass writes and a later one reads (or the frame's reader copies out).
-pub(super) const STORAGE_TARGET: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
-    .union(wgpu::TextureUsages::TEXTURE_BINDING)
-    .union(wgpu::TextureUsages::COPY_SRC);
-
-/// A single-level 2D texture of `width` x `height`.
-pub(super) fn texture_2d(
-    device: &wgpu::Device,
-    label: &str,
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-    (width, height): (u32, u32),
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
 }
