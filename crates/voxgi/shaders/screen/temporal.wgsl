@@ -95,6 +95,48 @@ fn same_surface(g: vec4<f32>, n: vec3<f32>, expected: f32) -> bool {
     return abs(g.a - expected) <= SAME_DISTANCE * expected && dot(g.rgb, n) >= SAME_NORMAL;
 }
 
+// The screen motion this frame's pixel p shows (background: the camera's turn).
+fn motion_at(p: vec2<i32>) -> vec2<f32> {
+    let size = vec2<i32>(frame.size);
+    let c = clamp(p, vec2<i32>(0), size - 1);
+    let m = textureLoad(motion, c, 0);
+    if m.w > 0.0 {
+        return m.xy;
+    }
+    return background_motion(vec2<u32>(c));
+}
+
+// Whether this frame's 3x3 neighbourhood moves in more than one way: a moving silhouette,
+// where the history on the two sides belongs to different surfaces.
+fn at_moving_edge(px: vec2<u32>, moved: vec2<f32>) -> bool {
+    var edge = false;
+    for (var y = -1; y <= 1; y++) {
+        for (var x = -1; x <= 1; x++) {
+            let d = motion_at(vec2<i32>(px) + vec2<i32>(x, y)) - moved;
+            edge = edge || dot(d, d) > 0.25;
+        }
+    }
+    return edge;
+}
+
+// The history at pos from only the texels that saw this pixel's surface, with tent weights
+// of the given radius: at a moving silhouette the others hold the surface that moved away.
+fn history_of_surface(pos: vec2<f32>, n: vec3<f32>, expected: f32, radius: f32) -> vec4<f32> {
+    let q = vec2<i32>(floor(pos));
+    var sum = vec4<f32>(0.0);
+    for (var y = -1; y <= 1; y++) {
+        for (var x = -1; x <= 1; x++) {
+            let t = q + vec2<i32>(x, y);
+            let d = abs(vec2<f32>(t) + 0.5 - pos) / radius;
+            let w = max(1.0 - d.x, 0.0) * max(1.0 - d.y, 0.0);
+            if w > 0.0 && same_surface(load_clamped(geometry_in, t), n, expected) {
+                sum += w * vec4<f32>(load_clamped(history_in, t).rgb, 1.0);
+            }
+        }
+    }
+    return sum;
+}
+
 // The history clipped towards the box of this frame's 3x3 neighbourhood (mean +- one standard
 // deviation, in YCoCg): colours the neighbourhood cannot make are history that no longer holds.
 fn clip_to_neighbourhood(px: vec2<u32>, history: vec3<f32>) -> vec3<f32> {
@@ -162,7 +204,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
             if seen {
-                history = vec4<f32>(history_at(pos), load_clamped(history_in, q).a);
+                var h = history_at(pos);
+                if at_moving_edge(px, moved) {
+                    var s = history_of_surface(pos, n, expected, 1.0);
+                    if s.w <= 0.0 {
+                        s = history_of_surface(pos, n, expected, 2.0);
+                    }
+                    h = s.rgb / max(s.w, 1e-6);
+                }
+                history = vec4<f32>(h, load_clamped(history_in, q).a);
                 history = vec4<f32>(clip_to_neighbourhood(px, history.rgb), history.a);
             }
         }
