@@ -3,6 +3,7 @@
 use crate::args::{SceneArg, SettingsArgs, load_scene_and_settings, parse_size, scene_label};
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use std::io::Write;
 use std::path::PathBuf;
 use voxgi::headless::{self, GpuContext};
 use voxgi::{Target, VoxelCounts, wgpu};
@@ -276,8 +277,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 "radii_ms": p.radii.as_secs_f64() * 1e3,
             })),
         });
-        std::fs::write(path, serde_json::to_string_pretty(&json)? + "\n")
-            .with_context(|| format!("{}", path.display()))?;
+        let text = serde_json::to_string_pretty(&json)? + "\n";
+        voxgi::scene::io::atomic::replace_with(path, |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("writing {}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())

@@ -605,3 +605,163 @@ fn every_setting_is_a_flag_and_documented() {
     ]);
     assert!(!o.status.success());
 }
+
+/// Every output on a full disk: an error naming the file, a non-zero exit, and a file that was
+/// there before left as it was. `/dev/full` fails every write with "no space left" as a full
+/// disk does; each output path is a link to it, so it carries the extension that picks the
+/// format. A second output beside it proves nothing half-written is left behind.
+#[cfg(unix)]
+#[test]
+fn every_output_on_a_full_disk_is_an_error_naming_the_file() {
+    if !std::path::Path::new("/dev/full").exists() {
+        eprintln!("skipped: no /dev/full");
+        return;
+    }
+    let dir = tmp("full_disk");
+    std::fs::create_dir_all(&dir).unwrap();
+    let full = |name: &str| {
+        let p = dir.join(name);
+        let _ = std::fs::remove_file(&p);
+        std::os::unix::fs::symlink("/dev/full", &p).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let reference = tmp("full_disk_reference.png");
+    let r = reference.to_str().unwrap();
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--size",
+        "32x32",
+        "--accumulate",
+        "2",
+        "-o",
+        r,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // (what, the -o argument, the file it names first, extra flags); a sequence of frames
+    // accumulates across frames, not within one.
+    let cases = [
+        (
+            "png",
+            full("out.png"),
+            full("out.png"),
+            ["--accumulate", "2"],
+        ),
+        (
+            "exr",
+            full("out.exr"),
+            full("out.exr"),
+            ["--accumulate", "2"],
+        ),
+        (
+            "sequence",
+            dir.join("seq_%02d.png").to_str().unwrap().to_string(),
+            full("seq_00.png"),
+            ["--frames", "2"],
+        ),
+    ];
+    for (kind, output, path, extra) in &cases {
+        let mut args = vec![
+            "render",
+            "--builtin",
+            "cornell-box",
+            "--size",
+            "32x32",
+            "-o",
+            output,
+        ];
+        args.extend(extra);
+        let o = voxgi(&args);
+        assert!(!o.status.success(), "{kind}: exit status 0 on a full disk");
+        let line = error_line(&o);
+        assert!(
+            line.contains(path.as_str()) && line.contains("No space left"),
+            "{kind}: {line}"
+        );
+        assert!(!stderr(&o).contains("wrote"), "{kind}: {}", stderr(&o));
+    }
+
+    let map = full("map.png");
+    let o = voxgi(&["compare", r, r, "--error-map", &map]);
+    assert!(
+        !o.status.success(),
+        "compare --error-map: exit status 0 on a full disk"
+    );
+    assert!(error_line(&o).contains(&map), "{}", error_line(&o));
+
+    for (flag, name) in [("--json", "bench.json"), ("--trace", "trace.json")] {
+        let path = full(name);
+        let o = voxgi(&[
+            "bench",
+            "--builtin",
+            "cornell-box",
+            "--size",
+            "32x32",
+            "--frames",
+            "2",
+            flag,
+            &path,
+        ]);
+        assert!(
+            !o.status.success(),
+            "bench {flag}: exit status 0 on a full disk"
+        );
+        assert!(
+            stderr(&o).contains(&path) && stderr(&o).contains("No space left"),
+            "bench {flag}: {}",
+            stderr(&o)
+        );
+    }
+
+    // Nothing but the links is left in the directory: no temporary file, no partial output.
+    let mut left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        [
+            "bench.json",
+            "map.png",
+            "out.exr",
+            "out.png",
+            "seq_00.png",
+            "trace.json"
+        ]
+    );
+}
+
+/// A failed render leaves an existing output untouched: the image is written beside it and
+/// renamed into place only when complete, so a reader never sees half a file either.
+#[test]
+fn an_output_is_replaced_whole_or_not_at_all() {
+    let out = tmp("replaced.png");
+    std::fs::write(&out, b"previous").unwrap();
+    // A scene that fails to load after the output path was checked.
+    let broken = tmp("broken.obj");
+    std::fs::write(&broken, "v 0 0 0\nf 1 2 3\n").unwrap();
+    let o = voxgi(&[
+        "render",
+        broken.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+    let o = voxgi(&[
+        "render",
+        "--builtin",
+        "cornell-box",
+        "--size",
+        "16x16",
+        "--accumulate",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(image::open(&out).unwrap().width(), 16);
+}

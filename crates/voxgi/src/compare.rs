@@ -249,10 +249,19 @@ fn hdr_flip(w: u32, h: u32, reference: &[[f32; 3]], test: &[[f32; 3]]) -> Vec<f3
 pub fn save_error_map(path: &Path, width: u32, height: u32, map: &[f32]) -> Result<()> {
     let img = nv_flip::FlipImageFloat::with_data(width, height, map);
     let rgb = img.apply_color_lut(&nv_flip::magma_lut()).to_vec();
-    image::save_buffer(path, &rgb, width, height, image::ExtendedColorType::Rgb8).map_err(|e| {
-        Error::Output {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        }
+    crate::scene::io::atomic::replace_with(path, |w| {
+        image::write_buffer_with_format(
+            w,
+            &rgb,
+            width,
+            height,
+            image::ExtendedColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(std::io::Error::other)
+    })
+    .map_err(|e| Error::Output {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
     })
 }

@@ -51,22 +51,33 @@ impl RenderOutput {
             path: path.to_path_buf(),
             reason,
         };
-        match ext.as_str() {
-            "png" => image::save_buffer(
-                path,
+        let write = |w: &mut std::io::BufWriter<std::fs::File>| match ext.as_str() {
+            "png" => image::write_buffer_with_format(
+                w,
                 &self.ldr,
                 self.width,
                 self.height,
                 image::ExtendedColorType::Rgba8,
+                image::ImageFormat::Png,
             )
-            .map_err(|e| fail(e.to_string())),
-            "exr" => {
-                let (w, h) = (self.width as usize, self.height as usize);
-                exr::prelude::write_rgb_file(path, w, h, |x, y| {
-                    let i = (y * w + x) * 4;
-                    (self.hdr[i], self.hdr[i + 1], self.hdr[i + 2])
-                })
-                .map_err(|e| fail(e.to_string()))
+            .map_err(std::io::Error::other),
+            _ => {
+                use exr::prelude::WritableImage as _;
+                let (wd, ht) = (self.width as usize, self.height as usize);
+                let channels =
+                    exr::prelude::SpecificChannels::rgb(|p: exr::prelude::Vec2<usize>| {
+                        let i = (p.1 * wd + p.0) * 4;
+                        (self.hdr[i], self.hdr[i + 1], self.hdr[i + 2])
+                    });
+                exr::prelude::Image::from_channels((wd, ht), channels)
+                    .write()
+                    .to_buffered(w)
+                    .map_err(std::io::Error::other)
+            }
+        };
+        match ext.as_str() {
+            "png" | "exr" => {
+                crate::scene::io::atomic::replace_with(path, write).map_err(|e| fail(e.to_string()))
             }
             _ => Err(fail(format!(
                 "unknown image type '.{ext}' (use .png or .exr)"

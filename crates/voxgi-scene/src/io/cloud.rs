@@ -105,7 +105,8 @@ pub fn write(path: &Path, pc: &PointCloud) -> Result<()> {
         }
         out.extend(c.map(linear_to_srgb8));
     }
-    std::fs::write(path, out).map_err(|e| SceneError::load(path, e))
+    super::atomic::replace_with(path, |w| std::io::Write::write_all(w, &out))
+        .map_err(|e| SceneError::load(path, e))
 }
 
 /// Inverse of [`srgb_to_linear`], quantised to 8 bits.

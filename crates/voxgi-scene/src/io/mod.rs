@@ -1,5 +1,6 @@
 //! File loaders. [`load`] picks one by extension; each returns a validated [`Scene`].
 
+pub mod atomic;
 pub mod cloud;
 pub mod emitters;
 pub mod gltf;

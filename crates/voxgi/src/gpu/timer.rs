@@ -171,7 +171,10 @@ impl GpuTimer {
                         .into(),
                 )
             })?;
-        wgpu_profiler::chrometrace::write_chrometrace(path, scopes).map_err(|e| Error::Output {
+        crate::scene::io::atomic::replace(path, |to| {
+            wgpu_profiler::chrometrace::write_chrometrace(to, scopes)
+        })
+        .map_err(|e| Error::Output {
             path: path.to_path_buf(),
             reason: e.to_string(),
         })
