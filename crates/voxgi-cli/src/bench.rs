@@ -17,7 +17,8 @@ pub struct BenchArgs {
     pub size: (u32, u32),
     /// Frames timed (after the warm-up). With temporal accumulation a still view stops
     /// rendering after 256 still frames (it has converged): time a still with fewer, or animate.
-    #[arg(long, value_name = "N", default_value_t = 20)]
+    #[arg(long, value_name = "N", default_value_t = 20,
+          value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub frames: u32,
     /// Frames rendered before timing starts.
     #[arg(long, value_name = "N", default_value_t = 2)]

@@ -159,9 +159,16 @@ fn absurd_arguments_are_refused_by_the_parser() {
             "--exposure",
             "nan-ish",
         ],
+        // Nothing to time: a table of zeros would look like a measurement.
+        vec!["bench", "--builtin", "cornell-box", "--frames", "0"],
     ] {
         let o = voxgi(&args);
         assert!(!o.status.success(), "{args:?} was accepted");
+        assert!(
+            !stderr(&o).contains("uploading scene"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
     }
     let o = voxgi(&[
         "render",

@@ -8,6 +8,9 @@ use voxgi_scene::{
     srgb_to_linear,
 };
 
+mod common;
+use common::load_warned;
+
 /// A fresh directory for one test (tests run in parallel).
 fn tmp(test: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("voxgi-loaders-{}-{test}", std::process::id()));
@@ -489,6 +492,13 @@ fn bad_inputs_fail_with_the_file_name() {
     let mut trunc_bin = (ply_head("binary_little_endian", "3") + "end_header\n").into_bytes();
     trunc_bin.extend([0u8; 20]);
     let light = |body: &str| format!("[[light]]\n{body}\n");
+    let colour_ply = |ty: &str, value: &str| {
+        format!(
+            "{}property {ty} red\nproperty {ty} green\nproperty {ty} blue\nend_header\n0 0 0 {value} 0 0\n",
+            ply_head("ascii", "1")
+        )
+        .into_bytes()
+    };
 
     // (case, file name, contents, fragment the reason must contain ("" = only the file name)).
     #[rustfmt::skip]
@@ -505,6 +515,10 @@ fn bad_inputs_fail_with_the_file_name() {
         ("ply missing z", "noz.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n".to_vec(), "x, y, z"),
         ("ply list past end", "list.ply", bin_list, "runs past"),
         ("ply ascii too few values", "short.ply", (ply_head("ascii", "2") + "end_header\n0 0 0\n1 1          \n").into_bytes(), "line 9: too few values for vertex 1"),
+        ("ply ascii colour beyond its type", "red300.ply", colour_ply("uchar", "300"), "300 is out of the range of its type uchar"),
+        ("ply ascii negative unsigned", "redneg.ply", colour_ply("ushort", "-1"), "out of the range of its type ushort"),
+        ("ply nan float colour", "nancol.ply", colour_ply("float", "nan"), "vertex 0: colour NaN is not a reflectance"),
+        ("ply negative float colour", "negcol.ply", colour_ply("float", "-0.5"), "colour -0.5"),
         ("obj face index out of range", "range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 40\n".to_vec(), "line 4: face vertex index 40 out of range (3 vertices"),
         ("obj no triangles", "points.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\n".to_vec(), "contains no triangles"),
         ("obj empty", "empty.obj", vec![], "contains no triangles"),
@@ -527,7 +541,8 @@ fn bad_inputs_fail_with_the_file_name() {
         ("toml unknown builtin", "nobuiltin.toml", b"[[include]]\nbuiltin = \"moon-base\"\n".to_vec(), "moon-base"),
         ("toml overflowing number", "overflow.toml", light("type = \"point\"\nintensity = 1e400\nposition = [0.0, 1.0, 0.0]").into_bytes(), "line 3"),
         ("toml specular out of range", "spec.toml", b"[[include]]\nbuiltin = \"cornell-box\"\n[include.material]\nspecular = 2.0\n".to_vec(), "specular"),
-        ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type"),
+        ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type '.xyz'"),
+        ("no extension", "scene", b"whatever".to_vec(), "no file extension to tell its type by"),
         ("gltf invalid json", "bad.gltf", b"{ not json".to_vec(), ""),
         ("glb empty", "empty.glb", vec![], ""),
         ("glb truncated", "trunc.glb", b"glTF\x02\x00\x00\x00\xff\xff\x00\x00".to_vec(), ""),
@@ -543,7 +558,7 @@ fn bad_inputs_fail_with_the_file_name() {
         dir.join("does_not_exist.ply"),
         "no such file",
     ));
-    rows.push(("directory path", dir.join("folder.obj"), ""));
+    rows.push(("directory path", dir.join("folder.obj"), "is a directory"));
     assert!(rows.len() >= 24);
     let mut failures = Vec::new();
     for (case, path, frag) in &rows {
@@ -1046,4 +1061,56 @@ fn the_point_cave_is_a_deterministic_tunnel() {
         builtin::by_name("point-cave").unwrap().point_count(),
         builtin::POINT_CAVE_POINTS
     );
+}
+
+/// What a loader accepts but should not pass over in silence: float colours above 1 (clamped)
+/// and data after the last element a PLY header declares (a wrong count), in both encodings.
+#[test]
+fn ply_oddities_are_warned_about() {
+    let dir = tmp("ply_warn");
+    let head = |fmt: &str| {
+        format!(
+            "ply\nformat {fmt} 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float red\nproperty float green\nproperty float blue\nend_header\n"
+        )
+    };
+    let bright = write(&dir, "bright.ply", head("ascii") + "0 0 0 1.5 0.5 2\n");
+    let (scene, w) = load_warned(&bright);
+    assert_eq!(scene.unwrap().point_clouds[0].colors[0], [1.0, 0.5, 1.0]);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("2 float colour values above 1")),
+        "{w:?}"
+    );
+
+    let ascii = write(
+        &dir,
+        "ascii_tail.ply",
+        head("ascii") + "0 0 0 0.5 0.5 0.5\n1 1 1 0.5 0.5 0.5\n\n",
+    );
+    let (scene, w) = load_warned(&ascii);
+    assert_eq!(scene.unwrap().point_clouds[0].positions.len(), 1);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("1 lines after the last element")),
+        "{w:?}"
+    );
+
+    let mut bin = head("binary_little_endian").into_bytes();
+    for v in [0f32, 0.0, 0.0, 0.5, 0.5, 0.5] {
+        bin.extend(v.to_le_bytes());
+    }
+    bin.extend([7u8; 5]);
+    let binary = write(&dir, "bin_tail.ply", bin);
+    let (scene, w) = load_warned(&binary);
+    assert_eq!(scene.unwrap().point_clouds[0].positions.len(), 1);
+    assert!(
+        w.iter()
+            .any(|w| w.contains("5 bytes after the last element")),
+        "{w:?}"
+    );
+
+    // A file that ends where its header says warns about nothing.
+    let exact = write(&dir, "exact.ply", head("ascii") + "0 0 0 0.5 0.5 0.5\n");
+    let (scene, w) = load_warned(&exact);
+    assert!(scene.is_ok() && w.is_empty(), "{w:?}");
 }

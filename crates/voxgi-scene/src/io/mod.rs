@@ -24,6 +24,15 @@ pub fn load(path: &Path) -> Result<Scene> {
     if !path.exists() {
         return Err(SceneError::load(path, "no such file"));
     }
+    if path.is_dir() {
+        return Err(SceneError::load(
+            path,
+            format!(
+                "is a directory, not a scene file (voxgi reads {})",
+                EXTENSIONS.join(", ")
+            ),
+        ));
+    }
     let scene = match ext.as_str() {
         "gltf" | "glb" => gltf::load(path)?,
         "obj" => {
@@ -40,12 +49,14 @@ pub fn load(path: &Path) -> Result<Scene> {
         "cloud" => cloud::load(path)?,
         "toml" => scene_file::load(path)?,
         _ => {
+            let kind = if ext.is_empty() {
+                "no file extension to tell its type by".to_string()
+            } else {
+                format!("unknown file type '.{ext}'")
+            };
             return Err(SceneError::load(
                 path,
-                format!(
-                    "unknown file type '.{ext}' (voxgi reads {})",
-                    EXTENSIONS.join(", ")
-                ),
+                format!("{kind} (voxgi reads {})", EXTENSIONS.join(", ")),
             ));
         }
     };

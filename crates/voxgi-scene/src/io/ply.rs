@@ -72,6 +72,27 @@ impl Ty {
             Ty::F32 | Ty::F64 => 1.0,
         }
     }
+    /// Smallest value of an integer type.
+    fn min(self) -> f64 {
+        match self {
+            Ty::I8 => -128.0,
+            Ty::I16 => -32768.0,
+            Ty::I32 => i32::MIN as f64,
+            _ => 0.0,
+        }
+    }
+    fn name(self) -> &'static str {
+        match self {
+            Ty::I8 => "char",
+            Ty::U8 => "uchar",
+            Ty::I16 => "short",
+            Ty::U16 => "ushort",
+            Ty::I32 => "int",
+            Ty::U32 => "uint",
+            Ty::F32 => "float",
+            Ty::F64 => "double",
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -281,6 +302,13 @@ impl<'a> Body<'a> {
                 if !ty.is_float() && v.fract() != 0.0 {
                     return Err(format!("line {line}: '{tok}' is not an integer ({what})"));
                 }
+                // A binary value always fits its type; text can say anything.
+                if !ty.is_float() && !(ty.min()..=ty.max()).contains(&v) {
+                    return Err(format!(
+                        "line {line}: {tok} is out of the range of its type {} ({what})",
+                        ty.name()
+                    ));
+                }
                 Ok(v)
             }
             Body::Binary { bytes, pos, big } => {
@@ -305,6 +333,14 @@ impl<'a> Body<'a> {
                     Ty::F64 => f64::from_le_bytes(a),
                 })
             }
+        }
+    }
+
+    /// What is left after the last element: bytes (binary) or non-empty lines (ASCII).
+    fn trailing(&mut self) -> usize {
+        match self {
+            Body::Ascii { lines, .. } => lines.filter(|(_, l)| !l.trim().is_empty()).count(),
+            Body::Binary { bytes, pos, .. } => bytes.len() - *pos,
         }
     }
 
@@ -333,11 +369,13 @@ pub fn load(path: &Path) -> Result<Scene> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "ply".into());
-    parse(&bytes, &name).map_err(|reason| SceneError::load(path, reason))
+    parse(&bytes, &name, &path.display().to_string())
+        .map_err(|reason| SceneError::load(path, reason))
 }
 
-/// Parses a whole PLY file; errors do not name the file (the caller adds it).
-pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
+/// Parses a whole PLY file into a scene called `name`; errors do not name the file (the caller
+/// adds it), warnings name it `file`.
+pub fn parse(bytes: &[u8], name: &str, file: &str) -> std::result::Result<Scene, String> {
     let h = parse_header(bytes)?;
     let mut body = match h.format {
         Format::Ascii => {
@@ -416,6 +454,7 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
     let mut indices: Vec<u32> = Vec::new();
     let mut face_count = 0usize;
     let mut skipped_faces = 0usize;
+    let mut bright_colors = 0usize;
     let mut values: Vec<f64> = Vec::new();
     let mut list: Vec<f64> = Vec::new();
     // Faces are checked against the vertex count once all elements are read (PLY allows any order).
@@ -499,7 +538,15 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
                     for k in 0..3 {
                         let v = get(layout.color[k]);
                         c[k] = if color_ty[k].is_float() {
-                            v.max(0.0) as f32
+                            if !(v.is_finite() && v >= 0.0) {
+                                return Err(format!(
+                                    "vertex {r}: colour {v} is not a reflectance >= 0"
+                                ));
+                            }
+                            if v > 1.0 {
+                                bright_colors += 1;
+                            }
+                            v.min(1.0) as f32
                         } else {
                             srgb_to_linear((v / color_ty[k].max()).clamp(0.0, 1.0) as f32)
                         };
@@ -543,7 +590,25 @@ pub fn parse(bytes: &[u8], name: &str) -> std::result::Result<Scene, String> {
         }
     }
     if skipped_faces > 0 {
-        log::warn!("{name}: skipped {skipped_faces} faces with fewer than 3 vertices");
+        log::warn!("{file}: skipped {skipped_faces} faces with fewer than 3 vertices");
+    }
+    if bright_colors > 0 {
+        log::warn!(
+            "{file}: {bright_colors} float colour values above 1 (a surface reflects at most \
+             all the light) clamped to 1"
+        );
+    }
+    let trailing = body.trailing();
+    if trailing > 0 {
+        let what = if h.format == Format::Ascii {
+            "lines"
+        } else {
+            "bytes"
+        };
+        log::warn!(
+            "{file}: {trailing} {what} after the last element the header declares, ignored \
+             (a wrong count in the header?)"
+        );
     }
     let has_face_element = h.elements.iter().any(|e| e.name == "face" && e.count > 0);
     let mut scene = Scene {

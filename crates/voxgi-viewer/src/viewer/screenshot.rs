@@ -137,14 +137,17 @@ impl Viewer {
                 Some(t) => self.save_texture(&t, &path)?,
                 None => self.save_screenshot(&path)?,
             }
-            let (mean, frames) = self.stats.steady_frame_ms();
+            let timing = match self.stats.steady_frame_ms() {
+                Some((mean, frames)) => format!(
+                    "{mean:.1} ms per frame, {:.1} fps, over the last {frames}",
+                    1e3 / mean.max(1e-3)
+                ),
+                None => "too few frames to time: the first two build the voxels".into(),
+            };
             eprintln!(
-                "wrote {} after {} frames ({:.1} ms per frame, {:.1} fps, over the last {})",
+                "wrote {} after {} frames ({timing})",
                 path.display(),
-                self.frames,
-                mean,
-                1e3 / mean.max(1e-3),
-                frames
+                self.frames
             );
             if self.ground.display != Display::ConeTraced {
                 eprintln!("{}", self.ground.label());

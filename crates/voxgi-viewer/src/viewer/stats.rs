@@ -41,12 +41,15 @@ impl Stats {
     }
 
     /// The mean milliseconds per frame over the recent frames but the first two, and how many
-    /// frames that is.
-    pub(super) fn steady_frame_ms(&self) -> (f32, usize) {
-        // The steady state: the frames after the first, which builds the voxels.
+    /// frames that is; none before a third frame (the first ones build the voxels).
+    pub(super) fn steady_frame_ms(&self) -> Option<(f32, usize)> {
         let recent: Vec<f32> = self.frame_ms.iter().skip(2).copied().collect();
-        let mean = recent.iter().sum::<f32>() / recent.len().max(1) as f32;
-        (mean, recent.len())
+        (!recent.is_empty()).then(|| {
+            (
+                recent.iter().sum::<f32>() / recent.len() as f32,
+                recent.len(),
+            )
+        })
     }
 }
 
