@@ -2,13 +2,13 @@
 //! light's views are. A shared resource: `shadow` renders into it, `inject` and `composite`
 //! read it.
 
-use crate::Result;
 use crate::gpu::layout;
 use crate::gpu_scene::{
     CONE_SHADOW_LIGHTS, GpuLight, GpuScene, LIGHT_DIRECTIONAL, LIGHT_DISC, LIGHT_POINT, LIGHT_RECT,
     LIGHT_SPOT, NO_INDEX,
 };
 use crate::options::{RendererOptions, ShadowFilter};
+use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use wgpu::util::DeviceExt;
@@ -445,6 +445,41 @@ pub fn composite_reads_shadow_maps(lights: &[GpuLight], cone_shadows: bool) -> b
     !cone_traced
 }
 
+/// Refuses an atlas the device cannot make, naming the count and the limit, before anything
+/// is made: more layers than its texture arrays hold, or more bytes than one allocation may
+/// take (wgpu's own error names neither; its largest buffer stands for the largest
+/// allocation, which is what Vulkan drivers derive it from).
+fn check_atlas(
+    views: &[GpuShadowView],
+    casts: &[bool],
+    res: u32,
+    limits: &wgpu::Limits,
+) -> Result<()> {
+    let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
+    let bytes = res as u64 * res as u64 * layers as u64 * 4;
+    let lights = casts.iter().filter(|&&c| c).count();
+    let cause = if layers > limits.max_texture_array_layers {
+        format!(
+            "more than this GPU's limit of {} texture array layers",
+            limits.max_texture_array_layers
+        )
+    } else if bytes > limits.max_buffer_size {
+        format!(
+            "{} MiB at {res}² texels a map, more than the {} MiB this GPU allocates at once",
+            bytes >> 20,
+            limits.max_buffer_size >> 20
+        )
+    } else {
+        return Ok(());
+    };
+    Err(Error::Setting(format!(
+        "{lights} shadow-casting lights need {layers} shadow-map layers, {cause} (a point or \
+         area light takes 6 layers, an area light 6 more for its sampled shadows with temporal \
+         accumulation, a spot or directional light 1): lower shadow_map_size or set \
+         cast_shadows = false on some lights"
+    )))
+}
+
 impl ShadowAtlas {
     /// Makes the atlas for `views` (owned by the lights in `view_light`), each map `res` texels
     /// square, with its depth buffer and view buffers, and with `moments` the prefiltered
@@ -661,12 +696,12 @@ pub fn plan_atlas(
     center: Vec3,
     radius: f32,
 ) -> Result<ShadowAtlas> {
+    let res = atlas_resolution(options, &scene.gpu_lights);
+    // Area-light shadows sampled over frames need the frames' accumulation.
+    let samples = options.temporal;
+    let (views, owners) = plan_views(&mut scene.gpu_lights, casts, center, radius, res, samples);
+    check_atlas(&views, casts, res, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
-        let res = atlas_resolution(options, &scene.gpu_lights);
-        // Area-light shadows sampled over frames need the frames' accumulation.
-        let samples = options.temporal;
-        let (views, owners) =
-            plan_views(&mut scene.gpu_lights, casts, center, radius, res, samples);
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
         let moments = options.shadow_filter == ShadowFilter::VsmEsm;
         ShadowAtlas::new(device, views, owners, res, moments, samples)

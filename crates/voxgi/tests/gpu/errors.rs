@@ -228,3 +228,82 @@ fn a_device_below_the_minimum_limits_is_refused_by_name() {
         Ok(_) => panic!("a device below the minimum was accepted"),
     }
 }
+
+/// More shadow maps than a texture array holds: an error naming the count and the device's
+/// limit, before the atlas is made (wgpu's validation error named neither); the same lights
+/// without shadows render.
+#[test]
+fn too_many_shadow_maps_name_the_limit() {
+    let ctx = ctx();
+    let max = ctx.device.limits().max_texture_array_layers;
+    // 64² maps: the layer count, not the memory, is what runs out.
+    let mut scene = voxgi::scene::builtin::cornell_box();
+    let base = scene.lights[0].clone();
+    // Six layers per point light: one light more than the array holds.
+    let n = max / 6 + 1;
+    for i in 0..n {
+        let mut l = base.clone();
+        l.kind = voxgi::scene::LightKind::Point;
+        l.position = Vec3::new(0.1 + 0.3 * i as f32 / n as f32, 0.4, 0.3);
+        l.intensity = 0.01;
+        scene.lights.push(l);
+    }
+    let options = RendererOptions {
+        voxel_resolution: 32,
+        shadow_map_size: 64,
+        ..Default::default()
+    };
+    let err = ctx.renderer(&scene, &options).err().expect("must fail");
+    let msg = err.to_string();
+    assert!(
+        msg.contains(&format!("limit of {max} texture array layers"))
+            && msg.contains("cast_shadows"),
+        "{msg}"
+    );
+    for l in &mut scene.lights[1..] {
+        l.cast_shadows = false;
+    }
+    ctx.renderer(&scene, &options)
+        .expect("the same lights without shadow maps");
+}
+
+/// A shadow atlas larger than one allocation may be: an error naming its size and the limit
+/// (on lavapipe 85 point lights with 1024² maps took 2 GiB and failed inside wgpu).
+#[test]
+fn a_shadow_atlas_too_large_to_allocate_names_its_size() {
+    let ctx = ctx();
+    let limits = ctx.device.limits();
+    let mut scene = voxgi::scene::builtin::cornell_box();
+    let base = scene.lights[0].clone();
+    let res = 2048u64;
+    // Enough point lights for one layer more than the allocation limit, within the layer limit.
+    let layers = (limits.max_buffer_size / (res * res * 4) + 1) as u32;
+    let n = layers.div_ceil(6);
+    if n * 6 > limits.max_texture_array_layers {
+        eprintln!("skipped: this device's allocation limit lies beyond its layer limit");
+        return;
+    }
+    for i in 0..n {
+        let mut l = base.clone();
+        l.kind = voxgi::scene::LightKind::Point;
+        l.position = Vec3::new(0.1 + 0.3 * i as f32 / n as f32, 0.4, 0.3);
+        scene.lights.push(l);
+    }
+    let options = RendererOptions {
+        voxel_resolution: 32,
+        shadow_map_size: res as u32,
+        ..Default::default()
+    };
+    let msg = ctx
+        .renderer(&scene, &options)
+        .err()
+        .expect("must fail")
+        .to_string();
+    assert!(
+        msg.contains(&format!(
+            "{} MiB this GPU allocates at once",
+            limits.max_buffer_size >> 20
+        )) && msg.contains("shadow_map_size"),
+        "{msg}"
+    );
+}
