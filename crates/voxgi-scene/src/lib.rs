@@ -29,8 +29,11 @@ pub const SWEEP_SAMPLES: u32 = 256;
 pub mod limits {
     /// Vertices or points in one mesh or cloud.
     pub const MAX_ELEMENTS: usize = 1 << 28;
-    /// Texture width or height.
+    /// Texture width or height: larger images are refused.
     pub const MAX_TEXTURE_DIM: u32 = 16384;
+    /// Texture width or height kept in memory: larger PNGs are reduced while they are decoded
+    /// (an RGBA8 texture of this size is 256 MiB), other formats refused.
+    pub const MAX_DECODED_DIM: u32 = 8192;
 }
 
 impl Scene {

@@ -783,7 +783,7 @@ fn bad_input_fails_with_the_file_name() {
                 d["images"] =
                     json!([{"uri": format!("data:image/png;base64,{}", base64(&huge_png))}]);
             }),
-            "larger than the 16384x16384 limit",
+            "larger than the 16384x16384 texture limit",
         ),
         (
             "stride_too_small.gltf",

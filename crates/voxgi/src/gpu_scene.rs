@@ -816,9 +816,29 @@ fn upload_textures(
     for (layer, &t) in used.iter().enumerate() {
         layer_of[t] = layer as i32;
         let tex = &scene.textures[t];
-        let img = image::RgbaImage::from_raw(tex.width, tex.height, tex.rgba8.clone()).ok_or_else(
-            || Error::Setting(format!("texture '{}' has the wrong byte count", tex.name)),
-        )?;
+        if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
+            return Err(Error::Setting(format!(
+                "texture '{}' has the wrong byte count",
+                tex.name
+            )));
+        }
+        // Halve by block means while both sides stay at least the layer's size: memory then
+        // follows the layer, not the image (an 8192² texture in f32 took 1 GiB more).
+        let mut k = 1;
+        while tex.width / (2 * k) >= size && tex.height / (2 * k) >= size {
+            k *= 2;
+        }
+        let img = if k > 1 {
+            let mut reduce = voxgi_scene::io::texture::Reducer::new(tex.width, tex.height, k);
+            for row in tex.rgba8.chunks_exact(tex.width as usize * 4) {
+                reduce.row(row);
+            }
+            let (w, h, data) = reduce.finish();
+            image::RgbaImage::from_raw(w, h, data)
+        } else {
+            image::RgbaImage::from_raw(tex.width, tex.height, tex.rgba8.clone())
+        }
+        .expect("byte count checked above");
         // Filter in linear light so mips of sRGB textures keep their brightness.
         let mut level = to_linear(&img);
         for mip in 0..mips {

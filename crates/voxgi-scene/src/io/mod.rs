@@ -7,6 +7,7 @@ pub mod gltf;
 pub mod obj;
 pub mod ply;
 pub mod scene_file;
+pub mod texture;
 
 use crate::{Result, Scene, SceneError};
 use std::path::Path;

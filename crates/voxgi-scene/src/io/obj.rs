@@ -209,24 +209,12 @@ fn convert_material(
 
 /// Decodes an image file to RGBA8 (sRGB values kept as they are).
 pub fn load_texture(p: &Path) -> std::result::Result<Texture, String> {
-    let reader = image::ImageReader::open(p)
-        .map_err(|e| e.to_string())?
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
-    let (w, h) = reader.into_dimensions().map_err(|e| e.to_string())?;
-    if w > limits::MAX_TEXTURE_DIM || h > limits::MAX_TEXTURE_DIM {
-        return Err(format!("{w}x{h} exceeds the texture size limit"));
-    }
-    let img = image::open(p).map_err(|e| e.to_string())?.to_rgba8();
-    Ok(Texture {
-        name: p
-            .file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        width: img.width(),
-        height: img.height(),
-        rgba8: img.into_raw(),
-    })
+    let bytes = std::fs::read(p).map_err(|e| e.to_string())?;
+    let name = p
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    super::texture::decode(&bytes, name)
 }
 
 /// tobj's errors carry no line numbers; for index errors find the offending line ourselves.

@@ -2,7 +2,7 @@
 //! into textures.
 
 use super::{R, io_reason};
-use crate::{Texture, limits};
+use crate::Texture;
 use std::path::Path;
 
 pub(super) fn load_buffers(
@@ -135,44 +135,11 @@ pub(super) fn load_image(image: &gltf::Image, base: &Path, buffers: &[Vec<u8>]) 
             read_uri(uri, base).map_err(|e| format!("image {i} ({}): {e}", short(uri)))?
         }
     };
-    let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-            .with_guessed_format()
-            .map_err(|e| format!("image {i}: {e}"))
-    };
-    let r = reader()?;
-    if r.format().is_none() {
-        return Err(format!(
-            "image {i}: unknown image format (voxgi reads PNG and JPEG)"
-        ));
-    }
-    let (w, h) = r.into_dimensions().map_err(|e| format!("image {i}: {e}"))?;
-    let max = limits::MAX_TEXTURE_DIM;
-    if w > max || h > max {
-        return Err(format!(
-            "image {i}: {w}x{h} is larger than the {max}x{max} limit"
-        ));
-    }
-    let mut r = reader()?;
-    let mut lim = image::Limits::default();
-    // Room for the largest allowed image at 16 bits per channel RGBA.
-    lim.max_alloc = Some(u64::from(max) * u64::from(max) * 8);
-    r.limits(lim);
-    // to_rgba8 converts any decoded layout (L8, LA8, RGB8, 16-bit, float) to RGBA8: grey is
-    // replicated, missing alpha is opaque, wider channels are rescaled.
-    let rgba = r
-        .decode()
-        .map_err(|e| format!("image {i}: {e}"))?
-        .to_rgba8();
-    Ok(Texture {
-        name: image
-            .name()
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("image {i}")),
-        width: rgba.width(),
-        height: rgba.height(),
-        rgba8: rgba.into_raw(),
-    })
+    let name = image
+        .name()
+        .map(str::to_string)
+        .unwrap_or_else(|| format!("image {i}"));
+    crate::io::texture::decode(&bytes, name).map_err(|e| format!("image {i}: {e}"))
 }
 
 pub(super) fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> R<&'b [u8]> {

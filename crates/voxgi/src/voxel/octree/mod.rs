@@ -91,8 +91,14 @@ fn create(
         None => checked(device, "pipeline creation", || OctreePipelines::new(device))?,
     };
     let l = device.limits();
-    let pools = OctreePools::for_leaves(desc.leaves)
-        .within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
+    let guess = OctreePools::for_leaves(desc.leaves);
+    log::info!(
+        "octree: pools for an estimated {} leaves: {} leaf tiles, {} MiB of nodes",
+        desc.leaves,
+        guess.leaf_tiles,
+        guess.node_bytes() >> 20
+    );
+    let pools = guess.within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
     let v = checked(device, "voxel octree", || {
         OctreeVolume::new(device, &p, desc.grid, desc.filtering, pools, desc.dynamic)
     })??;

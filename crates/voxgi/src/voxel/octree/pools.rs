@@ -38,16 +38,18 @@ impl OctreePools {
         p.slots = p
             .slots
             .min((max_binding / (SLOT_WORDS * 4)).min(u32::MAX as u64) as u32);
-        let node_bytes = |p: &OctreePools| {
-            let interior = 1 + p.even_tiles as u64 + p.odd_tiles as u64;
-            (NODE_HEADER + 8 * interior * NODE_WORDS + 8 * p.leaf_tiles as u64) * 4
-        };
-        while node_bytes(&p) > max_binding && p.leaf_tiles > 64 {
+        while p.node_bytes() > max_binding && p.leaf_tiles > 64 {
             p.leaf_tiles /= 2;
             p.even_tiles = (p.even_tiles / 2).max(64);
             p.odd_tiles = (p.odd_tiles / 2).max(64);
         }
         p
+    }
+
+    /// Bytes of the node buffer: `NODE_WORDS` per node above the leaves, one word per leaf.
+    pub fn node_bytes(&self) -> u64 {
+        let interior = 1 + self.even_tiles as u64 + self.odd_tiles as u64;
+        (NODE_HEADER + 8 * interior * NODE_WORDS + 8 * self.leaf_tiles as u64) * 4
     }
 
     /// Bytes these pools take on the GPU (bricks with six directions above level 0).
