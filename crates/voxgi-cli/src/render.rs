@@ -186,7 +186,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let opts = reference_options(args, &scene, &options);
         let mut tracer = p
             .stage("uploading scene and building the BVH", || {
-                PathTracer::new(&ctx.device, &ctx.queue, &scene, &options)
+                ctx.watch.check()?;
+                ctx.watch
+                    .explain(PathTracer::new(&ctx.device, &ctx.queue, &scene, &options))
             })
             .with_context(|| label.clone())?;
         eprintln!(
@@ -196,14 +198,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
         let t = Instant::now();
         let mut last = 0.0;
-        let out = tracer.render(&frame, w, h, &opts, &mut |done, total| {
-            let el = t.elapsed().as_secs_f64();
-            if el - last >= 1.0 || done == total {
-                last = el;
-                let eta = el / done as f64 * (total - done) as f64;
-                eprint!("\r  {done}/{total} spp  {el:.1} s elapsed  ETA {eta:.1} s   ");
-            }
-        })?;
+        let out = ctx
+            .watch
+            .explain(tracer.render(&frame, w, h, &opts, &mut |done, total| {
+                let el = t.elapsed().as_secs_f64();
+                if el - last >= 1.0 || done == total {
+                    last = el;
+                    let eta = el / done as f64 * (total - done) as f64;
+                    eprint!("\r  {done}/{total} spp  {el:.1} s elapsed  ETA {eta:.1} s   ");
+                }
+            }))?;
         eprintln!(
             "\nrendered {} spp in {:.2} s",
             opts.spp,
@@ -281,9 +285,13 @@ fn render_sequence(
             }
             None => {
                 scene.set_time(t);
-                let mut tracer = PathTracer::new(&ctx.device, &ctx.queue, scene, options)?;
+                ctx.watch.check()?;
+                let mut tracer =
+                    ctx.watch
+                        .explain(PathTracer::new(&ctx.device, &ctx.queue, scene, options))?;
                 let opts = reference_options(args, scene, options);
-                tracer.render(frame, w, h, &opts, &mut |_, _| {})?
+                ctx.watch
+                    .explain(tracer.render(frame, w, h, &opts, &mut |_, _| {}))?
             }
         };
         let path = frame_path(&args.output, k as u32)?;

@@ -39,6 +39,17 @@ pub enum Error {
         /// wgpu's message, or what was missing.
         reason: String,
     },
+    /// The GPU device was lost (a driver reset, a removed GPU, `Device::destroy`): nothing
+    /// more can be rendered on it. Seen through a `gpu::lost::DeviceWatch`.
+    #[error(
+        "the GPU device was lost ({reason}); nothing more can be drawn on it: open a new device \
+         (restart voxgi), and if it happens again update the GPU driver or lower the voxel \
+         resolution and image size (a driver may reset a GPU that works too long on one frame)"
+    )]
+    DeviceLost {
+        /// What the lost callback said.
+        reason: String,
+    },
     /// The scene failed to load or failed `Scene::validate` (voxgi-scene's error, unchanged).
     #[error(transparent)]
     Scene(#[from] voxgi_scene::SceneError),

@@ -21,6 +21,8 @@ pub struct GpuContext {
     /// GPU errors no error scope caught. wgpu's default is to panic; on its own device voxgi
     /// collects them here and turns them into an `Error` at the end of the frame.
     pub errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+    /// Whether the device was lost: every call below then answers `Error::DeviceLost`.
+    pub watch: crate::gpu::lost::DeviceWatch,
 }
 
 impl GpuContext {
@@ -115,17 +117,20 @@ impl GpuContext {
                 v.push(e.to_string());
             }
         }));
+        let watch = crate::gpu::lost::DeviceWatch::new(&device);
         Ok(GpuContext {
             device,
             queue,
             info,
             timestamps,
             errors,
+            watch,
         })
     }
 
     /// Takes the errors collected since the last call, as one `Error`.
     pub fn take_error(&self, context: &str) -> Result<()> {
+        self.watch.check()?;
         let mut v = self.errors.lock().map_err(|_| Error::Gpu {
             context: context.into(),
             reason: "error log poisoned".into(),
@@ -147,7 +152,11 @@ impl GpuContext {
         scene: &voxgi_scene::Scene,
         options: &crate::RendererOptions,
     ) -> Result<Renderer> {
-        let r = Renderer::new(&self.device, &self.queue, scene, options);
+        // On a lost device wgpu's helpers panic (a buffer made mapped cannot be mapped).
+        self.watch.check()?;
+        let r = self
+            .watch
+            .explain(Renderer::new(&self.device, &self.queue, scene, options));
         self.take_error("renderer creation")?;
         r
     }
@@ -176,9 +185,13 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Result<RenderOutput> {
+    ctx.watch.check()?;
     let output = Output::new(ctx, width, height)?;
-    output.frame(ctx, renderer, params)?;
-    output.read(ctx, renderer)
+    ctx.watch.explain(
+        output
+            .frame(ctx, renderer, params)
+            .and_then(|()| output.read(ctx, renderer)),
+    )
 }
 
 /// Frames `render_still` accumulates unless told otherwise: enough for the area light's
@@ -207,18 +220,22 @@ pub fn render_still(
             crate::TEMPORAL_STILL_FRAMES
         )));
     }
+    ctx.watch.check()?;
     let output = Output::new(ctx, width, height)?;
-    output.frame(ctx, renderer, params)?;
-    while !renderer.voxels_settled() {
+    let mut frames = || -> Result<RenderOutput> {
         output.frame(ctx, renderer, params)?;
-    }
-    if renderer.options().temporal && accumulate > 1 {
-        renderer.reset_history();
-        for _ in 0..accumulate {
+        while !renderer.voxels_settled() {
             output.frame(ctx, renderer, params)?;
         }
-    }
-    output.read(ctx, renderer)
+        if renderer.options().temporal && accumulate > 1 {
+            renderer.reset_history();
+            for _ in 0..accumulate {
+                output.frame(ctx, renderer, params)?;
+            }
+        }
+        output.read(ctx, renderer)
+    };
+    ctx.watch.explain(frames())
 }
 
 /// The texture headless frames are written to.

@@ -80,9 +80,20 @@ impl ApplicationHandler for App {
         let Some(v) = self.viewer.as_mut() else {
             return;
         };
-        match v.window_event(event_loop, event) {
+        // A lost device fails whatever comes next in ways that do not say so: name the loss.
+        let result = match v.watch.check() {
+            Ok(()) => v.window_event(event_loop, event),
+            Err(lost) => Err(lost.into()),
+        };
+        match result {
             Ok(()) => {}
-            Err(e) => self.fail(event_loop, e),
+            Err(e) => {
+                let e = match v.watch.check() {
+                    Err(lost) => anyhow::Error::from(lost),
+                    Ok(()) => e,
+                };
+                self.fail(event_loop, e)
+            }
         }
     }
 
@@ -117,6 +128,8 @@ struct Viewer {
     queue: wgpu::Queue,
     adapter: wgpu::AdapterInfo,
     timestamps: bool,
+    /// Whether the device was lost: the window then closes with `Error::DeviceLost`.
+    watch: voxgi::gpu::lost::DeviceWatch,
     renderer: Renderer,
     /// The scene as loaded (at time 0): what new options and the path tracer build from.
     scene: Arc<Scene>,
@@ -188,6 +201,7 @@ impl Viewer {
             cpu,
             timestamps,
             keeps_image,
+            watch,
         } = surface::open_window(event_loop, args, &scene_label(&scene))?;
 
         let mut options = RendererOptions {
@@ -247,6 +261,7 @@ impl Viewer {
             queue,
             adapter: info,
             timestamps,
+            watch,
             scene_name: scene_label(&scene),
             scene_radius: radius,
             cameras: scene.cameras.clone(),

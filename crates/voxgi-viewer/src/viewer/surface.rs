@@ -24,6 +24,8 @@ pub(super) struct Gpu {
     pub(super) timestamps: bool,
     /// The surface can be copied into: a still view is drawn once and copied after that.
     pub(super) keeps_image: bool,
+    /// Whether the device was lost.
+    pub(super) watch: voxgi::gpu::lost::DeviceWatch,
 }
 
 /// Opens the window titled after `scene_name`, a device that can draw into it, and the
@@ -102,6 +104,7 @@ pub(super) fn open_window(
         wgpu::PresentMode::AutoVsync
     };
     surface.configure(&device, &config);
+    let watch = voxgi::gpu::lost::DeviceWatch::new(&device);
     Ok(Gpu {
         window,
         surface,
@@ -112,6 +115,7 @@ pub(super) fn open_window(
         cpu,
         timestamps,
         keeps_image,
+        watch,
     })
 }
 

@@ -2,6 +2,7 @@
 
 pub mod feedback;
 pub mod layout;
+pub mod lost;
 pub mod readback;
 pub mod requirements;
 pub mod shader;

@@ -307,3 +307,32 @@ fn a_shadow_atlas_too_large_to_allocate_names_its_size() {
         "{msg}"
     );
 }
+
+/// A lost device (here destroyed; a driver reset reports the same way) is
+/// `Error::DeviceLost` for the frame that finds it and every call after, never a panic or a
+/// message about buffer mapping.
+#[test]
+fn a_lost_device_is_an_error_naming_it() {
+    // A device of its own: the shared one must survive.
+    let ctx = voxgi::headless::GpuContext::from_env().expect("a device");
+    let scene = voxgi::scene::builtin::cornell_box();
+    let options = RendererOptions {
+        voxel_resolution: 32,
+        ..Default::default()
+    };
+    let mut r = ctx.renderer(&scene, &options).unwrap();
+    let params = FrameParams::new(scene.cameras[0].clone());
+    voxgi::headless::render(&ctx, &mut r, &params, 32, 32).expect("a frame before the loss");
+    ctx.device.destroy();
+    let lost = |e: Error| {
+        assert!(matches!(e, Error::DeviceLost { .. }), "{e}");
+        assert!(
+            e.to_string()
+                .contains("device was lost (the device was destroyed)"),
+            "{e}"
+        );
+    };
+    lost(voxgi::headless::render(&ctx, &mut r, &params, 32, 32).expect_err("must fail"));
+    lost(voxgi::headless::render_still(&ctx, &mut r, &params, 32, 32, 4).expect_err("must fail"));
+    lost(ctx.renderer(&scene, &options).err().expect("must fail"));
+}
