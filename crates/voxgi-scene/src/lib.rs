@@ -29,6 +29,13 @@ pub const SWEEP_SAMPLES: u32 = 256;
 pub mod limits {
     /// Vertices or points in one mesh or cloud.
     pub const MAX_ELEMENTS: usize = 1 << 28;
+    /// Emitted radiance (emissive materials and points, an area light's radiance), W/(m² sr):
+    /// the largest finite half float, which is what voxgi stores radiance in.
+    pub const MAX_RADIANCE: f32 = 65504.0;
+    /// A point, spot or directional light's intensity × colour: far past anything that shows
+    /// more than a saturated image (1e10 W/sr still saturates a white wall 400 m away), and
+    /// far below where single-precision lighting overflows into NaN (about 1e30).
+    pub const MAX_LIGHT: f32 = 1e10;
     /// Texture width or height: larger images are refused.
     pub const MAX_TEXTURE_DIM: u32 = 16384;
     /// Texture width or height kept in memory: larger PNGs are reduced while they are decoded
@@ -290,14 +297,25 @@ impl Scene {
                     ));
                 }
             }
-            if m.base_color
-                .iter()
-                .chain(&m.emissive)
-                .any(|c| !c.is_finite() || *c < 0.0)
-            {
+            for (what, values) in [
+                ("base colour", &m.base_color[..]),
+                ("emission", &m.emissive[..]),
+            ] {
+                if let Some(c) = values.iter().find(|c| !c.is_finite() || **c < 0.0) {
+                    return bad(format!(
+                        "material {i} '{}': {what} {values:?} holds {c}, not a finite value >= 0",
+                        m.name
+                    ));
+                }
+            }
+            let brightest = m.emissive.iter().fold(0f32, |a, &b| a.max(b));
+            if brightest > limits::MAX_RADIANCE {
                 return bad(format!(
-                    "material {i} '{}': negative or non-finite colour",
-                    m.name
+                    "material {i} '{}': emission {brightest:e} is more than {}, the largest \
+                     radiance voxgi stores (half floats): scale the scene's light units down \
+                     and the exposure up",
+                    m.name,
+                    limits::MAX_RADIANCE
                 ));
             }
         }
@@ -341,6 +359,9 @@ impl Scene {
                     "light {i} '{}': non-finite or negative values, or direction not unit length",
                     l.name
                 ));
+            }
+            if let Err(e) = l.check_brightness() {
+                return bad(format!("light {i} '{}': {e}", l.name));
             }
             match l.kind {
                 LightKind::Spot {
@@ -386,6 +407,19 @@ impl Scene {
                 return bad(format!(
                     "point cloud {i} '{}': non-finite point position",
                     pc.name
+                ));
+            }
+            if let Some(e) = pc
+                .emission
+                .iter()
+                .flatten()
+                .find(|e| !(e.is_finite() && **e >= 0.0 && **e <= limits::MAX_RADIANCE))
+            {
+                return bad(format!(
+                    "point cloud {i} '{}': emission {e:e} is not a radiance from 0 to {}, the \
+                     largest voxgi stores (half floats)",
+                    pc.name,
+                    limits::MAX_RADIANCE
                 ));
             }
         }

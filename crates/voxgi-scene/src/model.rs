@@ -169,6 +169,33 @@ pub struct Light {
 }
 
 impl Light {
+    /// Refuses a light brighter than voxgi can show: an area light's radiance above what half
+    /// floats hold (`limits::MAX_RADIANCE`), another's intensity × colour above
+    /// `limits::MAX_LIGHT`.
+    pub fn check_brightness(&self) -> std::result::Result<(), String> {
+        let value = self.intensity * self.color.iter().fold(0f32, |a, &b| a.max(b));
+        let (max, shown, what) = match self.kind {
+            LightKind::Area { .. } => (
+                crate::limits::MAX_RADIANCE,
+                "65504",
+                "the largest radiance voxgi stores (half floats)",
+            ),
+            _ => (
+                crate::limits::MAX_LIGHT,
+                "1e10",
+                "the brightest light voxgi takes (it would only saturate the image, and \
+                 overflow into NaN further on)",
+            ),
+        };
+        if value > max {
+            return Err(format!(
+                "intensity × colour {value:e} is more than {shown}, {what}: scale the scene's \
+                 light units down and the exposure up"
+            ));
+        }
+        Ok(())
+    }
+
     /// The light moved by `m` (an affine transform): its position, its direction (an area
     /// light's as a normal) and an area light's extent.
     pub fn transformed(&self, m: Mat4) -> Light {

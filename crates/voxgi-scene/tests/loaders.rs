@@ -519,6 +519,10 @@ fn bad_inputs_fail_with_the_file_name() {
         ("ply ascii negative unsigned", "redneg.ply", colour_ply("ushort", "-1"), "out of the range of its type ushort"),
         ("ply nan float colour", "nancol.ply", colour_ply("float", "nan"), "vertex 0: colour NaN is not a reflectance"),
         ("ply negative float colour", "negcol.ply", colour_ply("float", "-0.5"), "colour -0.5"),
+        ("obj NaN diffuse colour", "kdnan.obj", b"mtllib kdnan.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n".to_vec(), "base colour [NaN, 0.0, 0.0, 1.0] holds NaN"),
+        ("obj negative diffuse colour", "kdneg.obj", b"mtllib kdneg.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n".to_vec(), "holds -1"),
+        ("obj emission past f32", "keinf.obj", b"mtllib keinf.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n".to_vec(), "emission [inf, 1.0, 1.0] holds inf"),
+        ("obj emission past half floats", "kebig.obj", b"mtllib kebig.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n".to_vec(), "emission 1e30 is more than 65504"),
         ("obj face index out of range", "range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 40\n".to_vec(), "line 4: face vertex index 40 out of range (3 vertices"),
         ("obj no triangles", "points.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\n".to_vec(), "contains no triangles"),
         ("obj empty", "empty.obj", vec![], "contains no triangles"),
@@ -540,6 +544,9 @@ fn bad_inputs_fail_with_the_file_name() {
         ("toml area without size", "nosize.toml", light("type = \"area\"\nintensity = 1.0\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nshape = \"rect\"").into_bytes(), "size"),
         ("toml unknown builtin", "nobuiltin.toml", b"[[include]]\nbuiltin = \"moon-base\"\n".to_vec(), "moon-base"),
         ("toml overflowing number", "overflow.toml", light("type = \"point\"\nintensity = 1e400\nposition = [0.0, 1.0, 0.0]").into_bytes(), "line 3"),
+        ("toml light past the limit", "hotlight.toml", light("type = \"point\"\nintensity = 3e38\nposition = [0.0, 1.0, 0.0]").into_bytes(), "3e38 is more than 1e10"),
+        ("toml area light past half floats", "hotarea.toml", light("type = \"area\"\nintensity = 1e5\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nshape = \"disc\"\nradius = 0.1").into_bytes(), "1e5 is more than 65504"),
+        ("toml emission past half floats", "hotmat.toml", b"[[include]]\nbuiltin = \"cube\"\n[include.material]\nemissive = [1e30, 0.0, 0.0]\n".to_vec(), "65504"),
         ("toml specular out of range", "spec.toml", b"[[include]]\nbuiltin = \"cornell-box\"\n[include.material]\nspecular = 2.0\n".to_vec(), "specular"),
         ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type '.xyz'"),
         ("no extension", "scene", b"whatever".to_vec(), "no file extension to tell its type by"),
@@ -548,6 +555,14 @@ fn bad_inputs_fail_with_the_file_name() {
         ("glb truncated", "trunc.glb", b"glTF\x02\x00\x00\x00\xff\xff\x00\x00".to_vec(), ""),
     ];
     write(&dir, "pong.toml", "[[include]]\nfile = \"ping.toml\"\n");
+    for (name, line) in [
+        ("kdnan", "Kd nan 0 0"),
+        ("kdneg", "Kd -1 0 0"),
+        ("keinf", "Ke inf 1 1"),
+        ("kebig", "Ke 1e30 0 0"),
+    ] {
+        write(&dir, &format!("{name}.mtl"), format!("newmtl m\n{line}\n"));
+    }
     std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
     let mut rows: Vec<(&str, PathBuf, &str)> = cases
         .iter()

@@ -364,7 +364,9 @@ pub fn check_light(light: &Light) -> Result<()> {
             light.name
         )));
     }
-    Ok(())
+    light
+        .check_brightness()
+        .map_err(|e| Error::Setting(format!("light '{}': {e}", light.name)))
 }
 
 /// One light in its GPU form (shadow fields left zero).

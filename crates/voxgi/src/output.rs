@@ -98,6 +98,7 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 
 /// Narkowicz's fit of the ACES reference rendering transform (as tonemap.wgsl).
 fn aces(x: f32) -> f32 {
+    let x = x.min(1e4);
     ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
 }
 
@@ -174,4 +175,21 @@ pub fn load_linear(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
         .map(|p| p.0.map(|v| voxgi_scene::srgb_to_linear(v as f32 / 255.0)))
         .collect();
     Ok((img.width(), img.height(), px))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Radiance far past what a tone curve needs (a bright light, a high exposure) saturates:
+    /// ACES's quadratics overflowed f32 past about 1e19 and gave NaN, written as black.
+    #[test]
+    fn huge_radiance_saturates_every_curve() {
+        for curve in [Tonemap::Aces, Tonemap::Neutral, Tonemap::Clamp] {
+            for v in [1e4f32, 1e20, 3e38] {
+                let px = tonemap(&[v, v, v, 1.0], 0.0, curve);
+                assert_eq!(px, [255, 255, 255, 255], "{curve:?} at {v}");
+            }
+        }
+    }
 }

@@ -152,12 +152,13 @@ fn convert_material(
         name: m.name.clone(),
         ..Default::default()
     };
-    let clean = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
+    // Kept as written: `Scene::validate` refuses NaN, negative and too-bright values,
+    // naming the material, as it does for glTF's.
     if let Some(kd) = m.diffuse {
-        mat.base_color = [clean(kd[0]), clean(kd[1]), clean(kd[2]), 1.0];
+        mat.base_color = [kd[0], kd[1], kd[2], 1.0];
     }
     if let Some(ke) = m.emissive {
-        mat.emissive = ke.map(clean);
+        mat.emissive = ke;
     }
     let alpha = m.dissolve.or_else(|| {
         m.unknown_param

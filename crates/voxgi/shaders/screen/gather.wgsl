@@ -5,6 +5,7 @@
 // roughness; with cone shadows, the visibility of the first area lights by one cone each.
 
 //!include shared/globals.wgsl
+//!include shared/half.wgsl
 //!include shared/brdf.wgsl
 //!include shared/cone.wgsl
 //!include shared/interleave.wgsl
@@ -127,7 +128,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let ab = textureSampleLevel(specular_table, table_sampler, uv, 0.0).rg;
         indirect += spec * specular_albedo(f0, ab);
     }
-    textureStore(indirect_out, gid.xy, vec4<f32>(indirect, g.ao));
+    textureStore(indirect_out, gid.xy, to_half(vec4<f32>(indirect, g.ao)));
     var vis = vec4<f32>(1.0);
     if frame.cone_shadows != 0u {
         vis = area_visibility(p, n);

@@ -4,6 +4,7 @@
 // and creases. The composite upsamples the result to full resolution (shared/upsample.wgsl).
 
 //!include shared/globals.wgsl
+//!include shared/half.wgsl
 //!include shared/interleave.wgsl
 //!include shared/upsample.wgsl
 
@@ -50,5 +51,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     } else {
         out = (sum0 + sum1) / max(w0 + w1, 1e-6);
     }
-    textureStore(filtered, gid.xy, out);
+    textureStore(filtered, gid.xy, to_half(out));
 }

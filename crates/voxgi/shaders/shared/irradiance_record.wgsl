@@ -3,8 +3,11 @@
 // the leaf's normal and how well its fragments' normals agree as snorm8, and 1 (a record
 // exists; an empty one is all zero).
 
+//!include shared/half.wgsl
+
 fn pack_irradiance(e: vec3<f32>, ao: f32, normal: vec4<f32>) -> vec4<u32> {
-    return vec4<u32>(pack2x16float(e.rg), pack2x16float(vec2<f32>(e.b, ao)), pack4x8snorm(normal), 1u);
+    let h = to_half(vec4<f32>(e, ao));
+    return vec4<u32>(pack2x16float(h.rg), pack2x16float(h.ba), pack4x8snorm(normal), 1u);
 }
 
 // Irradiance (rgb) and ambient occlusion (a).

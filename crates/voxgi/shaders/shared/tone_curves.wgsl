@@ -2,8 +2,10 @@
 // display so that both images of a split view are mapped alike. Mirrors output.rs's CPU
 // versions.
 
-// Narkowicz's fit of the ACES reference rendering transform.
-fn aces(x: vec3<f32>) -> vec3<f32> {
+// Narkowicz's fit of the ACES reference rendering transform. Its quadratics overflow f32 past
+// about 1e19 (infinity over infinity: NaN, a black or coloured pixel); it is 1 long before 1e4.
+fn aces(x_in: vec3<f32>) -> vec3<f32> {
+    let x = min(x_in, vec3<f32>(1e4));
     return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 

@@ -37,6 +37,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/light_model.wgsl",
     "shared/lights.wgsl",
     "shared/volume.wgsl",
+    "shared/half.wgsl",
     "shared/fragment.wgsl",
     "shared/voxel_debug.wgsl",
     "shared/cone.wgsl",

@@ -3,6 +3,7 @@
 // (voxels/octree/tree.wgsl), so the bricks need no separate border pass. @group(3).
 
 //!include voxels/leaves.wgsl
+//!include shared/half.wgsl
 
 @group(3) @binding(0) var leaf_atlas_out: texture_storage_3d<rgba16float, write>;
 
@@ -19,7 +20,7 @@ fn store_leaf_radiance(i: u32, v: vec4<f32>) {
     let info = leaf_slots[i * SLOT_STRIDE + 1u];
     let m = info & 0x1fffffffu;
     let o = info >> 29u;
-    let d = to_depth(v);
+    let d = to_half(to_depth(v));
     // Node 0 (the root) has no neighbours, so a missing one stays 0 down the chain.
     let x = leaf_neighbour(m, 0u);
     let y = leaf_neighbour(m, 1u);
