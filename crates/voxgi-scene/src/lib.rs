@@ -423,6 +423,16 @@ impl Scene {
                 ));
             }
         }
+        let b = self.bounds();
+        if !b.is_empty() && !(b.max - b.min).is_finite() {
+            let e = |v: Vec3| format!("({:e}, {:e}, {:e})", v.x, v.y, v.z);
+            return bad(format!(
+                "the geometry reaches from {} to {} m: its extent overflows single precision \
+                 (check the file's units and transforms)",
+                e(b.min),
+                e(b.max)
+            ));
+        }
         for (i, c) in self.cameras.iter().enumerate() {
             if !(c.position.is_finite()
                 && c.forward.is_finite()
@@ -449,41 +459,49 @@ impl Scene {
             .unwrap_or_else(|| Camera::viewing(self.swept_bounds()))
     }
 
-    /// The bounds of everything the scene draws at any time of its animations: what never
-    /// moves where it is, and what animations move at every pose they pass through (sampled
-    /// at `SWEEP_SAMPLES` + 1 times over the longest animation, as the box around each
-    /// instance's mesh bounds). Renderers place their volume around it.
+    /// The bounds renderers place their volume (and the default camera) around: everything
+    /// the scene draws at any time of its animations (`object_bounds`), but objects far
+    /// outside the rest (`bulk_bounds`' rule).
     pub fn swept_bounds(&self) -> Aabb {
+        self.bulk_bounds().0
+    }
+
+    /// Each drawn object's box (mesh instances, then point clouds) at any time of its
+    /// animations: where it never moves, its vertices' box; where an animation moves it, the
+    /// box around its mesh's box at every pose it passes through (sampled at `SWEEP_SAMPLES`
+    /// + 1 times over the longest animation). With each object's name.
+    pub fn object_bounds(&self) -> Vec<(String, Aabb)> {
         let animated = self.animated_instances();
-        let mut b = Aabb::EMPTY;
+        let mut out: Vec<(String, Aabb)> = Vec::new();
+        let mut sweep: Vec<(usize, usize, Aabb)> = Vec::new();
         for (i, inst) in self.instances.iter().enumerate() {
-            if animated.binary_search(&i).is_ok() {
+            let Some(mesh) = self.meshes.get(inst.mesh) else {
                 continue;
-            }
-            if let Some(mesh) = self.meshes.get(inst.mesh) {
+            };
+            let mut b = Aabb::EMPTY;
+            if animated.binary_search(&i).is_ok() {
+                for &p in &mesh.positions {
+                    b.grow(p);
+                }
+                sweep.push((out.len(), i, b));
+                b = Aabb::EMPTY;
+            } else {
                 for &p in &mesh.positions {
                     b.grow(inst.transform.transform_point3(p));
                 }
             }
+            out.push((inst.name.clone(), b));
         }
         for pc in &self.point_clouds {
+            let mut b = Aabb::EMPTY;
             for &p in &pc.positions {
                 b.grow(pc.transform.transform_point3(p));
             }
+            out.push((pc.name.clone(), b));
         }
-        if animated.is_empty() {
-            return b;
+        if sweep.is_empty() {
+            return out;
         }
-        let local: Vec<Aabb> = animated
-            .iter()
-            .map(|&i| {
-                let mut l = Aabb::EMPTY;
-                for &p in &self.meshes[self.instances[i].mesh].positions {
-                    l.grow(p);
-                }
-                l
-            })
-            .collect();
         let mut probe = Scene {
             instances: self.instances.clone(),
             lights: self.lights.clone(),
@@ -497,11 +515,105 @@ impl Scene {
             .fold(0.0f32, f32::max);
         for k in 0..=SWEEP_SAMPLES {
             probe.set_time(duration * k as f32 / SWEEP_SAMPLES as f32);
-            for (&i, l) in animated.iter().zip(&local) {
-                b = b.union(&l.transformed(probe.instances[i].transform));
+            for (o, i, local) in &sweep {
+                out[*o].1 = out[*o]
+                    .1
+                    .union(&local.transformed(probe.instances[*i].transform));
             }
         }
-        b
+        out
+    }
+
+    /// The box around the scene's objects (`object_bounds`) but those far outside the rest,
+    /// and the names of those left out. The rule: while the object farthest from the box of
+    /// the others lies more than `FAR_OUTSIDE` times that box's largest side away from it, it
+    /// is left out, up to a quarter of the objects. So a stray object kilometres (or 1e30 m)
+    /// from a room no longer spreads the room's voxels over the distance, and a scene whose
+    /// objects are all alike far apart keeps them all.
+    pub fn bulk_bounds(&self) -> (Aabb, Vec<String>) {
+        const FAR_OUTSIDE: f32 = 10.0;
+        let mut objects: Vec<(String, Aabb)> = self
+            .object_bounds()
+            .into_iter()
+            .filter(|(_, b)| !b.is_empty())
+            .collect();
+        let mut left_out = Vec::new();
+        let most = objects.len() / 4;
+        while left_out.len() < most && objects.len() > 1 {
+            // The box of all objects but i, from the unions before and after it.
+            let n = objects.len();
+            let mut before = vec![Aabb::EMPTY; n + 1];
+            let mut after = vec![Aabb::EMPTY; n + 1];
+            for i in 0..n {
+                before[i + 1] = before[i].union(&objects[i].1);
+                after[n - 1 - i] = after[n - i].union(&objects[n - 1 - i].1);
+            }
+            let gap = |i: usize| {
+                let others = before[i].union(&after[i + 1]);
+                let b = &objects[i].1;
+                let d = (others.min - b.max).max(b.min - others.max).max(Vec3::ZERO);
+                let side = (others.max - others.min)
+                    .max_element()
+                    .max(f32::MIN_POSITIVE);
+                d.length() / side
+            };
+            let (far, ratio) = (0..n)
+                .map(|i| (i, gap(i)))
+                .fold((0, 0.0f32), |a, b| if b.1 > a.1 { b } else { a });
+            if ratio.is_nan() || ratio <= FAR_OUTSIDE {
+                break;
+            }
+            left_out.push(objects.remove(far).0);
+        }
+        let bulk = objects.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b));
+        (bulk, left_out)
+    }
+
+    /// What the scene holds that can show nothing, one line each: a mesh instance whose
+    /// triangles have no area where it is placed (a zero scale, a degenerate mesh) and a point
+    /// cloud of several points all at one place. Front ends warn with these.
+    pub fn degenerate(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for inst in &self.instances {
+            let Some(m) = self.meshes.get(inst.mesh) else {
+                continue;
+            };
+            if m.indices.is_empty() {
+                continue;
+            }
+            // In single precision, as the GPU computes: a triangle of 1e-30 m sides has none.
+            let area: f32 = m
+                .indices
+                .chunks_exact(3)
+                .map(|t| {
+                    let [a, b, c] = [t[0], t[1], t[2]]
+                        .map(|i| inst.transform.transform_point3(m.positions[i as usize]));
+                    (b - a).cross(c - a).length() * 0.5
+                })
+                .sum();
+            if area.is_nan() || area <= 0.0 {
+                out.push(format!(
+                    "'{}': its {} triangles have no area where it is placed (a zero scale or a \
+                     degenerate mesh): it shows nothing",
+                    inst.name,
+                    m.indices.len() / 3
+                ));
+            }
+        }
+        for pc in &self.point_clouds {
+            let mut b = Aabb::EMPTY;
+            for &p in &pc.positions {
+                b.grow(pc.transform.transform_point3(p));
+            }
+            if pc.positions.len() > 1 && !b.is_empty() && b.max == b.min {
+                out.push(format!(
+                    "'{}': all its {} points lie at one place: it shows at most a dot",
+                    pc.name,
+                    pc.positions.len()
+                ));
+            }
+        }
+        out
     }
 
     /// The instances some animation moves, sorted, each once.

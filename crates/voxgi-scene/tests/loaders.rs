@@ -547,6 +547,7 @@ fn bad_inputs_fail_with_the_file_name() {
         ("toml light past the limit", "hotlight.toml", light("type = \"point\"\nintensity = 3e38\nposition = [0.0, 1.0, 0.0]").into_bytes(), "3e38 is more than 1e10"),
         ("toml area light past half floats", "hotarea.toml", light("type = \"area\"\nintensity = 1e5\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nshape = \"disc\"\nradius = 0.1").into_bytes(), "1e5 is more than 65504"),
         ("toml emission past half floats", "hotmat.toml", b"[[include]]\nbuiltin = \"cube\"\n[include.material]\nemissive = [1e30, 0.0, 0.0]\n".to_vec(), "65504"),
+        ("toml geometry past f32", "huge.toml", b"[[include]]\nbuiltin = \"cube\"\ntranslate = [3e38, 0.0, 0.0]\n[[include]]\nbuiltin = \"cube\"\ntranslate = [-3e38, 0.0, 0.0]\n".to_vec(), "reaches from (-3e38, -5e-1, -5e-1) to (3e38, 5e-1, 5e-1) m: its extent overflows single precision"),
         ("toml specular out of range", "spec.toml", b"[[include]]\nbuiltin = \"cornell-box\"\n[include.material]\nspecular = 2.0\n".to_vec(), "specular"),
         ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type '.xyz'"),
         ("no extension", "scene", b"whatever".to_vec(), "no file extension to tell its type by"),
@@ -1128,4 +1129,83 @@ fn ply_oddities_are_warned_about() {
     let exact = write(&dir, "exact.ply", head("ascii") + "0 0 0 0.5 0.5 0.5\n");
     let (scene, w) = load_warned(&exact);
     assert!(scene.is_ok() && w.is_empty(), "{w:?}");
+}
+
+/// The volume's box leaves out what lies far outside the rest (`Scene::bulk_bounds`): a stray
+/// cube a kilometre or 1e30 m from the Cornell box is left out by name, the box is the Cornell
+/// box's, and the default camera looks at it; objects alike far apart are all kept.
+#[test]
+fn the_bulk_leaves_out_what_lies_far_outside_the_rest() {
+    let room = builtin::cornell_box();
+    let room_box = room.bounds();
+    for x in [1e3f32, 1e30] {
+        let mut s = room.clone();
+        s.cameras.clear();
+        let cube = builtin::cube([0.5; 3]);
+        let i = s.add_mesh(
+            cube.meshes[0].clone(),
+            cube.materials[0].clone(),
+            Mat4::from_translation(Vec3::new(x, 0.0, 0.0)),
+        );
+        s.instances[i].name = "stray".into();
+        s.validate().unwrap();
+        let (bulk, left_out) = s.bulk_bounds();
+        assert_eq!(left_out, ["stray"], "at x = {x}");
+        assert_eq!(bulk, room_box, "at x = {x}");
+        let cam = s.default_camera();
+        assert!(cam.position.is_finite() && cam.position.distance(room_box.center()) < 10.0);
+    }
+    // Two rooms a kilometre apart: neither is a stray (at most a quarter of the objects go).
+    let mut two = room.clone();
+    let n = two.instances.len();
+    for i in 0..n {
+        let mut inst = two.instances[i].clone();
+        inst.transform = Mat4::from_translation(Vec3::new(1e3, 0.0, 0.0)) * inst.transform;
+        two.instances.push(inst);
+    }
+    let (bulk, left_out) = two.bulk_bounds();
+    assert!(left_out.is_empty(), "{left_out:?}");
+    assert!(bulk.max.x > 1e3);
+}
+
+/// Geometry that can show nothing is named: a zero scale, a triangle of 1e-30 m sides (its
+/// area underflows), a cloud of points all at one place; a sound scene names nothing.
+#[test]
+fn degenerate_geometry_is_named() {
+    assert!(builtin::cornell_box().degenerate().is_empty());
+    let mut s = builtin::cube([0.5; 3]);
+    s.instances[0].transform = Mat4::from_scale(Vec3::ZERO);
+    let d = s.degenerate();
+    assert!(
+        d.len() == 1 && d[0].contains("12 triangles have no area"),
+        "{d:?}"
+    );
+
+    let dir = tmp("degenerate");
+    let tiny = write(
+        &dir,
+        "tiny.obj",
+        "v 0 0 0\nv 1e-30 0 0\nv 0 1e-30 0\nf 1 2 3\n",
+    );
+    let d = io::load(&tiny).unwrap().degenerate();
+    assert!(
+        d.len() == 1 && d[0].contains("1 triangles have no area"),
+        "{d:?}"
+    );
+
+    let pc = PointCloud {
+        name: "dot".into(),
+        positions: vec![Vec3::ONE; 5],
+        colors: vec![[0.5; 3]; 5],
+        ..Default::default()
+    };
+    let s = voxgi_scene::Scene {
+        point_clouds: vec![pc],
+        ..Default::default()
+    };
+    let d = s.degenerate();
+    assert!(
+        d.len() == 1 && d[0].contains("all its 5 points lie at one place"),
+        "{d:?}"
+    );
 }

@@ -874,9 +874,10 @@ fn to_srgb8(img: &image::Rgba32FImage) -> Vec<u8> {
         .collect()
 }
 
-/// World-space bounds of everything drawn, never empty (a unit box for empty scenes).
+/// The sphere around the scene's bulk (`Scene::swept_bounds`), never empty (a unit sphere for
+/// empty scenes).
 pub fn scene_bounds(scene: &Scene) -> (Vec3, f32) {
-    bounding_sphere(scene.bounds())
+    bounding_sphere(scene.swept_bounds())
 }
 
 /// The sphere around `b` (centre, radius), never empty (a unit sphere for an empty box).

@@ -210,7 +210,22 @@ impl Renderer {
             GpuScene::new(device, queue, scene, options)
         })??;
         let state = SceneState::new(scene, &gpu_scene.instance_draw);
-        let bounds = scene.swept_bounds();
+        for d in scene.degenerate() {
+            log::warn!("{d}");
+        }
+        let (bounds, left_out) = scene.bulk_bounds();
+        if !left_out.is_empty() {
+            log::warn!(
+                "{} far outside the rest of the scene (more than 10 times its size away): the \
+                 voxels cover the rest, so {} no indirect light",
+                left_out.join(", "),
+                if left_out.len() == 1 {
+                    "it gets"
+                } else {
+                    "they get"
+                }
+            );
+        }
         let (center, radius) = bounding_sphere(bounds);
         let facts = SceneFacts {
             bounds,
