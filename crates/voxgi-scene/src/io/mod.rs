@@ -3,6 +3,8 @@
 pub mod atomic;
 pub mod cloud;
 pub mod emitters;
+#[doc(hidden)]
+pub mod fuzz;
 pub mod gltf;
 pub mod obj;
 pub mod ply;
