@@ -68,9 +68,13 @@ pub(super) fn open_window(
         ..Default::default()
     }))
     .with_context(|| format!("cannot open {}", info.name))?;
-    let (w, h) = args
+    let requested = args
         .size
         .unwrap_or(if cpu { (960, 480) } else { (1280, 720) });
+    let monitor = window
+        .current_monitor()
+        .map(|m| (m.size().width, m.size().height));
+    let (w, h) = fit_window(requested, monitor, device.limits().max_texture_dimension_2d)?;
     let _ = window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
     let size = window.inner_size();
     let caps = surface.get_capabilities(&adapter);
@@ -156,5 +160,68 @@ impl Viewer {
             self.config.present_mode = present_mode;
             self.surface.configure(&self.device, &self.config);
         }
+    }
+}
+
+/// The window size for `requested`: refused beyond what the device's textures hold (the frame
+/// is drawn into them), brought within the monitor's size (a window the screen cannot show
+/// is still drawn at full size every frame, minutes a frame on a CPU driver), kept otherwise.
+fn fit_window(
+    requested: (u32, u32),
+    monitor: Option<(u32, u32)>,
+    device_max: u32,
+) -> Result<(u32, u32)> {
+    let (w, h) = requested;
+    if w > device_max || h > device_max {
+        return Err(anyhow!(
+            "--size {w}x{h}: larger than this GPU's largest texture, {device_max}x{device_max}"
+        ));
+    }
+    match monitor {
+        Some((mw, mh)) if mw > 0 && mh > 0 && (w > mw || h > mh) => {
+            // Keep the aspect ratio.
+            let s = (mw as f64 / w as f64).min(mh as f64 / h as f64);
+            let fit = (
+                ((w as f64 * s) as u32).max(1),
+                ((h as f64 * s) as u32).max(1),
+            );
+            log::warn!(
+                "--size {w}x{h} is larger than the screen ({mw}x{mh}): opening {}x{} (render \
+                 larger images with `voxgi render`)",
+                fit.0,
+                fit.1
+            );
+            Ok(fit)
+        }
+        _ => Ok((w, h)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fit_window;
+
+    #[test]
+    fn the_window_fits_the_device_and_the_screen() {
+        assert_eq!(
+            fit_window((800, 600), Some((1920, 1080)), 8192).unwrap(),
+            (800, 600)
+        );
+        // 8192x8192 on a 1280x1024 screen: the largest square it shows.
+        assert_eq!(
+            fit_window((8192, 8192), Some((1280, 1024)), 16384).unwrap(),
+            (1024, 1024)
+        );
+        assert_eq!(
+            fit_window((4000, 1000), Some((2000, 2000)), 8192).unwrap(),
+            (2000, 500)
+        );
+        // No monitor known (some Wayland compositors): as asked, within the device.
+        assert_eq!(fit_window((3000, 2000), None, 8192).unwrap(), (3000, 2000));
+        let e = fit_window((20000, 100), Some((1920, 1080)), 16384).unwrap_err();
+        assert!(
+            e.to_string().contains("largest texture, 16384x16384"),
+            "{e}"
+        );
     }
 }
