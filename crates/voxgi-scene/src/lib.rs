@@ -36,6 +36,10 @@ pub mod limits {
     /// more than a saturated image (1e10 W/sr still saturates a white wall 400 m away), and
     /// far below where single-precision lighting overflows into NaN (about 1e30).
     pub const MAX_LIGHT: f32 = 1e10;
+    /// The largest side of the scene's bulk (`Scene::bulk_bounds`), m: a scene wider than a
+    /// million kilometres is in the wrong units (and squared distances in single precision
+    /// overflow past about 1e19).
+    pub const MAX_EXTENT: f32 = 1e9;
     /// Texture width or height: larger images are refused.
     pub const MAX_TEXTURE_DIM: u32 = 16384;
     /// Texture width or height kept in memory: larger PNGs are reduced while they are decoded
@@ -433,6 +437,7 @@ impl Scene {
                 e(b.max)
             ));
         }
+        self.checked_bulk()?;
         for (i, c) in self.cameras.iter().enumerate() {
             if !(c.position.is_finite()
                 && c.forward.is_finite()
@@ -522,6 +527,24 @@ impl Scene {
             }
         }
         out
+    }
+
+    /// `bulk_bounds`, refused where its largest side exceeds `limits::MAX_EXTENT`.
+    pub fn checked_bulk(&self) -> Result<(Aabb, Vec<String>)> {
+        let (b, left_out) = self.bulk_bounds();
+        let side = if b.is_empty() {
+            0.0
+        } else {
+            (b.max - b.min).max_element()
+        };
+        if side > limits::MAX_EXTENT {
+            return Err(SceneError::Invalid(format!(
+                "the scene spans {side:e} m, more than the {:e} m voxgi works with: check its \
+                 units and transforms",
+                limits::MAX_EXTENT
+            )));
+        }
+        Ok((b, left_out))
     }
 
     /// The box around the scene's objects (`object_bounds`) but those far outside the rest,

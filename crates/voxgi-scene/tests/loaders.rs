@@ -548,6 +548,7 @@ fn bad_inputs_fail_with_the_file_name() {
         ("toml area light past half floats", "hotarea.toml", light("type = \"area\"\nintensity = 1e5\nposition = [0.0, 1.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nshape = \"disc\"\nradius = 0.1").into_bytes(), "1e5 is more than 65504"),
         ("toml emission past half floats", "hotmat.toml", b"[[include]]\nbuiltin = \"cube\"\n[include.material]\nemissive = [1e30, 0.0, 0.0]\n".to_vec(), "65504"),
         ("toml geometry past f32", "huge.toml", b"[[include]]\nbuiltin = \"cube\"\ntranslate = [3e38, 0.0, 0.0]\n[[include]]\nbuiltin = \"cube\"\ntranslate = [-3e38, 0.0, 0.0]\n".to_vec(), "reaches from (-3e38, -5e-1, -5e-1) to (3e38, 5e-1, 5e-1) m: its extent overflows single precision"),
+        ("toml scene wider than voxgi works with", "wide.toml", b"[[include]]\nbuiltin = \"cube\"\nscale = 1e20\n".to_vec(), "the scene spans 1e20 m, more than the 1e9 m voxgi works with"),
         ("toml specular out of range", "spec.toml", b"[[include]]\nbuiltin = \"cornell-box\"\n[include.material]\nspecular = 2.0\n".to_vec(), "specular"),
         ("unknown extension", "scene.xyz", b"whatever".to_vec(), "unknown file type '.xyz'"),
         ("no extension", "scene", b"whatever".to_vec(), "no file extension to tell its type by"),

@@ -213,6 +213,7 @@ impl Renderer {
         for d in scene.degenerate() {
             log::warn!("{d}");
         }
+        // Its extent was checked by `validate`.
         let (bounds, left_out) = scene.bulk_bounds();
         if !left_out.is_empty() {
             log::warn!(
