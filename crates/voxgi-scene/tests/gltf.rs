@@ -785,6 +785,23 @@ fn bad_input_fails_with_the_file_name() {
             }),
             "larger than the 16384x16384 texture limit",
         ),
+        // Found by the fuzzer: the gltf crate's `Image::source` unwraps what these lack (the
+        // loader caught the panic, as "the glTF parser failed").
+        (
+            "image_without_source.gltf",
+            edited(|d| d["images"] = json!([{"uriextras": "data:image/png;base64,AAAA"}])),
+            "images[0]: neither a uri nor a bufferView",
+        ),
+        (
+            "image_view_without_mime.gltf",
+            edited(|d| d["images"] = json!([{"bufferView": 0}])),
+            "images[0]: an image in a buffer view needs a mimeType",
+        ),
+        (
+            "image_view_missing.gltf",
+            edited(|d| d["images"] = json!([{"bufferView": 9, "mimeType": "image/png"}])),
+            "images[0].bufferView: buffer view 9 does not exist",
+        ),
         (
             "stride_too_small.gltf",
             edited(|d| d["bufferViews"][0]["byteStride"] = json!(4)),

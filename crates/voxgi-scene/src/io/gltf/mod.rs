@@ -278,6 +278,27 @@ fn validate_json(root: &gltf::json::Root) -> R<()> {
             }
         }
     }
+    // `Image::source` unwraps these (a fuzzed file found it).
+    for (ii, im) in root.images.iter().enumerate() {
+        match (&im.buffer_view, &im.uri) {
+            (Some(v), _) if v.value() >= root.buffer_views.len() => {
+                return Err(format!(
+                    "images[{ii}].bufferView: buffer view {} does not exist ({} buffer views)",
+                    v.value(),
+                    root.buffer_views.len()
+                ));
+            }
+            (Some(_), _) if im.mime_type.is_none() => {
+                return Err(format!(
+                    "images[{ii}]: an image in a buffer view needs a mimeType"
+                ));
+            }
+            (None, None) => {
+                return Err(format!("images[{ii}]: neither a uri nor a bufferView"));
+            }
+            _ => {}
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, err| {
         let path = path();
