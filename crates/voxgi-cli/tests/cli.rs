@@ -740,35 +740,3 @@ fn every_output_on_a_full_disk_is_an_error_naming_the_file() {
         ]
     );
 }
-
-/// A failed render leaves an existing output untouched: the image is written beside it and
-/// renamed into place only when complete, so a reader never sees half a file either.
-#[test]
-fn an_output_is_replaced_whole_or_not_at_all() {
-    let out = tmp("replaced.png");
-    std::fs::write(&out, b"previous").unwrap();
-    // A scene that fails to load after the output path was checked.
-    let broken = tmp("broken.obj");
-    std::fs::write(&broken, "v 0 0 0\nf 1 2 3\n").unwrap();
-    let o = voxgi(&[
-        "render",
-        broken.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    assert_eq!(std::fs::read(&out).unwrap(), b"previous");
-    let o = voxgi(&[
-        "render",
-        "--builtin",
-        "cornell-box",
-        "--size",
-        "16x16",
-        "--accumulate",
-        "1",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(image::open(&out).unwrap().width(), 16);
-}

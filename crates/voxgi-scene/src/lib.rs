@@ -42,8 +42,8 @@ pub mod limits {
     pub const MAX_EXTENT: f32 = 1e9;
     /// Texture width or height: larger images are refused.
     pub const MAX_TEXTURE_DIM: u32 = 16384;
-    /// Texture width or height kept in memory: larger PNGs are reduced while they are decoded
-    /// (an RGBA8 texture of this size is 256 MiB), other formats refused.
+    /// Texture width or height kept in memory: larger images are reduced (an RGBA8 texture of
+    /// this size is 256 MiB), a PNG while it is decoded.
     pub const MAX_DECODED_DIM: u32 = 8192;
 }
 
@@ -471,6 +471,14 @@ impl Scene {
         self.bulk_bounds().0
     }
 
+    /// Everything the scene draws at any time of its animations, strays included
+    /// (`object_bounds`' union): what the camera's far plane must reach.
+    pub fn drawn_bounds(&self) -> Aabb {
+        self.object_bounds()
+            .iter()
+            .fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b))
+    }
+
     /// Each drawn object's box (mesh instances, then point clouds) at any time of its
     /// animations: where it never moves, its vertices' box; where an animation moves it, the
     /// box around its mesh's box at every pose it passes through (sampled at `SWEEP_SAMPLES`
@@ -550,9 +558,10 @@ impl Scene {
     /// The box around the scene's objects (`object_bounds`) but those far outside the rest,
     /// and the names of those left out. The rule: while the object farthest from the box of
     /// the others lies more than `FAR_OUTSIDE` times that box's largest side away from it, it
-    /// is left out, up to a quarter of the objects. So a stray object kilometres (or 1e30 m)
-    /// from a room no longer spreads the room's voxels over the distance, and a scene whose
-    /// objects are all alike far apart keeps them all.
+    /// is left out, up to a quarter of the objects, unless it is `FAR_OUTSIDE` times larger
+    /// than that box. So a stray object kilometres (or 1e30 m) from a room no longer spreads
+    /// the room's voxels over the distance, and a scene whose objects are all alike far apart
+    /// keeps them all.
     pub fn bulk_bounds(&self) -> (Aabb, Vec<String>) {
         const FAR_OUTSIDE: f32 = 10.0;
         let mut objects: Vec<(String, Aabb)> = self
@@ -574,10 +583,14 @@ impl Scene {
             let gap = |i: usize| {
                 let others = before[i].union(&after[i + 1]);
                 let b = &objects[i].1;
-                let d = (others.min - b.max).max(b.min - others.max).max(Vec3::ZERO);
                 let side = (others.max - others.min)
                     .max_element()
                     .max(f32::MIN_POSITIVE);
+                // An object far larger than the rest is the scene, not a stray.
+                if (b.max - b.min).max_element() > FAR_OUTSIDE * side {
+                    return 0.0;
+                }
+                let d = (others.min - b.max).max(b.min - others.max).max(Vec3::ZERO);
                 d.length() / side
             };
             let (far, ratio) = (0..n)
@@ -614,7 +627,8 @@ impl Scene {
                     (b - a).cross(c - a).length() * 0.5
                 })
                 .sum();
-            if area.is_nan() || area <= 0.0 {
+            // Not when the area overflowed (NaN: edges past 1e19 m, refused elsewhere).
+            if area == 0.0 {
                 out.push(format!(
                     "'{}': its {} triangles have no area where it is placed (a zero scale or a \
                      degenerate mesh): it shows nothing",

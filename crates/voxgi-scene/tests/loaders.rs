@@ -1146,7 +1146,7 @@ fn the_bulk_leaves_out_what_lies_far_outside_the_rest() {
         let i = s.add_mesh(
             cube.meshes[0].clone(),
             cube.materials[0].clone(),
-            Mat4::from_translation(Vec3::new(x, 0.0, 0.0)),
+            Mat4::from_translation(Vec3::new(x, 0.0, 0.0)) * Mat4::from_scale(Vec3::splat(0.1)),
         );
         s.instances[i].name = "stray".into();
         s.validate().unwrap();
@@ -1155,7 +1155,25 @@ fn the_bulk_leaves_out_what_lies_far_outside_the_rest() {
         assert_eq!(bulk, room_box, "at x = {x}");
         let cam = s.default_camera();
         assert!(cam.position.is_finite() && cam.position.distance(room_box.center()) < 10.0);
+        // What the far plane must reach still holds it.
+        assert!(s.drawn_bounds().max.x >= x);
     }
+    // A far larger object away from small ones is the scene, not a stray: a 10 m cube 1 km
+    // from 10 cm ones keeps them all.
+    let mut pair = builtin::cube([0.5; 3]);
+    pair.instances[0].transform = Mat4::from_scale(Vec3::splat(10.0));
+    let m = pair.meshes[0].clone();
+    let mat = pair.materials[0].clone();
+    for k in 0..3 {
+        pair.add_mesh(
+            m.clone(),
+            mat.clone(),
+            Mat4::from_translation(Vec3::new(1e3 + 0.01 * k as f32, 0.0, 0.0))
+                * Mat4::from_scale(Vec3::splat(0.1)),
+        );
+    }
+    let (_, left_out) = pair.bulk_bounds();
+    assert!(left_out.is_empty(), "{left_out:?}");
     // Two rooms a kilometre apart: neither is a stray (at most a quarter of the objects go).
     let mut two = room.clone();
     let n = two.instances.len();

@@ -874,10 +874,11 @@ fn to_srgb8(img: &image::Rgba32FImage) -> Vec<u8> {
         .collect()
 }
 
-/// The sphere around the scene's bulk (`Scene::swept_bounds`), never empty (a unit sphere for
-/// empty scenes).
-pub fn scene_bounds(scene: &Scene) -> (Vec3, f32) {
-    bounding_sphere(scene.swept_bounds())
+/// The sphere around everything the scene draws, strays included (`Scene::drawn_bounds`):
+/// the camera's far plane reaches past it, in the renderer and the path tracer alike. Never
+/// empty (a unit sphere for empty scenes).
+pub fn view_sphere(scene: &Scene) -> (Vec3, f32) {
+    bounding_sphere(scene.drawn_bounds())
 }
 
 /// The sphere around `b` (centre, radius), never empty (a unit sphere for an empty box).

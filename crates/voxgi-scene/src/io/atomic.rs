@@ -23,31 +23,69 @@ pub fn replace_with(
 
 /// Writes `path` through `write`, which gets the path to write to (for encoders that open the
 /// file themselves). A regular file (new or existing, also through a symbolic link) is written
-/// beside and renamed into place after an fsync; if anything fails the temporary file is
-/// removed and an existing file is left as it was. A device or pipe (`/dev/stdout`) is
-/// written in place, its errors returned all the same.
+/// beside and renamed into place after an fsync, keeping an existing file's permissions; if
+/// anything fails the temporary file is removed and an existing file is left as it was. A
+/// read-only file is an error. A device, a pipe or a path under `/dev` or `/proc`
+/// (`/dev/stdout`, which may lead to a redirected file) is written in place, its errors
+/// returned all the same.
 pub fn replace(path: &Path, write: impl FnOnce(&Path) -> io::Result<()>) -> io::Result<()> {
-    // Replace the file a link points to, not the link.
-    let target = fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    match fs::metadata(&target) {
-        Ok(m) if m.is_dir() => {
+    if path.starts_with("/dev") || path.starts_with("/proc") {
+        return write(path);
+    }
+    let target = resolve_links(path);
+    let existing = fs::metadata(&target).ok();
+    match &existing {
+        Some(m) if m.is_dir() => {
             return Err(io::Error::new(
                 io::ErrorKind::IsADirectory,
                 "is a directory",
             ));
         }
-        Ok(m) if !m.is_file() => return write(&target),
+        Some(m) if !m.is_file() => return write(&target),
+        Some(m) if m.permissions().readonly() => {
+            return Err(io::Error::new(
+                io::ErrorKind::PermissionDenied,
+                "the file is read-only",
+            ));
+        }
         _ => {}
     }
     let temp = temp_beside(&target);
     let result = write(&temp).and_then(|()| {
-        File::open(&temp)?.sync_all()?;
-        fs::rename(&temp, &target)
+        let f = fs::OpenOptions::new().write(true).open(&temp)?;
+        if let Some(m) = &existing {
+            f.set_permissions(m.permissions())?;
+        }
+        f.sync_all()?;
+        fs::rename(&temp, &target)?;
+        // The rename itself lasts once the directory is on the disk (best effort: not every
+        // platform opens directories).
+        if let Some(dir) = target.parent().and_then(|d| File::open(d).ok()) {
+            let _ = dir.sync_all();
+        }
+        Ok(())
     });
     if result.is_err() {
         let _ = fs::remove_file(&temp);
     }
     result
+}
+
+/// The file `path` names once symbolic links are followed, also when the last link dangles
+/// (then the file it would point to, which the write creates).
+fn resolve_links(path: &Path) -> PathBuf {
+    if let Ok(p) = fs::canonicalize(path) {
+        return p;
+    }
+    let mut p = path.to_path_buf();
+    // A chain of links, bounded as the kernel bounds it.
+    for _ in 0..40 {
+        match fs::read_link(&p) {
+            Ok(to) => p = p.parent().unwrap_or(Path::new(".")).join(to),
+            Err(_) => break,
+        }
+    }
+    p
 }
 
 /// A name in the target's directory that no other writer uses: hidden, with the process id
@@ -126,6 +164,37 @@ mod tests {
         }
         let err = replace_with(Path::new("/dev/full"), |w| w.write_all(&[0; 100_000])).unwrap_err();
         assert_eq!(err.raw_os_error(), Some(28), "{err}");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_dangling_link_creates_its_target_and_permissions_are_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("dangling");
+        let link = d.join("link.png");
+        std::os::unix::fs::symlink(d.join("made.png"), &link).unwrap();
+        replace_with(&link, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(fs::read(d.join("made.png")).unwrap(), b"new");
+        assert!(
+            fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+
+        let private = d.join("private.exr");
+        fs::write(&private, b"old").unwrap();
+        fs::set_permissions(&private, fs::Permissions::from_mode(0o600)).unwrap();
+        replace_with(&private, |w| w.write_all(b"new")).unwrap();
+        let mode = fs::metadata(&private).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o600);
+
+        // Read-only: refused (even for root, who could write it), the file as it was.
+        fs::set_permissions(&private, fs::Permissions::from_mode(0o444)).unwrap();
+        let e = replace_with(&private, |w| w.write_all(b"newer")).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::PermissionDenied);
+        assert_eq!(fs::read(&private).unwrap(), b"new");
+        fs::remove_dir_all(d).unwrap();
     }
 
     #[test]

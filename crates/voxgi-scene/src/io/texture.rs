@@ -1,6 +1,7 @@
 //! Decoding material textures with memory bounded by the texture limits: an image is refused
-//! above `MAX_TEXTURE_DIM`, kept as it is up to `MAX_DECODED_DIM`, and a PNG in between is
-//! reduced while it is decoded, row by row, so the full-size picture never exists in memory.
+//! above `MAX_TEXTURE_DIM`, kept as it is up to `MAX_DECODED_DIM`, and reduced in between: a
+//! PNG while it is decoded, row by row, so the full-size picture never exists in memory;
+//! another format (JPEG) once decoded in its own layout, without a full-size RGBA copy.
 //! (The renderer keeps at most its `max_texture_size` of each on the GPU.)
 
 use crate::limits::{MAX_DECODED_DIM, MAX_TEXTURE_DIM};
@@ -23,13 +24,10 @@ pub fn decode(bytes: &[u8], name: String) -> Result<Texture, String> {
         ));
     }
     if w.max(h) > MAX_DECODED_DIM {
-        if format != image::ImageFormat::Png {
-            return Err(format!(
-                "{w}x{h} is larger than {MAX_DECODED_DIM}x{MAX_DECODED_DIM}, and only a PNG \
-                 is reduced while it is decoded: save it smaller, or as a PNG"
-            ));
+        if format == image::ImageFormat::Png {
+            return decode_png_reduced(bytes, name, w, h);
         }
-        return decode_png_reduced(bytes, name, w, h);
+        return decode_reduced(bytes, name, w, h);
     }
     let mut reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
@@ -49,14 +47,62 @@ pub fn decode(bytes: &[u8], name: String) -> Result<Texture, String> {
     })
 }
 
-/// A PNG larger than `MAX_DECODED_DIM` reduced by the smallest power of two that brings it
-/// within, each texel the mean of its k×k block in linear light (alpha as it is), decoded row
-/// by row: memory holds one input row and one row of sums besides the result.
-fn decode_png_reduced(bytes: &[u8], name: String, w: u32, h: u32) -> Result<Texture, String> {
+/// The smallest power of two that brings `w` × `h` within `MAX_DECODED_DIM`.
+fn reduction(w: u32, h: u32) -> u32 {
     let mut k = 2u32;
     while w.max(h).div_ceil(k) > MAX_DECODED_DIM {
         k *= 2;
     }
+    k
+}
+
+/// An image of another format (JPEG) larger than `MAX_DECODED_DIM`: decoded whole in its own
+/// layout (at most `MAX_TEXTURE_DIM`² RGB, 768 MiB, for a JPEG), then reduced row by row as
+/// `decode_png_reduced` does, without a full-size RGBA copy.
+fn decode_reduced(bytes: &[u8], name: String, w: u32, h: u32) -> Result<Texture, String> {
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(u64::from(MAX_TEXTURE_DIM).pow(2) * 4);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| e.to_string())?;
+    let mut reduce = Reducer::new(w, h, reduction(w, h));
+    let mut rgba = vec![0u8; w as usize * 4];
+    let (src, channels) = match &img {
+        image::DynamicImage::ImageRgb8(b) => (b.as_raw().as_slice(), 3),
+        image::DynamicImage::ImageLuma8(b) => (b.as_raw().as_slice(), 1),
+        image::DynamicImage::ImageRgba8(b) => (b.as_raw().as_slice(), 4),
+        other => return Err(format!("{w}x{h} {:?}: too large to convert", other.color())),
+    };
+    for row in src.chunks_exact(w as usize * channels) {
+        for (px, o) in row.chunks_exact(channels).zip(rgba.chunks_exact_mut(4)) {
+            o.copy_from_slice(&match channels {
+                1 => [px[0], px[0], px[0], 255],
+                3 => [px[0], px[1], px[2], 255],
+                _ => [px[0], px[1], px[2], px[3]],
+            });
+        }
+        reduce.row(&rgba);
+    }
+    let (ow, oh, out) = reduce.finish();
+    log::warn!(
+        "texture {name}: {w}x{h} reduced to {ow}x{oh} (textures are kept at most \
+         {MAX_DECODED_DIM}x{MAX_DECODED_DIM})"
+    );
+    Ok(Texture {
+        name,
+        width: ow,
+        height: oh,
+        rgba8: out,
+    })
+}
+
+/// A PNG larger than `MAX_DECODED_DIM` reduced by the smallest power of two that brings it
+/// within, each texel the mean of its k×k block in linear light (alpha as it is), decoded row
+/// by row: memory holds one input row and one row of sums besides the result.
+fn decode_png_reduced(bytes: &[u8], name: String, w: u32, h: u32) -> Result<Texture, String> {
+    let k = reduction(w, h);
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::normalize_to_color8());
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
@@ -226,6 +272,30 @@ mod tests {
         assert_eq!((t.width, t.height), (MAX_DECODED_DIM / 2 + 1, 2));
         assert!(
             t.rgba8.chunks_exact(4).all(|p| p == [200, 200, 200, 255]),
+            "{:?}",
+            &t.rgba8[..8]
+        );
+    }
+
+    #[test]
+    fn a_jpeg_wider_than_kept_is_reduced_too() {
+        // A flat grey JPEG (JPEG keeps flat areas exact up to a step or two).
+        let (w, h) = (MAX_DECODED_DIM + 8, 16);
+        let mut b = Vec::new();
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut b, 95)
+            .encode(
+                &vec![120u8; (w * h) as usize],
+                w,
+                h,
+                image::ExtendedColorType::L8,
+            )
+            .unwrap();
+        let t = decode(&b, "wide.jpg".into()).unwrap();
+        assert_eq!((t.width, t.height), (MAX_DECODED_DIM / 2 + 4, 8));
+        assert!(
+            t.rgba8
+                .chunks_exact(4)
+                .all(|p| p[0].abs_diff(120) <= 2 && p[3] == 255),
             "{:?}",
             &t.rgba8[..8]
         );

@@ -119,13 +119,14 @@ fn at_moving_edge(px: vec2<u32>, moved: vec2<f32>) -> bool {
     return edge;
 }
 
-// The history at pos from only the texels that saw this pixel's surface, with tent weights
-// of the given radius: at a moving silhouette the others hold the surface that moved away.
+// The history at pos from only the texels within `radius` that saw this pixel's surface, with
+// tent weights: at a moving silhouette the others hold the surface that moved away.
 fn history_of_surface(pos: vec2<f32>, n: vec3<f32>, expected: f32, radius: f32) -> vec4<f32> {
     let q = vec2<i32>(floor(pos));
+    let reach = i32(ceil(radius));
     var sum = vec4<f32>(0.0);
-    for (var y = -1; y <= 1; y++) {
-        for (var x = -1; x <= 1; x++) {
+    for (var y = -reach; y <= reach; y++) {
+        for (var x = -reach; x <= reach; x++) {
             let t = q + vec2<i32>(x, y);
             let d = abs(vec2<f32>(t) + 0.5 - pos) / radius;
             let w = max(1.0 - d.x, 0.0) * max(1.0 - d.y, 0.0);

@@ -453,10 +453,14 @@ fn check_atlas(
     views: &[GpuShadowView],
     casts: &[bool],
     res: u32,
+    moments: bool,
     limits: &wgpu::Limits,
 ) -> Result<()> {
     let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
-    let bytes = res as u64 * res as u64 * layers as u64 * 4;
+    // The distance maps (R32Float), and with VSM/ESM filtering their moments (Rgba32Float),
+    // a texture of the same layers of its own.
+    let texel = if moments { 16 } else { 4 };
+    let bytes = res as u64 * res as u64 * layers as u64 * texel;
     let lights = casts.iter().filter(|&&c| c).count();
     let cause = if layers > limits.max_texture_array_layers {
         format!(
@@ -475,8 +479,8 @@ fn check_atlas(
     Err(Error::Setting(format!(
         "{lights} shadow-casting lights need {layers} shadow-map layers, {cause} (a point or \
          area light takes 6 layers, an area light 6 more for its sampled shadows with temporal \
-         accumulation, a spot or directional light 1): lower shadow_map_size or set \
-         cast_shadows = false on some lights"
+         accumulation, a spot or directional light 1): lower shadow_map_size, choose a \
+         shadow_filter other than vsm-esm, or set cast_shadows = false on some lights"
     )))
 }
 
@@ -700,10 +704,10 @@ pub fn plan_atlas(
     // Area-light shadows sampled over frames need the frames' accumulation.
     let samples = options.temporal;
     let (views, owners) = plan_views(&mut scene.gpu_lights, casts, center, radius, res, samples);
-    check_atlas(&views, casts, res, &device.limits())?;
+    let moments = options.shadow_filter == ShadowFilter::VsmEsm;
+    check_atlas(&views, casts, res, moments, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
-        let moments = options.shadow_filter == ShadowFilter::VsmEsm;
         ShadowAtlas::new(device, views, owners, res, moments, samples)
     })
 }

@@ -10,7 +10,7 @@
 
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, layout, readback, shader};
-use crate::gpu_scene::{GpuLight, GpuScene, NO_INDEX, check_light, gpu_light, scene_bounds};
+use crate::gpu_scene::{GpuLight, GpuScene, NO_INDEX, check_light, gpu_light, view_sphere};
 use crate::options::{FrameParams, RendererOptions};
 use crate::output::{RenderOutput, tonemap};
 use crate::view::lit_scene;
@@ -351,7 +351,7 @@ impl PathTracer {
         let scene = scene.as_ref();
         let device = device.clone();
         let queue = queue.clone();
-        let (center, radius) = scene_bounds(scene);
+        let (center, radius) = view_sphere(scene);
         let flat = flatten(scene);
         let depth = bvh_depth(&flat.nodes);
         if depth > MAX_BVH_DEPTH {

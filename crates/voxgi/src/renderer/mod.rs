@@ -134,8 +134,11 @@ pub struct Renderer {
     targets: Option<FrameTargets>,
     /// The temporal history's bookkeeping between frames.
     temporal: temporal::TemporalState,
+    /// The sphere around the scene's bulk: the voxels' and the shadow maps' domain.
     center: Vec3,
     radius: f32,
+    /// The sphere around everything drawn, strays included: the camera's far plane.
+    view: (Vec3, f32),
     default_camera: Camera,
     /// What option changes need from the scene, kept instead of the scene itself.
     facts: SceneFacts,
@@ -218,7 +221,8 @@ impl Renderer {
         if !left_out.is_empty() {
             log::warn!(
                 "{} far outside the rest of the scene (more than 10 times its size away): the \
-                 voxels cover the rest, so {} no indirect light",
+                 voxels and the shadow maps cover the rest, so {} no indirect light and \
+                 no shadows",
                 left_out.join(", "),
                 if left_out.len() == 1 {
                     "it gets"
@@ -323,6 +327,7 @@ impl Renderer {
             temporal: Default::default(),
             center,
             radius,
+            view: crate::gpu_scene::view_sphere(scene),
             default_camera,
             facts,
         })
