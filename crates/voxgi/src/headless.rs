@@ -249,20 +249,13 @@ struct Output {
 impl Output {
     fn new(ctx: &GpuContext, width: u32, height: u32) -> Result<Self> {
         crate::validate_size(width, height)?;
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("headless output"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: OUTPUT_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let texture = crate::frame::formats::texture_2d(
+            &ctx.device,
+            "headless output",
+            OUTPUT_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            (width, height),
+        );
         let view = texture.create_view(&Default::default());
         Ok(Output {
             texture,

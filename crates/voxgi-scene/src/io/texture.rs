@@ -29,13 +29,8 @@ pub fn decode(bytes: &[u8], name: String) -> Result<Texture, String> {
         }
         return decode_reduced(bytes, name, w, h);
     }
-    let mut reader = image::ImageReader::new(Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
-    let mut limits = image::Limits::default();
     // Room for the largest kept image at 16 bits per channel RGBA.
-    limits.max_alloc = Some(u64::from(MAX_DECODED_DIM).pow(2) * 8);
-    reader.limits(limits);
+    let reader = limited_reader(bytes, u64::from(MAX_DECODED_DIM).pow(2) * 8)?;
     // to_rgba8 converts any decoded layout (L8, LA8, RGB8, 16-bit, float) to RGBA8: grey is
     // replicated, missing alpha is opaque, wider channels are rescaled.
     let rgba = reader.decode().map_err(|e| e.to_string())?.to_rgba8();
@@ -45,6 +40,20 @@ pub fn decode(bytes: &[u8], name: String) -> Result<Texture, String> {
         height: rgba.height(),
         rgba8: rgba.into_raw(),
     })
+}
+
+/// A reader of `bytes` that allocates at most `max_alloc` bytes while decoding.
+fn limited_reader(
+    bytes: &[u8],
+    max_alloc: u64,
+) -> Result<image::ImageReader<Cursor<&[u8]>>, String> {
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(max_alloc);
+    reader.limits(limits);
+    Ok(reader)
 }
 
 /// The smallest power of two that brings `w` × `h` within `MAX_DECODED_DIM`.
@@ -60,13 +69,9 @@ fn reduction(w: u32, h: u32) -> u32 {
 /// layout (at most `MAX_TEXTURE_DIM`² RGB, 768 MiB, for a JPEG), then reduced row by row as
 /// `decode_png_reduced` does, without a full-size RGBA copy.
 fn decode_reduced(bytes: &[u8], name: String, w: u32, h: u32) -> Result<Texture, String> {
-    let mut reader = image::ImageReader::new(Cursor::new(bytes))
-        .with_guessed_format()
+    let img = limited_reader(bytes, u64::from(MAX_TEXTURE_DIM).pow(2) * 4)?
+        .decode()
         .map_err(|e| e.to_string())?;
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(u64::from(MAX_TEXTURE_DIM).pow(2) * 4);
-    reader.limits(limits);
-    let img = reader.decode().map_err(|e| e.to_string())?;
     let mut reduce = Reducer::new(w, h, reduction(w, h));
     let mut rgba = vec![0u8; w as usize * 4];
     let (src, channels) = match &img {
