@@ -259,6 +259,10 @@ pub struct DrawCall {
     /// The instance may move (`Instance::dynamic`): it is voxelized every frame it moved,
     /// apart from the static geometry, which is voxelized once.
     pub dynamic: bool,
+    /// Per triangle, its longest edge in metres as the instance is placed when the scene is
+    /// uploaded (rigid motion keeps it): how many voxel columns it can cover
+    /// (`fragments::triangle_table`). Empty for an area light's surface, which is not voxelized.
+    pub edges: Vec<f32>,
 }
 
 /// The scene's GPU buffers and textures, shared read-only by every pass, and the draw calls
@@ -411,6 +415,22 @@ pub fn gpu_light(l: &Light) -> GpuLight {
     g
 }
 
+/// The longest edge of each of `mesh`'s triangles placed by `transform`, in metres.
+fn longest_edges(mesh: &voxgi_scene::Mesh, transform: glam::Mat4) -> Vec<f32> {
+    let world: Vec<glam::Vec3> = mesh
+        .positions
+        .iter()
+        .map(|&p| transform.transform_point3(p))
+        .collect();
+    mesh.indices
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| world[i as usize]);
+            a.distance(b).max(b.distance(c)).max(c.distance(a))
+        })
+        .collect()
+}
+
 impl GpuScene {
     /// Uploads `scene`: flattens the meshes, makes one draw per instance, converts materials and
     /// lights, packs the point clouds, and builds the texture array (textures downsampled to
@@ -450,12 +470,18 @@ impl GpuScene {
                 continue;
             }
             instance_draw.push(Some(draws.len() as u32));
+            let edges = if inst.light.is_some() {
+                Vec::new()
+            } else {
+                longest_edges(mesh, inst.transform)
+            };
             calls.push(DrawCall {
                 indices: ranges[inst.mesh].0.clone(),
                 base_vertex: ranges[inst.mesh].1,
                 draw: draws.len() as u32,
                 light: inst.light,
                 dynamic: inst.dynamic,
+                edges,
             });
             draws.push(gpu_draw(inst.transform, mesh.material as u32, inst.light));
         }

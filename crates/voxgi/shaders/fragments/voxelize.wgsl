@@ -2,9 +2,9 @@
 //
 // Conservative and exact: a fragment is emitted for every voxel whose closed box the triangle
 // touches (Akenine-Moller's separating-axis test), so thin and axis-aligned triangles leave no
-// holes and the result does not depend on rasterization rules. One workgroup per triangle; its
-// threads share the triangle's columns along the dominant axis, where the triangle's plane
-// spans at most three voxels.
+// holes and the result does not depend on rasterization rules. One workgroup per table entry:
+// a triangle, or a share of a large one's columns along the dominant axis (where the
+// triangle's plane spans at most three voxels), which its threads divide.
 
 //!include shared/scene.wgsl
 //!include shared/fragment.wgsl
@@ -16,7 +16,8 @@
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 @group(0) @binding(6) var texture_sampler: sampler;
-// Per triangle: draw index, first index, base vertex, unused.
+// Per workgroup: draw index, first index, base vertex, and the share of the triangle's columns
+// (chunk | chunks << 16; 0: all of them).
 @group(0) @binding(7) var<storage, read> triangles: array<vec4<u32>>;
 @group(0) @binding(8) var<storage, read_write> fragments: array<Fragment>;
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
@@ -28,6 +29,8 @@
 // behind the surface (inside the solid), and the voxel behind it, inside, is filled wholly.
 // Static geometry fills every voxel it touches (a wall stays opaque whatever its thickness).
 override DYNAMIC_COVERAGE: bool = false;
+// Columns one table entry takes (`fragments::CHUNK_COLUMNS`); the last takes the rest.
+override CHUNK_COLUMNS: u32 = 32768u;
 
 // `surface`: how far the voxel's centre lies in front of the triangle's plane (voxels).
 fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emission: vec3<f32>, surface: f32) {
@@ -141,8 +144,12 @@ fn main(
     let nu = u32(hi[u] - lo[u] + 1);
     let nv = u32(hi[v] - lo[v] + 1);
     let total = nu * nv;
+    let chunk = info.w & 0xffffu;
+    let chunks = max(info.w >> 16u, 1u);
+    let begin = chunk * CHUNK_COLUMNS;
+    let end = select(min(total, begin + CHUNK_COLUMNS), total, chunk + 1u >= chunks);
     let d = dot(n, a);
-    for (var k = lane; k < total; k += 64u) {
+    for (var k = begin + lane; k < end; k += 64u) {
         let cu = lo[u] + i32(k % nu);
         let cv = lo[v] + i32(k / nu);
         // The plane's depth over the column's square (|n_w| is the largest component, so the

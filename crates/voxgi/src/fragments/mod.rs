@@ -235,22 +235,41 @@ impl FragmentEstimate {
     }
 }
 
-/// The triangles voxelize reads: per triangle, its draw, first index and base vertex.
+/// The triangles voxelize reads: per workgroup, a triangle's draw, first index and base
+/// vertex, and which share of its voxel columns the workgroup takes (`chunk | chunks << 16`).
 pub struct TriangleTable {
-    /// `[u32; 4]` per triangle (the fourth unused); one zero entry when empty.
+    /// `[u32; 4]` per workgroup; one zero entry when empty.
     pub buffer: wgpu::Buffer,
-    /// Triangles in the table.
+    /// Entries in the table (workgroups voxelize dispatches).
     pub count: u32,
     /// The dynamic instances' triangles (their fragments carry coverage), or the static ones'.
     pub dynamic: bool,
 }
 
-/// The triangle table of the static (`dynamic` false) or the dynamic instances. An error when
-/// the table would not fit one storage binding of this device.
+/// Voxel columns one voxelize workgroup takes at most (512 per thread). A CPU driver
+/// (llvmpipe) ends every loop of an invocation once they have run 65535 iterations in all,
+/// silently: one workgroup for a triangle over a 1024³ grid's whole floor made a fifth of its
+/// fragments. Larger triangles are split over several workgroups.
+pub const CHUNK_COLUMNS: u32 = 64 * 512;
+
+/// How many workgroups voxelize a triangle whose longest edge is `edge` metres on `grid`:
+/// its projection on the dominant plane fits a square of that side, so it covers at most
+/// `(edge / voxel + 2)²` columns. (A dynamic instance scaled up past its uploaded size makes
+/// the last workgroup take the rest.)
+pub fn chunks(edge: f32, grid: &Grid) -> u32 {
+    let side = (edge / grid.voxel_size).min(1e6) as f64 + 2.0;
+    ((side * side) / CHUNK_COLUMNS as f64)
+        .ceil()
+        .clamp(1.0, 65535.0) as u32
+}
+
+/// The triangle table of the static (`dynamic` false) or the dynamic instances on `grid`. An
+/// error when the table would not fit one storage binding of this device.
 pub fn triangle_table(
     device: &wgpu::Device,
     scene: &GpuScene,
     dynamic: bool,
+    grid: &Grid,
 ) -> Result<TriangleTable> {
     let mut t: Vec<[u32; 4]> = Vec::new();
     for call in scene.calls.iter().filter(|c| c.dynamic == dynamic) {
@@ -262,8 +281,11 @@ pub fn triangle_table(
         if call.light.is_some() {
             continue;
         }
-        for first in call.indices.clone().step_by(3) {
-            t.push([call.draw, first, call.base_vertex as u32, 0]);
+        for (first, &edge) in call.indices.clone().step_by(3).zip(&call.edges) {
+            let n = chunks(edge, grid);
+            for chunk in 0..n {
+                t.push([call.draw, first, call.base_vertex as u32, chunk | n << 16]);
+            }
         }
     }
     let n = t.len() as u32;
@@ -274,8 +296,8 @@ pub fn triangle_table(
     let limit = device.limits().max_storage_buffer_binding_size;
     if bytes > limit {
         return Err(Error::Setting(format!(
-            "the scene's {n} drawn triangles need a {} MiB voxelization table, more than this \
-             GPU's storage-buffer limit of {} MiB",
+            "the scene's drawn triangles need a {} MiB voxelization table ({n} workgroups), \
+             more than this GPU's storage-buffer limit of {} MiB",
             bytes >> 20,
             limit >> 20
         )));

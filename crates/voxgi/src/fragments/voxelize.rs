@@ -46,7 +46,10 @@ impl VoxelizePass {
                 "voxelize",
                 "fragments/voxelize.wgsl",
                 &layouts,
-                &[("DYNAMIC_COVERAGE", coverage)],
+                &[
+                    ("DYNAMIC_COVERAGE", coverage),
+                    ("CHUNK_COLUMNS", crate::fragments::CHUNK_COLUMNS as f64),
+                ],
             )
         };
         VoxelizePass {

@@ -11,6 +11,7 @@
 //! for everything, and no frame waits for the GPU.
 
 mod order;
+mod sizing;
 mod temporal;
 
 pub use temporal::STILL_FRAMES as TEMPORAL_STILL_FRAMES;
@@ -46,6 +47,7 @@ use crate::view::lit_scene;
 use crate::voxel::{Filtering, Grid, POOL_COUNTERS, StructureDesc, VoxelStructure};
 use crate::{Error, Result};
 use glam::Vec3;
+use sizing::Sizing;
 use updates::Pending;
 use voxgi_scene::{Aabb, Camera, Scene};
 use wgpu::util::DeviceExt;
@@ -281,10 +283,27 @@ impl Renderer {
         })?;
         let (static_triangles, dynamic_triangles) = checked(device, "voxelization table", || {
             Ok::<_, Error>((
-                triangle_table(device, &gpu_scene, false)?,
-                triangle_table(device, &gpu_scene, true)?,
+                triangle_table(device, &gpu_scene, false, &grid)?,
+                triangle_table(device, &gpu_scene, true, &grid)?,
             ))
         })??;
+        let mut fragments = fragments;
+        let mut built = false;
+        if sizing::in_doubt(device, &facts.estimate, &grid, volume.as_ref()) {
+            let sizing = Sizing {
+                device,
+                queue,
+                scene: &gpu_scene,
+                triangles: &static_triangles,
+                voxelize: &passes.voxelize,
+                splat: &passes.splat,
+            };
+            let (grown, whole) = sizing.fit(&fragments, &mut volume)?;
+            if let Some(f) = grown {
+                fragments = f;
+            }
+            built = whole;
+        }
         let brdf_tables = BrdfTables::new(device, queue);
         let voxel_bounces = voxel_bounce_count(facts.max_albedo, options);
         let cones = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -313,7 +332,10 @@ impl Renderer {
             dynamic_triangles,
             cones,
             voxel_bounces,
-            pending: Pending::everything(views),
+            pending: Pending {
+                built,
+                ..Pending::everything(views)
+            },
             progressive_left: 0,
             blend: None,
             blend_left: 0,
@@ -392,7 +414,7 @@ impl Renderer {
             None
         };
         // The fragments depend on the grid only: a change of anisotropy keeps their grown pool.
-        let fragments_new = if old.voxel_resolution != new.voxel_resolution {
+        let mut fragments_new = if old.voxel_resolution != new.voxel_resolution {
             Some(fragments::allocate(
                 device,
                 grid,
@@ -401,7 +423,18 @@ impl Renderer {
         } else {
             None
         };
-        let volume_new = if volume {
+        // Large triangles take more voxelize workgroups on a finer grid.
+        let tables_new = if fragments_new.is_some() {
+            Some(checked(device, "voxelization table", || {
+                Ok::<_, Error>((
+                    triangle_table(device, &self.scene, false, &grid)?,
+                    triangle_table(device, &self.scene, true, &grid)?,
+                ))
+            })??)
+        } else {
+            None
+        };
+        let mut volume_new = if volume {
             Some((new.voxels.info().create)(
                 device,
                 &self.facts.structure_desc(new, grid),
@@ -433,8 +466,33 @@ impl Renderer {
                     }),
                 )
             })?;
+        // Counted before anything is swapped in: an impossible resolution leaves the renderer
+        // as it was.
+        let mut built = false;
+        if let Some(v) = volume_new.as_mut()
+            && sizing::in_doubt(device, &self.facts.estimate, &grid, v.as_ref())
+        {
+            let sizing = Sizing {
+                device,
+                queue: &self.queue,
+                scene: &self.scene,
+                triangles: tables_new.as_ref().map_or(&self.static_triangles, |t| &t.0),
+                voxelize: &self.passes.voxelize,
+                splat: &self.passes.splat,
+            };
+            let (grown, whole) =
+                sizing.fit(fragments_new.as_ref().unwrap_or(&self.fragments), v)?;
+            if grown.is_some() {
+                fragments_new = grown;
+            }
+            built = whole;
+        }
         if let Some(a) = atlas_new {
             self.atlas = a;
+        }
+        if let Some((s, d)) = tables_new {
+            self.static_triangles = s;
+            self.dynamic_triangles = d;
         }
         let rebind = volume_new.is_some() || fragments_new.is_some();
         if let Some(f) = fragments_new {
@@ -488,6 +546,7 @@ impl Renderer {
         // A structure or an atlas made anew holds nothing yet, whatever the table says.
         if volume || atlas || changes == Some(Changes::Voxels) {
             self.invalidate();
+            self.pending.built = built;
         } else if changes == Some(Changes::Lighting) {
             self.pending.lights = true;
         }

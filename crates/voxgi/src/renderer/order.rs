@@ -368,7 +368,7 @@ impl Renderer {
             splat: (self.scene.geometry_points > 0)
                 .then(|| p.splat.bind(&self.device, &self.scene, &self.fragments)),
         });
-        if work.build.is_some() {
+        if work.build.is_some() && !pending.built {
             self.fragments.record_clear(encoder);
             p.voxelize
                 .record(encoder, &self.static_triangles, &fb.voxelize_static, timer);

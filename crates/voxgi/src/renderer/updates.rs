@@ -14,6 +14,9 @@ use voxgi_scene::{Aabb, Light};
 pub(super) struct Pending {
     /// Everything: the static geometry too, and every shadow view.
     pub(super) rebuild: bool,
+    /// The structure already holds the static geometry's build (counted before the first
+    /// frame, `sizing`): a rebuild skips voxelizing and building it again.
+    pub(super) built: bool,
     /// Dynamic geometry moved.
     pub(super) geometry: bool,
     /// A light changed.

@@ -123,6 +123,8 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
     fn pool_counter(&self) -> &wgpu::Buffer;
     /// Leaves the pools hold.
     fn leaf_capacity(&self) -> u64;
+    /// The most leaves its pools can hold on `device` (its storage-buffer limit).
+    fn leaf_limit(&self, device: &wgpu::Device) -> u64;
     /// Whether a build that counted `counted` (`pool_counter`'s words) overflowed a pool.
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool;
     /// Makes room for what a build counted; the contents are lost (the next build refills

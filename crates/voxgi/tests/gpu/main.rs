@@ -20,6 +20,7 @@ mod reference;
 mod registry;
 mod shaders;
 mod shadow_filter;
+mod sizing;
 mod temporal;
 mod vct;
 mod voxels;

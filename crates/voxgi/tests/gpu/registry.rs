@@ -102,6 +102,9 @@ impl VoxelStructure for StandIn {
     fn leaf_capacity(&self) -> u64 {
         self.inner.leaf_capacity()
     }
+    fn leaf_limit(&self, d: &voxgi::wgpu::Device) -> u64 {
+        self.inner.leaf_limit(d)
+    }
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
         self.inner.needs_growth(counted)
     }

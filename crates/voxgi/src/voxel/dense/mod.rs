@@ -816,6 +816,10 @@ impl VoxelStructure for DenseVolume {
         self.slot_capacity as u64
     }
 
+    fn leaf_limit(&self, device: &wgpu::Device) -> u64 {
+        crate::gpu::max_entries(device, SLOT_BYTES)
+    }
+
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
         counted[0] > self.slot_capacity
     }

@@ -90,7 +90,6 @@ fn create(
         Some(v) => v.pipelines.clone(),
         None => checked(device, "pipeline creation", || OctreePipelines::new(device))?,
     };
-    let l = device.limits();
     let guess = OctreePools::for_leaves(desc.leaves);
     log::info!(
         "octree: pools for an estimated {} leaves: {} leaf tiles, {} MiB of nodes",
@@ -98,11 +97,17 @@ fn create(
         guess.leaf_tiles,
         guess.node_bytes() >> 20
     );
-    let pools = guess.within(l.max_storage_buffer_binding_size.min(l.max_buffer_size));
+    let pools = guess.within(max_binding(device));
     let v = checked(device, "voxel octree", || {
         OctreeVolume::new(device, &p, desc.grid, desc.filtering, pools, desc.dynamic)
     })??;
     Ok(Box::new(v))
+}
+
+/// The largest buffer the octree may bind on `device`.
+fn max_binding(device: &wgpu::Device) -> u64 {
+    let l = device.limits();
+    l.max_storage_buffer_binding_size.min(l.max_buffer_size)
 }
 
 /// The sparse voxel octree: its node pool, leaf slots, brick atlases and bind groups.
@@ -527,6 +532,10 @@ impl VoxelStructure for OctreeVolume {
         self.pools.slots as u64
     }
 
+    fn leaf_limit(&self, device: &wgpu::Device) -> u64 {
+        max_binding(device) / (SLOT_WORDS * 4)
+    }
+
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
         self.pools.resized_for(counted).is_some()
     }
@@ -535,19 +544,31 @@ impl VoxelStructure for OctreeVolume {
         let Some(pools) = self.pools.resized_for(counted) else {
             return Ok(());
         };
-        let grown = crate::gpu::checked(device, "octree pools", || {
-            OctreeVolume::new(
-                device,
-                &self.pipelines,
-                self.grid,
-                Filtering {
-                    anisotropic: self.anisotropic,
-                    ndf: self.layout.ndf != 0,
-                },
-                pools,
-                self.snapshot.is_some(),
-            )
-        })??;
+        let make = |pools: OctreePools| {
+            crate::gpu::checked(device, "octree pools", || {
+                OctreeVolume::new(
+                    device,
+                    &self.pipelines,
+                    self.grid,
+                    Filtering {
+                        anisotropic: self.anisotropic,
+                        ndf: self.layout.ndf != 0,
+                    },
+                    pools,
+                    self.snapshot.is_some(),
+                )
+            })?
+        };
+        // Growing by half may pass a limit the counts themselves are within: then the counts
+        // (and an eighth) are tried, and their error is the one that names the real need.
+        let grown = make(pools).or_else(|e| {
+            let fitted = OctreePools::fitting(counted);
+            if fitted == pools {
+                Err(e)
+            } else {
+                make(fitted)
+            }
+        })?;
         *self = grown;
         Ok(())
     }

@@ -60,6 +60,17 @@ impl OctreePools {
             + (self.even_tiles as u64 + self.odd_tiles as u64) * (6 * brick + 8 * 16 + 8)
     }
 
+    /// Pools for what a build counted, and an eighth more.
+    pub fn fitting(counted: &[u32]) -> Self {
+        let need = |n: u32| n.saturating_add(n / 8).max(64);
+        OctreePools {
+            slots: need(counted[0]),
+            leaf_tiles: need(counted[1]),
+            even_tiles: need(counted[2]),
+            odd_tiles: need(counted[3]),
+        }
+    }
+
     /// The pools to make after a build that counted `counted` (`OctreeVolume::pool_counter`'s
     /// first four words), or None to keep these. A pool that overflowed hides what the levels
     /// below it would have needed, so every pool grows at least by half once one overflows.
@@ -68,13 +79,7 @@ impl OctreePools {
     pub fn resized_for(&self, counted: &[u32]) -> Option<Self> {
         let have = [self.slots, self.leaf_tiles, self.even_tiles, self.odd_tiles];
         if counted.iter().zip(have).all(|(&n, h)| n <= h) {
-            let need = |n: u32| n.saturating_add(n / 8).max(64);
-            let fit = OctreePools {
-                slots: need(counted[0]),
-                leaf_tiles: need(counted[1]),
-                even_tiles: need(counted[2]),
-                odd_tiles: need(counted[3]),
-            };
+            let fit = Self::fitting(counted);
             // Below a few MiB a shrink is not worth a rebuild.
             let oversized = self.bytes() > 2 * fit.bytes() && self.bytes() > 8 << 20;
             return oversized.then_some(fit);
