@@ -12,7 +12,7 @@ use voxgi::{FrameParams, RendererOptions, SceneSettings};
 
 #[derive(Args)]
 pub struct SceneArg {
-    /// Scene file: .gltf, .glb, .obj, .ply, .cloud or .toml.
+    /// Scene file: .gltf, .glb, .obj, .ply, .pcd, .cloud or .toml.
     #[arg(required_unless_present = "builtin", conflicts_with = "builtin")]
     pub scene: Option<PathBuf>,
     /// A built-in scene instead of a file: cornell-box, open-plane, closed-box, two-rooms,

@@ -158,10 +158,42 @@ shape = \"rect\"\nsize = [0.5, 0.5]\n[[animation]]\ntarget = \"cube\"\n\
 oscillate = { axis = [1.0, 0.0, 0.0], amplitude = 0.5, period = 2.0 }\n[camera]\n\
 position = [0.0, 1.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\n[settings]\nvoxel_resolution = 64\n"
         .to_vec();
+    let pcd_header = |data: &str| {
+        format!(
+            "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n\
+             WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA {data}\n"
+        )
+        .into_bytes()
+    };
+    let mut pcd_ascii = pcd_header("ascii");
+    pcd_ascii.extend(b"0 0 0 13120020\n1 0.5 nan 3296456\n");
+    let values: [[u32; 4]; 2] = [
+        [0, 0, 0, 0xc83214],
+        [1f32.to_bits(), 0.5f32.to_bits(), 0, 0x3214c8],
+    ];
+    let mut pcd_bin = pcd_header("binary");
+    pcd_bin.extend(values.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    // Fields one after another, compressed (or, too short for LZF, its literal runs).
+    let columns: Vec<u8> = (0..4)
+        .flat_map(|k| values.iter().flat_map(move |p| p[k].to_le_bytes()))
+        .collect();
+    let packed = lzf::compress(&columns).unwrap_or_else(|_| {
+        columns
+            .chunks(32)
+            .flat_map(|c| std::iter::once(c.len() as u8 - 1).chain(c.iter().copied()))
+            .collect()
+    });
+    let mut pcd_lzf = pcd_header("binary_compressed");
+    pcd_lzf.extend((packed.len() as u32).to_le_bytes());
+    pcd_lzf.extend((columns.len() as u32).to_le_bytes());
+    pcd_lzf.extend(&packed);
     vec![
         ("ply", ply_ascii),
         ("ply", ply_bin),
         ("obj", obj),
+        ("pcd", pcd_ascii),
+        ("pcd", pcd_bin),
+        ("pcd", pcd_lzf),
         ("cloud", cloud),
         ("gltf", gltf.into_bytes()),
         ("glb", glb),
@@ -232,7 +264,7 @@ fn mutated_files_load_or_fail_without_panicking() {
     // A seed must load as it is (a scene file whose includes lie beside it elsewhere does
     // not, once copied): its mutants would only test the missing include.
     seeds.retain(|(ext, d)| load_as(ext, d).is_ok());
-    assert!(seeds.len() >= 7, "{} seeds load", seeds.len());
+    assert!(seeds.len() >= 10, "{} seeds load", seeds.len());
     let quiet = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
     let mut rng = Rng(0x5eed_1234_abcd_0042);

@@ -17,7 +17,7 @@ use voxgi::scene::{Scene, builtin, io};
 #[derive(Parser, Debug, Clone)]
 #[command(name = "voxgi-viewer", version)]
 pub struct Args {
-    /// Scene file: .gltf, .glb, .obj, .ply, .cloud or .toml (or drop one onto the window).
+    /// Scene file: .gltf, .glb, .obj, .ply, .pcd, .cloud or .toml (or drop one onto the window).
     #[arg(conflicts_with = "builtin")]
     pub scene: Option<PathBuf>,
     /// A built-in scene instead: cornell-box, open-plane, closed-box, two-rooms, cube. Default

@@ -7,6 +7,7 @@ pub mod emitters;
 pub mod fuzz;
 pub mod gltf;
 pub mod obj;
+pub mod pcd;
 pub mod ply;
 pub mod scene_file;
 pub mod texture;
@@ -15,7 +16,7 @@ use crate::{Result, Scene, SceneError};
 use std::path::Path;
 
 /// File extensions `load` understands, for help texts and error messages.
-pub const EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "ply", "cloud", "toml"];
+pub const EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "ply", "pcd", "cloud", "toml"];
 
 /// Loads a scene file, choosing the loader by extension.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -49,6 +50,7 @@ pub fn load(path: &Path) -> Result<Scene> {
             emitters::promote_emissive_points(&mut s);
             s
         }
+        "pcd" => pcd::load(path)?,
         "cloud" => cloud::load(path)?,
         "toml" => scene_file::load(path)?,
         _ => {
