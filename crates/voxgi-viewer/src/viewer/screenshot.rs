@@ -144,8 +144,14 @@ impl Viewer {
                 ),
                 None => "too few frames to time: the first two build the voxels".into(),
             };
+            // The animation's time, to render the same instant again (`voxgi render --time`).
+            let time = if self.duration > 0.0 {
+                format!(", scene time {:.6} s", self.time)
+            } else {
+                String::new()
+            };
             eprintln!(
-                "wrote {} after {} frames ({timing})",
+                "wrote {} after {} frames ({timing}{time})",
                 path.display(),
                 self.frames
             );
