@@ -10,6 +10,23 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::{KeyCode, PhysicalKey};
 
+/// The keys the viewer binds (`key_pressed`, and flying's held keys).
+const VIEWER_KEYS: &[KeyCode] = &[
+    KeyCode::KeyF,
+    KeyCode::KeyH,
+    KeyCode::KeyG,
+    KeyCode::Space,
+    KeyCode::Tab,
+    KeyCode::F12,
+    KeyCode::KeyP,
+    KeyCode::KeyW,
+    KeyCode::KeyA,
+    KeyCode::KeyS,
+    KeyCode::KeyD,
+    KeyCode::KeyQ,
+    KeyCode::KeyE,
+];
+
 pub(super) enum Controller {
     Orbit(Orbit),
     Fly(Fly),
@@ -30,6 +47,29 @@ impl Viewer {
         event_loop: &ActiveEventLoop,
         event: WindowEvent,
     ) -> Result<()> {
+        // The viewer's keys are its own unless a text field is being typed in: egui would take
+        // Tab for moving the focus between widgets, and, once a button had the focus, every
+        // key after it, until the view was clicked.
+        if let WindowEvent::KeyboardInput { event: key, .. } = &event
+            && let PhysicalKey::Code(code) = key.physical_key
+            && VIEWER_KEYS.contains(&code)
+            && !self.egui_ctx.text_edit_focused()
+        {
+            if key.state == ElementState::Pressed {
+                if !key.repeat {
+                    self.key_pressed(code);
+                }
+                self.input.keys.insert(code);
+                self.egui_ctx.memory_mut(|m| {
+                    if let Some(id) = m.focused() {
+                        m.surrender_focus(id);
+                    }
+                });
+            } else {
+                self.input.keys.remove(&code);
+            }
+            return Ok(());
+        }
         let response = self.egui_state.on_window_event(&self.window, &event);
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
@@ -52,6 +92,11 @@ impl Viewer {
                     self.input.keys.remove(&code);
                 }
             }
+            // Over the panel the wheel scrolls it and a press is the panel's, whatever egui
+            // knew of the pointer at its last frame (a slow frame's was out of date, and the
+            // wheel zoomed the camera).
+            WindowEvent::MouseWheel { .. } | WindowEvent::MouseInput { .. }
+                if self.over_panel() => {}
             _ if response.consumed => {}
             // Presses only: releases were taken above.
             WindowEvent::KeyboardInput { event, .. } => {
@@ -94,6 +139,13 @@ impl Viewer {
             _ => {}
         }
         Ok(())
+    }
+
+    /// Whether the cursor is over the settings panel.
+    pub(super) fn over_panel(&self) -> bool {
+        self.input
+            .cursor
+            .is_some_and(|(x, _)| x < self.panel_px as f32)
     }
 
     /// Raw mouse motion: mouse look while flying with the left button held.

@@ -236,6 +236,12 @@ impl Viewer {
             .iter()
             .map(|a| a.duration())
             .fold(0.0f32, f32::max);
+        let panel_px = if args.screenshot.is_none() || args.with_ui {
+            ((panel::PANEL_WIDTH * window.scale_factor() as f32).round() as u32)
+                .min(window.inner_size().width)
+        } else {
+            0
+        };
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
             egui_ctx.clone(),
@@ -286,7 +292,9 @@ impl Viewer {
                 view: None,
                 shows: None,
             }),
-            panel_px: 0,
+            // Its width is fixed: known before the first frame lays it out, so that input
+            // arriving earlier (a wheel over where it will be) is the panel's too.
+            panel_px,
             reused: false,
             turntable: args.turntable,
             cpu,

@@ -12,7 +12,7 @@ use crate::settings::{PanelActions, frame_ui, options_ui};
 use std::path::PathBuf;
 
 /// The settings panel's width, points.
-const PANEL_WIDTH: f32 = 370.0;
+pub(super) const PANEL_WIDTH: f32 = 370.0;
 
 impl Viewer {
     pub(super) fn ui(&mut self, ui: &mut egui::Ui) -> PanelActions {
