@@ -147,7 +147,8 @@ impl Viewer {
     pub(super) fn set_display(&mut self, display: Display) {
         if display != Display::ConeTraced && self.playing {
             self.playing = false;
-            self.status = "paused: the path tracer shows a still scene".into();
+            self.toasts
+                .info("paused: the path tracer shows a still scene");
         }
         self.ground.display = display;
     }

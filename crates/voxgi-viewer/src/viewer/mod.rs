@@ -2,7 +2,8 @@
 //! fields and its creation. The viewer's work is spread over the child modules by job:
 //! `surface` (the device, the surface's configuration, resizing), `input` (keys and mouse to the
 //! camera controllers), `frame` (a frame's steps, the scene and the split view drawn into the
-//! window), `screenshot`, `panel` (the egui panel and the overlays), `stats` (frame and per-pass
+//! window), `screenshot`, `panel` (the egui panel and the overlays), `toasts` (messages over the
+//! view), `stats` (frame and per-pass
 //! times) and `open` (opening scenes, applying options, and the background work for both).
 
 mod frame;
@@ -12,6 +13,7 @@ mod panel;
 mod screenshot;
 mod stats;
 mod surface;
+mod toasts;
 
 use crate::Args;
 use crate::camera::Orbit;
@@ -177,7 +179,8 @@ struct Viewer {
     /// Frames drawn with nothing in the background (the path tracer built): what
     /// `--after-frames` counts, so a screenshot does not race a build.
     ready_frames: u32,
-    status: String,
+    /// Messages over the 3D view.
+    toasts: toasts::Toasts,
     show_panel: bool,
     // Screenshots.
     screenshot: Option<(PathBuf, u32)>,
@@ -307,7 +310,7 @@ impl Viewer {
             stats: Stats::new(),
             frames: 0,
             ready_frames: 0,
-            status: String::new(),
+            toasts: Default::default(),
             // A screenshot without the UI is of the whole window.
             show_panel: args.screenshot.is_none() || args.with_ui,
             screenshot: args

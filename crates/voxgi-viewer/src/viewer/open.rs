@@ -90,7 +90,7 @@ impl Viewer {
         self.ground.clear();
         self.stats.clear_passes();
         self.frame_scene();
-        self.status = format!("opened {}", o.path.display());
+        self.toasts.info(format!("opened {}", o.path.display()));
     }
 
     /// Applies the draft options: through `Renderer::set_options`, which rebuilds only what the
@@ -104,9 +104,9 @@ impl Viewer {
                     self.options = self.draft.clone();
                     self.stats.clear_passes();
                     self.version += 1;
-                    self.status = "options applied".into();
+                    self.toasts.info("options applied");
                 }
-                Err(e) => self.status = format!("the new options failed: {e:#}"),
+                Err(e) => self.toasts.error(format!("the new options failed: {e:#}")),
             }
             return;
         }
@@ -135,7 +135,7 @@ impl Viewer {
         self.options = options;
         self.stats.clear_passes();
         self.version += 1;
-        self.status = "options applied".into();
+        self.toasts.info("options applied");
     }
 
     /// Opens the system's file dialog on its own thread.
@@ -152,22 +152,21 @@ impl Viewer {
     pub(super) fn poll_jobs(&mut self) {
         match take(&mut self.rebuild) {
             Some(Ok((r, options))) => self.rebuilt(r, options),
-            Some(Err(e)) => self.status = format!("the new options failed: {e:#}"),
+            Some(Err(e)) => self.toasts.error(format!("the new options failed: {e:#}")),
             None => {}
         }
         match take(&mut self.opening) {
             Some(Ok(o)) => self.opened(o),
-            Some(Err(e)) => self.status = format!("{e:#}"),
+            Some(Err(e)) => self.toasts.error(format!("{e:#}")),
             None => {}
         }
         match take(&mut self.dialog) {
             Some(Ok(Some(path))) => self.open(&path),
-            Some(Ok(None)) => {
-                self.status = "no file chosen (the dialog needs xdg-desktop-portal or zenity; \
-                               a file dropped onto the window or a path typed above opens too)"
-                    .into()
-            }
-            Some(Err(e)) => self.status = format!("{e:#}"),
+            Some(Ok(None)) => self.toasts.info(
+                "no file chosen (the dialog needs xdg-desktop-portal or zenity; a file \
+                     dropped onto the window or a path typed in the panel opens too)",
+            ),
+            Some(Err(e)) => self.toasts.error(format!("{e:#}")),
             None => {}
         }
     }

@@ -53,9 +53,6 @@ impl Viewer {
                             actions.open = Some(PathBuf::from(self.open_path.trim()));
                         }
                     });
-                    if !self.status.is_empty() {
-                        ui.colored_label(egui::Color32::YELLOW, &self.status);
-                    }
                     ui.separator();
                     egui::CollapsingHeader::new("view")
                         .default_open(true)
@@ -191,6 +188,7 @@ impl Viewer {
     /// its sides.
     fn overlays_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
+        self.toasts.ui(&ctx);
         let mut running: Vec<String> = Vec::new();
         if let Some(job) = &self.rebuild {
             running.push(job.label());
@@ -324,7 +322,7 @@ impl Viewer {
                 // The path tracer takes the edit from `renderer.lights()` in its next update.
                 match self.renderer.set_light(i, &l) {
                     Ok(()) => self.ground.scene_changed(),
-                    Err(e) => self.status = format!("{e}"),
+                    Err(e) => self.toasts.error(format!("{e}")),
                 }
             }
         }

@@ -123,11 +123,13 @@ impl Viewer {
     pub(super) fn take_screenshots(&mut self, ui_capture: Option<wgpu::Texture>) -> Result<bool> {
         if self.screenshot_key {
             self.screenshot_key = false;
-            let path = PathBuf::from(format!("voxgi_{:05}.png", self.frames));
-            self.status = match self.save_screenshot(&path) {
-                Ok(()) => format!("wrote {}", path.display()),
-                Err(e) => format!("screenshot: {e:#}"),
-            };
+            let name = PathBuf::from(format!("voxgi_{:05}.png", self.frames));
+            // The whole path: the working directory is not on screen.
+            let path = std::path::absolute(&name).unwrap_or(name);
+            match self.save_screenshot(&path) {
+                Ok(()) => self.toasts.info(format!("wrote {}", path.display())),
+                Err(e) => self.toasts.error(format!("screenshot: {e:#}")),
+            }
         }
         if let Some((path, after)) = &self.screenshot
             && self.ready_frames >= *after
