@@ -3,6 +3,7 @@
 //! between them, or to a scene's own camera, keeps the view.
 
 use glam::Vec3;
+use std::time::Instant;
 use voxgi::scene::{Camera, Projection};
 
 /// Radians of turn per pixel of mouse motion.
@@ -109,6 +110,65 @@ pub struct Movement {
     pub forward: f32,
 }
 
+/// How long each fly key was held between frames, from the key events' arrival: flying covers
+/// the time the keys were down whatever the frame rate (per-frame steps capped for slow frames
+/// made a 3 s press move 0.18 m at 1 frame a second).
+#[derive(Debug, Default)]
+pub struct HeldKeys {
+    /// Per direction (right, up, forward; negative keys apart): when a held key went down or
+    /// the last frame took its time, whichever is later.
+    since: [[Option<Instant>; 2]; 3],
+    /// Seconds each was held since the last frame, for keys released since.
+    held: [[f32; 2]; 3],
+}
+
+/// Longest a frame's flight: a stall of the whole window does not throw the camera far.
+pub const LONGEST_STEP: f32 = 1.0;
+
+impl HeldKeys {
+    /// The key for `axis` (0 right, 1 up, 2 forward) in direction `positive` went down at `t`.
+    pub fn press(&mut self, axis: usize, positive: bool, t: Instant) {
+        let s = &mut self.since[axis][positive as usize];
+        if s.is_none() {
+            *s = Some(t);
+        }
+    }
+
+    /// It went up at `t`.
+    pub fn release(&mut self, axis: usize, positive: bool, t: Instant) {
+        let k = positive as usize;
+        if let Some(t0) = self.since[axis][k].take() {
+            self.held[axis][k] += t.saturating_duration_since(t0).as_secs_f32();
+        }
+    }
+
+    /// The movement since the last frame, at `t`: which way, and for how many seconds (at most
+    /// `LONGEST_STEP`), for `Fly::step`.
+    pub fn take(&mut self, t: Instant) -> (Movement, f32) {
+        let mut secs = [0.0f32; 3];
+        for (axis, s) in secs.iter_mut().enumerate() {
+            for k in 0..2 {
+                let mut h = std::mem::take(&mut self.held[axis][k]);
+                if let Some(t0) = &mut self.since[axis][k] {
+                    h += t.saturating_duration_since(*t0).as_secs_f32();
+                    *t0 = t;
+                }
+                *s += if k == 1 { h } else { -h };
+            }
+        }
+        let longest = secs.iter().fold(0.0f32, |m, s| m.max(s.abs()));
+        if longest == 0.0 {
+            return (Movement::default(), 0.0);
+        }
+        let m = Movement {
+            right: secs[0] / longest,
+            up: secs[1] / longest,
+            forward: secs[2] / longest,
+        };
+        (m, longest.min(LONGEST_STEP))
+    }
+}
+
 /// A free camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fly {
@@ -185,6 +245,46 @@ mod tests {
 
     fn close(a: Vec3, b: Vec3) -> bool {
         (a - b).abs().max_element() < 1e-4
+    }
+
+    #[test]
+    fn flying_covers_the_time_a_key_was_held_at_any_frame_rate() {
+        let t0 = Instant::now();
+        let at = |s: f32| t0 + std::time::Duration::from_secs_f32(s);
+        let cam = Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 60.0);
+        // W held for 3 s across frames a second apart, then one frame after its release.
+        let mut f = Fly::from_camera(&cam, 2.0);
+        let mut keys = HeldKeys::default();
+        keys.press(2, true, at(0.1));
+        for frame in 1..=3 {
+            let (m, dt) = keys.take(at(frame as f32));
+            f.step(m, dt);
+        }
+        keys.release(2, true, at(3.1));
+        let (m, dt) = keys.take(at(4.0));
+        f.step(m, dt);
+        assert!(
+            close(f.position, Vec3::new(0.0, 0.0, -6.0)),
+            "{}",
+            f.position
+        );
+        assert_eq!(keys.take(at(5.0)).1, 0.0, "nothing held after the release");
+        // W and D together for 0.5 s: half a second's flight, diagonally.
+        let mut f = Fly::from_camera(&cam, 2.0);
+        keys.press(2, true, at(10.0));
+        keys.press(0, true, at(10.0));
+        keys.release(2, true, at(10.5));
+        keys.release(0, true, at(10.5));
+        let (m, dt) = keys.take(at(10.6));
+        f.step(m, dt);
+        let d = 1.0 / 2f32.sqrt();
+        assert!(close(f.position, Vec3::new(d, 0.0, -d)), "{}", f.position);
+        // A 5 s stall with S held moves at most `LONGEST_STEP` seconds' worth.
+        let mut f = Fly::from_camera(&cam, 2.0);
+        keys.press(2, false, at(20.0));
+        let (m, dt) = keys.take(at(25.0));
+        f.step(m, dt);
+        assert!(close(f.position, Vec3::new(0.0, 0.0, 2.0 * LONGEST_STEP)));
     }
 
     #[test]

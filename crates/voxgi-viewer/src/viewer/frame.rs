@@ -25,7 +25,7 @@ impl Viewer {
     pub(super) fn redraw(&mut self) -> Result<bool> {
         self.poll_jobs();
         let dt = self.time_frame();
-        self.move_camera(dt);
+        self.move_camera();
         self.update_scene(dt)?;
 
         let Some(frame) = self.surface_texture()? else {

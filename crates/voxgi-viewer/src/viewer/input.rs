@@ -2,10 +2,11 @@
 //! raw mouse motion, the key bindings, and the camera controllers (orbit and fly) they drive.
 
 use super::Viewer;
-use crate::camera::{Fly, Movement, Orbit};
+use crate::camera::{Fly, HeldKeys, Orbit};
 use crate::ground_truth::Display;
 use anyhow::Result;
 use std::collections::HashSet;
+use std::time::Instant;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::{KeyCode, PhysicalKey};
@@ -25,7 +26,24 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::KeyD,
     KeyCode::KeyQ,
     KeyCode::KeyE,
+    KeyCode::ArrowUp,
+    KeyCode::ArrowDown,
+    KeyCode::ArrowLeft,
+    KeyCode::ArrowRight,
 ];
+
+/// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
+fn fly_key(code: KeyCode) -> Option<(usize, bool)> {
+    Some(match code {
+        KeyCode::KeyD | KeyCode::ArrowRight => (0, true),
+        KeyCode::KeyA | KeyCode::ArrowLeft => (0, false),
+        KeyCode::KeyE => (1, true),
+        KeyCode::KeyQ => (1, false),
+        KeyCode::KeyW | KeyCode::ArrowUp => (2, true),
+        KeyCode::KeyS | KeyCode::ArrowDown => (2, false),
+        _ => return None,
+    })
+}
 
 pub(super) enum Controller {
     Orbit(Orbit),
@@ -36,6 +54,8 @@ pub(super) enum Controller {
 #[derive(Default)]
 pub(super) struct Input {
     keys: HashSet<KeyCode>,
+    /// How long the fly keys were held.
+    fly: HeldKeys,
     left_down: bool,
     right_down: bool,
     cursor: Option<(f32, f32)>,
@@ -55,9 +75,13 @@ impl Viewer {
             && VIEWER_KEYS.contains(&code)
             && !self.egui_ctx.text_edit_focused()
         {
+            let now = Instant::now();
             if key.state == ElementState::Pressed {
                 if !key.repeat {
                     self.key_pressed(code);
+                }
+                if let Some((axis, positive)) = fly_key(code) {
+                    self.input.fly.press(axis, positive, now);
                 }
                 self.input.keys.insert(code);
                 self.egui_ctx.memory_mut(|m| {
@@ -66,6 +90,9 @@ impl Viewer {
                     }
                 });
             } else {
+                if let Some((axis, positive)) = fly_key(code) {
+                    self.input.fly.release(axis, positive, now);
+                }
                 self.input.keys.remove(&code);
             }
             return Ok(());
@@ -76,6 +103,15 @@ impl Viewer {
             WindowEvent::Resized(size) => self.resize(size),
             WindowEvent::RedrawRequested if self.redraw()? => event_loop.exit(),
             WindowEvent::DroppedFile(path) => self.open(&path),
+            // Keys released while another window had the keyboard never arrive here.
+            WindowEvent::Focused(false) => {
+                let now = Instant::now();
+                for code in std::mem::take(&mut self.input.keys) {
+                    if let Some((axis, positive)) = fly_key(code) {
+                        self.input.fly.release(axis, positive, now);
+                    }
+                }
+            }
             // A release always ends a drag or a held key, even over the panel: swallowed, it
             // would leave the camera turning or flying.
             WindowEvent::MouseInput {
@@ -182,19 +218,12 @@ impl Viewer {
         }
     }
 
-    /// The frame's camera motion, `dt` seconds of it: flying with the held keys, or the
-    /// orbit's turntable turn.
-    pub(super) fn move_camera(&mut self, dt: f32) {
+    /// The frame's camera motion: flying for as long as the keys were held since the last
+    /// frame, or the orbit's turntable turn.
+    pub(super) fn move_camera(&mut self) {
+        let (movement, secs) = self.input.fly.take(Instant::now());
         if let Controller::Fly(f) = &mut self.controller {
-            let k = |c: KeyCode| self.input.keys.contains(&c) as i32 as f32;
-            f.step(
-                Movement {
-                    right: k(KeyCode::KeyD) - k(KeyCode::KeyA),
-                    up: k(KeyCode::KeyE) - k(KeyCode::KeyQ),
-                    forward: k(KeyCode::KeyW) - k(KeyCode::KeyS),
-                },
-                dt,
-            );
+            f.step(movement, secs);
         }
         if let Controller::Orbit(o) = &mut self.controller
             && self.turntable != 0.0

@@ -189,6 +189,19 @@ impl Viewer {
     fn overlays_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.toasts.ui(&ctx);
+        if let Controller::Fly(f) = &self.controller {
+            let left = self.panel_px as f32 / ctx.pixels_per_point();
+            egui::Area::new(egui::Id::unique("fly"))
+                .anchor(egui::Align2::LEFT_TOP, [left + 8.0, 8.0])
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        ui.label(format!(
+                            "flying at {:.2} m/s · WASD or arrows, Q/E down/up · wheel: speed                              · drag: look · F: orbit",
+                            f.speed
+                        ))
+                    });
+                });
+        }
         let mut running: Vec<String> = Vec::new();
         if let Some(job) = &self.rebuild {
             running.push(job.label());
