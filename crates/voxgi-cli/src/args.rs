@@ -16,7 +16,7 @@ pub struct SceneArg {
     #[arg(required_unless_present = "builtin", conflicts_with = "builtin")]
     pub scene: Option<PathBuf>,
     /// A built-in scene instead of a file: cornell-box, open-plane, closed-box, two-rooms,
-    /// cube.
+    /// cube, point-cave.
     #[arg(long, value_name = "NAME")]
     pub builtin: Option<String>,
 }

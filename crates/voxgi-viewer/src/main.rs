@@ -20,8 +20,8 @@ pub struct Args {
     /// Scene file: .gltf, .glb, .obj, .ply, .pcd, .cloud or .toml (or drop one onto the window).
     #[arg(conflicts_with = "builtin")]
     pub scene: Option<PathBuf>,
-    /// A built-in scene instead: cornell-box, open-plane, closed-box, two-rooms, cube. Default
-    /// cornell-box when no file is given.
+    /// A built-in scene instead: cornell-box, open-plane, closed-box, two-rooms, cube,
+    /// point-cave. Default cornell-box when no file is given.
     #[arg(long, value_name = "NAME")]
     pub builtin: Option<String>,
     /// Window size in pixels. Default 1280x720 on a GPU, 960x480 on a CPU driver (the 3D view

@@ -171,6 +171,9 @@ fn parse_header(bytes: &[u8]) -> std::result::Result<Header, String> {
                             names[i], ty as char
                         ));
                     }
+                    if counts[i] == 0 {
+                        return Err(format!("field '{}': COUNT 0", names[i]));
+                    }
                     if counts[i] > 1 << 16 {
                         return Err(format!(
                             "field '{}': COUNT {} is more than {}",
@@ -291,10 +294,11 @@ pub fn parse(bytes: &[u8], name: &str, file: &str) -> std::result::Result<Scene,
                 );
             }
             let mut at = 0;
+            // Point p's field at `at + p * record`, within `need` for p < n (none for n = 0).
             h.fields
                 .iter()
                 .map(|f| {
-                    let c = (&body[at..need], record);
+                    let c = (body.get(at..need).unwrap_or_default(), record);
                     at += f.bytes();
                     c
                 })
@@ -592,6 +596,11 @@ mod tests {
         assert!(err(&bomb).contains("more than LZF expands to"));
         assert!(err(b"ply\nformat ascii 1.0\n").contains("not a PCD header keyword"));
         assert!(err(b"FIELDS x y z\n").contains("without a DATA line"));
+        // Fuzzing finding: binary data of no points sliced its fields past the end.
+        let none = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 0\nDATA binary\n";
+        assert!(err(none.as_bytes()).contains("contains no points"));
+        let zero = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 0 1\nPOINTS 1\nDATA ascii\n1 2\n";
+        assert!(err(zero.as_bytes()).contains("COUNT 0"));
         let text = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 two 3\n";
         assert!(err(text.as_bytes()).contains("line 6: 'two' (y) is not a number"));
     }

@@ -233,7 +233,8 @@ impl Viewer {
         }
         let screen = ctx.content_rect();
         let caption = |ui: &mut egui::Ui, text: String| {
-            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(text));
+            // One line: a caption wrapped onto three hid the image under it.
+            egui::Frame::popup(ui.style()).show(ui, |ui| ui.add(egui::Label::new(text).extend()));
         };
         match self.ground.display {
             Display::ConeTraced => {}
@@ -312,18 +313,26 @@ impl Viewer {
             if l.kind == voxgi::scene::LightKind::Directional {
                 ui.horizontal(|ui| {
                     ui.label("direction");
-                    for c in 0..3 {
+                    for (c, axis) in ["x ", "y ", "z "].into_iter().enumerate() {
                         changed |= ui
-                            .add(egui::DragValue::new(&mut l.direction[c]).speed(0.01))
+                            .add(
+                                egui::DragValue::new(&mut l.direction[c])
+                                    .speed(0.01)
+                                    .prefix(axis),
+                            )
                             .changed();
                     }
                 });
             } else {
                 ui.horizontal(|ui| {
                     ui.label("position");
-                    for c in 0..3 {
+                    for (c, axis) in ["x ", "y ", "z "].into_iter().enumerate() {
                         changed |= ui
-                            .add(egui::DragValue::new(&mut l.position[c]).speed(step))
+                            .add(
+                                egui::DragValue::new(&mut l.position[c])
+                                    .speed(step)
+                                    .prefix(axis),
+                            )
                             .changed();
                     }
                 });

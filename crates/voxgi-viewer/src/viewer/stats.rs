@@ -72,13 +72,13 @@ impl Viewer {
                 }
             }
             // A pass that did not run this frame (the voxel passes of a still scene) took 0 ms
-            // of it: the means are per frame, not per run.
+            // of it: the means are per frame, not per run. A frame shown again ran none: the
+            // bars keep the frames that drew (they all fell to 0.00 ms, hiding the real cost).
             for (name, v) in pass_ms {
-                let ms = times
-                    .iter()
-                    .find(|(n, _)| n == name)
-                    .map_or(0.0, |(_, ms)| *ms);
-                push(v, ms as f32);
+                let ms = times.iter().find(|(n, _)| n == name).map(|(_, ms)| *ms);
+                if ms.is_some() || !self.reused {
+                    push(v, ms.unwrap_or(0.0) as f32);
+                }
             }
         }
         Ok(())
@@ -107,10 +107,17 @@ impl Viewer {
             .iter()
             .flat_map(|(_, v)| v.iter().copied())
             .fold(1e-3f32, f32::max);
+        let width = self
+            .stats
+            .pass_ms
+            .iter()
+            .map(|(n, _)| n.chars().count())
+            .max()
+            .unwrap_or(0);
         for (name, v) in &self.stats.pass_ms {
             ui.horizontal(|ui| {
                 ui.label(
-                    egui::RichText::new(format!("{name:<12} {:>7.2} ms", mean(v))).monospace(),
+                    egui::RichText::new(format!("{name:<width$} {:>7.2} ms", mean(v))).monospace(),
                 );
                 let (rect, _) =
                     ui.allocate_exact_size(egui::vec2(120.0, 14.0), egui::Sense::hover());
@@ -137,10 +144,16 @@ impl Viewer {
         let memory = self.renderer.memory();
         let total: u64 = memory.iter().map(|(_, b)| b).sum();
         ui.label(format!("GPU memory {:.1} MiB", total as f64 / 1048576.0));
-        for (name, bytes) in memory.iter().filter(|(_, b)| *b >= 1 << 16) {
+        let shown: Vec<_> = memory.iter().filter(|(_, b)| *b >= 1 << 16).collect();
+        let width = shown
+            .iter()
+            .map(|(n, _)| n.chars().count())
+            .max()
+            .unwrap_or(0);
+        for (name, bytes) in shown {
             ui.label(
                 egui::RichText::new(format!(
-                    "  {name:<28} {:>8.2} MiB",
+                    "  {name:<width$} {:>8.2} MiB",
                     *bytes as f64 / 1048576.0
                 ))
                 .monospace()

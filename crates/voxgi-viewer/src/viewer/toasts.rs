@@ -72,12 +72,14 @@ impl Toasts {
                     egui::Frame::popup(ui.style()).fill(fill).show(ui, |ui| {
                         ui.set_max_width(420.0);
                         ui.horizontal(|ui| {
-                            ui.add(
-                                egui::Label::new(
-                                    egui::RichText::new(&t.text).color(egui::Color32::WHITE),
-                                )
-                                .wrap(),
-                            );
+                            // A message of several lines (a TOML error with its caret under
+                            // the column) keeps its columns in a fixed-width font.
+                            let text = egui::RichText::new(&t.text).color(egui::Color32::WHITE);
+                            if t.text.contains('\n') {
+                                ui.add(egui::Label::new(text.monospace()).extend());
+                            } else {
+                                ui.add(egui::Label::new(text).wrap());
+                            }
                             if t.error && ui.small_button("×").clicked() {
                                 dismiss = Some(i);
                             }
