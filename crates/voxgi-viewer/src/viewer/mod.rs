@@ -240,8 +240,9 @@ impl Viewer {
             .map(|a| a.duration())
             .fold(0.0f32, f32::max);
         let panel_px = if args.screenshot.is_none() || args.with_ui {
-            ((panel::PANEL_WIDTH * window.scale_factor() as f32).round() as u32)
-                .min(window.inner_size().width)
+            let scale = window.scale_factor() as f32;
+            let points = window.inner_size().width as f32 / scale;
+            ((panel::panel_width(points) * scale).round() as u32).min(window.inner_size().width)
         } else {
             0
         };

@@ -11,8 +11,15 @@ use crate::ground_truth::Display;
 use crate::settings::{PanelActions, frame_ui, options_ui};
 use std::path::PathBuf;
 
-/// The settings panel's width, points.
+/// The settings panel's width, points, in a window wide enough for it.
 pub(super) const PANEL_WIDTH: f32 = 370.0;
+
+/// The panel's width in a window `window` points wide: `PANEL_WIDTH`, or 40 % of a window
+/// too narrow to leave the picture 60 % beside it (at least 240 points, where the sliders
+/// still fit).
+pub(super) fn panel_width(window: f32) -> f32 {
+    PANEL_WIDTH.min(0.4 * window).max(240.0)
+}
 
 impl Viewer {
     pub(super) fn ui(&mut self, ui: &mut egui::Ui) -> PanelActions {
@@ -23,9 +30,11 @@ impl Viewer {
             return actions;
         }
         // A fixed width: a panel that followed its content would resize the 3D view (and
-        // restart the path tracer) whenever a label grew.
+        // restart the path tracer) whenever a label grew. A narrow window gets a narrower one
+        // (370 points of a 560-point window left 190 for the picture).
+        let width = panel_width(ui.ctx().content_rect().width());
         let panel = egui::Panel::left("settings")
-            .exact_size(PANEL_WIDTH)
+            .exact_size(width)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     ui.heading(&self.scene_name);
