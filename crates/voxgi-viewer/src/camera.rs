@@ -47,7 +47,18 @@ pub struct Orbit {
     pub pitch: f32,
     pub fov: f32,
     pub znear: f32,
+    /// An orthographic view: parallel rays, the target's plane as high as the perspective
+    /// view shows it (so toggling keeps its size).
+    pub ortho: bool,
 }
+
+/// The views `Orbit::view_along` offers, Blender's numpad keys' (1, 3, 7): along -Z (the front),
+/// -X (the right side), -Y (the top).
+pub const PRESETS: [(&str, Vec3); 3] = [
+    ("front", Vec3::NEG_Z),
+    ("right", Vec3::NEG_X),
+    ("top", Vec3::NEG_Y),
+];
 
 impl Orbit {
     /// The orbit that sees what `camera` sees, about the point `distance` ahead of it.
@@ -61,7 +72,14 @@ impl Orbit {
             pitch,
             fov: fov_degrees(camera),
             znear: camera.znear,
+            ortho: matches!(camera.projection, Projection::Orthographic { .. }),
         }
+    }
+
+    /// Looks along `dir` at the same target from the same distance (straight down stops short
+    /// of the pole, as a drag does).
+    pub fn view_along(&mut self, dir: Vec3) {
+        (self.yaw, self.pitch) = angles(dir);
     }
 
     pub fn eye(&self) -> Vec3 {
@@ -98,6 +116,11 @@ impl Orbit {
         let mut c = Camera::look_at(self.eye(), self.target, self.fov);
         c.name = "viewer".into();
         c.znear = self.znear.min(self.distance * 0.5).max(1e-5);
+        if self.ortho {
+            let ymag = self.distance * (self.fov.to_radians() * 0.5).tan();
+            // The image's aspect sets the width (`voxgi::view`).
+            c.projection = Projection::Orthographic { xmag: ymag, ymag };
+        }
         c
     }
 }
@@ -285,6 +308,32 @@ mod tests {
         let (m, dt) = keys.take(at(25.0));
         f.step(m, dt);
         assert!(close(f.position, Vec3::new(0.0, 0.0, 2.0 * LONGEST_STEP)));
+    }
+
+    #[test]
+    fn presets_look_along_their_axes_and_orthographic_keeps_the_size() {
+        let cam = Camera::look_at(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.5, 0.0), 60.0);
+        let mut o = Orbit::from_camera(&cam, 2.0);
+        let target = o.target;
+        for (name, dir) in PRESETS {
+            o.view_along(dir);
+            let c = o.camera();
+            assert!(
+                c.forward.dot(dir) > 0.999,
+                "{name}: looks along {}",
+                c.forward
+            );
+            assert!(close(o.target, target) && (o.eye() - target).length() - 2.0 < 1e-4);
+        }
+        o.ortho = true;
+        // The target's plane is as high as in perspective: 2 × 2 m × tan 30°.
+        match o.camera().projection {
+            Projection::Orthographic { ymag, .. } => {
+                assert!((2.0 * ymag - 4.0 * 30f32.to_radians().tan()).abs() < 1e-5)
+            }
+            p => panic!("{p:?}"),
+        }
+        assert!(Orbit::from_camera(&o.camera(), 2.0).ortho);
     }
 
     #[test]

@@ -30,6 +30,14 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::ArrowDown,
     KeyCode::ArrowLeft,
     KeyCode::ArrowRight,
+    KeyCode::Digit1,
+    KeyCode::Digit3,
+    KeyCode::Digit5,
+    KeyCode::Digit7,
+    KeyCode::Numpad1,
+    KeyCode::Numpad3,
+    KeyCode::Numpad5,
+    KeyCode::Numpad7,
 ];
 
 /// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
@@ -177,6 +185,32 @@ impl Viewer {
         Ok(())
     }
 
+    /// The orbit (from the view as it is, when flying) looking along preset `i`
+    /// (`camera::PRESETS`).
+    pub(super) fn view_preset(&mut self, i: usize) {
+        let mut o = self.orbit();
+        o.view_along(crate::camera::PRESETS[i].1);
+        self.controller = Controller::Orbit(o);
+        // A cut to another view: nothing of the last view's history belongs in it.
+        self.renderer.reset_history();
+    }
+
+    /// Switches between the perspective and the orthographic view (an orbit's).
+    pub(super) fn toggle_ortho(&mut self) {
+        let mut o = self.orbit();
+        o.ortho = !o.ortho;
+        self.controller = Controller::Orbit(o);
+        self.renderer.reset_history();
+    }
+
+    /// The orbit, or one that sees what the fly camera sees.
+    fn orbit(&self) -> Orbit {
+        match &self.controller {
+            Controller::Orbit(o) => o.clone(),
+            Controller::Fly(f) => Orbit::from_camera(&f.camera(), self.scene_radius),
+        }
+    }
+
     /// Whether the cursor is over the settings panel.
     pub(super) fn over_panel(&self) -> bool {
         self.input
@@ -211,6 +245,10 @@ impl Viewer {
                 let i = Display::ALL.iter().position(|d| *d == self.ground.display);
                 self.set_display(Display::ALL[(i.unwrap_or(0) + 1) % Display::ALL.len()]);
             }
+            KeyCode::Digit1 | KeyCode::Numpad1 => self.view_preset(0),
+            KeyCode::Digit3 | KeyCode::Numpad3 => self.view_preset(1),
+            KeyCode::Digit7 | KeyCode::Numpad7 => self.view_preset(2),
+            KeyCode::Digit5 | KeyCode::Numpad5 => self.toggle_ortho(),
             KeyCode::Space => self.playing = !self.playing,
             KeyCode::Tab => self.show_panel = !self.show_panel,
             KeyCode::F12 | KeyCode::KeyP => self.screenshot_key = true,

@@ -44,8 +44,8 @@ impl Viewer {
                     ));
                     ui.label(
                         "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
-                         to look) · H: frame · G: path tracer / split · Space: play · \
-                         P: screenshot · Tab: panel",
+                         to look) · H: frame · 1/3/7: front/right/top · 5: orthographic · \
+                         G: path tracer / split · Space: play · P: screenshot · Tab: panel",
                     );
                     ui.horizontal(|ui| {
                         if ui.button("Open…").clicked() {
@@ -67,6 +67,27 @@ impl Viewer {
                         .default_open(true)
                         .show(ui, |ui| {
                             frame_ui(ui, &mut self.params, self.options.voxel_levels());
+                            ui.horizontal(|ui| {
+                                for (i, (name, _)) in crate::camera::PRESETS.iter().enumerate() {
+                                    let key = ["1", "3", "7"][i];
+                                    if ui
+                                        .button(*name)
+                                        .on_hover_text(format!("key {key}"))
+                                        .clicked()
+                                    {
+                                        self.view_preset(i);
+                                    }
+                                }
+                                let ortho =
+                                    matches!(&self.controller, Controller::Orbit(o) if o.ortho);
+                                if ui
+                                    .selectable_label(ortho, "orthographic")
+                                    .on_hover_text("key 5")
+                                    .clicked()
+                                {
+                                    self.toggle_ortho();
+                                }
+                            });
                             let flags = render_flags(&self.params.camera);
                             ui.horizontal(|ui| {
                                 if ui.button("copy view as voxgi render flags").clicked() {
