@@ -273,8 +273,9 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
     let dir = std::env::temp_dir().join(format!("voxgi_viewer_keys_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("keys.png");
-    let viewer = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
+    let mut viewer = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
         .env("DISPLAY", &x.display)
+        .env("RUST_LOG", "voxgi_viewer=info")
         .args(["--builtin", "cornell-box", "--size", "640x360", "--with-ui"])
         .args([
             "--screenshot",
@@ -285,18 +286,33 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("run voxgi-viewer");
-    let started = std::time::Instant::now();
-    let window = loop {
-        let w = x.xdotool(&["search", "--name", "voxgi"]);
-        if let Some(w) = w.lines().next().filter(|w| !w.is_empty()) {
-            break w.to_string();
+    // The input goes in once the viewer shows its first frame (it logs it): before, the
+    // window shows the renderer being made, and the panel is not there to scroll.
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stderr = viewer.stderr.take().expect("piped");
+    let log = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = String::new();
+        for line in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            if line.contains("first frame shown") {
+                let _ = tx.send(());
+            }
+            all += &line;
+            all.push('\n');
         }
-        assert!(
-            started.elapsed().as_secs() < 120,
-            "no viewer window after 2 minutes"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(200));
-    };
+        all
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(180))
+        .expect("no first frame within 3 minutes");
+    let window = x.xdotool(&["search", "--name", "voxgi"]);
+    let window = window
+        .lines()
+        .next()
+        .expect("the viewer's window")
+        .to_string();
     // Without a window manager nothing gives the window the keyboard.
     x.xdotool(&["windowfocus", "--sync", &window]);
     // The wheel up (zoom in) five times over the panel, then Tab, then G (the path tracer).
@@ -307,9 +323,9 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
     x.xdotool(&["mousemove", "--window", &window, "500", "200"]);
     x.xdotool(&["key", "Tab"]);
     x.xdotool(&["key", "g"]);
-    let out = viewer.wait_with_output().expect("voxgi-viewer");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "voxgi-viewer failed:\n{stderr}");
+    let status = viewer.wait().expect("voxgi-viewer");
+    let stderr = log.join().expect("the log");
+    assert!(status.success(), "voxgi-viewer failed:\n{stderr}");
     let img = image::open(&png).expect("the screenshot").to_rgb8();
     // The panel hidden and the camera where it was: left of the box (the image spans the
     // window) the background is black; the panel there would be grey with text, and a

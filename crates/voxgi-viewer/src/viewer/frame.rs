@@ -46,6 +46,12 @@ impl Viewer {
         );
         let ui_capture = self.capture_with_ui(&mut encoder, &ui)?;
         self.present(encoder, frame, ui);
+        if let Some(t) = self.opened.take() {
+            log::info!(
+                "first frame shown {:.2} s after the window opened",
+                t.elapsed().as_secs_f32()
+            );
+        }
         self.record_pass_times()?;
         self.count_frame();
 

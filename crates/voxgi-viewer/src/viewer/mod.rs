@@ -11,6 +11,7 @@ mod input;
 mod open;
 mod panel;
 mod screenshot;
+mod starting;
 mod stats;
 mod surface;
 mod toasts;
@@ -22,20 +23,24 @@ use crate::jobs::Job;
 use anyhow::Result;
 use input::{Controller, Input};
 use open::Opened;
+use starting::Starting;
 use stats::Stats;
 use std::path::PathBuf;
 use std::sync::Arc;
 use voxgi::scene::Scene;
 use voxgi::{FrameParams, Renderer, RendererOptions, SceneSettings, wgpu};
 use winit::application::ApplicationHandler;
+use winit::event::StartCause;
 use winit::event::{DeviceEvent, WindowEvent};
-use winit::event_loop::ActiveEventLoop;
+use winit::event_loop::{ActiveEventLoop, ControlFlow};
 use winit::window::{Window, WindowId};
 
 /// The winit application: opens the window on `resumed`, then hands events to the `Viewer`.
 pub struct App {
     args: Args,
     scene: Option<(Scene, Option<SceneSettings>)>,
+    /// The window while its first renderer is made.
+    starting: Option<Starting>,
     viewer: Option<Viewer>,
     error: Option<anyhow::Error>,
 }
@@ -45,6 +50,7 @@ impl App {
         App {
             args,
             scene: Some(scene),
+            starting: None,
             viewer: None,
             error: None,
         }
@@ -62,23 +68,85 @@ impl App {
         self.error = Some(e);
         event_loop.exit();
     }
+
+    /// An event while the renderer is made: the progress frame, a resize, closing; the viewer
+    /// once the renderer is there.
+    fn starting_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
+        let Some(s) = self.starting.as_mut() else {
+            return;
+        };
+        let _ = s.egui_state.on_window_event(&s.gpu.window, &event);
+        match event {
+            WindowEvent::KeyboardInput { .. } => s.keys.push(event),
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => s.resize(size),
+            WindowEvent::RedrawRequested => match s.job.poll() {
+                None => {
+                    let (name, label) = (scene_label(&s.scene), s.job.label());
+                    if let Err(e) = s.redraw(&name, &label) {
+                        self.fail(event_loop, e);
+                    }
+                }
+                Some(made) => {
+                    // Shown while the first frame builds the voxels (GPU work that no frame
+                    // can interrupt).
+                    let name = scene_label(&s.scene);
+                    let shown = s.redraw(
+                        &name,
+                        "voxelizing the scene and lighting the voxels for the first frame …",
+                    );
+                    let mut s = self.starting.take().expect("checked above");
+                    let keys = std::mem::take(&mut s.keys);
+                    let viewer = shown.and(made).and_then(|r| Viewer::new(&self.args, s, r));
+                    match viewer.and_then(|mut v| {
+                        for k in keys {
+                            v.window_event(event_loop, k)?;
+                        }
+                        Ok(v)
+                    }) {
+                        Ok(v) => {
+                            v.window.request_redraw();
+                            self.viewer = Some(v);
+                        }
+                        Err(e) => self.fail(event_loop, e),
+                    }
+                }
+            },
+            _ => {}
+        }
+    }
 }
 
 impl ApplicationHandler for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.viewer.is_some() {
+        if self.viewer.is_some() || self.starting.is_some() {
             return;
         }
         let Some(scene) = self.scene.take() else {
             return;
         };
-        match Viewer::new(event_loop, &self.args, scene) {
-            Ok(v) => self.viewer = Some(v),
+        match Viewer::start(event_loop, &self.args, scene) {
+            Ok(s) => self.starting = Some(s),
             Err(e) => self.fail(event_loop, e),
         }
     }
 
+    fn new_events(&mut self, _: &ActiveEventLoop, cause: StartCause) {
+        // While the renderer is made, a progress frame ten times a second (`about_to_wait`).
+        if let Some(s) = &self.starting
+            && matches!(
+                cause,
+                StartCause::ResumeTimeReached { .. } | StartCause::Init
+            )
+        {
+            s.gpu.window.request_redraw();
+        }
+    }
+
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        if self.starting.is_some() {
+            return self.starting_event(event_loop, event);
+        }
         let Some(v) = self.viewer.as_mut() else {
             return;
         };
@@ -105,8 +173,14 @@ impl ApplicationHandler for App {
         }
     }
 
-    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
-        if let Some(v) = &self.viewer {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self.starting.is_some() {
+            // Not every loop: the thread making the renderer needs the CPU more.
+            event_loop.set_control_flow(ControlFlow::WaitUntil(
+                std::time::Instant::now() + std::time::Duration::from_millis(100),
+            ));
+        } else if let Some(v) = &self.viewer {
+            event_loop.set_control_flow(ControlFlow::Wait);
             v.window.request_redraw();
         }
     }
@@ -186,14 +260,86 @@ struct Viewer {
     screenshot: Option<(PathBuf, u32)>,
     screenshot_ui: bool,
     screenshot_key: bool,
+    /// When the window opened, until the first frame is shown.
+    opened: Option<std::time::Instant>,
 }
 
 impl Viewer {
-    fn new(
+    /// Opens the window and starts making the renderer for `scene` on a thread.
+    fn start(
         event_loop: &ActiveEventLoop,
         args: &Args,
         (scene, settings): (Scene, Option<SceneSettings>),
-    ) -> Result<Self> {
+    ) -> Result<Starting> {
+        let gpu = surface::open_window(event_loop, args, &scene_label(&scene))?;
+        let opened = std::time::Instant::now();
+        let cpu = gpu.cpu;
+        let mut options = RendererOptions {
+            // A CPU driver stays usable at half resolution.
+            half_resolution: cpu,
+            voxel_resolution: if cpu { 64 } else { 128 },
+            ..RendererOptions::default()
+        };
+        let mut scene = scene;
+        scene.set_time(0.0);
+        let mut params = FrameParams::new(scene.default_camera());
+        if let Some(s) = &settings {
+            s.apply(&mut options, &mut params)?;
+        }
+        let scene = Arc::new(scene);
+        let job = {
+            let (device, queue) = (gpu.device.clone(), gpu.queue.clone());
+            let (scene, options) = (scene.clone(), options.clone());
+            Job::spawn(
+                "uploading the scene and building the pipelines",
+                move || Ok(Renderer::new(&device, &queue, &scene, &options)?),
+            )
+        };
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &gpu.window,
+            Some(gpu.window.scale_factor() as f32),
+            None,
+            Some(gpu.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(
+            &gpu.device,
+            gpu.config.format,
+            egui_wgpu::RendererOptions::default(),
+        );
+        Ok(Starting {
+            gpu,
+            scene,
+            options,
+            params,
+            job,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            opened,
+            keys: Vec::new(),
+        })
+    }
+
+    /// The viewer over `renderer`, made for what `start` opened.
+    fn new(args: &Args, start: Starting, mut renderer: Renderer) -> Result<Self> {
+        let Starting {
+            gpu,
+            scene,
+            options,
+            params,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            opened,
+            ..
+        } = start;
+        log::info!(
+            "renderer made {:.2} s after the window opened",
+            opened.elapsed().as_secs_f32()
+        );
         let surface::Gpu {
             window,
             surface,
@@ -205,22 +351,8 @@ impl Viewer {
             timestamps,
             keeps_image,
             watch,
-        } = surface::open_window(event_loop, args, &scene_label(&scene))?;
-
-        let mut options = RendererOptions {
-            // A CPU driver stays usable at half resolution.
-            half_resolution: cpu,
-            voxel_resolution: if cpu { 64 } else { 128 },
-            ..RendererOptions::default()
-        };
-        let mut scene = scene;
-        scene.set_time(0.0);
+        } = gpu;
         let default_camera = scene.default_camera();
-        let mut params = FrameParams::new(default_camera.clone());
-        if let Some(s) = &settings {
-            s.apply(&mut options, &mut params)?;
-        }
-        let mut renderer = Renderer::new(&device, &queue, &scene, &options)?;
         renderer.enable_timing(timestamps);
         let mut ground = GroundTruth::new(args.display, cpu, timestamps);
         ground.divider = args.divider;
@@ -246,20 +378,6 @@ impl Viewer {
         } else {
             0
         };
-        let egui_ctx = egui::Context::default();
-        let egui_state = egui_winit::State::new(
-            egui_ctx.clone(),
-            egui::ViewportId::ROOT,
-            &window,
-            Some(window.scale_factor() as f32),
-            None,
-            Some(device.limits().max_texture_dimension_2d as usize),
-        );
-        let egui_renderer = egui_wgpu::Renderer::new(
-            &device,
-            config.format,
-            egui_wgpu::RendererOptions::default(),
-        );
         let orbit_distance = (bounds.center() - default_camera.position)
             .length()
             .max(radius * 0.1);
@@ -282,7 +400,7 @@ impl Viewer {
             controller: Controller::Orbit(Orbit::from_camera(&default_camera, orbit_distance)),
             params,
             renderer,
-            scene: Arc::new(scene),
+            scene,
             version: 0,
             last_time: 0.0,
             ground,
@@ -320,6 +438,7 @@ impl Viewer {
                 .map(|p| (p, args.after_frames.max(1))),
             screenshot_ui: args.with_ui,
             screenshot_key: false,
+            opened: Some(opened),
         })
     }
 }
