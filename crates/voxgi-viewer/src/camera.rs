@@ -125,6 +125,16 @@ impl Orbit {
     }
 }
 
+/// Where the world's X, Y and Z axes point on the screen seen through `camera`: per axis, its
+/// length-1 direction projected on the view plane, in screen axes (x right, y down), for the
+/// axis gizmo. An axis along the view shrinks to nothing.
+pub fn screen_axes(camera: &Camera) -> [[f32; 2]; 3] {
+    let f = camera.forward.normalize_or(Vec3::NEG_Z);
+    let right = f.cross(camera.up).normalize_or(Vec3::X);
+    let up = right.cross(f);
+    [Vec3::X, Vec3::Y, Vec3::Z].map(|a| [a.dot(right), -a.dot(up)])
+}
+
 /// Which way the fly keys push, each -1, 0 or 1: right, up, forward.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Movement {
@@ -334,6 +344,21 @@ mod tests {
             p => panic!("{p:?}"),
         }
         assert!(Orbit::from_camera(&o.camera(), 2.0).ortho);
+    }
+
+    #[test]
+    fn the_gizmo_shows_the_axes_as_the_camera_sees_them() {
+        let close2 = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-5;
+        // Looking along -Z: X to the right, Y up (negative screen y), Z at the viewer.
+        let front = screen_axes(&Camera::look_at(Vec3::Z, Vec3::ZERO, 45.0));
+        assert!(close2(front[0], [1.0, 0.0]) && close2(front[1], [0.0, -1.0]));
+        assert!(close2(front[2], [0.0, 0.0]));
+        // From +X looking at the origin: Z points left, X at the viewer.
+        let side = screen_axes(&Camera::look_at(Vec3::X, Vec3::ZERO, 45.0));
+        assert!(
+            close2(side[2], [-1.0, 0.0]) && close2(side[0], [0.0, 0.0]),
+            "{side:?}"
+        );
     }
 
     #[test]

@@ -38,6 +38,7 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::Numpad3,
     KeyCode::Numpad5,
     KeyCode::Numpad7,
+    KeyCode::KeyO,
 ];
 
 /// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
@@ -249,6 +250,7 @@ impl Viewer {
             KeyCode::Digit3 | KeyCode::Numpad3 => self.view_preset(1),
             KeyCode::Digit7 | KeyCode::Numpad7 => self.view_preset(2),
             KeyCode::Digit5 | KeyCode::Numpad5 => self.toggle_ortho(),
+            KeyCode::KeyO => self.frame_overlay = !self.frame_overlay,
             KeyCode::Space => self.playing = !self.playing,
             KeyCode::Tab => self.show_panel = !self.show_panel,
             KeyCode::F12 | KeyCode::KeyP => self.screenshot_key = true,

@@ -255,6 +255,8 @@ struct Viewer {
     ready_frames: u32,
     /// Messages over the 3D view.
     toasts: toasts::Toasts,
+    /// The frame time shown over the 3D view.
+    frame_overlay: bool,
     show_panel: bool,
     // Screenshots.
     screenshot: Option<(PathBuf, u32)>,
@@ -430,6 +432,7 @@ impl Viewer {
             frames: 0,
             ready_frames: 0,
             toasts: Default::default(),
+            frame_overlay: false,
             // A screenshot without the UI is of the whole window.
             show_panel: args.screenshot.is_none() || args.with_ui,
             screenshot: args

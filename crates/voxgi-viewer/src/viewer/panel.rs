@@ -45,7 +45,8 @@ impl Viewer {
                     ui.label(
                         "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
                          to look) · H: frame · 1/3/7: front/right/top · 5: orthographic · \
-                         G: path tracer / split · Space: play · P: screenshot · Tab: panel",
+                         G: path tracer / split · Space: play · P: screenshot · O: frame \
+                         time · Tab: panel",
                     );
                     ui.horizontal(|ui| {
                         if ui.button("Open…").clicked() {
@@ -219,10 +220,38 @@ impl Viewer {
     fn overlays_ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.toasts.ui(&ctx);
+        let left = self.panel_px as f32 / ctx.pixels_per_point();
+        self.axes_ui(&ctx, left);
+        let mut top = 8.0;
+        if self.frame_overlay {
+            let n = self.stats.frame_ms.len().max(1) as f32;
+            let ms = self.stats.frame_ms.iter().sum::<f32>() / n;
+            let what = if self.reused {
+                "the last image again"
+            } else {
+                self.ground.display.name()
+            };
+            egui::Area::new(egui::Id::unique("frame time"))
+                .anchor(egui::Align2::LEFT_TOP, [left + 8.0, top])
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        ui.add(
+                            egui::Label::new(
+                                egui::RichText::new(format!(
+                                    "{ms:.1} ms · {:.1} fps · {what}",
+                                    1e3 / ms.max(1e-3)
+                                ))
+                                .monospace(),
+                            )
+                            .extend(),
+                        )
+                    });
+                });
+            top += 30.0;
+        }
         if let Controller::Fly(f) = &self.controller {
-            let left = self.panel_px as f32 / ctx.pixels_per_point();
             egui::Area::new(egui::Id::unique("fly"))
-                .anchor(egui::Align2::LEFT_TOP, [left + 8.0, 8.0])
+                .anchor(egui::Align2::LEFT_TOP, [left + 8.0, top])
                 .show(&ctx, |ui| {
                     egui::Frame::popup(ui.style()).show(ui, |ui| {
                         ui.label(format!(
@@ -308,6 +337,39 @@ impl Viewer {
                     self.ground.divider = (self.ground.divider + moved).clamp(0.0, 1.0);
                 }
             }
+        }
+    }
+
+    /// The world's axes as the camera sees them, in the view's lower left corner (X red, Y
+    /// green, Z blue, as Blender and three.js draw them).
+    fn axes_ui(&self, ctx: &egui::Context, left: f32) {
+        let screen = ctx.content_rect();
+        let centre = egui::pos2(screen.left() + left + 40.0, screen.bottom() - 40.0);
+        let painter = ctx.layer_painter(egui::LayerId::new(
+            egui::Order::Foreground,
+            egui::Id::unique("axes"),
+        ));
+        let colours = [
+            egui::Color32::from_rgb(230, 70, 70),
+            egui::Color32::from_rgb(110, 200, 80),
+            egui::Color32::from_rgb(80, 140, 240),
+        ];
+        for (i, a) in crate::camera::screen_axes(&self.params.camera)
+            .iter()
+            .enumerate()
+        {
+            let d = egui::vec2(a[0], a[1]);
+            painter.line_segment(
+                [centre, centre + d * 26.0],
+                egui::Stroke::new(2.0, colours[i]),
+            );
+            painter.text(
+                centre + d * 34.0,
+                egui::Align2::CENTER_CENTER,
+                ["X", "Y", "Z"][i],
+                egui::FontId::proportional(12.0),
+                colours[i],
+            );
         }
     }
 

@@ -13,7 +13,7 @@ const HISTORY: usize = 120;
 /// Frame times and per-pass GPU times of the last `HISTORY` frames.
 pub(super) struct Stats {
     last_frame: Instant,
-    frame_ms: VecDeque<f32>,
+    pub(super) frame_ms: VecDeque<f32>,
     pass_ms: Vec<(&'static str, VecDeque<f32>)>,
 }
 
@@ -140,6 +140,7 @@ impl Viewer {
             });
         }
         ui.checkbox(&mut self.vsync, "vsync");
+        ui.checkbox(&mut self.frame_overlay, "frame time over the view (O)");
         ui.separator();
         let memory = self.renderer.memory();
         let total: u64 = memory.iter().map(|(_, b)| b).sum();
