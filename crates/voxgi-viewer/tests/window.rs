@@ -2,7 +2,6 @@
 //! built-in Cornell box opens the window, renders a few frames and writes a PNG whose walls and
 //! ceiling are what the Cornell box is.
 
-use std::path::PathBuf;
 use std::process::Command;
 
 fn run_viewer(args: &[&str]) -> Option<std::process::Output> {
@@ -41,23 +40,14 @@ fn mean(img: &image::RgbImage, x: (f32, f32), y: (f32, f32)) -> [f32; 3] {
 fn the_window_renders_the_cornell_box() {
     let dir = std::env::temp_dir().join(format!("voxgi_viewer_test_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let png: PathBuf = dir.join("cornell.png");
-    let Some(out) = run_viewer(&[
-        "--builtin",
-        "cornell-box",
-        "--size",
-        "640x360",
-        "--screenshot",
-        png.to_str().unwrap(),
-        "--after-frames",
-        "3",
-    ]) else {
+    let Some(img) = cornell(
+        &dir,
+        "cornell",
+        &["--size", "640x360", "--after-frames", "3"],
+    ) else {
         skip("no display and no xvfb-run (apt-get install xvfb); .ci/run installs it");
         return;
     };
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "voxgi-viewer failed:\n{stderr}");
-    let img = image::open(&png).expect("the screenshot").to_rgb8();
     assert_eq!((img.width(), img.height()), (640, 360));
     // 8-bit sRGB means over patches of a 640x360 view from the Cornell camera (measured on
     // lavapipe: left wall 147, 17, 3; right wall 57, 103, 7; ceiling 74, 50, 11).
@@ -83,26 +73,39 @@ fn the_window_renders_the_cornell_box() {
 }
 
 /// A screenshot of the built-in Cornell box at 320x180 after `frames` frames, shown as `display`.
-fn screenshot(dir: &std::path::Path, display: &str, frames: &str) -> Option<image::RgbImage> {
-    let png = dir.join(format!("{display}.png"));
-    let out = run_viewer(&[
+/// The built-in Cornell box's `--screenshot` as `dir/name.png` with `args` (the size, the
+/// frames, ...), read back; None without a display or xvfb-run.
+fn cornell(dir: &std::path::Path, name: &str, args: &[&str]) -> Option<image::RgbImage> {
+    let png = dir.join(format!("{name}.png"));
+    let mut all = vec![
         "--builtin",
         "cornell-box",
-        "--size",
-        "320x180",
-        "--display",
-        display,
         "--screenshot",
         png.to_str().unwrap(),
-        "--after-frames",
-        frames,
-    ])?;
+    ];
+    all.extend(args);
+    let out = run_viewer(&all)?;
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         out.status.success(),
-        "voxgi-viewer --display {display} failed:\n{stderr}"
+        "voxgi-viewer {args:?} failed:\n{stderr}"
     );
     Some(image::open(&png).expect("the screenshot").to_rgb8())
+}
+
+fn screenshot(dir: &std::path::Path, display: &str, frames: &str) -> Option<image::RgbImage> {
+    cornell(
+        dir,
+        display,
+        &[
+            "--size",
+            "320x180",
+            "--display",
+            display,
+            "--after-frames",
+            frames,
+        ],
+    )
 }
 
 /// Mean absolute difference of horizontally adjacent pixels over a patch: the path tracer's
@@ -353,24 +356,11 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
 fn a_screenshot_with_the_panel_in_a_narrow_window() {
     let dir = std::env::temp_dir().join(format!("voxgi_viewer_ui_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let png = dir.join("ui.png");
-    let Some(out) = run_viewer(&[
-        "--builtin",
-        "cornell-box",
-        "--size",
-        "560x360",
-        "--with-ui",
-        "--screenshot",
-        png.to_str().unwrap(),
-        "--after-frames",
-        "4",
-    ]) else {
+    let args = ["--size", "560x360", "--with-ui", "--after-frames", "4"];
+    let Some(img) = cornell(&dir, "ui", &args) else {
         skip("no display and no xvfb-run (apt-get install xvfb); .ci/run installs it");
         return;
     };
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "voxgi-viewer failed:\n{stderr}");
-    let img = image::open(&png).expect("the screenshot").to_rgb8();
     assert_eq!((img.width(), img.height()), (560, 360));
     // The panel takes 240 of the 560 points (not 370): the red wall shows just right of it,
     // and the green wall at the right edge.

@@ -319,7 +319,7 @@ pub(super) fn egui_pass(
 }
 
 /// A render pass into `view` alone, loading or clearing it.
-fn color_pass<'e>(
+pub(super) fn color_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
     view: &wgpu::TextureView,

@@ -73,22 +73,12 @@ impl Starting {
                 .update_buffers(&g.device, &g.queue, &mut encoder, &jobs, &screen);
         let view = frame.texture.create_view(&Default::default());
         {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("starting"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let pass = super::frame::color_pass(
+                &mut encoder,
+                "starting",
+                &view,
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            );
             self.egui_renderer
                 .render(&mut pass.forget_lifetime(), &jobs, &screen);
         }
