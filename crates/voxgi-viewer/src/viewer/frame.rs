@@ -44,8 +44,15 @@ impl Viewer {
             &ui.jobs,
             &ui.screen,
         );
-        let ui_capture = self.capture_with_ui(&mut encoder, &ui)?;
-        self.present(encoder, frame, ui);
+        let mut ui = ui;
+        let extra = std::mem::take(&mut ui.extra);
+        self.present(encoder, extra, frame);
+        // After the frame's submission: a second drawing in the frame's own encoder ended the
+        // renderer's GPU timer frame before its queries were submitted, and wgpu panicked.
+        let ui_capture = self.capture_with_ui(&ui)?;
+        for id in &ui.textures.free {
+            self.egui_renderer.free_texture(id);
+        }
         if let Some(t) = self.opened.take() {
             log::info!(
                 "first frame shown {:.2} s after the window opened",
@@ -128,13 +135,15 @@ impl Viewer {
         (ui, actions)
     }
 
-    /// Frees the textures the UI is done with, submits the frame's work and presents it.
-    fn present(&mut self, encoder: wgpu::CommandEncoder, frame: wgpu::SurfaceTexture, ui: UiFrame) {
-        for id in &ui.textures.free {
-            self.egui_renderer.free_texture(id);
-        }
+    /// Submits the frame's work (egui's buffer updates first) and presents it.
+    fn present(
+        &mut self,
+        encoder: wgpu::CommandEncoder,
+        extra: Vec<wgpu::CommandBuffer>,
+        frame: wgpu::SurfaceTexture,
+    ) {
         self.queue
-            .submit(ui.extra.into_iter().chain([encoder.finish()]));
+            .submit(extra.into_iter().chain([encoder.finish()]));
         self.window.pre_present_notify();
         self.queue.present(frame);
     }

@@ -94,27 +94,24 @@ impl Viewer {
     }
 
     /// A screenshot with the panel: the same frame drawn again into an image, when
-    /// `--screenshot --with-ui` takes it after this frame.
-    pub(super) fn capture_with_ui(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        ui: &UiFrame,
-    ) -> Result<Option<wgpu::Texture>> {
+    /// `--screenshot --with-ui` takes it after this frame; recorded and submitted on its own,
+    /// after the frame's work.
+    pub(super) fn capture_with_ui(&mut self, ui: &UiFrame) -> Result<Option<wgpu::Texture>> {
         let capture_ui = self.screenshot_ui
             && self
                 .screenshot
                 .as_ref()
                 .is_some_and(|(_, after)| self.ready_frames + 1 >= *after);
-        let ui_capture = if capture_ui {
-            let texture = self.capture_texture(self.config.format);
-            let v = texture.create_view(&Default::default());
-            self.draw_frame(encoder, &texture, false)?;
-            egui_pass(&self.egui_renderer, encoder, &v, &ui.jobs, &ui.screen);
-            Some(texture)
-        } else {
-            None
-        };
-        Ok(ui_capture)
+        if !capture_ui {
+            return Ok(None);
+        }
+        let texture = self.capture_texture(self.config.format);
+        let v = texture.create_view(&Default::default());
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.draw_frame(&mut encoder, &texture, false)?;
+        egui_pass(&self.egui_renderer, &mut encoder, &v, &ui.jobs, &ui.screen);
+        self.queue.submit([encoder.finish()]);
+        Ok(Some(texture))
     }
 
     /// Writes the screenshots this frame asks for: P's (F12's), and `--screenshot`'s once
