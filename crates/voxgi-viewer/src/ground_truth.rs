@@ -48,6 +48,11 @@ struct Traced {
     version: u64,
     /// The lights it has (as `Renderer::lights` numbers them): an edit is set in place.
     lights: Vec<Light>,
+    /// Frames before the first traced one on a CPU driver (2, then 1 in the frame that shows
+    /// why, then 0): such a driver compiles the path tracer's code at its first dispatch, inside
+    /// the queue, stopping the window for seconds (once per machine: the driver's shader cache
+    /// keeps the code), so a frame saying so is shown first.
+    compile_notice: u8,
 }
 
 /// A path tracer and what it was built for: the scene state (`version`) and the lights.
@@ -70,6 +75,8 @@ pub struct GroundTruth {
     pub frame_target_ms: Option<f32>,
     /// Time the path tracer's passes on the GPU.
     timing: bool,
+    /// The adapter is a CPU driver.
+    cpu: bool,
     /// Adapt the paths a frame to the frame's wall time instead of the GPU's timestamps.
     wall_clock: bool,
     /// Whether the last frame traced paths (so its time says something about them).
@@ -95,6 +102,7 @@ impl GroundTruth {
             paths_per_frame: if cpu { 1 << 14 } else { 1 << 22 },
             frame_target_ms: Some(default_target_ms(cpu)),
             timing,
+            cpu,
             wall_clock: cpu || !timing,
             traced_last_frame: false,
             next_row: 0,
@@ -127,7 +135,8 @@ impl GroundTruth {
     /// Whether the cone tracer's image is needed this frame: for its side of the split, or in
     /// place of a path tracer that is not built yet.
     pub fn needs_cone_tracing(&self) -> bool {
-        self.display != Display::PathTraced || self.traced.is_none()
+        self.display != Display::PathTraced
+            || self.traced.as_ref().is_none_or(|t| t.compile_notice > 0)
     }
 
     /// Takes a finished build, and starts one when the scene (its `version`) moved on from the
@@ -156,6 +165,7 @@ impl GroundTruth {
                         accumulation: None,
                         version: built_for,
                         lights: built_lights,
+                        compile_notice: if self.cpu { 2 } else { 0 },
                     })
                 }
                 Err(e) => self.error = Some(format!("{e:#}")),
@@ -252,6 +262,13 @@ impl GroundTruth {
 
     /// What the path tracer's build is doing, while one runs.
     pub fn job_label(&self) -> Option<String> {
+        if self.traced.as_ref().is_some_and(|t| t.compile_notice == 1) {
+            return Some(
+                "the CPU driver compiles the path tracer at its first frame: seconds, once \
+                 per machine …"
+                    .into(),
+            );
+        }
         self.building.as_ref().map(Job::label)
     }
 
@@ -274,6 +291,9 @@ impl GroundTruth {
             Some(a) if self.band_rows < a.height() => format!(", {} rows a frame", self.band_rows),
             _ => String::new(),
         };
+        if self.traced.as_ref().is_some_and(|t| t.compile_notice == 1) {
+            return "path tracer: compiling …".into();
+        }
         match (&self.building, samples) {
             (Some(job), Some(n)) => {
                 format!("path traced, {n} spp (the scene changed: {})", job.label())
@@ -301,6 +321,13 @@ impl GroundTruth {
         let Some(t) = &mut self.traced else {
             return Ok(());
         };
+        if t.compile_notice > 0 && accumulate {
+            t.compile_notice -= 1;
+            if t.compile_notice == 1 {
+                // This frame shows the label saying why the next one is late.
+                return Ok(());
+            }
+        }
         let size = (target.width, target.height);
         if t.accumulation.as_ref().map(|a| (a.width(), a.height())) != Some(size) {
             t.accumulation = Some(t.tracer.accumulation(size.0, size.1)?);

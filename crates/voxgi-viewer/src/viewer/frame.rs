@@ -47,6 +47,8 @@ impl Viewer {
         let mut ui = ui;
         let extra = std::mem::take(&mut ui.extra);
         self.present(encoder, extra, frame);
+        let busy = self.running().join(", ");
+        self.stats.presented(&busy);
         // After the frame's submission: a second drawing in the frame's own encoder ended the
         // renderer's GPU timer frame before its queries were submitted, and wgpu panicked.
         let ui_capture = self.capture_with_ui(&ui)?;
@@ -148,11 +150,35 @@ impl Viewer {
         self.queue.present(frame);
     }
 
+    /// What runs in the background, for the window's indicator and the frame-gap log.
+    pub(super) fn running(&self) -> Vec<String> {
+        let mut running: Vec<String> = Vec::new();
+        if let Some(job) = &self.rebuild {
+            running.push(job.label());
+        }
+        if let Some(job) = &self.opening {
+            running.push(job.label());
+        }
+        if let Some(job) = &self.dialog {
+            running.push(job.label());
+        }
+        if let Some(h) = &self.handover {
+            running.push(h.label().into());
+        }
+        if self.ground.display != Display::ConeTraced
+            && let Some(l) = self.ground.job_label()
+        {
+            running.push(l);
+        }
+        running
+    }
+
     /// Counts the frame, and as ready when nothing ran in the background.
     fn count_frame(&mut self) {
         self.frames += 1;
         let busy = self.rebuild.is_some()
             || self.opening.is_some()
+            || self.handover.is_some()
             || (self.ground.display != Display::ConeTraced && self.ground.building());
         if !busy {
             self.ready_frames += 1;

@@ -76,6 +76,15 @@ impl Viewer {
         event_loop: &ActiveEventLoop,
         event: WindowEvent,
     ) -> Result<()> {
+        let shows_on_screen = match &event {
+            WindowEvent::KeyboardInput { event, .. } => event.state == ElementState::Pressed,
+            WindowEvent::MouseInput { .. } | WindowEvent::MouseWheel { .. } => true,
+            WindowEvent::CursorMoved { .. } => self.input.left_down || self.input.right_down,
+            _ => false,
+        };
+        if shows_on_screen {
+            self.stats.input_arrived();
+        }
         // The viewer's keys are its own unless a text field is being typed in: egui would take
         // Tab for moving the focus between widgets, and, once a button had the focus, every
         // key after it, until the view was clicked.

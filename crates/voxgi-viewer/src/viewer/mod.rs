@@ -22,7 +22,7 @@ use crate::ground_truth::{Display, GroundTruth};
 use crate::jobs::Job;
 use anyhow::Result;
 use input::{Controller, Input};
-use open::Opened;
+use open::{Handover, Opened};
 use starting::Starting;
 use stats::Stats;
 use std::path::PathBuf;
@@ -91,10 +91,13 @@ impl App {
                     // Shown while the first frame builds the voxels (GPU work that no frame
                     // can interrupt).
                     let name = scene_label(&s.scene);
-                    let shown = s.redraw(
-                        &name,
-                        "voxelizing the scene and lighting the voxels for the first frame …",
-                    );
+                    let what = if s.gpu.cpu {
+                        "voxelizing the scene and lighting the voxels for the first frame; the \
+                         CPU driver compiles the shaders as they first run (once per machine) …"
+                    } else {
+                        "voxelizing the scene and lighting the voxels for the first frame …"
+                    };
+                    let shown = s.redraw(&name, what);
                     let mut s = self.starting.take().expect("checked above");
                     let keys = std::mem::take(&mut s.keys);
                     let viewer = shown.and(made).and_then(|r| Viewer::new(&self.args, s, r));
@@ -216,6 +219,7 @@ struct Viewer {
     // Background work, each shown in the window while it runs.
     rebuild: Option<Job<(Renderer, RendererOptions)>>,
     opening: Option<Job<Opened>>,
+    handover: Option<Handover>,
     dialog: Option<Job<Option<PathBuf>>>,
     open_path: String,
     vsync: bool,
@@ -408,6 +412,7 @@ impl Viewer {
             ground,
             rebuild: None,
             opening: None,
+            handover: None,
             dialog: None,
             open_path: String::new(),
             vsync: !args.no_vsync,

@@ -14,6 +14,23 @@ use std::sync::Arc;
 use voxgi::scene::Scene;
 use voxgi::{FrameParams, Renderer, RendererOptions};
 
+/// A renderer made in the background, waiting a frame to take over: its first frame builds
+/// the voxels (and on a CPU driver compiles the shaders it is the first to run), seconds in
+/// which no frame can be shown, so one frame saying so is shown first.
+pub(super) enum Handover {
+    Rebuilt(Box<(Renderer, RendererOptions)>),
+    Opened(Box<Opened>),
+}
+
+impl Handover {
+    pub(super) fn label(&self) -> &'static str {
+        match self {
+            Handover::Rebuilt(..) => "the new options' first frame: building the voxels …",
+            Handover::Opened(..) => "the new scene's first frame: building the voxels …",
+        }
+    }
+}
+
 /// A file loaded and its renderer built, off the window's thread.
 pub(super) struct Opened {
     path: PathBuf,
@@ -148,15 +165,21 @@ impl Viewer {
         }));
     }
 
-    /// Takes the results of finished background work.
+    /// Takes the results of finished background work: a renderer made in the background
+    /// takes over a frame after it is done (`Handover`).
     pub(super) fn poll_jobs(&mut self) {
+        match self.handover.take() {
+            Some(Handover::Rebuilt(b)) => self.rebuilt(b.0, b.1),
+            Some(Handover::Opened(o)) => self.opened(*o),
+            None => {}
+        }
         match take(&mut self.rebuild) {
-            Some(Ok((r, options))) => self.rebuilt(r, options),
+            Some(Ok(made)) => self.handover = Some(Handover::Rebuilt(Box::new(made))),
             Some(Err(e)) => self.toasts.error(format!("the new options failed: {e:#}")),
             None => {}
         }
         match take(&mut self.opening) {
-            Some(Ok(o)) => self.opened(o),
+            Some(Ok(o)) => self.handover = Some(Handover::Opened(Box::new(o))),
             Some(Err(e)) => self.toasts.error(format!("{e:#}")),
             None => {}
         }

@@ -261,30 +261,20 @@ impl Viewer {
                     });
                 });
         }
-        let mut running: Vec<String> = Vec::new();
-        if let Some(job) = &self.rebuild {
-            running.push(job.label());
-        }
-        if let Some(job) = &self.opening {
-            running.push(job.label());
-        }
-        if let Some(job) = &self.dialog {
-            running.push(job.label());
-        }
-        if self.ground.display != Display::ConeTraced
-            && let Some(l) = self.ground.job_label()
-        {
-            running.push(l);
-        }
+        let running = self.running();
         if !running.is_empty() {
+            // A fixed width: anchored by its right edge, a box whose width changed with its text
+            // was drawn where the last frame's width put it, partly off the window.
+            let width = (ctx.content_rect().width() * 0.3).clamp(200.0, 340.0);
             egui::Area::new(egui::Id::unique("jobs"))
                 .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
                 .show(&ctx, |ui| {
                     egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        ui.set_width(width);
                         for r in &running {
                             ui.horizontal(|ui| {
                                 ui.spinner();
-                                ui.label(r);
+                                ui.add(egui::Label::new(r).wrap());
                             });
                         }
                     });

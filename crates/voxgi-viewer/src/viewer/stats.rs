@@ -10,11 +10,26 @@ use std::time::Instant;
 /// Per-pass GPU milliseconds of recent frames, for the rolling graph.
 const HISTORY: usize = 120;
 
-/// Frame times and per-pass GPU times of the last `HISTORY` frames.
+/// A wait this long between two frames, or from an input to the frame showing it, is logged
+/// (the window then feels stuck; at 10 frames a second it does not).
+const LOGGED_GAP_S: f32 = 0.1;
+
+/// Recent waits are shown for this long.
+const RECENT_S: f32 = 10.0;
+
+/// Frame times and per-pass GPU times of the last `HISTORY` frames, and how smoothly frames
+/// come: the waits between presented frames and from input to the frame that shows it.
 pub(super) struct Stats {
     last_frame: Instant,
     pub(super) frame_ms: VecDeque<f32>,
     pass_ms: Vec<(&'static str, VecDeque<f32>)>,
+    last_present: Option<Instant>,
+    /// The first input event no presented frame has shown yet.
+    input_since: Option<Instant>,
+    /// The longest wait between two presented frames in the last `RECENT_S`, and when it ended.
+    pub(super) worst_gap: Option<(f32, Instant)>,
+    /// The longest wait from an input to the frame showing it in the last `RECENT_S`.
+    pub(super) worst_input: Option<(f32, Instant)>,
 }
 
 impl Stats {
@@ -23,6 +38,42 @@ impl Stats {
             last_frame: Instant::now(),
             frame_ms: Default::default(),
             pass_ms: Vec::new(),
+            // The viewer is made right after the starting window's last progress frame.
+            last_present: Some(Instant::now()),
+            input_since: None,
+            worst_gap: None,
+            worst_input: None,
+        }
+    }
+
+    /// An input event arrived (a key, a click, a drag, the wheel): the next presented frame
+    /// shows it.
+    pub(super) fn input_arrived(&mut self) {
+        self.input_since.get_or_insert_with(Instant::now);
+    }
+
+    /// A frame was presented while `busy` ran in the background (empty: nothing): the wait
+    /// since the last one and since the input it shows are kept, and logged when long.
+    pub(super) fn presented(&mut self, busy: &str) {
+        let now = Instant::now();
+        let during = if busy.is_empty() {
+            String::new()
+        } else {
+            format!(" (during {busy})")
+        };
+        if let Some(last) = self.last_present.replace(now) {
+            let gap = (now - last).as_secs_f32();
+            if gap > LOGGED_GAP_S {
+                log::info!("frame gap {gap:.3} s{during}");
+            }
+            keep_worst(&mut self.worst_gap, gap, now);
+        }
+        if let Some(t) = self.input_since.take() {
+            let delay = (now - t).as_secs_f32();
+            if delay > LOGGED_GAP_S {
+                log::info!("input shown {delay:.3} s after it arrived{during}");
+            }
+            keep_worst(&mut self.worst_input, delay, now);
         }
     }
 
@@ -90,6 +141,13 @@ impl Viewer {
         ui.label(format!(
             "frame {frame:.1} ms ({:.1} fps)",
             1e3 / frame.max(1e-3)
+        ));
+        let recent = |w: Option<(f32, Instant)>| w.map_or(0.0, |(s, _)| s * 1e3);
+        ui.label(format!(
+            "longest wait in the last {RECENT_S:.0} s: {:.0} ms between frames, {:.0} ms from \
+             input to frame",
+            recent(self.stats.worst_gap),
+            recent(self.stats.worst_input)
         ));
         if self.reused {
             ui.label("cone tracing: nothing changed, the last image is shown again");
@@ -164,9 +222,39 @@ impl Viewer {
     }
 }
 
+/// Keeps the longer of `worst` and `wait`, forgetting a worst older than `RECENT_S`.
+fn keep_worst(worst: &mut Option<(f32, Instant)>, wait: f32, now: Instant) {
+    let stale = worst.is_none_or(|(w, at)| w <= wait || (now - at).as_secs_f32() > RECENT_S);
+    if stale {
+        *worst = Some((wait, now));
+    }
+}
+
 fn push(v: &mut VecDeque<f32>, x: f32) {
     if v.len() == HISTORY {
         v.pop_front();
     }
     v.push_back(x);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    /// The panel shows the longest recent wait: a shorter one does not replace it, a longer
+    /// one does, and once it is older than `RECENT_S` the next wait, however short, does.
+    #[test]
+    fn the_worst_wait_is_kept_for_ten_seconds() {
+        let t0 = Instant::now();
+        let at = |s: f32| t0 + Duration::from_secs_f32(s);
+        let mut worst = None;
+        keep_worst(&mut worst, 0.5, at(0.0));
+        keep_worst(&mut worst, 0.2, at(1.0));
+        assert_eq!(worst, Some((0.5, at(0.0))));
+        keep_worst(&mut worst, 0.7, at(2.0));
+        assert_eq!(worst, Some((0.7, at(2.0))));
+        keep_worst(&mut worst, 0.1, at(2.0 + RECENT_S + 0.5));
+        assert_eq!(worst, Some((0.1, at(2.0 + RECENT_S + 0.5))));
+    }
 }
