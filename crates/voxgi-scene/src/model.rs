@@ -169,6 +169,30 @@ pub struct Light {
 }
 
 impl Light {
+    /// An area light's frame: object to world for the emitter `Scene::add_area_light` builds
+    /// around it, from its edge vectors (or its radius and its normal's orthonormal pair, as the
+    /// disc's vertices are placed), its normal and its position. `None` for other kinds. A moved
+    /// light's emitter moves by `new.emitter_frame() * old.emitter_frame().inverse()`.
+    pub fn emitter_frame(&self) -> Option<Mat4> {
+        let LightKind::Area { shape } = self.kind else {
+            return None;
+        };
+        let n = self.direction.normalize();
+        let (a, b) = match shape {
+            AreaShape::Rect { u, v } => (u, v),
+            AreaShape::Disc { radius } => {
+                let (t, b) = n.any_orthonormal_pair();
+                (t * radius, b * radius)
+            }
+        };
+        Some(Mat4::from_cols(
+            a.extend(0.0),
+            b.extend(0.0),
+            n.extend(0.0),
+            self.position.extend(1.0),
+        ))
+    }
+
     /// Refuses a light brighter than voxgi can show: an area light's radiance above what half
     /// floats hold (`limits::MAX_RADIANCE`), another's intensity × colour above
     /// `limits::MAX_LIGHT`.

@@ -12,8 +12,10 @@ use voxgi_scene::{Aabb, Light, Scene};
 pub struct InstanceState {
     /// For messages.
     pub name: String,
-    /// Only dynamic instances may move.
+    /// Only dynamic instances may move (and area lights' emitters, with their light).
     pub dynamic: bool,
+    /// The area light whose visible surface this is.
+    pub light: Option<usize>,
     /// Its draw in `GpuScene::draws` (`None`: a mesh without triangles, nothing to move).
     pub draw: Option<u32>,
     /// Its mesh's bounds in object space.
@@ -45,6 +47,11 @@ pub struct SceneState {
 }
 
 impl SceneState {
+    /// Whether an animation moves instance `i`.
+    pub fn animates_instance(&self, i: usize) -> bool {
+        self.animated_instances.binary_search(&i).is_ok()
+    }
+
     /// Where the dynamic instances are now (empty when there are none).
     pub fn dynamic_bounds(&self) -> Aabb {
         self.instances
@@ -77,6 +84,7 @@ impl SceneState {
                 InstanceState {
                     name: inst.name.clone(),
                     dynamic: inst.dynamic,
+                    light: inst.light,
                     draw: draws.get(i).copied().flatten(),
                     local,
                     transform: inst.transform,

@@ -10,7 +10,9 @@
 
 use crate::gpu::timer::GpuTimer;
 use crate::gpu::{checked, layout, readback, shader};
-use crate::gpu_scene::{GpuLight, GpuScene, NO_INDEX, check_light, gpu_light, view_sphere};
+use crate::gpu_scene::{
+    GpuLight, GpuScene, LIGHT_DISC, LIGHT_RECT, NO_INDEX, check_light, gpu_light, view_sphere,
+};
 use crate::options::{FrameParams, RendererOptions};
 use crate::output::{RenderOutput, tonemap};
 use crate::view::lit_scene;
@@ -452,9 +454,10 @@ impl PathTracer {
 
     /// Changes light `index` (as `Renderer::lights` numbers them: the scene's, and the default
     /// sun when one was added) to `light`, as `Renderer::set_light` does: everything but its
-    /// kind. The triangles stay where they were built, area lights' emitters included, so this
-    /// is exactly a path tracer built afresh with the new light. Accumulations made before show
-    /// the old light: `Accumulation::reset` them.
+    /// kind, and but an area light's place and shape (its emitter's triangles are built into
+    /// the BVH: an error, make a new PathTracer), so this is exactly a path tracer built afresh
+    /// with the new light. Accumulations made before show the old light: `Accumulation::reset`
+    /// them.
     pub fn set_light(&mut self, index: usize, light: &Light) -> Result<()> {
         let count = self.scene.gpu_lights.len();
         let was = *self.scene.gpu_lights.get(index).ok_or_else(|| {
@@ -467,6 +470,15 @@ impl PathTracer {
         if g.kind != was.kind {
             return Err(Error::Setting(format!(
                 "light '{}': its kind is fixed once uploaded; make a new PathTracer to change it",
+                light.name
+            )));
+        }
+        let placed = |l: &GpuLight| (l.position, l.direction, l.axis_u, l.axis_v);
+        if matches!(g.kind, LIGHT_RECT | LIGHT_DISC) && placed(&g) != placed(&was) {
+            // Its emitter's triangles are in the BVH where the light was.
+            return Err(Error::Setting(format!(
+                "area light '{}': its emitter is built into the path tracer's triangles; make a \
+                 new PathTracer to move or reshape it",
                 light.name
             )));
         }

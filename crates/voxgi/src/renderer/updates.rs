@@ -103,7 +103,9 @@ impl Renderer {
     /// Changes light `index` (into the scene's lights) to `light`: its position, direction,
     /// colour, intensity, range, cone angles or area shape. Its kind (directional, point,
     /// spot, area) and whether it casts shadows are fixed once uploaded (an error: make a new
-    /// `Renderer`). The light's shadow views re-render and the voxel light is redone.
+    /// `Renderer`). The light's shadow views re-render and the voxel light is redone; an area
+    /// light's visible surface (its emitter instance, unless an animation moves it) moves with
+    /// it, no voxel work (emitters are not voxelized).
     pub fn set_light(&mut self, index: usize, light: &Light) -> Result<()> {
         let count = self.state.lights.len();
         let old = self.state.lights.get(index).ok_or_else(|| {
@@ -128,7 +130,14 @@ impl Renderer {
         g.shadow_count = was.shadow_count;
         g.sample_first = was.sample_first;
         self.scene.gpu_lights[index] = g;
+        let emitter_move = match (old.emitter_frame(), light.emitter_frame()) {
+            (Some(from), Some(to)) if from != to => Some(to * from.inverse()),
+            _ => None,
+        };
         self.state.lights[index] = light.clone();
+        if let Some(m) = emitter_move {
+            self.move_emitters(index, m);
+        }
         // Re-plan every view (a light's views follow its position and direction) and re-render
         // those that changed: the moved light's.
         let res = self.atlas.texture.width();
@@ -153,6 +162,33 @@ impl Renderer {
         );
         self.pending.lights = true;
         Ok(())
+    }
+
+    /// Moves the visible surfaces of area light `light` by `m` (from its old frame to its new),
+    /// static or not: they are drawn and cast shadows on the other lights' views, but they are
+    /// not voxelized, so no voxel work follows. An emitter an animation moves is left to it.
+    fn move_emitters(&mut self, light: usize, m: Mat4) {
+        for i in 0..self.state.instances.len() {
+            let inst = &self.state.instances[i];
+            if inst.light != Some(light) || self.state.animates_instance(i) {
+                continue;
+            }
+            let transform = m * inst.transform;
+            let (old, new) = (
+                inst.world_bounds(inst.transform),
+                inst.world_bounds(transform),
+            );
+            if let Some(draw) = inst.draw {
+                self.scene.set_transform(&self.queue, draw, transform);
+                for v in 0..self.atlas.views.len() {
+                    let view = &self.atlas.views[v];
+                    let dirt = shadow::box_dirt(view, old.min, old.max)
+                        .merge(shadow::box_dirt(view, new.min, new.max));
+                    self.pending.view(v, dirt);
+                }
+            }
+            self.state.instances[i].transform = transform;
+        }
     }
 
     /// Sets the scene's time, in seconds: every animation moves its instances and lights to

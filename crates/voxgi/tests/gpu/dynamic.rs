@@ -634,3 +634,56 @@ fn voxel_light_follows_a_change_over_a_few_frames() {
         "the last step is not the fresh renderer's light"
     );
 }
+
+/// Moving an area light moves the surface that shows it (the Cornell box's ceiling panel) and
+/// the shadows that panel casts: the frame after `set_light` is the frame of a renderer built
+/// with the light and its emitter moved, and it is not the frame of one that left the panel
+/// where it was (what `set_light` drew before).
+#[test]
+fn a_moved_area_light_takes_its_visible_surface_along() {
+    use voxgi::scene::LightKind;
+    let scene = builtin::cornell_box();
+    let light = scene
+        .lights
+        .iter()
+        .position(|l| matches!(l.kind, LightKind::Area { .. }))
+        .expect("the Cornell box has an area light");
+    let emitter = scene
+        .instances
+        .iter()
+        .position(|i| i.light == Some(light))
+        .expect("and its emitter");
+    let old = scene.lights[light].clone();
+    let mut moved = old.clone();
+    moved.position += Vec3::new(0.15, 0.0, -0.1);
+    let to = moved.emitter_frame().unwrap() * old.emitter_frame().unwrap().inverse();
+
+    let mut r = renderer(&scene, &options());
+    let p = params(&r);
+    frame(&mut r, &p, SIZE, SIZE);
+    r.set_light(light, &moved).expect("same kind");
+    let mut got = frame(&mut r, &p, SIZE, SIZE);
+    while !r.voxels_settled() {
+        got = frame(&mut r, &p, SIZE, SIZE);
+    }
+    let fresh = |emitter_moves: bool| {
+        let mut s = scene.clone();
+        s.lights[light] = moved.clone();
+        if emitter_moves {
+            s.instances[emitter].transform = to * s.instances[emitter].transform;
+        }
+        let mut f = renderer(&s, &options());
+        let mut out = frame(&mut f, &p, SIZE, SIZE);
+        while !f.voxels_settled() {
+            out = frame(&mut f, &p, SIZE, SIZE);
+        }
+        out.ldr
+    };
+    let (want, left_behind) = (fresh(true), fresh(false));
+    // The same scene state drawn by the same passes: a code value of rounding at most.
+    let off = largest_difference(&got.ldr, &want);
+    assert!(off <= 1, "differs from a fresh build by {off} code values");
+    // The panel is a bright quad in view: where it was and where it is now differ by far more.
+    let stale = largest_difference(&got.ldr, &left_behind);
+    assert!(stale > 50, "a panel left in place differs by only {stale}");
+}

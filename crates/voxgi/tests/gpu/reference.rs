@@ -728,6 +728,12 @@ fn a_light_set_in_place_equals_a_fresh_path_tracer() {
         .set_light(0, &point)
         .expect_err("an area light made a point light");
     assert!(e.to_string().contains("kind"), "{e}");
+    let mut moved = light.clone();
+    moved.position.x += 0.1;
+    let e = edited
+        .set_light(0, &moved)
+        .expect_err("an area light moved away from its emitter's triangles");
+    assert!(e.to_string().contains("new PathTracer"), "{e}");
     let mut nan = light;
     nan.intensity = f32::NAN;
     assert!(edited.set_light(0, &nan).is_err(), "a NaN intensity");
