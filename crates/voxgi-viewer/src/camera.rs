@@ -125,13 +125,49 @@ impl Orbit {
     }
 }
 
+/// The camera's right and up axes: unit, square to its view direction and to each other.
+pub fn view_axes(camera: &Camera) -> (Vec3, Vec3) {
+    let f = camera.forward.normalize_or(Vec3::NEG_Z);
+    let right = f.cross(camera.up).normalize_or(Vec3::X);
+    (right, right.cross(f))
+}
+
+/// Half the view's height in metres at depth `z` along the view (the projection `voxgi::view`
+/// makes).
+fn half_height(camera: &Camera, z: f32) -> f32 {
+    match camera.projection {
+        Projection::Perspective { yfov } => z * (yfov * 0.5).tan(),
+        Projection::Orthographic { ymag, .. } => ymag,
+    }
+}
+
+/// Where `p` shows in a `size` (width, height) view through `camera`, in the view's pixels from
+/// its top left; `None` when it is behind the camera or nearer than its near plane.
+pub fn project(camera: &Camera, size: [f32; 2], p: Vec3) -> Option<[f32; 2]> {
+    let d = p - camera.position;
+    let z = d.dot(camera.forward.normalize_or(Vec3::NEG_Z));
+    if z <= camera.znear {
+        return None;
+    }
+    let (right, up) = view_axes(camera);
+    let half = half_height(camera, z);
+    let aspect = size[0] / size[1].max(1.0);
+    let (x, y) = (d.dot(right) / (half * aspect), d.dot(up) / half);
+    Some([(x + 1.0) * 0.5 * size[0], (1.0 - y) * 0.5 * size[1]])
+}
+
+/// Metres a point at `p` moves on the screen for each pixel of a view `height` pixels high:
+/// what turns a drag into a move at the point's depth.
+pub fn metres_per_pixel(camera: &Camera, height: f32, p: Vec3) -> f32 {
+    let z = (p - camera.position).dot(camera.forward.normalize_or(Vec3::NEG_Z));
+    2.0 * half_height(camera, z.max(camera.znear)) / height.max(1.0)
+}
+
 /// Where the world's X, Y and Z axes point on the screen seen through `camera`: per axis, its
 /// length-1 direction projected on the view plane, in screen axes (x right, y down), for the
 /// axis gizmo. An axis along the view shrinks to nothing.
 pub fn screen_axes(camera: &Camera) -> [[f32; 2]; 3] {
-    let f = camera.forward.normalize_or(Vec3::NEG_Z);
-    let right = f.cross(camera.up).normalize_or(Vec3::X);
-    let up = right.cross(f);
+    let (right, up) = view_axes(camera);
     [Vec3::X, Vec3::Y, Vec3::Z].map(|a| [a.dot(right), -a.dot(up)])
 }
 
@@ -278,6 +314,45 @@ mod tests {
 
     fn close(a: Vec3, b: Vec3) -> bool {
         (a - b).abs().max_element() < 1e-4
+    }
+
+    /// A light dragged by the gizmo stays under the cursor: a point moved by `metres_per_pixel`
+    /// along the view's right and up axes lands that many pixels right and up, in both
+    /// projections; the point looked at is the view's centre, one behind the camera is nowhere.
+    #[test]
+    fn a_point_moved_by_metres_per_pixel_follows_the_cursor() {
+        let size = [800.0, 400.0];
+        for ortho in [false, true] {
+            let mut orbit = Orbit::from_camera(
+                &Camera::look_at(Vec3::new(1.0, 2.0, 5.0), Vec3::ZERO, 50.0),
+                6.0,
+            );
+            orbit.ortho = ortho;
+            let cam = orbit.camera();
+            let target = cam.position + cam.forward * 4.0;
+            let c = project(&cam, size, target).unwrap();
+            assert!(
+                (c[0] - 400.0).abs() < 1e-3 && (c[1] - 200.0).abs() < 1e-3,
+                "{c:?}"
+            );
+            let p = target + Vec3::new(0.3, -0.2, 0.1);
+            let at = project(&cam, size, p).unwrap();
+            let m = metres_per_pixel(&cam, size[1], p);
+            let (right, up) = view_axes(&cam);
+            let moved = project(&cam, size, p + (right * 25.0 + up * 10.0) * m).unwrap();
+            // f32 over metres of distance: a thousandth of a pixel.
+            assert!(
+                (moved[0] - at[0] - 25.0).abs() < 1e-2,
+                "{ortho}: {at:?} -> {moved:?}"
+            );
+            assert!(
+                (moved[1] - at[1] + 10.0).abs() < 1e-2,
+                "{ortho}: {at:?} -> {moved:?}"
+            );
+            if !ortho {
+                assert!(project(&cam, size, cam.position - cam.forward).is_none());
+            }
+        }
     }
 
     #[test]

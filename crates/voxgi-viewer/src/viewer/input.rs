@@ -39,6 +39,8 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::Numpad5,
     KeyCode::Numpad7,
     KeyCode::KeyO,
+    KeyCode::Escape,
+    KeyCode::KeyL,
 ];
 
 /// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
@@ -250,7 +252,8 @@ impl Viewer {
                     }
                 };
             }
-            KeyCode::KeyH => self.frame_scene(),
+            KeyCode::KeyH => self.frame_selection(),
+            KeyCode::Escape => self.selected_light = None,
             KeyCode::KeyG => {
                 let i = Display::ALL.iter().position(|d| *d == self.ground.display);
                 self.set_display(Display::ALL[(i.unwrap_or(0) + 1) % Display::ALL.len()]);
@@ -260,6 +263,7 @@ impl Viewer {
             KeyCode::Digit7 | KeyCode::Numpad7 => self.view_preset(2),
             KeyCode::Digit5 | KeyCode::Numpad5 => self.toggle_ortho(),
             KeyCode::KeyO => self.frame_overlay = !self.frame_overlay,
+            KeyCode::KeyL => self.show_gizmos = !self.show_gizmos,
             KeyCode::Space => self.playing = !self.playing,
             KeyCode::Tab => self.show_panel = !self.show_panel,
             KeyCode::F12 | KeyCode::KeyP => self.screenshot_key = true,

@@ -7,6 +7,7 @@
 //! times) and `open` (opening scenes, applying options, and the background work for both).
 
 mod frame;
+mod gizmos;
 mod input;
 mod open;
 mod panel;
@@ -237,6 +238,12 @@ struct Viewer {
     cpu: bool,
     scene_name: String,
     scene_radius: f32,
+    /// The centre of the scene's bounds (with every pose of its animations).
+    scene_center: glam::Vec3,
+    /// The light the gizmos selected (H frames it).
+    selected_light: Option<usize>,
+    /// Whether the light gizmos are drawn.
+    show_gizmos: bool,
     /// The scene's own cameras, to pick from.
     cameras: Vec<voxgi::scene::Camera>,
     options: RendererOptions,
@@ -398,6 +405,9 @@ impl Viewer {
             watch,
             scene_name: scene_label(&scene),
             scene_radius: radius,
+            scene_center: bounds.center(),
+            selected_light: None,
+            show_gizmos: true,
             cameras: scene.cameras.clone(),
             // The path tracer shows a still scene: play with G's cone tracing.
             playing: duration > 0.0 && args.display == Display::ConeTraced,

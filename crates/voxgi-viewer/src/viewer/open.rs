@@ -90,6 +90,8 @@ impl Viewer {
         self.params = o.settings_params;
         let bounds = o.scene.swept_bounds();
         self.scene_radius = (bounds.size().length() * 0.5).max(1e-3);
+        self.scene_center = bounds.center();
+        self.selected_light = None;
         self.duration = o
             .scene
             .animations

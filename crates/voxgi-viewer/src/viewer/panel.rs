@@ -44,9 +44,9 @@ impl Viewer {
                     ));
                     ui.label(
                         "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
-                         to look) · H: frame · 1/3/7: front/right/top · 5: orthographic · \
+                         to look) · H: frame (the selected light) · 1/3/7: front/right/top · 5: orthographic · \
                          G: path tracer / split · Space: play · P: screenshot · O: frame \
-                         time · Tab: panel",
+                         time · L: light gizmos · Tab: panel",
                     );
                     ui.horizontal(|ui| {
                         if ui.button("Open…").clicked() {
@@ -222,6 +222,7 @@ impl Viewer {
         self.toasts.ui(&ctx);
         let left = self.panel_px as f32 / ctx.pixels_per_point();
         self.axes_ui(&ctx, left);
+        self.gizmos_ui(&ctx);
         let mut top = 8.0;
         if self.frame_overlay {
             let n = self.stats.frame_ms.len().max(1) as f32;
@@ -366,6 +367,10 @@ impl Viewer {
     /// Each light's colour, intensity and placement; a change goes to `Renderer::set_light`,
     /// which re-renders its shadow views and re-lights the voxels.
     fn lights_ui(&mut self, ui: &mut egui::Ui) {
+        ui.checkbox(
+            &mut self.show_gizmos,
+            "gizmos over the view (L): click one to select, drag to move",
+        );
         let lights: Vec<voxgi::scene::Light> = self.renderer.lights().to_vec();
         for (i, light) in lights.iter().enumerate() {
             let mut l = light.clone();
@@ -375,7 +380,11 @@ impl Viewer {
                 voxgi::scene::LightKind::Spot { .. } => "spot",
                 voxgi::scene::LightKind::Area { .. } => "area",
             };
-            ui.label(egui::RichText::new(format!("{} ({kind})", l.name)).strong());
+            let selected = self.selected_light == Some(i);
+            let name = egui::RichText::new(format!("{} ({kind})", l.name)).strong();
+            if ui.selectable_label(selected, name).clicked() {
+                self.selected_light = (!selected).then_some(i);
+            }
             let speed = 0.01 * l.intensity.max(0.1);
             // Only what the user changed counts: the colour button rounds its value through
             // HSV when first shown, which is not an edit.
@@ -424,10 +433,7 @@ impl Viewer {
                     l.direction = light.direction;
                 }
                 // The path tracer takes the edit from `renderer.lights()` in its next update.
-                match self.renderer.set_light(i, &l) {
-                    Ok(()) => self.ground.scene_changed(),
-                    Err(e) => self.toasts.error(format!("{e}")),
-                }
+                self.set_light(i, &l);
             }
         }
     }
