@@ -372,3 +372,99 @@ fn a_screenshot_with_the_panel_in_a_narrow_window() {
         "right wall {green:?}"
     );
 }
+
+/// X opens the export dialog with its file field taking the keyboard; Enter exports the view
+/// through the window's own renderer, spread over the window's frames. The file is what
+/// `voxgi render` writes for the same scene, camera, options and frames accumulated: the
+/// library's `render_still` on a renderer of the test's own.
+#[test]
+fn the_export_is_what_voxgi_render_writes() {
+    use voxgi::{FrameParams, RendererOptions, headless};
+    let Some(x) = Xvfb::start() else {
+        skip("no Xvfb or no xdotool (apt-get install xvfb xdotool); .ci/run installs them");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxgi_viewer_export_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("voxgi_cornell-box.png");
+    let _ = std::fs::remove_file(&png);
+    let mut viewer = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
+        .current_dir(&dir)
+        .env("DISPLAY", &x.display)
+        .env("RUST_LOG", "voxgi_viewer=info")
+        .args(["--builtin", "cornell-box", "--size", "640x360"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run voxgi-viewer");
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stderr = viewer.stderr.take().expect("piped");
+    let log = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = String::new();
+        for line in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            if line.contains("first frame shown") {
+                let _ = tx.send(());
+            }
+            all += &line;
+            all.push('\n');
+        }
+        all
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(180))
+        .expect("no first frame within 3 minutes");
+    let window = x.xdotool(&["search", "--name", "voxgi"]);
+    let window = window
+        .lines()
+        .next()
+        .expect("the viewer's window")
+        .to_string();
+    x.xdotool(&["windowfocus", "--sync", &window]);
+    x.xdotool(&["key", "x"]);
+    // The field takes the keyboard in the frame after the dialog opens.
+    std::thread::sleep(std::time::Duration::from_secs(3));
+    x.xdotool(&["key", "Return"]);
+    let waiting = std::time::Instant::now();
+    while !png.exists() && waiting.elapsed().as_secs() < 300 {
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    }
+    let _ = viewer.kill();
+    let _ = viewer.wait();
+    let stderr = log.join().expect("the log");
+    assert!(png.exists(), "no export within 5 minutes:\n{stderr}");
+    let got = image::open(&png).expect("the export").to_rgba8();
+
+    // What the viewer starts with (`Viewer::start`, `ExportDialog::new`).
+    let ctx = headless::GpuContext::from_env().expect("a device");
+    let cpu = ctx.info.device_type == voxgi::wgpu::DeviceType::Cpu;
+    let options = RendererOptions {
+        half_resolution: cpu,
+        voxel_resolution: if cpu { 64 } else { 128 },
+        ..RendererOptions::default()
+    };
+    let ((w, h), frames) = if cpu {
+        ((960, 540), 16)
+    } else {
+        ((1920, 1080), headless::DEFAULT_ACCUMULATE)
+    };
+    assert_eq!((got.width(), got.height()), (w, h), "the export's size");
+    let scene = voxgi::scene::builtin::cornell_box();
+    let mut r = ctx.renderer(&scene, &options).expect("a renderer");
+    let params = FrameParams::new(r.default_camera().clone());
+    let want = headless::render_still(&ctx, &mut r, &params, w, h, frames).expect("a still");
+    // The viewer's orbit camera is the scene's camera turned into yaw, pitch and distance and
+    // back: a rounding of a few ulps moves an edge pixel by a code value or two (measured: 1).
+    let worst = got
+        .as_raw()
+        .iter()
+        .zip(&want.ldr)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    assert!(
+        worst <= 2,
+        "the export differs from render_still by {worst}"
+    );
+}

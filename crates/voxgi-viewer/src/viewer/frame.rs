@@ -34,6 +34,9 @@ impl Viewer {
         let view = frame.texture.create_view(&Default::default());
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.draw_frame(&mut encoder, &frame.texture, true)?;
+        if let Err(e) = self.export_frame(&mut encoder) {
+            self.toasts.error(format!("{e:#}"));
+        }
 
         // The UI, drawn over the image.
         let (ui, actions) = self.run_ui(&mut encoder);
@@ -49,6 +52,9 @@ impl Viewer {
         self.present(encoder, extra, frame);
         let busy = self.running().join(", ");
         self.stats.presented(&busy);
+        if let Err(e) = self.export_done() {
+            self.toasts.error(format!("{e:#}"));
+        }
         // After the frame's submission: a second drawing in the frame's own encoder ended the
         // renderer's GPU timer frame before its queries were submitted, and wgpu panicked.
         let ui_capture = self.capture_with_ui(&ui)?;
@@ -165,6 +171,10 @@ impl Viewer {
         if let Some(h) = &self.handover {
             running.push(h.label().into());
         }
+        running.extend(self.export_label());
+        if let Some(job) = &self.saving {
+            running.push(job.label());
+        }
         if self.ground.display != Display::ConeTraced
             && let Some(l) = self.ground.job_label()
         {
@@ -179,6 +189,8 @@ impl Viewer {
         let busy = self.rebuild.is_some()
             || self.opening.is_some()
             || self.handover.is_some()
+            || self.export.is_some()
+            || self.saving.is_some()
             || (self.ground.display != Display::ConeTraced && self.ground.building());
         if !busy {
             self.ready_frames += 1;
@@ -223,6 +235,10 @@ impl Viewer {
             self.reused = false;
         }
         if self.images.is_none() {
+            if self.export.is_some() {
+                // The export has the renderer; nothing holds the last image to show.
+                return Ok(());
+            }
             return self.draw_scene(
                 encoder,
                 &Target::new(&surface_view, format, w, h),
@@ -262,7 +278,10 @@ impl Viewer {
             self.renderer.receive_feedback()?;
             let shows = Some((self.params.clone(), self.version));
             let images = self.images.as_mut().expect("checked above");
-            if images.shows == shows && self.renderer.is_idle() {
+            // While an export has the renderer, the view shows its last image.
+            let exporting =
+                self.export.is_some() && images.cone.is_some() && images.shows.is_some();
+            if exporting || (images.shows == shows && self.renderer.is_idle()) {
                 self.reused |= accumulate;
             } else {
                 let v = cone.create_view(&Default::default());

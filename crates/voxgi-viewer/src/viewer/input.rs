@@ -41,6 +41,7 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::KeyO,
     KeyCode::Escape,
     KeyCode::KeyL,
+    KeyCode::KeyX,
 ];
 
 /// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
@@ -264,6 +265,10 @@ impl Viewer {
             KeyCode::Digit5 | KeyCode::Numpad5 => self.toggle_ortho(),
             KeyCode::KeyO => self.frame_overlay = !self.frame_overlay,
             KeyCode::KeyL => self.show_gizmos = !self.show_gizmos,
+            KeyCode::KeyX => {
+                self.export_dialog.open = true;
+                self.export_dialog.focus_file = true;
+            }
             KeyCode::Space => self.playing = !self.playing,
             KeyCode::Tab => self.show_panel = !self.show_panel,
             KeyCode::F12 | KeyCode::KeyP => self.screenshot_key = true,

@@ -6,6 +6,7 @@
 //! view), `stats` (frame and per-pass
 //! times) and `open` (opening scenes, applying options, and the background work for both).
 
+mod export;
 mod frame;
 mod gizmos;
 mod input;
@@ -221,6 +222,10 @@ struct Viewer {
     rebuild: Option<Job<(Renderer, RendererOptions)>>,
     opening: Option<Job<Opened>>,
     handover: Option<Handover>,
+    /// A file being written (an export): the message to show when it is done.
+    saving: Option<Job<String>>,
+    export_dialog: export::ExportDialog,
+    export: Option<export::Export>,
     dialog: Option<Job<Option<PathBuf>>>,
     open_path: String,
     vsync: bool,
@@ -394,6 +399,7 @@ impl Viewer {
         let orbit_distance = (bounds.center() - default_camera.position)
             .length()
             .max(radius * 0.1);
+        let export_dialog = export::ExportDialog::new(cpu, &scene_label(&scene));
         Ok(Viewer {
             window,
             surface,
@@ -423,6 +429,9 @@ impl Viewer {
             rebuild: None,
             opening: None,
             handover: None,
+            saving: None,
+            export_dialog,
+            export: None,
             dialog: None,
             open_path: String::new(),
             vsync: !args.no_vsync,

@@ -185,6 +185,11 @@ impl Viewer {
             Some(Err(e)) => self.toasts.error(format!("{e:#}")),
             None => {}
         }
+        match take(&mut self.saving) {
+            Some(Ok(done)) => self.toasts.info(done),
+            Some(Err(e)) => self.toasts.error(format!("{e:#}")),
+            None => {}
+        }
         match take(&mut self.dialog) {
             Some(Ok(Some(path))) => self.open(&path),
             Some(Ok(None)) => self.toasts.info(

@@ -46,11 +46,14 @@ impl Viewer {
                         "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
                          to look) · H: frame (the selected light) · 1/3/7: front/right/top · 5: orthographic · \
                          G: path tracer / split · Space: play · P: screenshot · O: frame \
-                         time · L: light gizmos · Tab: panel",
+                         time · L: light gizmos · X: export · Tab: panel",
                     );
                     ui.horizontal(|ui| {
                         if ui.button("Open…").clicked() {
                             actions.open_dialog = true;
+                        }
+                        if ui.button("Export…").clicked() {
+                            self.export_dialog.open = true;
                         }
                         let edit = ui.add(
                             egui::TextEdit::singleline(&mut self.open_path)
@@ -223,6 +226,7 @@ impl Viewer {
         let left = self.panel_px as f32 / ctx.pixels_per_point();
         self.axes_ui(&ctx, left);
         self.gizmos_ui(&ctx);
+        self.export_ui(&ctx);
         let mut top = 8.0;
         if self.frame_overlay {
             let n = self.stats.frame_ms.len().max(1) as f32;

@@ -570,10 +570,10 @@ impl Renderer {
             && (!self.options.temporal || self.temporal.converged())
     }
 
-    /// Whether a voxel counter read back is submitted but has not completed (`headless::render`
-    /// waits for it before deciding that a frame is final).
-    #[cfg(feature = "headless")]
-    pub(crate) fn feedback_in_flight(&self) -> bool {
+    /// Whether a voxel counter read back is submitted but has not completed: a frame drawn
+    /// before it is back may be followed by a rebuild (`headless::render` waits for it before
+    /// deciding that a frame is final; so does the viewer's export).
+    pub fn feedback_in_flight(&self) -> bool {
         self.counters.in_flight()
     }
 
