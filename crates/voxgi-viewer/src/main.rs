@@ -39,6 +39,9 @@ pub struct Args {
     /// rendered scene.
     #[arg(long, requires = "screenshot")]
     pub with_ui: bool,
+    /// Draw the ground grid in --screenshot's image too (the window shows it; K toggles it).
+    #[arg(long, requires = "screenshot")]
+    pub grid: bool,
     /// Present without waiting for the display's refresh.
     #[arg(long)]
     pub no_vsync: bool,

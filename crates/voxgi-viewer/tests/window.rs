@@ -468,3 +468,45 @@ fn the_export_is_what_voxgi_render_writes() {
         "the export differs from render_still by {worst}"
     );
 }
+
+/// The ground grid lies on the Cornell box's floor and behind what stands on it: `--grid`
+/// changes the floor in front of the boxes and nothing on the tall box's face or the walls.
+#[test]
+fn the_grid_is_on_the_floor_and_behind_the_boxes() {
+    let dir = std::env::temp_dir().join(format!("voxgi_viewer_grid_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let args = ["--size", "320x320", "--after-frames", "3"];
+    let Some(plain) = cornell(&dir, "plain", &args) else {
+        skip("no display and no xvfb-run (apt-get install xvfb); .ci/run installs it");
+        return;
+    };
+    let grid = cornell(&dir, "grid", &[&args[..], &["--grid"]].concat()).expect("ran once");
+    // Per region: how many pixels changed by more than 16 code values, and the largest change.
+    let changed = |x: (f32, f32), y: (f32, f32)| {
+        let (w, h) = (plain.width() as f32, plain.height() as f32);
+        let (mut count, mut most) = (0, 0u8);
+        for py in (y.0 * h) as u32..(y.1 * h) as u32 {
+            for px in (x.0 * w) as u32..(x.1 * w) as u32 {
+                let (a, b) = (plain.get_pixel(px, py).0, grid.get_pixel(px, py).0);
+                let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+                count += usize::from(d > 16);
+                most = most.max(d);
+            }
+        }
+        (count, most)
+    };
+    // The floor between the boxes and the camera: a 10 cm grid's lines cross the patch
+    // (128 x 22 pixels; measured: 81 pixels changed by up to 35).
+    let (floor, _) = changed((0.3, 0.7), (0.9, 0.97));
+    assert!(floor > 40, "{floor} pixels of the floor's patch changed");
+    // The tall box's face, the back wall and the red wall: the same frames drawn the same way
+    // (measured: no pixel; two code values allow for a run's rounding).
+    for (what, x, y) in [
+        ("tall box", (0.3, 0.4), (0.45, 0.6)),
+        ("back wall", (0.45, 0.55), (0.2, 0.3)),
+        ("red wall", (0.05, 0.1), (0.3, 0.6)),
+    ] {
+        let (_, most) = changed(x, y);
+        assert!(most <= 2, "the {what} changed by {most}");
+    }
+}

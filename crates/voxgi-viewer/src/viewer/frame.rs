@@ -239,11 +239,15 @@ impl Viewer {
                 // The export has the renderer; nothing holds the last image to show.
                 return Ok(());
             }
-            return self.draw_scene(
+            self.draw_scene(
                 encoder,
                 &Target::new(&surface_view, format, w, h),
                 accumulate,
-            );
+            )?;
+            if self.show_grid && self.ground.needs_cone_tracing() {
+                self.draw_grid(encoder, &surface_view, (w, h));
+            }
+            return Ok(());
         }
         let (x0, vw) = self.view_columns();
         let stale = self
@@ -295,6 +299,10 @@ impl Viewer {
                 images.shows = shows;
             }
             encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
+            if self.show_grid && self.export.is_none() {
+                let v = view.create_view(&Default::default());
+                self.draw_grid(encoder, &v, (vw, h));
+            }
         }
         let v = view.create_view(&Default::default());
         let r = self.ground.record(

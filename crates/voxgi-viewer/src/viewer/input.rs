@@ -42,6 +42,7 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::Escape,
     KeyCode::KeyL,
     KeyCode::KeyX,
+    KeyCode::KeyK,
 ];
 
 /// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
@@ -265,6 +266,7 @@ impl Viewer {
             KeyCode::Digit5 | KeyCode::Numpad5 => self.toggle_ortho(),
             KeyCode::KeyO => self.frame_overlay = !self.frame_overlay,
             KeyCode::KeyL => self.show_gizmos = !self.show_gizmos,
+            KeyCode::KeyK => self.show_grid = !self.show_grid,
             KeyCode::KeyX => {
                 self.export_dialog.open = true;
                 self.export_dialog.focus_file = true;

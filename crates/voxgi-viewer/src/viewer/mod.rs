@@ -9,6 +9,7 @@
 mod export;
 mod frame;
 mod gizmos;
+mod grid;
 mod input;
 mod open;
 mod panel;
@@ -249,6 +250,10 @@ struct Viewer {
     selected_light: Option<usize>,
     /// Whether the light gizmos are drawn.
     show_gizmos: bool,
+    /// The grid's height (`grid::height`).
+    scene_floor: f32,
+    grid: grid::GridPass,
+    show_grid: bool,
     /// The scene's own cameras, to pick from.
     cameras: Vec<voxgi::scene::Camera>,
     options: RendererOptions,
@@ -400,6 +405,7 @@ impl Viewer {
             .length()
             .max(radius * 0.1);
         let export_dialog = export::ExportDialog::new(cpu, &scene_label(&scene));
+        let grid = grid::GridPass::new(&device, config.format);
         Ok(Viewer {
             window,
             surface,
@@ -414,6 +420,10 @@ impl Viewer {
             scene_center: bounds.center(),
             selected_light: None,
             show_gizmos: true,
+            scene_floor: grid::height(&scene),
+            grid,
+            // Like the panel: in the window and in screenshots of it, not in those of the scene.
+            show_grid: args.screenshot.is_none() || args.with_ui || args.grid,
             cameras: scene.cameras.clone(),
             // The path tracer shows a still scene: play with G's cone tracing.
             playing: duration > 0.0 && args.display == Display::ConeTraced,

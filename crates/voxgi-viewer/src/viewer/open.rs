@@ -91,6 +91,7 @@ impl Viewer {
         let bounds = o.scene.swept_bounds();
         self.scene_radius = (bounds.size().length() * 0.5).max(1e-3);
         self.scene_center = bounds.center();
+        self.scene_floor = super::grid::height(&o.scene);
         self.selected_light = None;
         self.duration = o
             .scene

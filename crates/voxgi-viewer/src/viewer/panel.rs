@@ -91,6 +91,8 @@ impl Viewer {
                                 {
                                     self.toggle_ortho();
                                 }
+                                ui.checkbox(&mut self.show_grid, "grid")
+                                    .on_hover_text("the ground grid under the scene (key K)");
                             });
                             let flags = render_flags(&self.params.camera);
                             ui.horizontal(|ui| {

@@ -125,6 +125,8 @@ pub struct Renderer {
     blend_left: u32,
     /// Frames rendered, for `voxel_update_interval`.
     frame_index: u64,
+    /// The world-to-clip matrix of the last frame, without its jitter (`depth`).
+    drawn_view_proj: glam::Mat4,
     /// Instances, lights and animations as last set.
     state: SceneState,
     counters: CounterReadback,
@@ -340,6 +342,7 @@ impl Renderer {
             blend: None,
             blend_left: 0,
             frame_index: 0,
+            drawn_view_proj: glam::Mat4::IDENTITY,
             state,
             counters: CounterReadback::new("voxel counters readback", 1 + POOL_COUNTERS),
             pools: 0,
@@ -733,6 +736,17 @@ impl Renderer {
             Some(h) => &h.color[self.temporal.written()],
             None => &t.hdr_texture,
         })
+    }
+
+    /// The last frame's depth and the world-to-clip matrix it was drawn with, for an
+    /// application's own overlays (a ground grid, gizmos) hidden behind the scene as they
+    /// should be. The depth is the G-buffer's (`Depth32Float`, 0 near to 1 far, 1 where
+    /// nothing was drawn) at the last target's size, with `TEXTURE_BINDING` usage; with
+    /// temporal accumulation it was drawn a sub-pixel jitter off the matrix (without it),
+    /// which an overlay can ignore. `None` before the first frame.
+    pub fn depth(&self) -> Option<(&wgpu::TextureView, glam::Mat4)> {
+        let t = self.targets.as_ref()?;
+        Some((&t.depth, self.drawn_view_proj))
     }
 
     /// Forgets the temporal history: the next frame shows only itself. Call it on a camera

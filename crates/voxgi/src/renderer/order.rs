@@ -87,6 +87,7 @@ impl Renderer {
         // Whether the light or the geometry may differ from the last frame's.
         let changed = self.voxel_work_pending() | self.scene.advance_motion(&self.queue);
         let view_proj = camera_view_proj(&params.camera, width, height, self.view.0, self.view.1);
+        self.drawn_view_proj = view_proj;
         let history = self.temporal.begin(temporal, params, view_proj, changed);
         // Area lights' sample views move to this frame's points on their lights: every frame
         // that accumulates (not the first of a history, which shows PCSS, nor a held one).
