@@ -51,7 +51,7 @@ pub(super) fn height(scene: &voxgi::scene::Scene) -> f32 {
             let [a, b, c] = [0, 1, 2].map(|k| p[t[k] as usize]);
             let n = (b - a).cross(c - a);
             let area = 0.5 * n.length();
-            if !(area > 0.0) || n.y < 0.95 * n.length() {
+            if area.is_nan() || area <= 0.0 || n.y < 0.95 * n.length() {
                 continue;
             }
             total += area;
