@@ -1244,3 +1244,57 @@ fn degenerate_geometry_is_named() {
         "{d:?}"
     );
 }
+
+/// `[[view]]`s are named cameras after the scene's others (the `[camera]` first, then the
+/// included files'), in the file's order; a view without a name, or a `[camera]` with one, is
+/// an error that says so.
+#[test]
+fn scene_file_views_are_named_cameras_after_the_others() {
+    let dir = tmp("views");
+    let main = write(
+        &dir,
+        "views.toml",
+        r#"[[include]]
+builtin = "cornell-box"
+
+[camera]
+position = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+
+[[view]]
+name = "left"
+position = [-2.0, 0.5, 1.0]
+target = [0.0, 0.5, 0.0]
+fov = 30.0
+
+[[view]]
+name = "above"
+position = [0.0, 4.0, 0.1]
+target = [0.0, 0.0, 0.0]
+"#,
+    );
+    let scene = io::load(&main).unwrap();
+    let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names.first(), Some(&"scene file camera"));
+    assert_eq!(&names[names.len() - 2..], ["left", "above"]);
+    let left = &scene.cameras[names.len() - 2];
+    assert!(left.position.distance(Vec3::new(-2.0, 0.5, 1.0)) < 1e-6);
+    assert!(
+        matches!(left.projection, Projection::Perspective { yfov } if (yfov.to_degrees() - 30.0).abs() < 1e-4)
+    );
+
+    let unnamed = write(
+        &dir,
+        "unnamed.toml",
+        "[[view]]\nposition = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n",
+    );
+    let e = io::load(&unnamed).unwrap_err().to_string();
+    assert!(e.contains("view 1") && e.contains("needs a name"), "{e}");
+    let named = write(
+        &dir,
+        "named.toml",
+        "[camera]\nname = \"x\"\nposition = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n",
+    );
+    let e = io::load(&named).unwrap_err().to_string();
+    assert!(e.contains("[[view]]"), "{e}");
+}

@@ -53,6 +53,11 @@
 //! znear = 0.01                     # optional
 //! zfar = 100.0                     # optional
 //!
+//! [[view]]                         # any number: named views (the viewer's bookmarks), after
+//! name = "gallery"                 #   the scene's other cameras, with the [camera]'s keys
+//! position = [2.0, 1.5, 0.0]
+//! target = [0.0, 1.0, 0.0]
+//!
 //! [settings]                       # anything; handed to the renderer untouched
 //! voxel_resolution = 256
 //!
@@ -95,6 +100,8 @@ struct SceneFile {
     #[serde(default)]
     light: Vec<LightDef>,
     camera: Option<CameraDef>,
+    #[serde(default)]
+    view: Vec<CameraDef>,
     settings: Option<toml::Table>,
     #[serde(default)]
     animation: Vec<AnimationDef>,
@@ -231,6 +238,8 @@ struct LightDef {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 struct CameraDef {
+    /// Only `[[view]]`s have (and need) one.
+    name: Option<String>,
     position: [f32; 3],
     target: [f32; 3],
     #[serde(default = "default_fov")]
@@ -401,35 +410,48 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     }
 
     if let Some(c) = &file.camera {
-        let (p, t) = (Vec3::from(c.position), Vec3::from(c.target));
-        if !(p.is_finite() && t.is_finite()) || p.distance(t) <= 0.0 {
-            return Err(err(
-                "camera: position and target must be finite and differ".into()
-            ));
+        if c.name.is_some() {
+            return Err(err("camera: a name is for [[view]]s".into()));
         }
-        if !(c.fov > 0.0 && c.fov < 180.0) {
-            return Err(err(format!(
-                "camera: fov {} is not in (0, 180) degrees",
-                c.fov
-            )));
-        }
-        let mut cam = Camera::look_at(p, t, c.fov);
-        cam.name = "scene file camera".into();
-        if let Some(zn) = c.znear {
-            if zn.is_nan() || zn <= 0.0 {
-                return Err(err(format!("camera: znear {zn} must be > 0")));
-            }
-            cam.znear = zn;
-        }
-        if let Some(zf) = c.zfar {
-            if zf.is_nan() || zf <= cam.znear {
-                return Err(err(format!("camera: zfar {zf} must exceed znear")));
-            }
-            cam.zfar = Some(zf);
-        }
+        let cam = make_camera(c, "scene file camera").map_err(|r| err(format!("camera: {r}")))?;
         scene.cameras.insert(0, cam);
     }
+    for (i, v) in file.view.iter().enumerate() {
+        let name = v
+            .name
+            .as_deref()
+            .ok_or_else(|| err(format!("view {}: a view needs a name", i + 1)))?;
+        let cam =
+            make_camera(v, name).map_err(|r| err(format!("view {} ('{name}'): {r}", i + 1)))?;
+        scene.cameras.push(cam);
+    }
     Ok((scene, file.settings))
+}
+
+/// A `[camera]` or a `[[view]]`.
+fn make_camera(c: &CameraDef, name: &str) -> std::result::Result<Camera, String> {
+    let (p, t) = (Vec3::from(c.position), Vec3::from(c.target));
+    if !(p.is_finite() && t.is_finite()) || p.distance(t) <= 0.0 {
+        return Err("position and target must be finite and differ".into());
+    }
+    if !(c.fov > 0.0 && c.fov < 180.0) {
+        return Err(format!("fov {} is not in (0, 180) degrees", c.fov));
+    }
+    let mut cam = Camera::look_at(p, t, c.fov);
+    cam.name = name.into();
+    if let Some(zn) = c.znear {
+        if zn.is_nan() || zn <= 0.0 {
+            return Err(format!("znear {zn} must be > 0"));
+        }
+        cam.znear = zn;
+    }
+    if let Some(zf) = c.zfar {
+        if zf.is_nan() || zf <= cam.znear {
+            return Err(format!("zfar {zf} must exceed znear"));
+        }
+        cam.zfar = Some(zf);
+    }
+    Ok(cam)
 }
 
 fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Result<(), String> {

@@ -241,6 +241,21 @@ impl Setting {
         })
     }
 
+    /// `v` as a scene file's `[settings]` writes it: what `from_toml` reads back as `v`.
+    pub fn to_toml(&self, v: Value) -> toml::Value {
+        match v {
+            Value::Bool(b) => toml::Value::Boolean(b),
+            Value::Int(UNLIMITED_BOUNCES) if matches!(self.domain, Domain::Bounces) => {
+                toml::Value::String("unlimited".into())
+            }
+            Value::Int(n) => toml::Value::Integer(n.into()),
+            Value::Float(x) | Value::Auto(Some(x)) => short(x),
+            Value::Auto(None) => toml::Value::String("auto".into()),
+            Value::Name(n) => toml::Value::String(n.into()),
+            Value::Rgb(c) => toml::Value::Array(c.map(short).into()),
+        }
+    }
+
     /// Its value from a scene file's TOML value.
     pub fn from_toml(&self, v: &toml::Value) -> Result<Value> {
         let bad = || {
@@ -395,6 +410,11 @@ impl FrameParams {
     }
 }
 
+/// `x` as the shortest decimal that reads back as it (0.1, not 0.10000000149011612).
+fn short(x: f32) -> toml::Value {
+    toml::Value::Float(x.to_string().parse().unwrap_or(x.into()))
+}
+
 /// A scene file's `[settings]` table, parsed: the settings it names with their values, in the
 /// table's order. Unknown keys and values of the wrong form are errors that name the key.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -480,6 +500,28 @@ mod tests {
         SceneSettings::from_table(&table)?.apply(&mut o, &mut f)?;
         o.validate()?;
         Ok((o, f))
+    }
+
+    /// What the viewer saves into a scene file reads back as itself: every setting's default,
+    /// and values off it (unlimited bounces, a fixed cone length, a background colour).
+    #[test]
+    fn every_setting_written_as_toml_reads_back() {
+        for s in SETTINGS {
+            let v = s.default_value();
+            assert_eq!(s.from_toml(&s.to_toml(v)).unwrap(), v, "{}", s.key);
+        }
+        let cases = [
+            ("bounces", Value::Int(UNLIMITED_BOUNCES)),
+            ("max_distance", Value::Auto(Some(12.5))),
+            ("background", Value::Rgb([0.1, 0.2, 0.3])),
+            ("step_factor", Value::Float(0.3)),
+        ];
+        for (key, v) in cases {
+            let s = Setting::get(key).unwrap();
+            assert_eq!(s.from_toml(&s.to_toml(v)).unwrap(), v, "{key}");
+        }
+        let s = Setting::get("step_factor").unwrap();
+        assert_eq!(s.to_toml(Value::Float(0.3)).to_string(), "0.3");
     }
 
     #[test]
