@@ -43,6 +43,7 @@ const VIEWER_KEYS: &[KeyCode] = &[
     KeyCode::KeyL,
     KeyCode::KeyX,
     KeyCode::KeyK,
+    KeyCode::KeyB,
 ];
 
 /// The fly keys: the axis each pushes along (0 right, 1 up, 2 forward) and which way.
@@ -267,6 +268,7 @@ impl Viewer {
             KeyCode::KeyO => self.frame_overlay = !self.frame_overlay,
             KeyCode::KeyL => self.show_gizmos = !self.show_gizmos,
             KeyCode::KeyK => self.show_grid = !self.show_grid,
+            KeyCode::KeyB => self.bookmark(),
             KeyCode::KeyX => {
                 self.export_dialog.open = true;
                 self.export_dialog.focus_file = true;

@@ -13,6 +13,7 @@ mod grid;
 mod input;
 mod open;
 mod panel;
+mod save;
 mod screenshot;
 mod starting;
 mod stats;
@@ -254,8 +255,14 @@ struct Viewer {
     scene_floor: f32,
     grid: grid::GridPass,
     show_grid: bool,
-    /// The scene's own cameras, to pick from.
+    /// The scene's own cameras, to pick from, and the bookmarks from `first_bookmark` on
+    /// (the scene file's `[[view]]`s and those added).
     cameras: Vec<voxgi::scene::Camera>,
+    first_bookmark: usize,
+    /// Where the view is saved.
+    source: Option<save::Source>,
+    /// The settings when the scene was opened: saving writes those changed since.
+    opened_options: (RendererOptions, FrameParams),
     options: RendererOptions,
     draft: RendererOptions,
     params: FrameParams,
@@ -425,6 +432,9 @@ impl Viewer {
             // Like the panel: in the window and in screenshots of it, not in those of the scene.
             show_grid: args.screenshot.is_none() || args.with_ui || args.grid,
             cameras: scene.cameras.clone(),
+            first_bookmark: scene.cameras.len() - save::views_in(args.scene.as_deref()),
+            source: save::source(args.scene.as_deref(), args.builtin.as_deref()),
+            opened_options: (options.clone(), params.clone()),
             // The path tracer shows a still scene: play with G's cone tracing.
             playing: duration > 0.0 && args.display == Display::ConeTraced,
             draft: options.clone(),

@@ -103,6 +103,9 @@ impl Viewer {
         self.playing = self.duration > 0.0 && self.ground.display == Display::ConeTraced;
         self.scene_name = scene_label(&o.scene);
         self.cameras = o.scene.cameras.clone();
+        self.first_bookmark = self.cameras.len() - super::save::views_in(Some(&o.path));
+        self.source = super::save::source(Some(&o.path), None);
+        self.opened_options = (self.options.clone(), self.params.clone());
         self.window
             .set_title(&format!("voxgi — {}", self.scene_name));
         self.scene = Arc::new(o.scene);

@@ -46,7 +46,7 @@ impl Viewer {
                         "drag: orbit · right-drag: pan · wheel: zoom · F: fly (WASD/QE, drag \
                          to look) · H: frame (the selected light) · 1/3/7: front/right/top · 5: orthographic · \
                          G: path tracer / split · Space: play · P: screenshot · O: frame \
-                         time · L: light gizmos · X: export · Tab: panel",
+                         time · L: light gizmos · X: export · B: bookmark · Tab: panel",
                     );
                     ui.horizontal(|ui| {
                         if ui.button("Open…").clicked() {
@@ -102,26 +102,7 @@ impl Viewer {
                             });
                             ui.label(egui::RichText::new(flags).monospace().small());
                         });
-                    if !self.cameras.is_empty() {
-                        ui.horizontal(|ui| {
-                            ui.label("scene camera:");
-                            let mut pick = None;
-                            for (i, c) in self.cameras.iter().enumerate() {
-                                let name = if c.name.is_empty() {
-                                    format!("{i}")
-                                } else {
-                                    c.name.clone()
-                                };
-                                if ui.button(name).clicked() {
-                                    pick = Some(c.clone());
-                                }
-                            }
-                            if let Some(c) = pick {
-                                self.controller =
-                                    Controller::Orbit(Orbit::from_camera(&c, self.scene_radius));
-                            }
-                        });
-                    }
+                    self.cameras_ui(ui);
                     egui::CollapsingHeader::new("ground truth")
                         .default_open(true)
                         .show(ui, |ui| {
@@ -333,6 +314,64 @@ impl Viewer {
                     let moved = response.drag_delta().x / width.max(1.0);
                     self.ground.divider = (self.ground.divider + moved).clamp(0.0, 1.0);
                 }
+            }
+        }
+    }
+
+    /// The scene's cameras and the bookmarks (wrapped onto as many rows as they need), a
+    /// button to bookmark the view, and one to save the view into the scene file.
+    fn cameras_ui(&mut self, ui: &mut egui::Ui) {
+        let mut pick = None;
+        let mut forget = None;
+        ui.horizontal_wrapped(|ui| {
+            ui.label("cameras:");
+            for (i, c) in self.cameras.iter().enumerate() {
+                let name = if c.name.is_empty() {
+                    format!("{i}")
+                } else {
+                    c.name.clone()
+                };
+                let b = ui.button(name);
+                if b.clicked() {
+                    pick = Some(c.clone());
+                }
+                if i >= self.first_bookmark {
+                    b.context_menu(|ui| {
+                        if ui.button("forget this view").clicked() {
+                            forget = Some(i);
+                        }
+                    });
+                }
+            }
+            if ui
+                .button("+ bookmark")
+                .on_hover_text("the view as a named camera (key B); right-click one to forget it")
+                .clicked()
+            {
+                self.bookmark();
+            }
+        });
+        if let Some(c) = pick {
+            self.controller = Controller::Orbit(Orbit::from_camera(&c, self.scene_radius));
+            self.renderer.reset_history();
+        }
+        if let Some(i) = forget {
+            self.cameras.remove(i);
+        }
+        if let Some(target) = self.source.as_ref().map(|s| s.target()) {
+            let name = target.file_name().map_or_else(
+                || target.display().to_string(),
+                |n| n.to_string_lossy().into(),
+            );
+            if ui
+                .button(format!("save the view into {name}"))
+                .on_hover_text(
+                    "the camera, the bookmarks, the settings changed here and the scene \
+                     file's own lights as edited; comments and the rest stay",
+                )
+                .clicked()
+            {
+                self.save_view();
             }
         }
     }
