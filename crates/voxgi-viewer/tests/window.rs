@@ -261,6 +261,76 @@ impl Drop for Xvfb {
     }
 }
 
+/// The viewer running on `x` with `args` (in `dir`), its first frame shown and its window given
+/// the keyboard; the thread collecting its log, which ends with it.
+struct Running {
+    child: std::process::Child,
+    log: Option<std::thread::JoinHandle<String>>,
+    window: String,
+}
+
+impl Running {
+    fn start(x: &Xvfb, dir: &std::path::Path, args: &[&str]) -> Running {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
+            .current_dir(dir)
+            .env("DISPLAY", &x.display)
+            .env("RUST_LOG", "voxgi_viewer=info")
+            .args(args)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run voxgi-viewer");
+        // Input goes in once the viewer shows its first frame (it logs it): before, the
+        // window shows the renderer being made.
+        let (tx, rx) = std::sync::mpsc::channel();
+        let stderr = child.stderr.take().expect("piped");
+        let log = std::thread::spawn(move || {
+            use std::io::BufRead;
+            let mut all = String::new();
+            for line in std::io::BufReader::new(stderr)
+                .lines()
+                .map_while(Result::ok)
+            {
+                if line.contains("first frame shown") {
+                    let _ = tx.send(());
+                }
+                all += &line;
+                all.push('\n');
+            }
+            all
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(180))
+            .expect("no first frame within 3 minutes");
+        let window = x.xdotool(&["search", "--name", "voxgi"]);
+        let window = window
+            .lines()
+            .next()
+            .expect("the viewer's window")
+            .to_string();
+        // Without a window manager nothing gives the window the keyboard.
+        x.xdotool(&["windowfocus", "--sync", &window]);
+        Running {
+            child,
+            log: Some(log),
+            window,
+        }
+    }
+
+    /// Waits for the viewer to exit (`--screenshot`); its log, after checking it succeeded.
+    fn finish(mut self) -> String {
+        let status = self.child.wait().expect("voxgi-viewer");
+        let log = self.log.take().expect("once").join().expect("the log");
+        assert!(status.success(), "voxgi-viewer failed:\n{log}");
+        log
+    }
+
+    /// Ends the viewer; its log.
+    fn kill(mut self) -> String {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        self.log.take().expect("once").join().expect("the log")
+    }
+}
+
 /// Tab hides the panel and the viewer's keys still work after it, and the wheel over the panel
 /// leaves the camera alone. Before, egui took Tab to move its focus to "Open…" (the panel
 /// stayed) and every key after it until the view was clicked, and a wheel over the panel
@@ -276,48 +346,15 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
     let dir = std::env::temp_dir().join(format!("voxgi_viewer_keys_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("keys.png");
-    let mut viewer = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
-        .env("DISPLAY", &x.display)
-        .env("RUST_LOG", "voxgi_viewer=info")
-        .args(["--builtin", "cornell-box", "--size", "640x360", "--with-ui"])
-        .args([
-            "--screenshot",
-            png.to_str().unwrap(),
-            "--after-frames",
-            "40",
-        ])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("run voxgi-viewer");
-    // The input goes in once the viewer shows its first frame (it logs it): before, the
-    // window shows the renderer being made, and the panel is not there to scroll.
-    let (tx, rx) = std::sync::mpsc::channel();
-    let stderr = viewer.stderr.take().expect("piped");
-    let log = std::thread::spawn(move || {
-        use std::io::BufRead;
-        let mut all = String::new();
-        for line in std::io::BufReader::new(stderr)
-            .lines()
-            .map_while(Result::ok)
-        {
-            if line.contains("first frame shown") {
-                let _ = tx.send(());
-            }
-            all += &line;
-            all.push('\n');
-        }
-        all
-    });
-    rx.recv_timeout(std::time::Duration::from_secs(180))
-        .expect("no first frame within 3 minutes");
-    let window = x.xdotool(&["search", "--name", "voxgi"]);
-    let window = window
-        .lines()
-        .next()
-        .expect("the viewer's window")
-        .to_string();
-    // Without a window manager nothing gives the window the keyboard.
-    x.xdotool(&["windowfocus", "--sync", &window]);
+    let shot = [
+        "--screenshot",
+        png.to_str().unwrap(),
+        "--after-frames",
+        "40",
+    ];
+    let args = ["--builtin", "cornell-box", "--size", "640x360", "--with-ui"];
+    let viewer = Running::start(&x, &dir, &[&args[..], &shot[..]].concat());
+    let window = viewer.window.clone();
     // The wheel up (zoom in) five times over the panel, then Tab, then G (the path tracer).
     x.xdotool(&["mousemove", "--window", &window, "100", "200"]);
     for _ in 0..5 {
@@ -326,9 +363,7 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
     x.xdotool(&["mousemove", "--window", &window, "500", "200"]);
     x.xdotool(&["key", "Tab"]);
     x.xdotool(&["key", "g"]);
-    let status = viewer.wait().expect("voxgi-viewer");
-    let stderr = log.join().expect("the log");
-    assert!(status.success(), "voxgi-viewer failed:\n{stderr}");
+    viewer.finish();
     let img = image::open(&png).expect("the screenshot").to_rgb8();
     // The panel hidden and the camera where it was: left of the box (the image spans the
     // window) the background is black; the panel there would be grey with text, and a
@@ -388,40 +423,7 @@ fn the_export_is_what_voxgi_render_writes() {
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("voxgi_cornell-box.png");
     let _ = std::fs::remove_file(&png);
-    let mut viewer = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
-        .current_dir(&dir)
-        .env("DISPLAY", &x.display)
-        .env("RUST_LOG", "voxgi_viewer=info")
-        .args(["--builtin", "cornell-box", "--size", "640x360"])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("run voxgi-viewer");
-    let (tx, rx) = std::sync::mpsc::channel();
-    let stderr = viewer.stderr.take().expect("piped");
-    let log = std::thread::spawn(move || {
-        use std::io::BufRead;
-        let mut all = String::new();
-        for line in std::io::BufReader::new(stderr)
-            .lines()
-            .map_while(Result::ok)
-        {
-            if line.contains("first frame shown") {
-                let _ = tx.send(());
-            }
-            all += &line;
-            all.push('\n');
-        }
-        all
-    });
-    rx.recv_timeout(std::time::Duration::from_secs(180))
-        .expect("no first frame within 3 minutes");
-    let window = x.xdotool(&["search", "--name", "voxgi"]);
-    let window = window
-        .lines()
-        .next()
-        .expect("the viewer's window")
-        .to_string();
-    x.xdotool(&["windowfocus", "--sync", &window]);
+    let viewer = Running::start(&x, &dir, &["--builtin", "cornell-box", "--size", "640x360"]);
     x.xdotool(&["key", "x"]);
     // The field takes the keyboard in the frame after the dialog opens.
     std::thread::sleep(std::time::Duration::from_secs(3));
@@ -430,9 +432,7 @@ fn the_export_is_what_voxgi_render_writes() {
     while !png.exists() && waiting.elapsed().as_secs() < 300 {
         std::thread::sleep(std::time::Duration::from_millis(200));
     }
-    let _ = viewer.kill();
-    let _ = viewer.wait();
-    let stderr = log.join().expect("the log");
+    let stderr = viewer.kill();
     assert!(png.exists(), "no export within 5 minutes:\n{stderr}");
     let got = image::open(&png).expect("the export").to_rgba8();
 
@@ -509,4 +509,47 @@ fn the_grid_is_on_the_floor_and_behind_the_boxes() {
         let (_, most) = changed(x, y);
         assert!(most <= 2, "the {what} changed by {most}");
     }
+}
+
+/// The panel's edge drags it wider (up to 70 % of the window) and the 3D view beside it
+/// narrower: dragged from 256 points (a 640-point window's default) to 400, the panel's grey
+/// reaches past where the picture began.
+#[test]
+fn the_panel_is_resized_by_its_edge() {
+    let Some(x) = Xvfb::start() else {
+        skip("no Xvfb or no xdotool (apt-get install xvfb xdotool); .ci/run installs them");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxgi_viewer_panel_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("panel.png");
+    let shot = [
+        "--screenshot",
+        png.to_str().unwrap(),
+        "--after-frames",
+        "30",
+    ];
+    let args = ["--builtin", "cornell-box", "--size", "640x360", "--with-ui"];
+    let viewer = Running::start(&x, &dir, &[&args[..], &shot[..]].concat());
+    let w = viewer.window.clone();
+    // Just right of the edge (egui grabs a few points either side), then along, slowly: a
+    // frame of the CPU driver takes a few hundred milliseconds.
+    x.xdotool(&["mousemove", "--window", &w, "258", "200"]);
+    std::thread::sleep(std::time::Duration::from_millis(800));
+    x.xdotool(&["mousedown", "1"]);
+    for to in ["300", "350", "400"] {
+        std::thread::sleep(std::time::Duration::from_millis(500));
+        x.xdotool(&["mousemove", "--window", &w, to, "200"]);
+    }
+    std::thread::sleep(std::time::Duration::from_millis(800));
+    x.xdotool(&["mouseup", "1"]);
+    viewer.finish();
+    let img = image::open(&png).expect("the screenshot").to_rgb8();
+    // Between 300 and 380 points: the panel's flat dark grey (27 of 255) where the picture was:
+    // the black margin left of the box or its red wall.
+    let grey = mean(&img, (0.47, 0.58), (0.55, 0.6));
+    assert!(
+        (grey[0] - grey[2]).abs() < 3.0 && grey[0] > 15.0 && grey[0] < 60.0,
+        "where the panel should be now: {grey:?}"
+    );
 }

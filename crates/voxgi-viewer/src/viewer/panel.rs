@@ -29,14 +29,17 @@ impl Viewer {
             self.panel_px = 0;
             return actions;
         }
-        // A fixed width: a panel that followed its content would resize the 3D view (and
-        // restart the path tracer) whenever a label grew. A narrow window gets a narrower one
-        // (370 points of a 560-point window left 190 for the picture).
-        let width = panel_width(ui.ctx().content_rect().width());
+        // Its edge drags it wider or narrower; it starts narrower in a narrow window (370
+        // points of a 560-point window left 190 for the picture). Its content scrolls both
+        // ways: a panel that followed its content's width would resize the 3D view (and
+        // restart the path tracer) whenever a label grew, and could not be made narrower.
+        let window = ui.ctx().content_rect().width();
         let panel = egui::Panel::left("settings")
-            .exact_size(width)
+            .resizable(true)
+            .default_size(panel_width(window))
+            .size_range(240.0f32.min(window)..=(0.7 * window).max(240.0f32.min(window)))
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
+                egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
                     ui.heading(&self.scene_name);
                     ui.label(format!(
                         "{} ({:?})",
