@@ -115,6 +115,7 @@ impl Viewer {
     fn run_ui(&mut self, encoder: &mut wgpu::CommandEncoder) -> (UiFrame, PanelActions) {
         let (w, h) = (self.config.width, self.config.height);
         let raw = self.egui_state.take_egui_input(&self.window);
+        self.input.batch_taken();
         let ctx = self.egui_ctx.clone();
         let mut actions = PanelActions::default();
         let full = ctx.run_ui(raw, |ui| actions = self.ui(ui));

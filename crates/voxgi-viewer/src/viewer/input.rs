@@ -5,7 +5,7 @@ use super::Viewer;
 use crate::camera::{Fly, HeldKeys, Orbit};
 use crate::ground_truth::Display;
 use anyhow::Result;
-use std::collections::HashSet;
+use std::collections::{HashSet, VecDeque};
 use std::time::Instant;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
@@ -73,6 +73,68 @@ pub(super) struct Input {
     left_down: bool,
     right_down: bool,
     cursor: Option<(f32, f32)>,
+    /// Pointer events held for egui's next frame (`holds_for_next_frame`), in order.
+    held: VecDeque<WindowEvent>,
+    /// In the events egui's next frame gets: a button went down or up, the pointer moved,
+    /// with a button down.
+    batch_button: bool,
+    batch_moved: bool,
+    batch_moved_down: bool,
+    /// A button is down as egui was told (`left_down` and `right_down` are the 3D view's).
+    egui_down: bool,
+}
+
+/// What a pointer event does, for `Input::holds`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pointer {
+    Moved,
+    Pressed,
+    Released,
+    Wheel,
+}
+
+impl Input {
+    /// egui took this frame's events: the next batch starts.
+    pub(super) fn batch_taken(&mut self) {
+        self.batch_button = false;
+        self.batch_moved = false;
+        self.batch_moved_down = false;
+    }
+
+    /// Whether a pointer event waits for egui's next frame (else it goes into this one's
+    /// batch). egui sees a frame's events all at once: a click or a drag whose press and
+    /// release fell in one slow frame (a few hundred milliseconds on a CPU driver) was lost (the
+    /// time slider's quick click, a 0.75 s drag of the split view's divider), and egui picks
+    /// what a press grabs by where the pointer is at the end of the press's frame. So a batch
+    /// gets one button change at most; a press shares one neither with the moves before it
+    /// (the frame's delta would count them as dragged) nor with those after it (the pointer
+    /// would have left the widget); a release shares one neither with its press nor with a
+    /// move while a button is down; and what comes after an event held back is held back too.
+    /// `queued`: events are held already.
+    fn holds(&mut self, p: Pointer, queued: bool) -> bool {
+        let hold = match p {
+            Pointer::Pressed => self.batch_button || self.batch_moved,
+            Pointer::Released => self.batch_button || self.batch_moved_down,
+            Pointer::Moved => self.batch_button && self.egui_down,
+            Pointer::Wheel => false,
+        };
+        if hold || queued {
+            return true;
+        }
+        match p {
+            Pointer::Pressed | Pointer::Released => {
+                self.batch_button = true;
+                self.egui_down = p == Pointer::Pressed;
+                self.batch_moved_down = self.egui_down;
+            }
+            Pointer::Moved => {
+                self.batch_moved = true;
+                self.batch_moved_down |= self.egui_down;
+            }
+            Pointer::Wheel => {}
+        }
+        false
+    }
 }
 
 impl Viewer {
@@ -120,11 +182,24 @@ impl Viewer {
             }
             return Ok(());
         }
+        if self.holds_for_next_frame(&event) {
+            self.input.held.push_back(event);
+            return Ok(());
+        }
         let response = self.egui_state.on_window_event(&self.window, &event);
         match event {
+            WindowEvent::RedrawRequested => {
+                // What waited for this frame goes in first (in order; what is still too much
+                // for it waits again).
+                for held in std::mem::take(&mut self.input.held) {
+                    self.window_event(event_loop, held)?;
+                }
+                if self.redraw()? {
+                    event_loop.exit();
+                }
+            }
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => self.resize(size),
-            WindowEvent::RedrawRequested if self.redraw()? => event_loop.exit(),
             WindowEvent::DroppedFile(path) => self.open(&path),
             // Keys released while another window had the keyboard never arrive here.
             WindowEvent::Focused(false) => {
@@ -234,6 +309,21 @@ impl Viewer {
     }
 
     /// Raw mouse motion: mouse look while flying with the left button held.
+    /// Whether a pointer event waits for egui's next frame (`Input::holds`).
+    fn holds_for_next_frame(&mut self, event: &WindowEvent) -> bool {
+        let pointer = match event {
+            WindowEvent::MouseInput { state, .. } => match state {
+                ElementState::Pressed => Pointer::Pressed,
+                ElementState::Released => Pointer::Released,
+            },
+            WindowEvent::CursorMoved { .. } => Pointer::Moved,
+            WindowEvent::MouseWheel { .. } => Pointer::Wheel,
+            _ => return false,
+        };
+        let queued = !self.input.held.is_empty();
+        self.input.holds(pointer, queued)
+    }
+
     pub(super) fn mouse_motion(&mut self, dx: f32, dy: f32) {
         if let Controller::Fly(f) = &mut self.controller
             && self.input.left_down
@@ -300,5 +390,86 @@ impl Viewer {
             Controller::Orbit(o) => o.camera(),
             Controller::Fly(f) => f.camera(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Feeds `events` as they arrive, `|` marking where egui takes a frame's batch; returns
+    /// the batches egui gets (held events go in first at each frame, as `window_event` does).
+    fn batches(events: &str) -> Vec<Vec<Pointer>> {
+        let mut input = Input::default();
+        let mut held: VecDeque<Pointer> = VecDeque::new();
+        let mut batch = Vec::new();
+        let mut out = Vec::new();
+        let mut feed = |input: &mut Input, held: &mut VecDeque<Pointer>, p, batch: &mut Vec<_>| {
+            let queued = !held.is_empty();
+            if input.holds(p, queued) {
+                held.push_back(p);
+            } else {
+                batch.push(p);
+            }
+        };
+        let frame = |input: &mut Input, held: &mut VecDeque<Pointer>, batch: &mut Vec<Pointer>| {
+            for p in std::mem::take(held) {
+                let queued = !held.is_empty();
+                if input.holds(p, queued) {
+                    held.push_back(p);
+                } else {
+                    batch.push(p);
+                }
+            }
+            input.batch_taken();
+            std::mem::take(batch)
+        };
+        for c in events.chars() {
+            match c {
+                'm' => feed(&mut input, &mut held, Pointer::Moved, &mut batch),
+                'p' => feed(&mut input, &mut held, Pointer::Pressed, &mut batch),
+                'r' => feed(&mut input, &mut held, Pointer::Released, &mut batch),
+                'w' => feed(&mut input, &mut held, Pointer::Wheel, &mut batch),
+                '|' => out.push(frame(&mut input, &mut held, &mut batch)),
+                _ => {}
+            }
+        }
+        while !held.is_empty() || !batch.is_empty() {
+            out.push(frame(&mut input, &mut held, &mut batch));
+        }
+        out
+    }
+
+    /// A drag within one slow frame (move onto the divider, press, three moves, release) comes
+    /// out as egui needs it: the hover, the press alone, the moves with the button down, the
+    /// release; a quick click as a press and a release a frame apart; moves and the wheel in a
+    /// frame with nothing pressed are not held.
+    #[test]
+    fn a_drag_within_one_slow_frame_reaches_egui_over_four() {
+        use Pointer::*;
+        assert_eq!(
+            batches("mpmmmr|"),
+            vec![
+                vec![Moved],
+                vec![Pressed],
+                vec![Moved, Moved, Moved],
+                vec![Released]
+            ]
+        );
+        assert_eq!(batches("|pr|"), vec![vec![], vec![Pressed], vec![Released]]);
+        assert_eq!(
+            batches("mmwm|mm|"),
+            vec![vec![Moved, Moved, Wheel, Moved], vec![Moved, Moved]]
+        );
+        // Moves while the button is down, frame after frame, are not held back.
+        assert_eq!(
+            batches("p|mm|mm|r|"),
+            vec![
+                vec![Pressed],
+                vec![Moved, Moved],
+                vec![Moved, Moved],
+                vec![Released]
+            ]
+        );
     }
 }
