@@ -404,7 +404,7 @@ mod tests {
         let mut held: VecDeque<Pointer> = VecDeque::new();
         let mut batch = Vec::new();
         let mut out = Vec::new();
-        let mut feed = |input: &mut Input, held: &mut VecDeque<Pointer>, p, batch: &mut Vec<_>| {
+        let feed = |input: &mut Input, held: &mut VecDeque<Pointer>, p, batch: &mut Vec<_>| {
             let queued = !held.is_empty();
             if input.holds(p, queued) {
                 held.push_back(p);
