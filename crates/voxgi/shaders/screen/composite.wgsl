@@ -49,7 +49,8 @@ struct Upsampled {
 // silhouettes and creases. Where no sample shares the pixel's surface, the nearest stands in.
 fn upsampled(px: vec2<u32>, n0: vec3<f32>, d0: f32) -> Upsampled {
     let low_size = textureDimensions(indirect);
-    let scale = max(u32(frame.size.x) / low_size.x, 1u);
+    // Rounded up, as the gather's size was (see gather.wgsl).
+    let scale = max((u32(frame.size.x) + low_size.x - 1u) / low_size.x, 1u);
     let c0 = min(px / scale, low_size - 1u);
     let f = vec2<f32>(px - c0 * scale) / f32(scale);
     var ind = vec4<f32>(0.0);

@@ -79,7 +79,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if any(gid.xy >= out_size) {
         return;
     }
-    let scale = u32(frame.size.x) / out_size.x;
+    // 1, or 2 at half resolution: rounded up, as the target's size was (an odd width's
+    // 355 / 178 truncated to 1 traced the left half of the image only).
+    let scale = (u32(frame.size.x) + out_size.x - 1u) / out_size.x;
     let px = min(gid.xy * scale, vec2<u32>(frame.size) - 1u);
     let depth = textureLoad(gb_depth, px, 0);
     if depth >= 1.0 {

@@ -18,6 +18,7 @@ mod point_gi;
 mod points;
 mod reference;
 mod registry;
+mod resize;
 mod shaders;
 mod shadow_filter;
 mod sizing;
