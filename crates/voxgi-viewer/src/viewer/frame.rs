@@ -79,6 +79,7 @@ impl Viewer {
     /// for the camera and the animation.
     fn time_frame(&mut self) -> f32 {
         let elapsed = self.stats.frame_started();
+        self.scale.frame(elapsed * 1e3, self.moving);
         let tracing_only = self.reused || !self.ground.needs_cone_tracing();
         self.ground.frame_time(elapsed * 1e3, tracing_only);
         // Slow frames do not make the animation or the fly camera jump.
@@ -246,29 +247,29 @@ impl Viewer {
                 accumulate,
             )?;
             if self.show_grid && self.ground.needs_cone_tracing() {
-                self.draw_grid(encoder, &surface_view, (w, h));
+                self.draw_grid(encoder, &surface_view, (w, h), (w, h));
             }
             return Ok(());
         }
         let (x0, vw) = self.view_columns();
-        let stale = self
-            .images
-            .as_ref()
-            .and_then(|i| i.view.as_ref())
-            .is_none_or(|t| (t.width(), t.height()) != (vw, h));
-        let fresh = stale.then(|| {
-            (
-                self.image_texture("cone-traced view", format, vw, h),
-                self.image_texture("view", format, vw, h),
-            )
-        });
-        if stale {
-            log::debug!("view images: {vw}x{h} at column {x0}");
+        // Cone tracing draws at the moving view's fraction of the view (`budget`).
+        let (cw, ch) = super::budget::scaled(vw, h, self.scale.value());
+        let images = self.images.as_ref().expect("checked above");
+        let size = |t: &Option<wgpu::Texture>| t.as_ref().map(|t| (t.width(), t.height()));
+        let view_stale = size(&images.view) != Some((vw, h));
+        let cone_stale = size(&images.cone) != Some((cw, ch));
+        let view_image = view_stale.then(|| self.image_texture("view", format, vw, h));
+        let cone_image = cone_stale.then(|| self.image_texture("cone-traced view", format, cw, ch));
+        if view_stale || cone_stale {
+            log::debug!("view images: {vw}x{h} at column {x0}, cone traced at {cw}x{ch}");
         }
         let images = self.images.as_mut().expect("checked above");
-        if let Some((cone, view)) = fresh {
-            images.cone = Some(cone);
+        if let Some(view) = view_image {
             images.view = Some(view);
+            images.shows = None;
+        }
+        if let Some(cone) = cone_image {
+            images.cone = Some(cone);
             images.shows = None;
         }
         let cone = images.cone.clone().expect("made above");
@@ -286,11 +287,16 @@ impl Viewer {
             // While an export has the renderer, the view shows its last image.
             let exporting =
                 self.export.is_some() && images.cone.is_some() && images.shows.is_some();
+            if accumulate {
+                // Against the last frame's view, not the image's (a new size forgets that).
+                let last = self.last_view.replace(shows.clone().expect("set above"));
+                self.moving = last.is_some_and(|l| Some(l) != shows);
+            }
             if exporting || (images.shows == shows && self.renderer.is_idle()) {
                 self.reused |= accumulate;
             } else {
                 let v = cone.create_view(&Default::default());
-                let target = Target::new(&v, format, vw, h);
+                let target = Target::new(&v, format, cw, ch);
                 if accumulate {
                     self.renderer.render(encoder, &target, &self.params)?;
                 } else {
@@ -299,10 +305,14 @@ impl Viewer {
                 }
                 images.shows = shows;
             }
-            encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
+            let v = view.create_view(&Default::default());
+            if (cw, ch) == (vw, h) {
+                encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
+            } else {
+                self.upscale.draw(&self.device, encoder, &cone, &v);
+            }
             if self.show_grid && self.export.is_none() {
-                let v = view.create_view(&Default::default());
-                self.draw_grid(encoder, &v, (vw, h));
+                self.draw_grid(encoder, &v, (vw, h), (cw, ch));
             }
         }
         let v = view.create_view(&Default::default());

@@ -14,7 +14,7 @@ struct GpuGrid {
     inv_view_proj: [[f32; 4]; 4],
     /// The plane's height, the minor spacing, the distance the grid fades out by, unused.
     plane: [f32; 4],
-    /// The target's size in pixels, unused.
+    /// The target's size in pixels, and the depth's size over it.
     size: [f32; 4],
 }
 
@@ -159,12 +159,14 @@ impl GridPass {
 }
 
 impl Viewer {
-    /// Draws the grid over `target` (`size` pixels), which holds the renderer's last frame.
+    /// Draws the grid over `target` (`size` pixels), which holds the renderer's last frame,
+    /// drawn at `drawn` pixels (its depth's size).
     pub(super) fn draw_grid(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
         size: (u32, u32),
+        drawn: (u32, u32),
     ) {
         let Some((depth, view_proj)) = self.renderer.depth() else {
             return;
@@ -182,7 +184,12 @@ impl Viewer {
                 self.scene_radius * 4.0,
                 0.0,
             ],
-            size: [size.0 as f32, size.1 as f32, 0.0, 0.0],
+            size: [
+                size.0 as f32,
+                size.1 as f32,
+                drawn.0 as f32 / size.0 as f32,
+                drawn.1 as f32 / size.1 as f32,
+            ],
         };
         if !Mat4::from_cols_array_2d(&u.inv_view_proj).is_finite() {
             return;

@@ -8,7 +8,8 @@ struct Grid {
     inv_view_proj: mat4x4<f32>,
     // x: the plane's height, y: minor spacing, z: distance at which the grid has faded out.
     plane: vec4<f32>,
-    // xy: the target's size in pixels.
+    // xy: the target's size in pixels; zw: the depth's size over it (a moving view is drawn
+    // smaller).
     size: vec4<f32>,
 };
 
@@ -56,7 +57,7 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let density = max(w.x, w.y) / spacing;
     let dense = 1.0 - smoothstep(0.15, 0.5, density);
 
-    let scene_z = textureLoad(depth, vec2<i32>(pos.xy), 0);
+    let scene_z = textureLoad(depth, vec2<i32>(pos.xy * g.size.zw), 0);
     let scene = unproject(ndc, scene_z);
     let hit = length(p - near);
     // In front of what the renderer drew (or on it: the floor the grid lies on), within a

@@ -110,14 +110,16 @@ impl Input {
     /// (the frame's delta would count them as dragged) nor with those after it (the pointer
     /// would have left the widget); a release shares one neither with its press nor with a
     /// move while a button is down; and what comes after an event held back is held back too.
-    /// `queued`: events are held already.
-    fn holds(&mut self, p: Pointer, queued: bool) -> bool {
-        let hold = match p {
-            Pointer::Pressed => self.batch_button || self.batch_moved,
-            Pointer::Released => self.batch_button || self.batch_moved_down,
-            Pointer::Moved => self.batch_button && self.egui_down,
-            Pointer::Wheel => false,
-        };
+    /// `queued`: events are held already; `ui`: the pointer is over egui's widgets (else
+    /// nothing is held: the 3D view's own drags need none of it).
+    fn holds(&mut self, p: Pointer, queued: bool, ui: bool) -> bool {
+        let hold = ui
+            && match p {
+                Pointer::Pressed => self.batch_button || self.batch_moved,
+                Pointer::Released => self.batch_button || self.batch_moved_down,
+                Pointer::Moved => self.batch_button && self.egui_down,
+                Pointer::Wheel => false,
+            };
         if hold || queued {
             return true;
         }
@@ -321,7 +323,12 @@ impl Viewer {
             _ => return false,
         };
         let queued = !self.input.held.is_empty();
-        self.input.holds(pointer, queued)
+        // Over the 3D view (no widget under the pointer, none dragged) nothing waits: an orbit
+        // drag started two slow frames late.
+        let ui = self.over_panel()
+            || self.egui_ctx.is_pointer_over_egui()
+            || self.egui_ctx.dragged_id().is_some();
+        self.input.holds(pointer, queued, ui)
     }
 
     pub(super) fn mouse_motion(&mut self, dx: f32, dy: f32) {
@@ -406,7 +413,7 @@ mod tests {
         let mut out = Vec::new();
         let feed = |input: &mut Input, held: &mut VecDeque<Pointer>, p, batch: &mut Vec<_>| {
             let queued = !held.is_empty();
-            if input.holds(p, queued) {
+            if input.holds(p, queued, true) {
                 held.push_back(p);
             } else {
                 batch.push(p);
@@ -415,7 +422,7 @@ mod tests {
         let frame = |input: &mut Input, held: &mut VecDeque<Pointer>, batch: &mut Vec<Pointer>| {
             for p in std::mem::take(held) {
                 let queued = !held.is_empty();
-                if input.holds(p, queued) {
+                if input.holds(p, queued, true) {
                     held.push_back(p);
                 } else {
                     batch.push(p);
@@ -461,6 +468,11 @@ mod tests {
             batches("mmwm|mm|"),
             vec![vec![Moved, Moved, Wheel, Moved], vec![Moved, Moved]]
         );
+        // Over the 3D view nothing waits: an orbit drag starts in its first frame.
+        let mut input = Input::default();
+        for p in [Moved, Pressed, Moved, Moved, Released] {
+            assert!(!input.holds(p, false, false), "{p:?} held over the view");
+        }
         // Moves while the button is down, frame after frame, are not held back.
         assert_eq!(
             batches("p|mm|mm|r|"),

@@ -6,6 +6,7 @@
 //! view), `stats` (frame and per-pass
 //! times) and `open` (opening scenes, applying options, and the background work for both).
 
+mod budget;
 mod export;
 mod frame;
 mod gizmos;
@@ -19,6 +20,7 @@ mod starting;
 mod stats;
 mod surface;
 mod toasts;
+mod upscale;
 
 use crate::Args;
 use crate::camera::Orbit;
@@ -254,6 +256,13 @@ struct Viewer {
     /// The grid's height (`grid::height`).
     scene_floor: f32,
     grid: grid::GridPass,
+    /// The moving view's resolution, and the pass that stretches it over the view.
+    scale: budget::Scale,
+    upscale: upscale::UpscalePass,
+    /// The last frame drew a view that moved (the camera, the scene).
+    moving: bool,
+    /// The frame parameters and scene state the last frame drew.
+    last_view: Option<(FrameParams, u64)>,
     show_grid: bool,
     /// The scene's own cameras, to pick from, and the bookmarks from `first_bookmark` on
     /// (the scene file's `[[view]]`s and those added).
@@ -413,6 +422,7 @@ impl Viewer {
             .max(radius * 0.1);
         let export_dialog = export::ExportDialog::new(cpu, &scene_label(&scene));
         let grid = grid::GridPass::new(&device, config.format);
+        let upscale = upscale::UpscalePass::new(&device, config.format);
         Ok(Viewer {
             window,
             surface,
@@ -429,6 +439,11 @@ impl Viewer {
             show_gizmos: true,
             scene_floor: grid::height(&scene),
             grid,
+            // A screenshot is of the view at full resolution, frame after frame.
+            scale: budget::Scale::new(cpu, args.screenshot.is_none()),
+            upscale,
+            moving: false,
+            last_view: None,
             // Like the panel: in the window and in screenshots of it, not in those of the scene.
             show_grid: args.screenshot.is_none() || args.with_ui || args.grid,
             cameras: scene.cameras.clone(),

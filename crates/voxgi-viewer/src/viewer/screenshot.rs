@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use voxgi::{Target, wgpu};
 
 impl Viewer {
-    /// An image the view is drawn into, copied from and read back (screenshots, the view's
-    /// cone-traced and composed images).
+    /// An image the view is drawn into, copied from, sampled (upscaled) and read back
+    /// (screenshots, the view's cone-traced and composed images).
     pub(super) fn image_texture(
         &self,
         label: &str,
@@ -32,7 +32,8 @@ impl Viewer {
             format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         })
     }

@@ -198,6 +198,11 @@ impl Viewer {
             });
         }
         ui.checkbox(&mut self.vsync, "vsync");
+        let (budget, now) = (self.scale.budget_ms, self.scale.value() * 100.0);
+        ui.checkbox(
+            &mut self.scale.auto,
+            format!("a moving view drawn smaller, for {budget:.0} ms a frame (now {now:.0} %)"),
+        );
         ui.checkbox(&mut self.frame_overlay, "frame time over the view (O)");
         ui.separator();
         let memory = self.renderer.memory();
