@@ -616,9 +616,13 @@ impl Scene {
                     outer,
                     tracks,
                 } => {
-                    if let Some(l) = self.lights.get_mut(*light) {
-                        *l = tracks.apply(rest, *outer, t);
-                    }
+                    // Its visible surface, if it is an area light's, goes along.
+                    crate::set_light(
+                        &mut self.lights,
+                        &mut self.instances,
+                        *light,
+                        tracks.apply(rest, *outer, t),
+                    );
                 }
             }
         }

@@ -620,4 +620,56 @@ mod tests {
         assert!(geo.normalize().dot(Vec3::NEG_Y) > 0.999);
         assert_eq!(s.materials[m.material].emissive, CORNELL_LIGHT);
     }
+
+    /// `Scene::set_light` moves an area light's visible surface with it (the Cornell box's
+    /// ceiling panel follows its lamp, turned a quarter about the vertical); another light's
+    /// change leaves the instances alone.
+    #[test]
+    fn an_area_light_set_anew_takes_its_emitter_along() {
+        use glam::{Quat, Vec3};
+        let mut scene = cornell_box();
+        let light = scene
+            .lights
+            .iter()
+            .position(|l| matches!(l.kind, crate::LightKind::Area { .. }))
+            .unwrap();
+        let emitter = scene
+            .instances
+            .iter()
+            .position(|i| i.light == Some(light))
+            .unwrap();
+        let corners = |s: &crate::Scene| -> Vec<Vec3> {
+            let inst = &s.instances[emitter];
+            let mesh = &s.meshes[inst.mesh];
+            mesh.positions
+                .iter()
+                .map(|p| inst.transform.transform_point3(*p))
+                .collect()
+        };
+        let before = corners(&scene);
+        let mut moved = scene.lights[light].clone();
+        let turn = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+        let shift = Vec3::new(0.1, -0.05, 0.02);
+        moved.position += shift;
+        if let crate::LightKind::Area {
+            shape: crate::AreaShape::Rect { u, v },
+        } = &mut moved.kind
+        {
+            (*u, *v) = (turn * *u, turn * *v);
+        }
+        let centre = scene.lights[light].position;
+        scene.set_light(light, moved.clone());
+        for (b, a) in before.iter().zip(corners(&scene)) {
+            let want = moved.position + turn * (*b - centre);
+            assert!(a.distance(want) < 1e-5, "{a} against {want}");
+        }
+        let others: Vec<_> = scene.instances.iter().map(|i| i.transform).collect();
+        let mut sun = crate::Scene::default_sun();
+        sun.intensity = 2.0;
+        scene.lights.push(sun.clone());
+        let last = scene.lights.len() - 1;
+        sun.direction = Vec3::new(0.3, -1.0, 0.0).normalize();
+        scene.set_light(last, sun);
+        assert!(scene.instances.iter().map(|i| i.transform).eq(others));
+    }
 }

@@ -107,6 +107,13 @@ impl Scene {
         self.instances.len() - 1
     }
 
+    /// Replaces light `index` with `light`; an area light's visible surfaces (the instances
+    /// whose `light` it is) move with it, from its old frame to its new
+    /// (`Light::emitter_frame`), as `Renderer::set_light` moves them. Out of range: nothing.
+    pub fn set_light(&mut self, index: usize, light: Light) {
+        set_light(&mut self.lights, &mut self.instances, index, light);
+    }
+
     /// Adds an area light together with the emissive surface that shows it, so the light is
     /// visible to the camera and to voxelization.
     pub fn add_area_light(&mut self, light: Light) -> usize {
@@ -682,4 +689,25 @@ impl Scene {
             cast_shadows: true,
         }
     }
+}
+
+/// `Scene::set_light` on the scene's lights and instances (borrowed apart, for `set_time`).
+pub(crate) fn set_light(
+    lights: &mut [Light],
+    instances: &mut [Instance],
+    index: usize,
+    light: Light,
+) {
+    let Some(old) = lights.get(index) else {
+        return;
+    };
+    if let (Some(from), Some(to)) = (old.emitter_frame(), light.emitter_frame())
+        && from != to
+    {
+        let m = to * from.inverse();
+        for inst in instances.iter_mut().filter(|i| i.light == Some(index)) {
+            inst.transform = m * inst.transform;
+        }
+    }
+    lights[index] = light;
 }

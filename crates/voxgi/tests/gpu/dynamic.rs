@@ -155,7 +155,7 @@ fn sequence_of_moves(options: &RendererOptions) {
         }
         if let Some(l) = l {
             r.set_light(light, &l).expect("same kind of light");
-            scene.lights[light] = l.clone();
+            scene.set_light(light, l.clone());
             // The emitter's surface is drawn where the scene says: keep it with the light.
         }
         let got = frame(&mut r, &p, SIZE, SIZE);
@@ -193,7 +193,7 @@ fn a_moving_light_renders_like_a_fresh_renderer() {
             let mut l = scene.lights[0].clone();
             l.position.x = x;
             r.set_light(0, &l).expect("same kind of light");
-            scene.lights[0] = l;
+            scene.set_light(0, l);
             let got = frame(&mut r, &p, SIZE, SIZE);
             let want = frame(&mut renderer(&scene, &options), &p, SIZE, SIZE);
             assert_same_image(&got, &want, &format!("{what} ({voxels:?})"));
@@ -544,7 +544,7 @@ fn catch_up_after_a_change(voxels: voxgi::VoxelKind) {
         }
         r.set_light(light, &moved).expect("same kind");
         let mut after = scene.clone();
-        after.lights[light] = moved.clone();
+        after.set_light(light, moved.clone());
         let mut fresh = renderer(&after, &options);
         let mut want = frame(&mut fresh, &p, 32, 32);
         while !fresh.voxels_settled() {
@@ -554,7 +554,7 @@ fn catch_up_after_a_change(voxels: voxgi::VoxelKind) {
         eprintln!("{what} ({voxels:?}): within 1 % after {frames} frames; errors {errors:.4?}");
         results.push((what, frames));
     }
-    scene.lights[light] = moved;
+    scene.set_light(light, moved);
     // Progressive: each frame adds a bounce on top of the old light, which is close already.
     assert!(results[0].1 <= 6, "{voxels:?}: {:?}", results[0]);
     // Every 4th frame: the indirect light waits for the next update, at most 4 frames away.
@@ -605,7 +605,7 @@ fn voxel_light_follows_a_change_over_a_few_frames() {
         r.voxels_settled(),
         "still blending after {VOXEL_BLEND_FRAMES} frames"
     );
-    scene.lights[light] = moved;
+    scene.set_light(light, moved);
     let fresh = renderer(&scene, &options);
     let mut fresh = fresh;
     frame(&mut fresh, &p, 16, 16);
