@@ -80,23 +80,10 @@ impl Renderer {
                 inst.name
             )));
         }
-        let (old, new) = (
-            inst.world_bounds(inst.transform),
-            inst.world_bounds(transform),
-        );
-        if let Some(draw) = inst.draw {
-            self.scene.set_transform(&self.queue, draw, transform);
-            for i in 0..self.atlas.views.len() {
-                let v = &self.atlas.views[i];
-                let dirt = shadow::box_dirt(v, old.min, old.max)
-                    .merge(shadow::box_dirt(v, new.min, new.max));
-                self.pending.view(i, dirt);
-            }
-            let moved = old.union(&new);
+        if let Some(moved) = self.place(instance, transform) {
             self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
             self.pending.geometry = true;
         }
-        self.state.instances[instance].transform = transform;
         Ok(())
     }
 
@@ -170,25 +157,32 @@ impl Renderer {
     fn move_emitters(&mut self, light: usize, m: Mat4) {
         for i in 0..self.state.instances.len() {
             let inst = &self.state.instances[i];
-            if inst.light != Some(light) || self.state.animates_instance(i) {
-                continue;
+            if inst.light == Some(light) && !self.state.animates_instance(i) {
+                self.place(i, m * inst.transform);
             }
-            let transform = m * inst.transform;
-            let (old, new) = (
-                inst.world_bounds(inst.transform),
-                inst.world_bounds(transform),
-            );
-            if let Some(draw) = inst.draw {
-                self.scene.set_transform(&self.queue, draw, transform);
-                for v in 0..self.atlas.views.len() {
-                    let view = &self.atlas.views[v];
-                    let dirt = shadow::box_dirt(view, old.min, old.max)
-                        .merge(shadow::box_dirt(view, new.min, new.max));
-                    self.pending.view(v, dirt);
-                }
-            }
-            self.state.instances[i].transform = transform;
         }
+    }
+
+    /// Puts instance `i` at `transform`: its draw's transform written, and the shadow views
+    /// that saw its old place or see its new one out of date. Returns where it was and is
+    /// (world space), when it has a draw.
+    fn place(&mut self, i: usize, transform: Mat4) -> Option<Aabb> {
+        let inst = &self.state.instances[i];
+        let (old, new) = (
+            inst.world_bounds(inst.transform),
+            inst.world_bounds(transform),
+        );
+        let draw = inst.draw;
+        self.state.instances[i].transform = transform;
+        let draw = draw?;
+        self.scene.set_transform(&self.queue, draw, transform);
+        for v in 0..self.atlas.views.len() {
+            let view = &self.atlas.views[v];
+            let dirt = shadow::box_dirt(view, old.min, old.max)
+                .merge(shadow::box_dirt(view, new.min, new.max));
+            self.pending.view(v, dirt);
+        }
+        Some(old.union(&new))
     }
 
     /// Sets the scene's time, in seconds: every animation moves its instances and lights to
