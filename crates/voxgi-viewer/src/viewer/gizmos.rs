@@ -79,8 +79,9 @@ impl Viewer {
             ),
             camera: self.params.camera.clone(),
         };
+        // Under windows and toasts (the export dialog drew the markers over itself).
         let painter = ctx.layer_painter(egui::LayerId::new(
-            egui::Order::Middle,
+            egui::Order::Background,
             egui::Id::unique("light gizmos"),
         ));
         let (center, radius) = (self.scene_center, self.scene_radius);
@@ -105,7 +106,7 @@ impl Viewer {
             );
             self.light_shape(&painter, &view, light, p, line);
             let response = egui::Area::new(egui::Id::unique(("light gizmo", i)))
-                .order(egui::Order::Middle)
+                .order(egui::Order::Background)
                 .movable(false)
                 .fixed_pos(at - egui::Vec2::splat(MARKER))
                 .show(ctx, |ui| {
