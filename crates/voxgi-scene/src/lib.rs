@@ -701,10 +701,7 @@ pub(crate) fn set_light(
     let Some(old) = lights.get(index) else {
         return;
     };
-    if let (Some(from), Some(to)) = (old.emitter_frame(), light.emitter_frame())
-        && from != to
-    {
-        let m = to * from.inverse();
+    if let Some(m) = old.emitter_move(&light) {
         for inst in instances.iter_mut().filter(|i| i.light == Some(index)) {
             inst.transform = m * inst.transform;
         }

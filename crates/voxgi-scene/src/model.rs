@@ -171,8 +171,7 @@ pub struct Light {
 impl Light {
     /// An area light's frame: object to world for the emitter `Scene::add_area_light` builds
     /// around it, from its edge vectors (or its radius and its normal's orthonormal pair, as the
-    /// disc's vertices are placed), its normal and its position. `None` for other kinds. A moved
-    /// light's emitter moves by `new.emitter_frame() * old.emitter_frame().inverse()`.
+    /// disc's vertices are placed), its normal and its position. `None` for other kinds.
     pub fn emitter_frame(&self) -> Option<Mat4> {
         let LightKind::Area { shape } = self.kind else {
             return None;
@@ -191,6 +190,15 @@ impl Light {
             n.extend(0.0),
             self.position.extend(1.0),
         ))
+    }
+
+    /// How this area light's visible surface moves when the light becomes `to`: from this
+    /// frame to the new one (`emitter_frame`); `None` when it stays (no move, not an area light).
+    pub fn emitter_move(&self, to: &Light) -> Option<Mat4> {
+        match (self.emitter_frame(), to.emitter_frame()) {
+            (Some(from), Some(to)) if from != to => Some(to * from.inverse()),
+            _ => None,
+        }
     }
 
     /// Refuses a light brighter than voxgi can show: an area light's radiance above what half

@@ -120,20 +120,8 @@ impl Viewer {
         {
             bail!("{}: no such folder", dir.display());
         }
-        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("export"),
-            size: wgpu::Extent3d {
-                width: d.width,
-                height: d.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let (w, h) = (d.width, d.height);
+        let texture = self.image_texture("export", FORMAT, w, h);
         let frames = if self.options.temporal { d.frames } else { 1 };
         if self.playing {
             self.playing = false;

@@ -274,6 +274,7 @@ impl Viewer {
         }
         let cone = images.cone.clone().expect("made above");
         let view = images.view.clone().expect("made above");
+        let view_v = view.create_view(&Default::default());
         let extent = wgpu::Extent3d {
             width: vw,
             height: h,
@@ -285,8 +286,7 @@ impl Viewer {
             let shows = Some((self.params.clone(), self.version));
             let images = self.images.as_mut().expect("checked above");
             // While an export has the renderer, the view shows its last image.
-            let exporting =
-                self.export.is_some() && images.cone.is_some() && images.shows.is_some();
+            let exporting = self.export.is_some() && images.shows.is_some();
             if accumulate {
                 // Against the last frame's view, not the image's (a new size forgets that).
                 let last = self.last_view.replace(shows.clone().expect("set above"));
@@ -305,20 +305,18 @@ impl Viewer {
                 }
                 images.shows = shows;
             }
-            let v = view.create_view(&Default::default());
             if (cw, ch) == (vw, h) {
                 encoder.copy_texture_to_texture(cone.as_image_copy(), view.as_image_copy(), extent);
             } else {
-                self.upscale.draw(&self.device, encoder, &cone, &v);
+                self.upscale.draw(&self.device, encoder, &cone, &view_v);
             }
             if self.show_grid && self.export.is_none() {
-                self.draw_grid(encoder, &v, (vw, h), (cw, ch));
+                self.draw_grid(encoder, &view_v, (vw, h), (cw, ch));
             }
         }
-        let v = view.create_view(&Default::default());
         let r = self.ground.record(
             encoder,
-            &Target::new(&v, format, vw, h),
+            &Target::new(&view_v, format, vw, h),
             &self.params,
             self.options.bounces,
             accumulate,

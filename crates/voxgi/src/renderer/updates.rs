@@ -117,10 +117,7 @@ impl Renderer {
         g.shadow_count = was.shadow_count;
         g.sample_first = was.sample_first;
         self.scene.gpu_lights[index] = g;
-        let emitter_move = match (old.emitter_frame(), light.emitter_frame()) {
-            (Some(from), Some(to)) if from != to => Some(to * from.inverse()),
-            _ => None,
-        };
+        let emitter_move = old.emitter_move(light);
         self.state.lights[index] = light.clone();
         if let Some(m) = emitter_move {
             self.move_emitters(index, m);
