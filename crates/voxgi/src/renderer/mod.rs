@@ -11,6 +11,7 @@
 //! for everything, and no frame waits for the GPU.
 
 mod order;
+pub use order::PreparedStep;
 mod sizing;
 mod temporal;
 
@@ -125,6 +126,8 @@ pub struct Renderer {
     blend_left: u32,
     /// Frames rendered, for `voxel_update_interval`.
     frame_index: u64,
+    /// Voxel work `prepare` recorded for the next frame.
+    prepared: Option<order::Prepared>,
     /// The world-to-clip matrix of the last frame, without its jitter (`depth`).
     drawn_view_proj: glam::Mat4,
     /// Instances, lights and animations as last set.
@@ -342,6 +345,7 @@ impl Renderer {
             blend: None,
             blend_left: 0,
             frame_index: 0,
+            prepared: None,
             drawn_view_proj: glam::Mat4::IDENTITY,
             state,
             counters: CounterReadback::new("voxel counters readback", 1 + POOL_COUNTERS),

@@ -39,6 +39,25 @@ use crate::view::camera_view_proj;
 use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, Region, VoxelWork};
 use glam::{Mat4, Vec3};
 
+/// What `Renderer::prepare` did, for the frame it prepared.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Prepared {
+    /// It rebuilt the voxels: the frame starts a new history.
+    rebuild: bool,
+    /// What the leaves' light did (`record_voxels`), for the frame's blend step.
+    relit: Option<bool>,
+}
+
+/// A piece of a frame's voxel work recorded ahead (`Renderer::prepare`), to be submitted on
+/// its own.
+pub struct PreparedStep {
+    /// The pass it records (`voxelize`, `build`, `inject`, `filter`, `bounce`, ...): its
+    /// timing scope's name.
+    pub pass: &'static str,
+    /// Its commands, for `Queue::submit`.
+    pub commands: wgpu::CommandBuffer,
+}
+
 impl Renderer {
     /// Records one frame into `encoder` and writes the tone-mapped image into `target` (its
     /// whole extent). Submit the encoder before the next call: the frame's uniforms are written
@@ -80,12 +99,15 @@ impl Renderer {
             self.binds = None;
             self.temporal.reset();
         }
+        // This frame's voxel work, or some of it, recorded ahead by `prepare`.
+        let prepared = self.prepared.take();
         // A new scene or structure: what the history holds is of another.
-        if self.pending.rebuild {
+        if self.pending.rebuild || prepared.is_some_and(|p| p.rebuild) {
             self.temporal.reset();
         }
         // Whether the light or the geometry may differ from the last frame's.
-        let changed = self.voxel_work_pending() | self.scene.advance_motion(&self.queue);
+        let changed =
+            self.voxel_work_pending() | prepared.is_some() | self.scene.advance_motion(&self.queue);
         let view_proj = camera_view_proj(&params.camera, width, height, self.view.0, self.view.1);
         self.drawn_view_proj = view_proj;
         let history = self.temporal.begin(temporal, params, view_proj, changed);
@@ -104,8 +126,15 @@ impl Renderer {
         self.record_shadows(encoder, sampling);
         let interval = self.options.voxel_update_interval.max(1) as u64;
         // A rebuild (the first frame among them) never waits for its turn.
-        let due = self.voxel_work_pending()
-            && (self.pending.rebuild || self.frame_index.is_multiple_of(interval));
+        // After `prepare`, only what changed since (its work was this frame's, a progressive
+        // bounce included).
+        let due = if prepared.is_some() {
+            let p = &self.pending;
+            p.rebuild || p.geometry || p.lights
+        } else {
+            self.voxel_work_pending()
+                && (self.pending.rebuild || self.frame_index.is_multiple_of(interval))
+        };
         let moved = due && (self.pending.rebuild || self.pending.geometry);
         // The structure's per-frame step: it may ask for voxels of its own (a camera-following
         // structure) even when nothing changed.
@@ -115,9 +144,13 @@ impl Renderer {
             dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
         });
         let relit = if due || !work.is_empty() {
-            self.record_voxels(encoder, work)
+            self.record_voxels(encoder, work, &mut |_, _| {})
         } else {
             None
+        };
+        let relit = match (relit, prepared.and_then(|p| p.relit)) {
+            (Some(a), Some(b)) => Some(a || b),
+            (a, b) => a.or(b),
         };
         self.record_blend(encoder, relit);
         self.frame_index += 1;
@@ -186,6 +219,54 @@ impl Renderer {
         p.tonemap.record(encoder, globals, target, shown, timer);
         timer.resolve(encoder);
         Ok(())
+    }
+
+    /// Records the voxel work the next `render` would record (all of it after the renderer was
+    /// made, `invalidate` or a voxel option's change; what changed otherwise), ahead of that
+    /// frame and in pieces of one pass each, in order. Submitting each in a submission of its
+    /// own, the caller can keep drawing meanwhile (another renderer's frames, a progress
+    /// frame): on a CPU driver a new renderer's first frame is otherwise seconds of GPU work
+    /// that no frame can come between. Submit every piece, in order, before the next `render`,
+    /// which then records none of this work; dropped, the work is lost until the next
+    /// `invalidate`. Empty when no voxel work is pending. The pieces are not timed.
+    pub fn prepare(&mut self, params: &FrameParams) -> Result<Vec<PreparedStep>> {
+        params.validate(self.options.voxel_levels())?;
+        self.receive_feedback()?;
+        if !self.voxel_work_pending() {
+            return Ok(Vec::new());
+        }
+        let timed = std::mem::replace(&mut self.timer, GpuTimer::disabled(&self.queue));
+        let device = self.device.clone();
+        let new = || {
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("prepare"),
+            })
+        };
+        let mut pieces = Vec::new();
+        let mut cut = |encoder: &mut wgpu::CommandEncoder, pass: &'static str| {
+            let done = std::mem::replace(encoder, new());
+            pieces.push(PreparedStep {
+                pass,
+                commands: done.finish(),
+            });
+        };
+        let mut encoder = new();
+        // The shadow maps injection reads: all of them after a rebuild. Not the area lights'
+        // sample views, which only an accumulating frame reads (that frame draws them).
+        self.record_shadows(&mut encoder, false);
+        cut(&mut encoder, "shadow");
+        let moved = self.pending.rebuild || self.pending.geometry;
+        let work = self.volume.plan(&FrameChanges {
+            camera: params.camera.position,
+            rebuild: self.pending.rebuild,
+            dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
+        });
+        let rebuild = self.pending.rebuild;
+        let relit = self.record_voxels(&mut encoder, work, &mut cut);
+        self.timer = timed;
+        // The blend step and the history's restart belong to the frame.
+        self.prepared = Some(Prepared { rebuild, relit });
+        Ok(pieces)
     }
 
     /// Writes the last frame's image into `target` again, tone-mapped as it was, without
@@ -321,12 +402,16 @@ impl Renderer {
     /// and update (after it moved), inject, then filter and bounce; with progressive bounces,
     /// one bounce per update until converged.
     ///
+    /// `cut` is called after each piece of work (its pass named) that may be submitted on its
+    /// own (`prepare`); a frame's recording does nothing there.
+    ///
     /// Returns what the leaves' light did: `Some(rebuilt)` when it was computed anew (every
     /// leaf new with `rebuilt`), `None` when it stayed.
     fn record_voxels(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         work: VoxelWork,
+        cut: &mut dyn FnMut(&mut wgpu::CommandEncoder, &'static str),
     ) -> Option<bool> {
         let pending = std::mem::take(&mut self.pending);
         let geometry = !work.is_empty();
@@ -379,8 +464,10 @@ impl Renderer {
             p.splat
                 .record(encoder, &self.scene, fb.splat.as_ref(), timer);
             self.fragments.record_mark(encoder);
+            cut(encoder, "voxelize");
             self.volume
                 .record_build(&self.device, encoder, &self.fragments, timer);
+            cut(encoder, "build");
         }
         if work.update.is_some() {
             self.fragments.record_truncate(encoder);
@@ -392,6 +479,7 @@ impl Renderer {
             );
             self.volume
                 .record_update(&self.device, encoder, &self.fragments, timer);
+            cut(encoder, "update");
         }
         if geometry {
             // The kernels never write past their buffers, they only count: the counts come
@@ -417,12 +505,17 @@ impl Renderer {
             .get_or_insert_with(|| p.bounce.bind(&self.device, &*self.volume, &self.cones));
         // One bounce, and the filtering its stored light needs.
         let bounce =
-            |encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer, steps: BounceSteps| {
+            |encoder: &mut wgpu::CommandEncoder,
+             timer: &mut GpuTimer,
+             steps: BounceSteps,
+             cut: &mut dyn FnMut(&mut wgpu::CommandEncoder, &'static str)| {
                 let volume = &*self.volume;
                 p.bounce
                     .record(encoder, volume, bounce_globals, steps, timer);
+                cut(encoder, "bounce");
                 if steps.store {
                     volume.record_filter(encoder, timer);
+                    cut(encoder, "filter");
                 }
             };
         if geometry || pending.lights {
@@ -432,6 +525,7 @@ impl Renderer {
                 InjectPass::record
             };
             inject(&p.inject, encoder, &*self.volume, timer);
+            cut(encoder, "inject");
             if progressive {
                 // One bounce per update from the previous update's light; after a change
                 // this many updates make every leaf's light converge again (the first from
@@ -439,6 +533,7 @@ impl Renderer {
                 self.progressive_left = self.voxel_bounces + 1;
             } else {
                 self.volume.record_filter(encoder, timer);
+                cut(encoder, "filter");
                 let n = self.voxel_bounces;
                 for i in 0..n {
                     // With leaves the last bounce's light is what the pixels read: it keeps
@@ -449,7 +544,7 @@ impl Renderer {
                         irradiance: last,
                         store: !last,
                     };
-                    bounce(encoder, timer, steps);
+                    bounce(encoder, timer, steps, cut);
                 }
             }
         }
@@ -462,7 +557,7 @@ impl Renderer {
                 irradiance: bounces::leaves(&self.options),
                 store: true,
             };
-            bounce(encoder, timer, steps);
+            bounce(encoder, timer, steps, cut);
             self.progressive_left -= 1;
         }
         // The shadow views were consumed by `record_shadows` this frame; injection's start over.

@@ -16,6 +16,7 @@ mod ndf_mips;
 mod options;
 mod point_gi;
 mod points;
+mod prepare;
 mod reference;
 mod registry;
 mod resize;
