@@ -115,8 +115,15 @@ impl Viewer {
     /// updates, and buffers recorded into `encoder`); returns that and what the panel asked for.
     fn run_ui(&mut self, encoder: &mut wgpu::CommandEncoder) -> (UiFrame, PanelActions) {
         let (w, h) = (self.config.width, self.config.height);
-        let raw = self.egui_state.take_egui_input(&self.window);
+        let mut raw = self.egui_state.take_egui_input(&self.window);
         self.input.batch_taken();
+        // At a GPU's frame rate egui's easing of the wheel is smooth; at a CPU driver's it
+        // drags on for seconds.
+        if self.stats.frame_ms.back().is_some_and(|&ms| ms > 50.0) {
+            let line = self.egui_ctx.options(|o| o.input_options.line_scroll_speed);
+            let page = h as f32 / self.egui_ctx.pixels_per_point();
+            super::input::wheel_at_once(&mut raw.events, line, page);
+        }
         let ctx = self.egui_ctx.clone();
         let mut actions = PanelActions::default();
         let full = ctx.run_ui(raw, |ui| actions = self.ui(ui));
@@ -171,7 +178,7 @@ impl Viewer {
             running.push(job.label());
         }
         if let Some(h) = &self.handover {
-            running.push(h.label().into());
+            running.push(h.label());
         }
         running.extend(self.export_label());
         if let Some(job) = &self.saving {
@@ -292,7 +299,10 @@ impl Viewer {
                 let last = self.last_view.replace(shows.clone().expect("set above"));
                 self.moving = last.is_some_and(|l| Some(l) != shows);
             }
-            if exporting || (images.shows == shows && self.renderer.is_idle()) {
+            // A still view stops accumulating while a new renderer's voxel work runs: it
+            // is about to be replaced, and its frames would come between that work's passes.
+            let handing_over = self.handover.is_some();
+            if exporting || (images.shows == shows && (self.renderer.is_idle() || handing_over)) {
                 self.reused |= accumulate;
             } else {
                 let v = cone.create_view(&Default::default());

@@ -400,6 +400,48 @@ impl Viewer {
     }
 }
 
+/// Below this many points a wheel step is not eased by egui (its "smooth" input).
+const UNEASED_STEP: f32 = 7.5;
+
+/// Makes this batch's wheel notches scroll in full in the frame they arrive. egui eases a
+/// notch in over frames, each frame advancing the easing by at most 0.1 s (`stable_dt`
+/// capped), whatever the frame's real length: at a CPU driver's two frames a second the panel
+/// crept on for seconds after a scroll, moving under the pointer (a click right after it
+/// missed the widget it aimed at). A notch is given instead as steps of points small enough
+/// that egui applies them at once (`line` and `page`: points per line and per page).
+pub(super) fn wheel_at_once(events: &mut Vec<egui::Event>, line: f32, page: f32) {
+    let mut out = Vec::with_capacity(events.len());
+    for e in events.drain(..) {
+        let egui::Event::MouseWheel {
+            unit,
+            delta,
+            modifiers,
+            phase,
+            source,
+        } = e
+        else {
+            out.push(e);
+            continue;
+        };
+        let points = match unit {
+            egui::MouseWheelUnit::Point => delta,
+            egui::MouseWheelUnit::Line => delta * line,
+            egui::MouseWheelUnit::Page => delta * page,
+        };
+        let steps = (points.length() / UNEASED_STEP).ceil().max(1.0);
+        for _ in 0..steps as usize {
+            out.push(egui::Event::MouseWheel {
+                unit: egui::MouseWheelUnit::Point,
+                delta: points / steps,
+                modifiers,
+                phase,
+                source,
+            });
+        }
+    }
+    *events = out;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -483,5 +525,58 @@ mod tests {
                 vec![Released]
             ]
         );
+    }
+
+    /// A scroll area's offset in the frame of a notch of the wheel: its whole 3 lines with
+    /// `wheel_at_once`, against the 90 % egui's easing gives a frame of 0.1 s or more (the
+    /// rest over the next frames).
+    #[test]
+    fn a_wheel_notch_scrolls_in_full_in_its_frame() {
+        let offset_after_notch = |at_once: bool| {
+            let ctx = egui::Context::default();
+            let run = |events: Vec<egui::Event>, time: f64| {
+                let mut raw = egui::RawInput {
+                    screen_rect: Some(egui::Rect::from_min_size(
+                        egui::Pos2::ZERO,
+                        egui::vec2(300.0, 200.0),
+                    )),
+                    time: Some(time),
+                    predicted_dt: 0.5,
+                    events,
+                    ..Default::default()
+                };
+                if at_once {
+                    let line = ctx.options(|o| o.input_options.line_scroll_speed);
+                    wheel_at_once(&mut raw.events, line, 200.0);
+                }
+                let mut offset = 0.0;
+                let _ = ctx.run_ui(raw, |ui| {
+                    egui::CentralPanel::default().show(ui, |ui| {
+                        let out = egui::ScrollArea::vertical().show(ui, |ui| {
+                            for i in 0..200 {
+                                ui.label(format!("row {i}"));
+                            }
+                        });
+                        offset = out.state.unclamped_offset().y;
+                    });
+                });
+                offset
+            };
+            run(vec![egui::Event::PointerMoved(egui::pos2(50.0, 50.0))], 0.0);
+            run(vec![egui::Event::PointerMoved(egui::pos2(50.0, 50.0))], 0.5);
+            let notch = egui::Event::MouseWheel {
+                unit: egui::MouseWheelUnit::Line,
+                delta: egui::vec2(0.0, -3.0),
+                modifiers: Default::default(),
+                phase: egui::TouchPhase::Move,
+                source: egui::MouseWheelSource::Wheel,
+            };
+            run(vec![notch], 1.0)
+        };
+        let line = egui::Context::default().options(|o| o.input_options.line_scroll_speed);
+        let (eased, at_once) = (offset_after_notch(false), offset_after_notch(true));
+        eprintln!("3 lines of {line} points: eased {eased}, at once {at_once}");
+        assert!((at_once - 3.0 * line).abs() < 0.5, "at once: {at_once}");
+        assert!(eased < 0.95 * 3.0 * line, "eased: {eased}");
     }
 }

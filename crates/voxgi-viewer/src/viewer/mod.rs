@@ -14,6 +14,7 @@ mod grid;
 mod input;
 mod open;
 mod panel;
+mod pieces;
 mod save;
 mod screenshot;
 mod starting;
@@ -29,6 +30,7 @@ use crate::jobs::Job;
 use anyhow::Result;
 use input::{Controller, Input};
 use open::{Handover, Opened};
+use pieces::Pieces;
 use starting::Starting;
 use stats::Stats;
 use std::path::PathBuf;
@@ -86,42 +88,67 @@ impl App {
             WindowEvent::KeyboardInput { .. } => s.keys.push(event),
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => s.resize(size),
-            WindowEvent::RedrawRequested => match s.job.poll() {
-                None => {
-                    let (name, label) = (scene_label(&s.scene), s.job.label());
-                    if let Err(e) = s.redraw(&name, &label) {
-                        self.fail(event_loop, e);
-                    }
-                }
-                Some(made) => {
-                    // Shown while the first frame builds the voxels (GPU work that no frame
-                    // can interrupt).
-                    let name = scene_label(&s.scene);
-                    let what = if s.gpu.cpu {
-                        "voxelizing the scene and lighting the voxels for the first frame; the \
-                         CPU driver compiles the shaders as they first run (once per machine) …"
-                    } else {
-                        "voxelizing the scene and lighting the voxels for the first frame …"
-                    };
-                    let shown = s.redraw(&name, what);
-                    let mut s = self.starting.take().expect("checked above");
-                    let keys = std::mem::take(&mut s.keys);
-                    let viewer = shown.and(made).and_then(|r| Viewer::new(&self.args, s, r));
-                    match viewer.and_then(|mut v| {
-                        for k in keys {
-                            v.window_event(event_loop, k)?;
-                        }
-                        Ok(v)
+            WindowEvent::RedrawRequested => {
+                if s.pieces.is_none()
+                    && let Some(made) = s.job.poll()
+                {
+                    match made.and_then(|mut r| {
+                        let pieces = Pieces::new(&mut r, &s.params)?;
+                        Ok((r, pieces))
                     }) {
-                        Ok(v) => {
-                            v.window.request_redraw();
-                            self.viewer = Some(v);
-                        }
-                        Err(e) => self.fail(event_loop, e),
+                        Ok(p) => s.pieces = Some(p),
+                        Err(e) => return self.fail(event_loop, e),
                     }
                 }
-            },
+                let name = scene_label(&s.scene);
+                let label = match &mut s.pieces {
+                    None => s.job.label(),
+                    Some((_, pieces)) => {
+                        if !pieces.submit_next(&s.gpu.queue) {
+                            return self.take_over(event_loop);
+                        }
+                        let compiling = if s.gpu.cpu {
+                            " (the CPU driver compiles each shader as it first runs, once per \
+                             machine)"
+                        } else {
+                            ""
+                        };
+                        format!(
+                            "voxelizing the scene and lighting the voxels: {}{compiling} …",
+                            pieces.progress()
+                        )
+                    }
+                };
+                if let Err(e) = s.redraw(&name, &label) {
+                    self.fail(event_loop, e);
+                }
+            }
             _ => {}
+        }
+    }
+}
+
+impl App {
+    /// The renderer made and its first voxel work submitted: the viewer takes the window.
+    fn take_over(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(mut s) = self.starting.take() else {
+            return;
+        };
+        let Some((renderer, _)) = s.pieces.take() else {
+            return;
+        };
+        let keys = std::mem::take(&mut s.keys);
+        match Viewer::new(&self.args, s, renderer).and_then(|mut v| {
+            for k in keys {
+                v.window_event(event_loop, k)?;
+            }
+            Ok(v)
+        }) {
+            Ok(v) => {
+                v.window.request_redraw();
+                self.viewer = Some(v);
+            }
+            Err(e) => self.fail(event_loop, e),
         }
     }
 }
@@ -183,11 +210,17 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if self.starting.is_some() {
-            // Not every loop: the thread making the renderer needs the CPU more.
-            event_loop.set_control_flow(ControlFlow::WaitUntil(
-                std::time::Instant::now() + std::time::Duration::from_millis(100),
-            ));
+        if let Some(s) = &self.starting {
+            if s.pieces.is_some() {
+                // The voxel work's passes, one a frame, as fast as the GPU takes them.
+                event_loop.set_control_flow(ControlFlow::Wait);
+                s.gpu.window.request_redraw();
+            } else {
+                // Not every loop: the thread making the renderer needs the CPU more.
+                event_loop.set_control_flow(ControlFlow::WaitUntil(
+                    std::time::Instant::now() + std::time::Duration::from_millis(100),
+                ));
+            }
         } else if let Some(v) = &self.viewer {
             event_loop.set_control_flow(ControlFlow::Wait);
             v.window.request_redraw();
@@ -354,6 +387,8 @@ impl Viewer {
             options,
             params,
             job,
+            pieces: None,
+            stats: Stats::new(),
             egui_ctx,
             egui_state,
             egui_renderer,
@@ -373,10 +408,11 @@ impl Viewer {
             egui_state,
             egui_renderer,
             opened,
+            stats,
             ..
         } = start;
         log::info!(
-            "renderer made {:.2} s after the window opened",
+            "renderer made and its first voxel work submitted {:.2} s after the window opened",
             opened.elapsed().as_secs_f32()
         );
         let surface::Gpu {
@@ -487,7 +523,7 @@ impl Viewer {
             input: Input::default(),
             duration,
             time: 0.0,
-            stats: Stats::new(),
+            stats,
             frames: 0,
             ready_frames: 0,
             toasts: Default::default(),

@@ -3,6 +3,7 @@
 //! taking what finished; framing the scene's camera.
 
 use super::input::Controller;
+use super::pieces::Pieces;
 use super::{Viewer, scene_label};
 use crate::camera::Orbit;
 use crate::ground_truth::Display;
@@ -14,20 +15,25 @@ use std::sync::Arc;
 use voxgi::scene::Scene;
 use voxgi::{FrameParams, Renderer, RendererOptions};
 
-/// A renderer made in the background, waiting a frame to take over: its first frame builds
-/// the voxels (and on a CPU driver compiles the shaders it is the first to run), seconds in
-/// which no frame can be shown, so one frame saying so is shown first.
-pub(super) enum Handover {
+/// A renderer made in the background, taking over once its first voxel work is done: that
+/// work is submitted a pass a frame (`Pieces`) while the current renderer goes on drawing.
+pub(super) struct Handover {
+    taking: Taking,
+    pieces: Pieces,
+}
+
+enum Taking {
     Rebuilt(Box<(Renderer, RendererOptions)>),
     Opened(Box<Opened>),
 }
 
 impl Handover {
-    pub(super) fn label(&self) -> &'static str {
-        match self {
-            Handover::Rebuilt(..) => "the new options' first frame: building the voxels …",
-            Handover::Opened(..) => "the new scene's first frame: building the voxels …",
-        }
+    pub(super) fn label(&self) -> String {
+        let what = match self.taking {
+            Taking::Rebuilt(..) => "the voxels for the new options",
+            Taking::Opened(..) => "the new scene's voxels",
+        };
+        format!("building {what}: {}", self.pieces.progress())
     }
 }
 
@@ -140,16 +146,25 @@ impl Viewer {
         }));
     }
 
+    /// Gives `renderer` (made for new options) the lights as edited in the current one.
+    fn adopt_lights(&self, renderer: &mut Renderer) {
+        let lights = self.renderer.lights();
+        if renderer.lights().len() == lights.len() {
+            for (i, l) in lights.iter().enumerate() {
+                // Only what differs: an unchanged light would relight the voxels.
+                if renderer.lights()[i] != *l {
+                    // A light whose kind differs (the default sun switched) keeps the new one's.
+                    let _ = renderer.set_light(i, l);
+                }
+            }
+        }
+    }
+
     /// The new options' renderer takes over, with the scene's time and the lights as edited.
     fn rebuilt(&mut self, mut renderer: Renderer, options: RendererOptions) {
         renderer.enable_timing(self.timestamps);
-        let lights = self.renderer.lights().to_vec();
-        if renderer.lights().len() == lights.len() {
-            for (i, l) in lights.iter().enumerate() {
-                // A light whose kind differs (the default sun switched) keeps the new one's.
-                let _ = renderer.set_light(i, l);
-            }
-        }
+        // Lights edited while its voxels were built (relit in its first frame).
+        self.adopt_lights(&mut renderer);
         self.renderer = renderer;
         // The path tracer sees the scene's lights, and the default sun when there are none.
         if options.default_light != self.options.default_light {
@@ -172,20 +187,43 @@ impl Viewer {
     }
 
     /// Takes the results of finished background work: a renderer made in the background
-    /// takes over a frame after it is done (`Handover`).
+    /// submits its first voxel work a pass a frame, then takes over (`Handover`).
     pub(super) fn poll_jobs(&mut self) {
-        match self.handover.take() {
-            Some(Handover::Rebuilt(b)) => self.rebuilt(b.0, b.1),
-            Some(Handover::Opened(o)) => self.opened(*o),
-            None => {}
+        if let Some(h) = &mut self.handover
+            && !h.pieces.submit_next(&self.queue)
+        {
+            match self.handover.take().map(|h| h.taking) {
+                Some(Taking::Rebuilt(b)) => self.rebuilt(b.0, b.1),
+                Some(Taking::Opened(o)) => self.opened(*o),
+                None => {}
+            }
         }
         match take(&mut self.rebuild) {
-            Some(Ok(made)) => self.handover = Some(Handover::Rebuilt(Box::new(made))),
+            Some(Ok((mut renderer, options))) => {
+                self.adopt_lights(&mut renderer);
+                match Pieces::new(&mut renderer, &self.params) {
+                    Ok(pieces) => {
+                        self.handover = Some(Handover {
+                            taking: Taking::Rebuilt(Box::new((renderer, options))),
+                            pieces,
+                        })
+                    }
+                    Err(e) => self.toasts.error(format!("the new options failed: {e:#}")),
+                }
+            }
             Some(Err(e)) => self.toasts.error(format!("the new options failed: {e:#}")),
             None => {}
         }
         match take(&mut self.opening) {
-            Some(Ok(o)) => self.handover = Some(Handover::Opened(Box::new(o))),
+            Some(Ok(mut o)) => match Pieces::new(&mut o.renderer, &o.settings_params) {
+                Ok(pieces) => {
+                    self.handover = Some(Handover {
+                        taking: Taking::Opened(Box::new(o)),
+                        pieces,
+                    })
+                }
+                Err(e) => self.toasts.error(format!("{}: {e:#}", o.path.display())),
+            },
             Some(Err(e)) => self.toasts.error(format!("{e:#}")),
             None => {}
         }

@@ -1,8 +1,8 @@
 //! The window while its first renderer is made: `Renderer::new` (the scene's upload, the
 //! pipelines, the voxel pools) runs on a thread, and the window shows what is being built and
 //! for how long, ten times a second, instead of staying black (7 s for Sponza on lavapipe, up
-//! to 23 s on a busy machine). The first frame's voxel build is one piece of GPU work: the
-//! last progress frame says it is under way while it runs.
+//! to 23 s on a busy machine). Then its first voxel work is submitted a pass a frame
+//! (`Pieces`), the progress frame naming the pass, before the viewer takes over.
 
 use super::surface::Gpu;
 use crate::jobs::Job;
@@ -18,11 +18,15 @@ pub(super) struct Starting {
     pub(super) options: RendererOptions,
     pub(super) params: FrameParams,
     pub(super) job: Job<Renderer>,
+    /// The renderer once made, and its first voxel work being submitted a pass a frame.
+    pub(super) pieces: Option<(Renderer, super::pieces::Pieces)>,
     pub(super) egui_ctx: egui::Context,
     pub(super) egui_state: egui_winit::State,
     pub(super) egui_renderer: egui_wgpu::Renderer,
     /// When the window opened.
     pub(super) opened: std::time::Instant,
+    /// The waits between frames, from the window's first on (the viewer's then).
+    pub(super) stats: super::stats::Stats,
     /// Keys pressed and released meanwhile, for the viewer once it is there (Tab, F, G ...).
     pub(super) keys: Vec<winit::event::WindowEvent>,
 }
@@ -88,6 +92,7 @@ impl Starting {
         g.queue.submit(extra.into_iter().chain([encoder.finish()]));
         g.window.pre_present_notify();
         g.queue.present(frame);
+        self.stats.presented(label);
         Ok(())
     }
 

@@ -38,7 +38,7 @@ impl Stats {
             last_frame: Instant::now(),
             frame_ms: Default::default(),
             pass_ms: Vec::new(),
-            // The viewer is made right after the starting window's last progress frame.
+            // Made when the window opens.
             last_present: Some(Instant::now()),
             input_since: None,
             worst_gap: None,
