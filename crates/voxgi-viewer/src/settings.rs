@@ -196,10 +196,17 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
     actions
 }
 
-/// Whether applying `draft` over `current` needs a new renderer (a setting that shapes the
-/// uploaded scene), rather than `Renderer::set_options`.
+/// Whether applying `draft` over `current` is done by a new renderer made in the background
+/// while the current one draws, rather than by `Renderer::set_options` on the window's
+/// thread: when a setting shapes the uploaded scene, and when the voxels or their light are
+/// computed again (new pipelines, a structure counted before it is built, and seconds of voxel
+/// work a CPU driver would do between two frames; the new renderer's is submitted a pass a
+/// frame).
 pub fn needs_new_renderer(current: &RendererOptions, draft: &RendererOptions) -> bool {
-    voxgi::settings::changes_between(current, draft) == Some(Changes::Scene)
+    matches!(
+        voxgi::settings::changes_between(current, draft),
+        Some(Changes::Scene | Changes::Voxels | Changes::Lighting)
+    )
 }
 
 /// The panel's per-frame section: a widget per frame parameter of the table over `params`;

@@ -124,6 +124,7 @@ impl Viewer {
             let page = h as f32 / self.egui_ctx.pixels_per_point();
             super::input::wheel_at_once(&mut raw.events, line, page);
         }
+        log::trace!("egui input at {:?}: {:?}", raw.time, raw.events);
         let ctx = self.egui_ctx.clone();
         let mut actions = PanelActions::default();
         let full = ctx.run_ui(raw, |ui| actions = self.ui(ui));

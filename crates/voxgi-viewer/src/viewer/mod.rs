@@ -30,7 +30,7 @@ use crate::jobs::Job;
 use anyhow::Result;
 use input::{Controller, Input};
 use open::{Handover, Opened};
-use pieces::Pieces;
+use pieces::{Pieces, Step};
 use starting::Starting;
 use stats::Stats;
 use std::path::PathBuf;
@@ -103,9 +103,11 @@ impl App {
                 let name = scene_label(&s.scene);
                 let label = match &mut s.pieces {
                     None => s.job.label(),
-                    Some((_, pieces)) => {
-                        if !pieces.submit_next(&s.gpu.queue) {
-                            return self.take_over(event_loop);
+                    Some((renderer, pieces)) => {
+                        match pieces.step(renderer, &s.gpu.queue, &s.params) {
+                            Ok(Step::Done) => return self.take_over(event_loop),
+                            Ok(Step::Submitted | Step::Waiting) => {}
+                            Err(e) => return self.fail(event_loop, e.into()),
                         }
                         let compiling = if s.gpu.cpu {
                             " (the CPU driver compiles each shader as it first runs, once per \

@@ -3,7 +3,7 @@
 //! taking what finished; framing the scene's camera.
 
 use super::input::Controller;
-use super::pieces::Pieces;
+use super::pieces::{Pieces, Step};
 use super::{Viewer, scene_label};
 use crate::camera::Orbit;
 use crate::ground_truth::Display;
@@ -146,8 +146,12 @@ impl Viewer {
         }));
     }
 
-    /// Gives `renderer` (made for new options) the lights as edited in the current one.
-    fn adopt_lights(&self, renderer: &mut Renderer) {
+    /// Gives `renderer` (made for new options) the scene's time and the lights as edited in
+    /// the current one.
+    fn adopt_state(&self, renderer: &mut Renderer) {
+        if let Err(e) = renderer.set_time(self.time) {
+            log::warn!("the new renderer's scene time: {e}");
+        }
         let lights = self.renderer.lights();
         if renderer.lights().len() == lights.len() {
             for (i, l) in lights.iter().enumerate() {
@@ -164,7 +168,7 @@ impl Viewer {
     fn rebuilt(&mut self, mut renderer: Renderer, options: RendererOptions) {
         renderer.enable_timing(self.timestamps);
         // Lights edited while its voxels were built (relit in its first frame).
-        self.adopt_lights(&mut renderer);
+        self.adopt_state(&mut renderer);
         self.renderer = renderer;
         // The path tracer sees the scene's lights, and the default sun when there are none.
         if options.default_light != self.options.default_light {
@@ -189,18 +193,28 @@ impl Viewer {
     /// Takes the results of finished background work: a renderer made in the background
     /// submits its first voxel work a pass a frame, then takes over (`Handover`).
     pub(super) fn poll_jobs(&mut self) {
-        if let Some(h) = &mut self.handover
-            && !h.pieces.submit_next(&self.queue)
-        {
-            match self.handover.take().map(|h| h.taking) {
-                Some(Taking::Rebuilt(b)) => self.rebuilt(b.0, b.1),
-                Some(Taking::Opened(o)) => self.opened(*o),
-                None => {}
+        if let Some(h) = &mut self.handover {
+            let (renderer, params) = match &mut h.taking {
+                Taking::Rebuilt(b) => (&mut b.0, &self.params),
+                Taking::Opened(o) => (&mut o.renderer, &o.settings_params),
+            };
+            match h.pieces.step(renderer, &self.queue, params) {
+                Ok(Step::Submitted | Step::Waiting) => {}
+                Ok(Step::Done) => match self.handover.take().map(|h| h.taking) {
+                    Some(Taking::Rebuilt(b)) => self.rebuilt(b.0, b.1),
+                    Some(Taking::Opened(o)) => self.opened(*o),
+                    None => {}
+                },
+                Err(e) => {
+                    self.handover = None;
+                    self.toasts
+                        .error(format!("building the voxels failed: {e:#}"));
+                }
             }
         }
         match take(&mut self.rebuild) {
             Some(Ok((mut renderer, options))) => {
-                self.adopt_lights(&mut renderer);
+                self.adopt_state(&mut renderer);
                 match Pieces::new(&mut renderer, &self.params) {
                     Ok(pieces) => {
                         self.handover = Some(Handover {
