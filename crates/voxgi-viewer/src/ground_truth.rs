@@ -257,6 +257,10 @@ impl GroundTruth {
             && std::mem::take(&mut self.traced_last_frame)
         {
             self.paths_per_frame = next_budget(self.paths_per_frame, ms, target);
+            log::debug!(
+                "path tracer: {ms:.0} ms a frame, {} paths next",
+                self.paths_per_frame
+            );
         }
     }
 
@@ -369,11 +373,11 @@ impl GroundTruth {
     }
 }
 
-/// How long the path tracer may take a frame by default: a CPU driver draws a frame in a few
-/// hundred milliseconds at best (and its budget is a whole frame's wall time); a GPU stays
-/// interactive beside cone tracing.
+/// How long the path tracer may take a frame by default: on a CPU driver a whole frame's wall
+/// time, short enough that input is answered about ten times a second (at 300 ms a click
+/// waited up to two frames); a GPU stays interactive beside cone tracing.
 pub fn default_target_ms(cpu: bool) -> f32 {
-    if cpu { 300.0 } else { 10.0 }
+    if cpu { 100.0 } else { 10.0 }
 }
 
 /// The paths a frame for the next frame: scaled by how far the last frame's path tracing time

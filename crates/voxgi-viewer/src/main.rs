@@ -51,7 +51,7 @@ pub struct Args {
     pub display: ground_truth::Display,
     /// Paths the path tracer traces a frame (a band of rows when fewer than the image has).
     /// Default: adapted so that tracing takes about 10 ms of GPU time a frame, or on a CPU
-    /// driver so that a still view's frames take about 300 ms.
+    /// driver so that a still view's frames take about 100 ms (input is answered that often).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1024..=1 << 26))]
     pub paths_per_frame: Option<u32>,
     /// Turn the orbit camera by this many degrees each frame: a turntable, for demos and for

@@ -300,12 +300,25 @@ impl Viewer {
                 let last = self.last_view.replace(shows.clone().expect("set above"));
                 self.moving = last.is_some_and(|l| Some(l) != shows);
             }
-            // A still view stops accumulating while a new renderer's voxel work runs: it
-            // is about to be replaced, and its frames would come between that work's passes.
-            let handing_over = self.handover.is_some();
-            if exporting || (images.shows == shows && (self.renderer.is_idle() || handing_over)) {
+            let still = images.shows == shows;
+            if !still {
+                self.still_frames = 0;
+            }
+            // A still view stops accumulating while a new renderer's voxel work runs (it is
+            // about to be replaced, and its frames would come between that work's passes),
+            // after `still_cap` frames, and, on a CPU driver, for a frame that answers input
+            // (the panel's answer then comes in a frame of its own, not after another
+            // accumulation of half a second).
+            let hold = self.renderer.is_idle()
+                || self.handover.is_some()
+                || self.still_frames >= self.still_cap
+                || (self.cpu && self.stats.input_waiting());
+            if exporting || (still && hold) {
                 self.reused |= accumulate;
             } else {
+                if still && accumulate {
+                    self.still_frames += 1;
+                }
                 let v = cone.create_view(&Default::default());
                 let target = Target::new(&v, format, cw, ch);
                 if accumulate {

@@ -296,6 +296,10 @@ struct Viewer {
     upscale: upscale::UpscalePass,
     /// The last frame drew a view that moved (the camera, the scene).
     moving: bool,
+    /// Frames cone tracing accumulated of the view as it is now (0 after any change), and
+    /// how many it accumulates before it holds the image (`still_cap`).
+    still_frames: u32,
+    still_cap: u32,
     /// The frame parameters and scene state the last frame drew.
     last_view: Option<(FrameParams, u64)>,
     show_grid: bool,
@@ -481,6 +485,8 @@ impl Viewer {
             scale: budget::Scale::new(cpu, args.screenshot.is_none()),
             upscale,
             moving: false,
+            still_frames: 0,
+            still_cap: still_cap(cpu, args.screenshot.is_some()),
             last_view: None,
             // Like the panel: in the window and in screenshots of it, not in those of the scene.
             show_grid: args.screenshot.is_none() || args.with_ui || args.grid,
@@ -548,5 +554,18 @@ fn scene_label(scene: &Scene) -> String {
         "scene".into()
     } else {
         scene.name.clone()
+    }
+}
+
+/// Frames a still view accumulates before the image is held. On a CPU driver each is half a
+/// second of Sponza, and input waits for the one in flight: 64 (the anti-aliasing and the
+/// area lights' sampled shadows have mostly converged by then) keep that to half a minute
+/// after each change instead of two; a GPU, and a screenshot that asks for its frames,
+/// accumulate as many as the renderer does.
+fn still_cap(cpu: bool, screenshot: bool) -> u32 {
+    if cpu && !screenshot {
+        64
+    } else {
+        voxgi::TEMPORAL_STILL_FRAMES
     }
 }

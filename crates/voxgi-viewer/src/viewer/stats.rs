@@ -52,6 +52,11 @@ impl Stats {
         self.input_since.get_or_insert_with(Instant::now);
     }
 
+    /// Whether an input event arrived that no presented frame shows yet.
+    pub(super) fn input_waiting(&self) -> bool {
+        self.input_since.is_some()
+    }
+
     /// A frame was presented while `busy` ran in the background (empty: nothing): the wait
     /// since the last one and since the input it shows are kept, and logged when long.
     pub(super) fn presented(&mut self, busy: &str) {
@@ -151,6 +156,13 @@ impl Viewer {
         ));
         if self.reused {
             ui.label("cone tracing: nothing changed, the last image is shown again");
+        }
+        if self.still_frames > 0 {
+            ui.label(format!(
+                "the still view: {} of {} frames accumulated",
+                self.still_frames.min(self.still_cap),
+                self.still_cap
+            ));
         }
         if let Some(c) = self.renderer.last_voxel_counts() {
             ui.label(format!("{} fragments, {} voxels", c.fragments, c.occupied));
