@@ -524,6 +524,9 @@ pub enum AnimationTarget {
         /// moving glTF node. Each with its state in the world when the motion is the identity
         /// (for motions from rest, its rest state).
         lights: Vec<(usize, Light)>,
+        /// Point clouds (`Scene::point_clouds` indices; all dynamic) that move with them, each
+        /// with its transform in the animation's space when the motion is the identity.
+        clouds: Vec<(usize, Mat4)>,
         /// The motion.
         motion: Motion,
     },
@@ -567,8 +570,33 @@ impl AnimationTarget {
             outer: Mat4::IDENTITY,
             inner,
             lights,
+            clouds: Vec::new(),
             motion,
         }
+    }
+
+    /// The same target, moving point clouds `clouds` of `scene` along too, at rest where they
+    /// are now (with the area lights they show). A light target is returned as it is.
+    pub fn with_clouds(mut self, scene: &Scene, clouds: impl IntoIterator<Item = usize>) -> Self {
+        if let AnimationTarget::Instances {
+            outer,
+            lights,
+            clouds: moved,
+            ..
+        } = &mut self
+        {
+            let into_space = outer.inverse();
+            for c in clouds {
+                let Some(pc) = scene.point_clouds.get(c) else {
+                    continue;
+                };
+                moved.push((c, into_space * pc.transform));
+                if let Some(rest) = pc.light.and_then(|l| scene.lights.get(l).map(|r| (l, r))) {
+                    lights.push((rest.0, rest.1.clone()));
+                }
+            }
+        }
+        self
     }
 }
 
@@ -593,6 +621,7 @@ impl Scene {
                     outer,
                     inner,
                     lights,
+                    clouds,
                     motion,
                 } => {
                     let motion = motion.at(t);
@@ -600,6 +629,11 @@ impl Scene {
                     for (&i, r) in instances.iter().zip(inner) {
                         if let Some(inst) = self.instances.get_mut(i) {
                             inst.transform = m * *r;
+                        }
+                    }
+                    for (c, r) in clouds {
+                        if let Some(pc) = self.point_clouds.get_mut(*c) {
+                            pc.transform = m * *r;
                         }
                     }
                     // The rest light is in the world: move it by the motion seen from there.
@@ -883,6 +917,7 @@ mod tests {
                 outer: Mat4::IDENTITY,
                 inner: vec![below],
                 lights: Vec::new(),
+                clouds: Vec::new(),
                 motion: child.clone(),
             },
         });
@@ -955,6 +990,7 @@ mod tests {
                 outer: Mat4::IDENTITY,
                 inner: vec![rest],
                 lights: Vec::new(),
+                clouds: Vec::new(),
                 motion: Motion::Keyframes {
                     translation: Some(
                         Track::new(
@@ -1023,6 +1059,7 @@ mod tests {
                 outer: Mat4::IDENTITY,
                 inner: vec![rest],
                 lights: Vec::new(),
+                clouds: Vec::new(),
                 motion: Motion::Keyframes {
                     translation: Some(slide.clone()),
                     rotation: None,

@@ -196,6 +196,7 @@ impl Scene {
             m
         }));
         let other_instances = other.instances.len();
+        let other_clouds = other.point_clouds.len();
         self.instances
             .extend(other.instances.into_iter().map(|mut i| {
                 i.mesh += mesh0;
@@ -214,6 +215,7 @@ impl Scene {
         self.lights
             .extend(other.lights.into_iter().map(|l| l.transformed(transform)));
         let inst0 = self.instances.len() - other_instances;
+        let cloud0 = self.point_clouds.len() - other_clouds;
         self.animations
             .extend(other.animations.into_iter().map(|mut a| {
                 match &mut a.target {
@@ -221,9 +223,11 @@ impl Scene {
                         instances,
                         outer,
                         lights,
+                        clouds,
                         ..
                     } => {
                         instances.iter_mut().for_each(|i| *i += inst0);
+                        clouds.iter_mut().for_each(|(c, _)| *c += cloud0);
                         *outer = transform * *outer;
                         for (l, rest) in lights.iter_mut() {
                             *l += light0;
@@ -512,22 +516,27 @@ impl Scene {
             }
             out.push((inst.name.clone(), b));
         }
-        for pc in &self.point_clouds {
+        let animated_clouds = self.animated_clouds();
+        let mut cloud_sweep: Vec<(usize, usize, Aabb)> = Vec::new();
+        for (c, pc) in self.point_clouds.iter().enumerate() {
             let mut b = Aabb::EMPTY;
-            for &p in &pc.positions {
-                b.grow(pc.transform.transform_point3(p));
+            if animated_clouds.binary_search(&c).is_ok() {
+                for &p in &pc.positions {
+                    b.grow(p);
+                }
+                cloud_sweep.push((out.len(), c, b));
+                b = Aabb::EMPTY;
+            } else {
+                for &p in &pc.positions {
+                    b.grow(pc.transform.transform_point3(p));
+                }
             }
             out.push((pc.name.clone(), b));
         }
-        if sweep.is_empty() {
+        if sweep.is_empty() && cloud_sweep.is_empty() {
             return out;
         }
-        let mut probe = Scene {
-            instances: self.instances.clone(),
-            lights: self.lights.clone(),
-            animations: self.animations.clone(),
-            ..Default::default()
-        };
+        let mut probe = self.without_geometry();
         let duration = self
             .animations
             .iter()
@@ -535,6 +544,11 @@ impl Scene {
             .fold(0.0f32, f32::max);
         for k in 0..=SWEEP_SAMPLES {
             probe.set_time(duration * k as f32 / SWEEP_SAMPLES as f32);
+            for (o, c, local) in &cloud_sweep {
+                out[*o].1 = out[*o]
+                    .1
+                    .union(&local.transformed(probe.point_clouds[*c].transform));
+            }
             for (o, i, local) in &sweep {
                 out[*o].1 = out[*o]
                     .1
@@ -658,6 +672,45 @@ impl Scene {
             }
         }
         out
+    }
+
+    /// What `set_time` touches and nothing else: the instances, the lights, the point clouds'
+    /// transforms (no points), the animations. Cheap to sample at many times.
+    pub fn without_geometry(&self) -> Scene {
+        Scene {
+            instances: self.instances.clone(),
+            lights: self.lights.clone(),
+            point_clouds: self
+                .point_clouds
+                .iter()
+                .map(|pc| PointCloud {
+                    name: pc.name.clone(),
+                    transform: pc.transform,
+                    dynamic: pc.dynamic,
+                    light: pc.light,
+                    ..Default::default()
+                })
+                .collect(),
+            animations: self.animations.clone(),
+            ..Default::default()
+        }
+    }
+
+    /// The point clouds some animation moves, sorted, each once.
+    pub fn animated_clouds(&self) -> Vec<usize> {
+        let mut v: Vec<usize> = self
+            .animations
+            .iter()
+            .flat_map(|a| match &a.target {
+                animation::AnimationTarget::Instances { clouds, .. } => {
+                    clouds.iter().map(|(c, _)| *c).collect()
+                }
+                animation::AnimationTarget::Light { .. } => Vec::new(),
+            })
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
     }
 
     /// The instances some animation moves, sorted, each once.

@@ -874,6 +874,42 @@ position = [[0.0, 2.0, 0.0], [0.0, 3.0, 0.0]]
     assert_eq!(a.instances[0].transform, b.instances[0].transform);
 }
 
+/// An include sampled as points and marked dynamic moves with its animation (it stood still,
+/// silently, when only instances moved), and the scene's bounds cover where it goes.
+#[test]
+fn an_animated_point_include_moves() {
+    let dir = tmp("anim-points");
+    let path = write(
+        &dir,
+        "moving-points.toml",
+        r#"
+[[include]]
+name = "boxes"
+builtin = "cube"
+points = 0.1
+dynamic = true
+
+[[animation]]
+target = "boxes"
+times = [0.0, 2.0]
+translate = [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]]
+"#,
+    );
+    let s = voxgi_scene::io::load(&path).expect("loads");
+    assert!(s.instances.is_empty(), "the cube became points");
+    assert!(!s.point_clouds.is_empty());
+    assert!(s.point_clouds.iter().all(|pc| pc.dynamic));
+    let rest: Vec<_> = s.point_clouds.iter().map(|pc| pc.transform).collect();
+    let half = s.at_time(1.0);
+    for (pc, r) in half.point_clouds.iter().zip(&rest) {
+        let want = glam::Mat4::from_translation(Vec3::new(1.5, 0.0, 0.0)) * *r;
+        assert!(pc.transform.abs_diff_eq(want, 1e-6), "{}", pc.name);
+    }
+    // The box around every pose: the cube at rest spans x -0.5..0.5, at t = 2 2.5..3.5.
+    let b = s.drawn_bounds();
+    assert!(b.min.x <= -0.5 + 1e-4 && b.max.x >= 3.5 - 1e-4, "{b:?}");
+}
+
 #[test]
 fn bad_animations_are_errors_naming_the_file_and_the_animation() {
     let dir = tmp("badanim");

@@ -287,8 +287,9 @@ pub struct GpuScene {
     /// One `GpuLight` per scene light; its shadow fields are written when the shadow views are
     /// planned.
     pub lights: wgpu::Buffer,
-    /// All point clouds' surfels (`GpuPoint`), in world space: first the geometry's, then the
-    /// area lights' surfaces (`gpu_cloud_order`).
+    /// All point clouds' surfels (`GpuPoint`), in world space: first the static geometry's,
+    /// then the dynamic geometry's, then the area lights' surfaces (`gpu_cloud_order`). A
+    /// dynamic cloud that moves is written anew where it is (`set_cloud`).
     pub points: wgpu::Buffer,
     /// One f32 per point (shadow pass only): how far the point's neighbours stray from its
     /// tangent plane, in metres (`pointcloud::surface_spread`); shadow maps push the surfel
@@ -302,6 +303,14 @@ pub struct GpuScene {
     /// The first `geometry_points` of `points` are geometry: voxelized and shadowing every
     /// light. The rest show area lights.
     pub geometry_points: u32,
+    /// The first `static_points` of the geometry's points never move (voxelized once); the
+    /// rest, up to `geometry_points`, are dynamic clouds' (voxelized with each update).
+    pub static_points: u32,
+    /// Each point cloud's range of `points`, by its index in the scene.
+    pub cloud_ranges: Vec<std::ops::Range<u32>>,
+    /// The dynamic clouds' surface spread in their own units (`pointcloud::surface_spread`),
+    /// by cloud index (empty for the others), for writing them again where they move.
+    local_spread: Vec<Vec<f32>>,
     /// The points showing each area light: a range of `points` and the light's index. They
     /// are drawn and shadow the other lights, but not their own.
     pub emitter_points: Vec<(std::ops::Range<u32>, usize)>,
@@ -510,9 +519,11 @@ impl GpuScene {
             points,
             regions,
             geometry,
+            static_geometry,
             emitters,
+            clouds,
         } = gpu_points(scene);
-        let spread = point_spread(scene);
+        let (spread, local_spread) = point_spread(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
             let mut data = bytes.to_vec();
@@ -563,6 +574,12 @@ impl GpuScene {
             point_regions: storage("point regions", bytemuck::cast_slice(&regions), 4),
             point_count: points.len() as u32,
             geometry_points: geometry as u32,
+            static_points: static_geometry as u32,
+            cloud_ranges: clouds
+                .into_iter()
+                .map(|r| r.start as u32..r.end as u32)
+                .collect(),
+            local_spread,
             emitter_points: emitters
                 .into_iter()
                 .map(|(r, l)| (r.start as u32..r.end as u32, l))
@@ -588,6 +605,23 @@ impl GpuScene {
             gpu_draws: draws,
             instance_draw,
         })
+    }
+
+    /// Writes point cloud `cloud` (an index into the scene's clouds, uploaded dynamic) anew
+    /// where `pc` (the cloud as uploaded, with its new transform) puts it: its surfels, their
+    /// regions and spread, as a fresh upload computes them.
+    pub fn set_cloud(&self, queue: &wgpu::Queue, cloud: usize, pc: &voxgi_scene::PointCloud) {
+        let Some(range) = self.cloud_ranges.get(cloud).filter(|r| !r.is_empty()) else {
+            return;
+        };
+        let (points, regions) = cloud_points(pc);
+        let spread = scaled_spread(pc, &self.local_spread[cloud]);
+        let at = range.start as u64;
+        queue.write_buffer(&self.points, at * 32, bytemuck::cast_slice(&points));
+        queue.write_buffer(&self.point_regions, at * 4, bytemuck::cast_slice(&regions));
+        if spread.len() == points.len() {
+            queue.write_buffer(&self.point_spread, at * 4, bytemuck::cast_slice(&spread));
+        }
     }
 
     /// Writes a new object-to-world transform for draw `draw`.
@@ -649,58 +683,87 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
     let mut points = Vec::with_capacity(scene.point_count());
     let mut regions = Vec::with_capacity(scene.point_count());
     let mut emitters = Vec::new();
-    let mut geometry = 0;
-    for pc in gpu_cloud_order(scene) {
+    let mut clouds = vec![0..0; scene.point_clouds.len()];
+    let (mut geometry, mut static_geometry) = (0, 0);
+    for c in gpu_cloud_order(scene) {
+        let pc = &scene.point_clouds[c];
+        let range = points.len()..points.len() + pc.positions.len();
         match pc.light {
-            None => geometry += pc.positions.len(),
-            Some(l) => emitters.push((points.len()..points.len() + pc.positions.len(), l)),
+            None if pc.dynamic => geometry += pc.positions.len(),
+            None => {
+                geometry += pc.positions.len();
+                static_geometry += pc.positions.len();
+            }
+            Some(l) => emitters.push((range.clone(), l)),
         }
-        let m = pc.transform;
-        let normal_matrix = m.inverse().transpose();
-        let normal_matrix = if normal_matrix.is_finite() {
-            normal_matrix
-        } else {
-            Mat4::IDENTITY
-        };
-        let scale = cloud_scale(pc);
-        let length = |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
-        for (i, &p) in pc.positions.iter().enumerate() {
-            let local_n = pc
-                .normals
-                .get(i)
-                .map_or(Vec3::ZERO, |n| n.normalize_or_zero());
-            let n = normal_matrix.transform_vector3(local_n).normalize_or_zero();
-            regions.push(length(pc.regions.get(i), scale));
-            // Under a non-uniform scale a disc becomes an ellipse; drawn as a disc it takes the
-            // ellipse's long axis, so that neighbours still meet along it: with the mean scale a
-            // flattened box's sides showed rows of holes between their discs.
-            let disc_scale = if local_n == Vec3::ZERO {
-                scale
-            } else {
-                largest_stretch(m, local_n)
-            };
-            points.push(GpuPoint::new(
-                m.transform_point3(p),
-                length(pc.radii.get(i), disc_scale),
-                n,
-                pc.colors.get(i).copied().unwrap_or([0.8; 3]),
-                pc.emission.get(i).copied().unwrap_or([0.0; 3]),
-            ));
-        }
+        clouds[c] = range;
+        let (p, r) = cloud_points(pc);
+        points.extend(p);
+        regions.extend(r);
     }
     GpuPoints {
         points,
         regions,
         geometry,
+        static_geometry,
         emitters,
+        clouds,
     }
 }
 
-/// The order in which the point clouds' points are uploaded: the geometry's clouds, then the
-/// area lights' surfaces, so that the passes that treat them apart take them as ranges.
-pub fn gpu_cloud_order(scene: &Scene) -> impl Iterator<Item = &voxgi_scene::PointCloud> {
-    let geometry = scene.point_clouds.iter().filter(|pc| pc.light.is_none());
-    geometry.chain(scene.point_clouds.iter().filter(|pc| pc.light.is_some()))
+/// One cloud's surfels in world space and their regions (see `gpu_points`).
+pub fn cloud_points(pc: &voxgi_scene::PointCloud) -> (Vec<GpuPoint>, Vec<f32>) {
+    let mut points = Vec::with_capacity(pc.positions.len());
+    let mut regions = Vec::with_capacity(pc.positions.len());
+    let m = pc.transform;
+    let normal_matrix = m.inverse().transpose();
+    let normal_matrix = if normal_matrix.is_finite() {
+        normal_matrix
+    } else {
+        Mat4::IDENTITY
+    };
+    let scale = cloud_scale(pc);
+    let length = |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
+    for (i, &p) in pc.positions.iter().enumerate() {
+        let local_n = pc
+            .normals
+            .get(i)
+            .map_or(Vec3::ZERO, |n| n.normalize_or_zero());
+        let n = normal_matrix.transform_vector3(local_n).normalize_or_zero();
+        regions.push(length(pc.regions.get(i), scale));
+        // Under a non-uniform scale a disc becomes an ellipse; drawn as a disc it takes the
+        // ellipse's long axis, so that neighbours still meet along it: with the mean scale a
+        // flattened box's sides showed rows of holes between their discs.
+        let disc_scale = if local_n == Vec3::ZERO {
+            scale
+        } else {
+            largest_stretch(m, local_n)
+        };
+        points.push(GpuPoint::new(
+            m.transform_point3(p),
+            length(pc.radii.get(i), disc_scale),
+            n,
+            pc.colors.get(i).copied().unwrap_or([0.8; 3]),
+            pc.emission.get(i).copied().unwrap_or([0.0; 3]),
+        ));
+    }
+    (points, regions)
+}
+
+/// The order in which the point clouds' points are uploaded, as cloud indices: the static
+/// geometry's clouds, the dynamic geometry's, then the area lights' surfaces, so that the
+/// passes that treat them apart take them as ranges.
+pub fn gpu_cloud_order(scene: &Scene) -> Vec<usize> {
+    let clouds = &scene.point_clouds;
+    // 0: static geometry, 1: dynamic geometry, 2: an area light's surface; stable within each.
+    let class = |c: &usize| match (&clouds[*c].light, clouds[*c].dynamic) {
+        (None, false) => 0,
+        (None, true) => 1,
+        (Some(_), _) => 2,
+    };
+    let mut order: Vec<usize> = (0..clouds.len()).collect();
+    order.sort_by_key(class);
+    order
 }
 
 /// The point clouds as the GPU takes them, one entry per point in each.
@@ -711,15 +774,25 @@ pub struct GpuPoints {
     pub regions: Vec<f32>,
     /// The first `geometry` points are geometry (see `GpuScene::geometry_points`).
     pub geometry: usize,
+    /// The first `static_geometry` of them never move (see `GpuScene::static_points`).
+    pub static_geometry: usize,
     /// The points showing each area light, and its index (see `GpuScene::emitter_points`).
     pub emitters: Vec<(std::ops::Range<usize>, usize)>,
+    /// Each cloud's points, by its index in the scene.
+    pub clouds: Vec<std::ops::Range<usize>>,
 }
 
 /// Each point's world-space surface spread (see `GpuScene::point_spread`), in `gpu_points`'
 /// order: a k-nearest-neighbour search per cloud, so only the rasterizer's upload pays for it.
-pub fn point_spread(scene: &Scene) -> Vec<f32> {
+/// Also the dynamic clouds' spreads in their own units, by cloud index (empty for the others).
+pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
     let mut out = Vec::with_capacity(scene.point_count());
-    for pc in gpu_cloud_order(scene).filter(|pc| !pc.positions.is_empty()) {
+    let mut local = vec![Vec::new(); scene.point_clouds.len()];
+    for c in gpu_cloud_order(scene) {
+        let pc = &scene.point_clouds[c];
+        if pc.positions.is_empty() {
+            continue;
+        }
         let start = web_time::Instant::now();
         // 24 neighbours (then dilated over 24 more) span a few point spacings each way.
         let spread = pointcloud::surface_spread(pc, 24);
@@ -729,13 +802,20 @@ pub fn point_spread(scene: &Scene) -> Vec<f32> {
             pc.positions.len(),
             start.elapsed().as_secs_f64()
         );
-        let scale = cloud_scale(pc);
-        out.extend(
-            (0..pc.positions.len())
-                .map(|i| spread.get(i).map_or(0.0, |&s| finite_or_zero(s * scale))),
-        );
+        out.extend(scaled_spread(pc, &spread));
+        if pc.dynamic {
+            local[c] = spread;
+        }
     }
-    out
+    (out, local)
+}
+
+/// `pc`'s surface spread (in its own units, by point) in the world: by the cloud's scale.
+fn scaled_spread(pc: &voxgi_scene::PointCloud, spread: &[f32]) -> Vec<f32> {
+    let scale = cloud_scale(pc);
+    (0..pc.positions.len())
+        .map(|i| spread.get(i).map_or(0.0, |&s| finite_or_zero(s * scale)))
+        .collect()
 }
 
 /// How much `m`'s linear part stretches the plane normal to the unit vector `n` at most: the

@@ -1,11 +1,13 @@
 //! What the renderer keeps of the scene after uploading it, to apply updates: each instance's
-//! transform, motion class and mesh bounds; the lights; the animations, and the space
-//! everything animated sweeps (which the voxel grid and the shadow views must cover).
+//! transform, motion class and mesh bounds; each point cloud's (and a dynamic one's points,
+//! to place them again); the lights; the animations, and the space everything animated sweeps
+//! (which the voxel grid and the shadow views must cover).
 
 use crate::{Error, Result};
 use glam::Mat4;
+use std::sync::Arc;
 use voxgi_scene::animation::{Animation, AnimationTarget};
-use voxgi_scene::{Aabb, Light, Scene};
+use voxgi_scene::{Aabb, Light, PointCloud, Scene};
 
 /// One instance as the renderer knows it.
 #[derive(Clone, Debug)]
@@ -32,17 +34,37 @@ impl InstanceState {
     }
 }
 
-/// The scene's mutable state: instances, lights and animations.
+/// One point cloud as the renderer knows it.
+#[derive(Clone, Debug)]
+pub struct CloudState {
+    /// Only dynamic clouds move.
+    pub dynamic: bool,
+    /// The area light whose visible surface it is (drawn, not voxelized).
+    pub light: Option<usize>,
+    /// Its points' bounds in its own space.
+    pub local: Aabb,
+    /// A dynamic cloud as uploaded (its points in its own space), to place it again.
+    pub points: Option<Arc<PointCloud>>,
+    /// The cloud's name, for messages.
+    pub name: String,
+    /// Its space to world, now.
+    pub transform: Mat4,
+}
+
+/// The scene's mutable state: instances, point clouds, lights and animations.
 pub struct SceneState {
     /// Every scene instance, in the scene's order.
     pub instances: Vec<InstanceState>,
+    /// Every point cloud, in the scene's order.
+    pub clouds: Vec<CloudState>,
     /// Every light (the default sun included when one was added), as last set.
     pub lights: Vec<Light>,
     /// The animations, over a copy of the scene without its geometry (instances and lights
     /// only: all that `Scene::set_time` touches).
     animated: Scene,
-    /// Instances and lights that some animation moves.
+    /// Instances, clouds and lights that some animation moves.
     animated_instances: Vec<usize>,
+    animated_clouds: Vec<usize>,
     animated_lights: Vec<usize>,
 }
 
@@ -52,12 +74,19 @@ impl SceneState {
         self.animated_instances.binary_search(&i).is_ok()
     }
 
-    /// Where the dynamic instances are now (empty when there are none).
+    /// Where the dynamic instances and geometry clouds are now (empty when there are none).
     pub fn dynamic_bounds(&self) -> Aabb {
+        let clouds = self
+            .clouds
+            .iter()
+            .filter(|c| c.dynamic && c.light.is_none())
+            .fold(Aabb::EMPTY, |b, c| {
+                b.union(&c.local.transformed(c.transform))
+            });
         self.instances
             .iter()
             .filter(|i| i.dynamic && i.draw.is_some())
-            .fold(Aabb::EMPTY, |b, i| b.union(&i.world_bounds(i.transform)))
+            .fold(clouds, |b, i| b.union(&i.world_bounds(i.transform)))
     }
 }
 
@@ -65,6 +94,8 @@ impl SceneState {
 pub struct TimeChanges {
     /// Instances with a new transform: (index, transform).
     pub instances: Vec<(usize, Mat4)>,
+    /// Point clouds with a new transform: (index, transform).
+    pub clouds: Vec<(usize, Mat4)>,
     /// Lights with new values: (index, light).
     pub lights: Vec<(usize, Light)>,
 }
@@ -91,6 +122,25 @@ impl SceneState {
                 }
             })
             .collect();
+        let clouds = scene
+            .point_clouds
+            .iter()
+            .map(|pc| {
+                let mut local = Aabb::EMPTY;
+                for &p in &pc.positions {
+                    local.grow(p);
+                }
+                CloudState {
+                    dynamic: pc.dynamic,
+                    light: pc.light,
+                    local,
+                    points: pc.dynamic.then(|| Arc::new(pc.clone())),
+                    name: pc.name.clone(),
+                    transform: pc.transform,
+                }
+            })
+            .collect();
+        let animated_clouds = scene.animated_clouds();
         let mut animated_instances = Vec::new();
         let mut animated_lights = Vec::new();
         for a in &scene.animations {
@@ -110,14 +160,11 @@ impl SceneState {
         animated_lights.dedup();
         SceneState {
             instances,
+            clouds,
             lights: scene.lights.clone(),
-            animated: Scene {
-                instances: scene.instances.clone(),
-                lights: scene.lights.clone(),
-                animations: scene.animations.clone(),
-                ..Default::default()
-            },
+            animated: scene.without_geometry(),
             animated_instances,
+            animated_clouds,
             animated_lights,
         }
     }
@@ -141,6 +188,14 @@ impl SceneState {
                 (m != self.instances[i].transform).then_some((i, m))
             })
             .collect();
+        let clouds = self
+            .animated_clouds
+            .iter()
+            .filter_map(|&c| {
+                let m = self.animated.point_clouds[c].transform;
+                (m != self.clouds[c].transform).then_some((c, m))
+            })
+            .collect();
         let lights = self
             .animated_lights
             .iter()
@@ -149,6 +204,10 @@ impl SceneState {
                 (*light != self.lights[l]).then(|| (l, light.clone()))
             })
             .collect();
-        Ok(TimeChanges { instances, lights })
+        Ok(TimeChanges {
+            instances,
+            clouds,
+            lights,
+        })
     }
 }

@@ -307,7 +307,7 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     };
 
     // Each include's instances, for the animations that name it.
-    let mut include_instances: Vec<(Option<&str>, std::ops::Range<usize>, bool)> = Vec::new();
+    let mut include_instances: Vec<IncludeRange> = Vec::new();
     for (i, inc) in file.include.iter().enumerate() {
         let what = format!("include {}", i + 1);
         let mut sub = match (&inc.file, &inc.builtin) {
@@ -379,13 +379,14 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         // area lights.
         crate::io::emitters::promote_emissive_quads(&mut sub);
         crate::io::emitters::promote_emissive_points(&mut sub);
-        let first = scene.instances.len();
+        let (first, first_cloud) = (scene.instances.len(), scene.point_clouds.len());
         scene.append(sub, transform, inc.dynamic);
-        include_instances.push((
-            inc.name.as_deref(),
-            first..scene.instances.len(),
-            inc.dynamic,
-        ));
+        include_instances.push(IncludeRange {
+            name: inc.name.as_deref(),
+            instances: first..scene.instances.len(),
+            clouds: first_cloud..scene.point_clouds.len(),
+            dynamic: inc.dynamic,
+        });
     }
 
     for (i, l) in file.light.iter().enumerate() {
@@ -655,12 +656,19 @@ fn parse_repeat(s: Option<&str>) -> std::result::Result<Repeat, String> {
     }
 }
 
-/// One `[[animation]]` table as an `Animation` of `scene`, whose includes are
-/// `includes` (name, instance range, dynamic).
+/// What an `[[include]]` added to the scene, for the animations that name it.
+struct IncludeRange<'a> {
+    name: Option<&'a str>,
+    instances: std::ops::Range<usize>,
+    clouds: std::ops::Range<usize>,
+    dynamic: bool,
+}
+
+/// One `[[animation]]` table as an `Animation` of `scene`, whose includes are `includes`.
 fn make_animation(
     a: &AnimationDef,
     scene: &Scene,
-    includes: &[(Option<&str>, std::ops::Range<usize>, bool)],
+    includes: &[IncludeRange],
 ) -> std::result::Result<Animation, String> {
     let interpolation = parse_interpolation(a.interpolation.as_deref())?;
     let repeat = parse_repeat(a.repeat.as_deref())?;
@@ -691,7 +699,7 @@ fn make_animation(
     };
     let include = includes
         .iter()
-        .filter(|(name, ..)| *name == Some(a.target.as_str()))
+        .filter(|inc| inc.name == Some(a.target.as_str()))
         .collect::<Vec<_>>();
     let light = scene
         .lights
@@ -702,8 +710,8 @@ fn make_animation(
         .collect::<Vec<_>>();
     let name = a.name.clone().unwrap_or_else(|| a.target.clone());
     match (include.as_slice(), light.as_slice()) {
-        ([(_, range, dynamic)], []) => {
-            if !dynamic {
+        ([inc], []) => {
+            if !inc.dynamic {
                 return Err(
                     "the include is static: set `dynamic = true` on it to let it move".into(),
                 );
@@ -799,7 +807,8 @@ fn make_animation(
             };
             Ok(Animation {
                 name,
-                target: AnimationTarget::instances(scene, range.clone().collect(), motion),
+                target: AnimationTarget::instances(scene, inc.instances.clone().collect(), motion)
+                    .with_clouds(scene, inc.clouds.clone()),
             })
         }
         ([], [l]) => {

@@ -21,14 +21,15 @@
 
 @group(0) @binding(0) var<uniform> grid: FragmentGrid;
 @group(0) @binding(1) var<storage, read> points: array<Point>;
-// Per point: the edge of its region of influence, metres (0: a point alone, one voxel). Its
-// length is the point count (the host runs the pass only when there are points).
+// Per point: the edge of its region of influence, metres (0: a point alone, one voxel).
 @group(0) @binding(2) var<storage, read> regions: array<f32>;
 @group(0) @binding(3) var<storage, read_write> fragments: array<Fragment>;
 // [0]: fragments emitted (may exceed the capacity: the host then grows the buffer and redoes).
 @group(0) @binding(4) var<storage, read_write> fragment_count: array<atomic<u32>>;
 // Fragments are made in these voxels only.
 @group(0) @binding(5) var<uniform> region: FragmentRegion;
+// The points splatted: x the first, y the count (the static geometry's or the dynamic clouds').
+@group(0) @binding(6) var<uniform> range: vec4<u32>;
 
 const SUB: u32 = 1024u;
 
@@ -45,10 +46,13 @@ fn flat(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = flat(gid, nwg);
-    if i >= arrayLength(&regions) {
+    let local = flat(gid, nwg);
+    if local >= range.y {
         return;
     }
+    // The point's index in the whole buffer: its rounding hash is the same whichever pass
+    // splats it.
+    let i = range.x + local;
     let pt = points[i];
     // Voxel space by multiplications only (inverse from the host), so the CPU twin rounds alike.
     let p = (pt.position - grid.origin) * grid.inv_voxel_size;

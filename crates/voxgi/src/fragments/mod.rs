@@ -61,9 +61,9 @@ pub const REGION_STRIDE: u64 = 256;
 /// Which geometry a pass makes fragments of: it decides the region the pass binds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Geometry {
-    /// The static geometry and the point clouds, for a build.
+    /// The static geometry (meshes and point clouds), for a build.
     Static,
-    /// The dynamic geometry, for an update.
+    /// The dynamic geometry (meshes and point clouds), for an update.
     Dynamic,
 }
 

@@ -5,6 +5,7 @@ use crate::fragments::{Fragments, Geometry};
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
+use wgpu::util::DeviceExt;
 
 /// The splat compute pass (shaders/fragments/splat.wgsl): its pipeline and bind group layout.
 pub struct SplatPass {
@@ -25,6 +26,7 @@ impl SplatPass {
                 layout::storage(3, c, false),
                 layout::storage(4, c, false),
                 layout::uniform(5, c, false),
+                layout::uniform(6, c, false),
             ],
         });
         let pipeline = crate::gpu::shader::grouped_pipeline(
@@ -37,40 +39,45 @@ impl SplatPass {
         SplatPass { pipeline, layout }
     }
 
-    /// The pass's bind group over `scene`'s geometry points into `fragments` (made once per
-    /// fragment buffer).
+    /// The pass's bind group over `scene`'s static geometry points (`Geometry::Static`: the
+    /// build's) or its dynamic clouds' (`Geometry::Dynamic`: each update's) into `fragments`
+    /// (made once per fragment buffer).
     pub fn bind(
         &self,
         device: &wgpu::Device,
         scene: &GpuScene,
         fragments: &Fragments,
-    ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
+        which: Geometry,
+    ) -> SplatBind {
+        let (first, count) = points_of(scene, which);
+        let range = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("splat range"),
+            contents: bytemuck::cast_slice(&[first, count, 0, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat"),
             layout: &self.layout,
             entries: &layout::entries(vec![
                 fragments.grid_uniform.as_entire_binding(),
                 scene.points.as_entire_binding(),
-                // The shader's point count is this binding's length.
-                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &scene.point_regions,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(scene.geometry_points as u64 * 4),
-                }),
+                scene.point_regions.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
-                fragments.region(Geometry::Static),
+                fragments.region(which),
+                range.as_entire_binding(),
             ]),
-        })
+        });
+        SplatBind { group, count }
     }
 
-    /// Records the pass over every point of `scene`, one thread per point, appending to
-    /// `fragments` and its count (after `voxelize`, into the same build). Timed as "splat".
+    /// Records the pass over the points `bind` took, one thread per point, appending to
+    /// `fragments` and its count (after `voxelize`, into the same build or update). Timed as
+    /// "splat".
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        bind: Option<&wgpu::BindGroup>,
+        bind: Option<&SplatBind>,
         timer: &mut GpuTimer,
     ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -79,12 +86,29 @@ impl SplatPass {
         });
         // Area lights' surfaces are not voxelized (see `triangle_table`); they follow the
         // geometry's points.
-        let (Some(bind), true) = (bind, scene.geometry_points > 0) else {
+        let Some(bind) = bind.filter(|b| b.count > 0) else {
             return;
         };
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, bind, &[]);
-        let (x, y) = layout::groups_2d(scene.geometry_points, 64);
+        pass.set_bind_group(0, &bind.group, &[]);
+        let (x, y) = layout::groups_2d(bind.count, 64);
         pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+/// A splat bind group and how many points it splats.
+pub struct SplatBind {
+    group: wgpu::BindGroup,
+    count: u32,
+}
+
+/// The first point and the count of `scene`'s static geometry points or its dynamic ones.
+pub fn points_of(scene: &GpuScene, which: Geometry) -> (u32, u32) {
+    match which {
+        Geometry::Static => (0, scene.static_points),
+        Geometry::Dynamic => (
+            scene.static_points,
+            scene.geometry_points - scene.static_points,
+        ),
     }
 }

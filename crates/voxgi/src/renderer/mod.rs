@@ -155,7 +155,7 @@ pub struct Renderer {
 struct SceneFacts {
     /// Everything the scene draws at any time (what animations move, at all their poses).
     bounds: Aabb,
-    /// Whether any instance is dynamic.
+    /// Whether any instance or geometry point cloud is dynamic.
     dynamic: bool,
     estimate: FragmentEstimate,
     /// The largest albedo of any material (the unlimited-bounce count's convergence).
@@ -241,7 +241,11 @@ impl Renderer {
         let (center, radius) = bounding_sphere(bounds);
         let facts = SceneFacts {
             bounds,
-            dynamic: scene.instances.iter().any(|i| i.dynamic),
+            dynamic: scene.instances.iter().any(|i| i.dynamic)
+                || scene
+                    .point_clouds
+                    .iter()
+                    .any(|pc| pc.dynamic && pc.light.is_none() && !pc.positions.is_empty()),
             estimate: FragmentEstimate::of(scene),
             max_albedo: scene
                 .materials

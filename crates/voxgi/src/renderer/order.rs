@@ -2,7 +2,8 @@
 //! a reader learns the pipeline (docs/ARCHITECTURE.md draws it):
 //!
 //! ```text
-//! shadow → [moments] → [voxelize (static) → splat → <kind>_build] → [voxelize (dynamic) → <kind>_update]
+//! shadow → [moments] → [voxelize (static) → splat (static) → <kind>_build]
+//!        → [voxelize (dynamic) → splat (dynamic) → <kind>_update]
 //!        → inject → filter → (bounce → filter) × (bounces − 1) → [bounce (records)] → [blend → filter]
 //!        → gbuffer → gather → upsample → composite → [debug] → [temporal] → tonemap
 //! ```
@@ -22,6 +23,8 @@
 use super::Renderer;
 use super::temporal::FrameHistory;
 use crate::Result;
+use crate::fragments::Geometry;
+use crate::fragments::splat::SplatBind;
 use crate::frame::globals::{self, GlobalsSources};
 use crate::frame::sequence;
 use crate::frame::targets::{FrameTargets, Target};
@@ -453,16 +456,24 @@ impl Renderer {
                 &self.dynamic_triangles,
                 &self.fragments,
             ),
-            splat: (self.scene.geometry_points > 0)
-                .then(|| p.splat.bind(&self.device, &self.scene, &self.fragments)),
+            splat_static: (self.scene.static_points > 0).then(|| {
+                p.splat
+                    .bind(&self.device, &self.scene, &self.fragments, Geometry::Static)
+            }),
+            splat_dynamic: (self.scene.geometry_points > self.scene.static_points).then(|| {
+                p.splat.bind(
+                    &self.device,
+                    &self.scene,
+                    &self.fragments,
+                    Geometry::Dynamic,
+                )
+            }),
         });
         if work.build.is_some() && !pending.built {
             self.fragments.record_clear(encoder);
             p.voxelize
                 .record(encoder, &self.static_triangles, &fb.voxelize_static, timer);
-            // Point clouds are static: the renderer places them once.
-            p.splat
-                .record(encoder, &self.scene, fb.splat.as_ref(), timer);
+            p.splat.record(encoder, fb.splat_static.as_ref(), timer);
             self.fragments.record_mark(encoder);
             cut(encoder, "voxelize");
             self.volume
@@ -477,6 +488,7 @@ impl Renderer {
                 &fb.voxelize_dynamic,
                 timer,
             );
+            p.splat.record(encoder, fb.splat_dynamic.as_ref(), timer);
             self.volume
                 .record_update(&self.device, encoder, &self.fragments, timer);
             cut(encoder, "update");
@@ -638,8 +650,10 @@ pub(super) struct FrameBinds {
 pub(super) struct FragmentBinds {
     voxelize_static: wgpu::BindGroup,
     voxelize_dynamic: wgpu::BindGroup,
-    /// None without geometry points (the pass then records an empty scope).
-    splat: Option<wgpu::BindGroup>,
+    /// The static and the dynamic geometry points' (None without such points: the pass
+    /// then records an empty scope).
+    splat_static: Option<SplatBind>,
+    splat_dynamic: Option<SplatBind>,
 }
 
 /// The shadow pass's bind group and the moments pass's (with VSM/ESM): made on the first

@@ -11,7 +11,9 @@
 
 use crate::fragments::splat::SplatPass;
 use crate::fragments::voxelize::VoxelizePass;
-use crate::fragments::{self, FRAGMENT_BYTES, FragmentEstimate, Fragments, TriangleTable};
+use crate::fragments::{
+    self, FRAGMENT_BYTES, FragmentEstimate, Fragments, Geometry, TriangleTable,
+};
 use crate::gpu::readback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
@@ -103,21 +105,22 @@ impl Sizing<'_> {
         Ok((grown, built))
     }
 
-    /// Voxelizes the static geometry and the points into `fragments`, waited for: the
+    /// Voxelizes the static geometry and the static points into `fragments`, waited for: the
     /// fragments made, counted past the capacity.
     fn voxelize(&self, fragments: &Fragments) -> Result<u64> {
         let voxelize = self
             .voxelize
             .bind(self.device, self.scene, self.triangles, fragments);
-        let splat = (self.scene.geometry_points > 0)
-            .then(|| self.splat.bind(self.device, self.scene, fragments));
+        let splat = (self.scene.static_points > 0).then(|| {
+            self.splat
+                .bind(self.device, self.scene, fragments, Geometry::Static)
+        });
         let mut timer = GpuTimer::disabled(self.queue);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         fragments.record_clear(&mut encoder);
         self.voxelize
             .record(&mut encoder, self.triangles, &voxelize, &mut timer);
-        self.splat
-            .record(&mut encoder, self.scene, splat.as_ref(), &mut timer);
+        self.splat.record(&mut encoder, splat.as_ref(), &mut timer);
         fragments.record_mark(&mut encoder);
         Ok(self.read(encoder, &[(&fragments.count, 1)])?[0] as u64)
     }

@@ -87,6 +87,58 @@ impl Renderer {
         Ok(())
     }
 
+    /// Moves point cloud `cloud` (an index into the scene's point clouds) to `transform`, as
+    /// `set_instance_transform` moves an instance: only dynamic clouds move
+    /// (`PointCloud::dynamic`, `dynamic = true` on its include); a static one or a transform
+    /// that is not finite is an error. Its surfels are written anew where it is now; the next
+    /// voxel update splats it there (an area light's surface is only drawn), and the shadow
+    /// views that see its old or new place re-render.
+    pub fn set_cloud_transform(&mut self, cloud: usize, transform: Mat4) -> Result<()> {
+        let count = self.state.clouds.len();
+        let c = self.state.clouds.get(cloud).ok_or_else(|| {
+            Error::Setting(format!(
+                "point cloud {cloud} does not exist (the scene has {count})"
+            ))
+        })?;
+        if !transform.is_finite() {
+            return Err(Error::Setting(format!(
+                "point cloud '{}': the transform is not finite",
+                c.name
+            )));
+        }
+        if transform == c.transform {
+            return Ok(());
+        }
+        let Some(points) = c.points.clone().filter(|_| c.dynamic) else {
+            return Err(Error::Setting(format!(
+                "point cloud '{}' is static: only dynamic clouds move (mark it dynamic in the \
+                 scene: `dynamic = true` on its include)",
+                c.name
+            )));
+        };
+        let (old, new) = (
+            c.local.transformed(c.transform),
+            c.local.transformed(transform),
+        );
+        let geometry = c.light.is_none();
+        let mut placed = (*points).clone();
+        placed.transform = transform;
+        self.scene.set_cloud(&self.queue, cloud, &placed);
+        self.state.clouds[cloud].transform = transform;
+        for v in 0..self.atlas.views.len() {
+            let view = &self.atlas.views[v];
+            let dirt = shadow::box_dirt(view, old.min, old.max)
+                .merge(shadow::box_dirt(view, new.min, new.max));
+            self.pending.view(v, dirt);
+        }
+        if geometry {
+            let moved = old.union(&new);
+            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
+            self.pending.geometry = true;
+        }
+        Ok(())
+    }
+
     /// Changes light `index` (into the scene's lights) to `light`: its position, direction,
     /// colour, intensity, range, cone angles or area shape. Its kind (directional, point,
     /// spot, area) and whether it casts shadows are fixed once uploaded (an error: make a new
@@ -182,13 +234,16 @@ impl Renderer {
         Some(old.union(&new))
     }
 
-    /// Sets the scene's time, in seconds: every animation moves its instances and lights to
-    /// their state at `t` (`Scene::set_time`), through `set_instance_transform` and
-    /// `set_light`. Only what changed is updated.
+    /// Sets the scene's time, in seconds: every animation moves its instances, point clouds
+    /// and lights to their state at `t` (`Scene::set_time`), through `set_instance_transform`,
+    /// `set_cloud_transform` and `set_light`. Only what changed is updated.
     pub fn set_time(&mut self, t: f32) -> Result<()> {
         let changes = self.state.set_time(t)?;
         for (i, m) in changes.instances {
             self.set_instance_transform(i, m)?;
+        }
+        for (c, m) in changes.clouds {
+            self.set_cloud_transform(c, m)?;
         }
         for (l, light) in changes.lights {
             self.set_light(l, &light)?;

@@ -282,6 +282,7 @@ pub(super) fn load_animations(
                 outer: Mat4::IDENTITY,
                 inner,
                 lights,
+                clouds: Vec::new(),
                 motion: Motion::Nodes {
                     nodes: nodes.clone(),
                     node: a,
