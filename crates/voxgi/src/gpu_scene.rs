@@ -308,6 +308,9 @@ pub struct GpuScene {
     pub static_points: u32,
     /// Each point cloud's range of `points`, by its index in the scene.
     pub cloud_ranges: Vec<std::ops::Range<u32>>,
+    /// With dynamic clouds, one vec4 per point: where it was drawn at the last frame less
+    /// where it is (the motion vectors' share of the points); one element without.
+    pub point_motion: wgpu::Buffer,
     /// The dynamic clouds' surface spread in their own units (`pointcloud::surface_spread`),
     /// by cloud index (empty for the others), for writing them again where they move.
     local_spread: Vec<Vec<f32>>,
@@ -572,6 +575,15 @@ impl GpuScene {
             points: storage("points", bytemuck::cast_slice(&points), 32),
             point_spread: storage("point spread", bytemuck::cast_slice(&spread), 4),
             point_regions: storage("point regions", bytemuck::cast_slice(&regions), 4),
+            point_motion: storage(
+                "point motion",
+                &[],
+                if scene.point_clouds.iter().any(|pc| pc.dynamic) {
+                    points.len() * 16
+                } else {
+                    16
+                },
+            ),
             point_count: points.len() as u32,
             geometry_points: geometry as u32,
             static_points: static_geometry as u32,
@@ -605,6 +617,21 @@ impl GpuScene {
             gpu_draws: draws,
             instance_draw,
         })
+    }
+
+    /// Writes dynamic cloud `cloud`'s motion (`point_motion`): one offset per point, from
+    /// where it is to where it was drawn at the last frame.
+    pub fn set_cloud_motion(&self, queue: &wgpu::Queue, cloud: usize, motion: &[[f32; 4]]) {
+        let Some(range) = self.cloud_ranges.get(cloud) else {
+            return;
+        };
+        if range.len() == motion.len() && self.point_motion.size() >= range.end as u64 * 16 {
+            queue.write_buffer(
+                &self.point_motion,
+                range.start as u64 * 16,
+                bytemuck::cast_slice(motion),
+            );
+        }
     }
 
     /// Writes point cloud `cloud` (an index into the scene's clouds, uploaded dynamic) anew
@@ -669,6 +696,7 @@ impl GpuScene {
             ("points", self.points.size()),
             ("point spread", self.point_spread.size()),
             ("point regions", self.point_regions.size()),
+            ("point motion", self.point_motion.size()),
             ("textures", tex),
         ]
     }

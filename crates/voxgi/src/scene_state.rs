@@ -49,6 +49,10 @@ pub struct CloudState {
     pub name: String,
     /// Its space to world, now.
     pub transform: Mat4,
+    /// Its space to world when the last frame drew it, and whether that frame's motion
+    /// (`GpuScene::point_motion`) was not zero.
+    pub drawn: Mat4,
+    pub moving: bool,
 }
 
 /// The scene's mutable state: instances, point clouds, lights and animations.
@@ -137,6 +141,8 @@ impl SceneState {
                     points: pc.dynamic.then(|| Arc::new(pc.clone())),
                     name: pc.name.clone(),
                     transform: pc.transform,
+                    drawn: pc.transform,
+                    moving: false,
                 }
             })
             .collect();

@@ -18,6 +18,9 @@
 @group(0) @binding(7) var<storage, read> point_spread: array<f32>;
 // Per draw, its model matrix in the previous frame.
 @group(0) @binding(8) var<storage, read> prev_models: array<mat4x4<f32>>;
+// Per point of a scene with dynamic clouds: where it was at the last frame, less where it is
+// (xyz; zero where it did not move). One element, never read, in a scene without.
+@group(0) @binding(9) var<storage, read> point_motion: array<vec4<f32>>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -137,11 +140,16 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
     var q = p;
     q.position += point_normal(p) * min(point_spread[vi / 6u], p.radius);
     var out: PointOut;
-    // Point clouds do not move (yet): only the camera's motion.
     let world = vec4<f32>(surfel_world(q, n, corner), 1.0);
+    // A moving cloud's surfel was where its point was at the last frame (the disc's turn is
+    // left out of the motion vector).
+    var moved = vec3<f32>(0.0);
+    if arrayLength(&point_motion) > vi / 6u {
+        moved = point_motion[vi / 6u].xyz;
+    }
     out.clip = frame.view_proj * world;
     out.now = frame.view_proj_unjittered * world;
-    out.then = frame.prev_view_proj * world;
+    out.then = frame.prev_view_proj * vec4<f32>(world.xyz + moved, 1.0);
     out.world = world.xyz;
     out.disc = corner;
     out.normal = n;

@@ -109,8 +109,10 @@ impl Renderer {
             self.temporal.reset();
         }
         // Whether the light or the geometry may differ from the last frame's.
-        let changed =
-            self.voxel_work_pending() | prepared.is_some() | self.scene.advance_motion(&self.queue);
+        let changed = self.voxel_work_pending()
+            | prepared.is_some()
+            | self.scene.advance_motion(&self.queue)
+            | self.advance_cloud_motion();
         let view_proj = camera_view_proj(&params.camera, width, height, self.view.0, self.view.1);
         self.drawn_view_proj = view_proj;
         let history = self.temporal.begin(temporal, params, view_proj, changed);

@@ -234,6 +234,42 @@ impl Renderer {
         Some(old.union(&new))
     }
 
+    /// Writes the motion of the dynamic clouds since the last frame (`GpuScene::point_motion`,
+    /// for the motion vectors): where they moved, and zero again where they stopped. Returns
+    /// whether any moved.
+    pub(super) fn advance_cloud_motion(&mut self) -> bool {
+        let mut moved = false;
+        for c in 0..self.state.clouds.len() {
+            let cs = &self.state.clouds[c];
+            let Some(points) = &cs.points else {
+                continue;
+            };
+            let now_moving = cs.transform != cs.drawn;
+            if !now_moving && !cs.moving {
+                continue;
+            }
+            let (then, now) = (cs.drawn, cs.transform);
+            let motion: Vec<[f32; 4]> = points
+                .positions
+                .iter()
+                .map(|&p| {
+                    let d = if now_moving {
+                        then.transform_point3(p) - now.transform_point3(p)
+                    } else {
+                        glam::Vec3::ZERO
+                    };
+                    [d.x, d.y, d.z, 0.0]
+                })
+                .collect();
+            self.scene.set_cloud_motion(&self.queue, c, &motion);
+            let cs = &mut self.state.clouds[c];
+            cs.drawn = now;
+            cs.moving = now_moving;
+            moved |= now_moving;
+        }
+        moved
+    }
+
     /// Sets the scene's time, in seconds: every animation moves its instances, point clouds
     /// and lights to their state at `t` (`Scene::set_time`), through `set_instance_transform`,
     /// `set_cloud_transform` and `set_light`. Only what changed is updated.

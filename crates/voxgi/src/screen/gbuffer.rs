@@ -39,6 +39,7 @@ impl GbufferPass {
                 layout::storage(6, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(7, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(8, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(9, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let module = shader::module(device, "screen/gbuffer.wgsl");
@@ -112,6 +113,7 @@ impl GbufferPass {
                 scene.points.as_entire_binding(),
                 scene.point_spread.as_entire_binding(),
                 scene.prev_models.as_entire_binding(),
+                scene.point_motion.as_entire_binding(),
             ]),
         })
     }
