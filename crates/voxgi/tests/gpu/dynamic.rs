@@ -158,23 +158,36 @@ fn sequence_of_moves(options: &RendererOptions) {
             scene.set_light(light, l.clone());
             // The emitter's surface is drawn where the scene says: keep it with the light.
         }
-        let got = frame(&mut r, &p, SIZE, SIZE);
-        let mut fresh = renderer(&scene, options);
-        let want = frame(&mut fresh, &p, SIZE, SIZE);
         let what = &format!("{what} ({:?}, {} bounces)", options.voxels, options.bounces);
-        assert_same_image(&got, &want, what);
-        assert_eq!(
-            r.voxel_counts().expect("counts").occupied,
-            fresh.voxel_counts().expect("counts").occupied,
-            "{what}: occupied voxels"
-        );
-        for ((name, a), (_, b)) in volume_bytes(&r).iter().zip(volume_bytes(&fresh).iter()) {
-            assert!(
-                a == b,
-                "{what}: the volume's {name} differs from a fresh build"
-            );
-        }
+        assert_like_fresh(&mut r, &scene, options, what);
     }
+}
+
+/// `r`'s next frame (from the scene's camera) equals the first of a renderer made on `scene`,
+/// and so do its occupied voxels and its volume. Returns that frame.
+fn assert_like_fresh(
+    r: &mut Renderer,
+    scene: &Scene,
+    options: &RendererOptions,
+    what: &str,
+) -> voxgi::RenderOutput {
+    let p = params(r);
+    let got = frame(r, &p, SIZE, SIZE);
+    let mut fresh = renderer(scene, options);
+    let want = frame(&mut fresh, &p, SIZE, SIZE);
+    assert_same_image(&got, &want, what);
+    assert_eq!(
+        r.voxel_counts().expect("counts").occupied,
+        fresh.voxel_counts().expect("counts").occupied,
+        "{what}: occupied voxels"
+    );
+    for ((name, a), (_, b)) in volume_bytes(r).iter().zip(volume_bytes(&fresh).iter()) {
+        assert!(
+            a == b,
+            "{what}: the volume's {name} differs from a fresh build"
+        );
+    }
+    got
 }
 
 /// The Cornell box with a dynamic 12 cm cube sampled as points (about 3.5 to a voxel's edge at
@@ -214,25 +227,11 @@ fn a_moving_point_cloud_renders_like_a_fresh_renderer() {
             let m = cube_at(at);
             r.set_cloud_transform(cloud, m).expect("dynamic cloud");
             scene.point_clouds[cloud].transform = m;
-            let got = frame(&mut r, &p, SIZE, SIZE);
-            let mut fresh = renderer(&scene, &options);
-            let want = frame(&mut fresh, &p, SIZE, SIZE);
             let what = format!(
                 "move {step} ({:?}, {} bounces)",
                 options.voxels, options.bounces
             );
-            assert_same_image(&got, &want, &what);
-            assert_eq!(
-                r.voxel_counts().expect("counts").occupied,
-                fresh.voxel_counts().expect("counts").occupied,
-                "{what}: occupied voxels"
-            );
-            for ((name, a), (_, b)) in volume_bytes(&r).iter().zip(volume_bytes(&fresh).iter()) {
-                assert!(
-                    a == b,
-                    "{what}: the volume's {name} differs from a fresh build"
-                );
-            }
+            let got = assert_like_fresh(&mut r, &scene, &options, &what);
             if step == 0 {
                 let moved = first
                     .ldr

@@ -14,15 +14,21 @@ const SIZE: u32 = 64;
 /// A white wall at z = 0 (4 m square, facing +z) and a dynamic red cube of edge 0.5 m in
 /// front of it, centred at (x, 0, 0.5); returns the scene and the cube's instance.
 fn wall_and_cube(x: f32) -> (Scene, usize) {
+    let mut scene = wall();
+    let cube = scene.instances.len();
+    scene.append(builtin::cube([0.8, 0.1, 0.1]), cube_at(x), true);
+    (scene, cube)
+}
+
+/// A white wall at z = 0, 4 m square, facing +z.
+fn wall() -> Scene {
     let mut scene = Scene::default();
     scene.add_mesh(
         quad_mesh("wall", Vec3::ZERO, 4.0),
         Material::diffuse("wall", [0.8; 3]),
         Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
     );
-    let cube = scene.instances.len();
-    scene.append(builtin::cube([0.8, 0.1, 0.1]), cube_at(x), true);
-    (scene, cube)
+    scene
 }
 
 fn cube_at(x: f32) -> Mat4 {
@@ -92,12 +98,7 @@ fn motion_vectors_of_a_moving_instance_are_exact() {
 /// motion vectors are the move's, and stop when it stops (they were the camera's alone).
 #[test]
 fn motion_vectors_of_a_moving_point_cloud_are_exact() {
-    let mut scene = Scene::default();
-    scene.add_mesh(
-        quad_mesh("wall", Vec3::ZERO, 4.0),
-        Material::diffuse("wall", [0.8; 3]),
-        Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
-    );
+    let mut scene = wall();
     let cloud = scene.point_clouds.len();
     let points = voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.8, 0.1, 0.1]), 0.02);
     scene.append(points, cube_at(0.0), true);
