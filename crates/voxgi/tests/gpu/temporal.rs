@@ -7,7 +7,7 @@ use voxgi::compare::{Image, compare};
 use voxgi::headless;
 use voxgi::scene::glam::{Mat4, Vec3};
 use voxgi::scene::{Camera, Material, Scene, builtin};
-use voxgi::{FrameParams, RenderOutput, RendererOptions, ViewMode, VoxelKind};
+use voxgi::{FrameParams, RenderOutput, Renderer, RendererOptions, ViewMode, VoxelKind};
 
 const SIZE: u32 = 64;
 
@@ -75,23 +75,18 @@ fn hdr_at(o: &RenderOutput, x: u32, y: u32) -> [f32; 4] {
 #[test]
 fn motion_vectors_of_a_moving_instance_are_exact() {
     let (scene, cube) = wall_and_cube(0.0);
-    let cam = front_camera();
-    let mut r = renderer(&scene, &small(false));
-    let params = FrameParams {
-        view: ViewMode::Motion,
-        ..clamped(&cam)
-    };
-    frame(&mut r, &params, SIZE, SIZE);
-    let d = Vec3::new(0.1, 0.06, 0.0);
-    r.set_instance_transform(cube, Mat4::from_translation(d) * cube_at(0.0))
-        .expect("dynamic cube");
-    let out = frame(&mut r, &params, SIZE, SIZE);
-    let (px, dist) = motion_error(&out, &cam, d, 0.75);
+    let ((px, dist), still) = motion_after_move(&scene, |r, m| {
+        r.set_instance_transform(cube, m).expect("dynamic cube")
+    });
     // The motion is about 1.7 px here; half floats store it to 1/1024 px and the distance
     // (3.75 m) to 1/2048 of itself; measured 0.0003 px and 0.09 %. The disocclusion test
     // that reads the distance allows 3 %.
     assert!(px < 0.005, "motion off by {px} px");
     assert!(dist < 2e-3, "previous distance off by {dist}");
+    assert!(
+        still < 0.005,
+        "a cube that stopped still moves by {still} px"
+    );
 }
 
 /// The same for the cube sampled as a dynamic point cloud (`set_cloud_transform`): its surfels'
@@ -102,25 +97,34 @@ fn motion_vectors_of_a_moving_point_cloud_are_exact() {
     let cloud = scene.point_clouds.len();
     let points = voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.8, 0.1, 0.1]), 0.02);
     scene.append(points, cube_at(0.0), true);
+    let ((px, dist), still) = motion_after_move(&scene, |r, m| {
+        r.set_cloud_transform(cloud, m).expect("dynamic cloud")
+    });
+    // As for the mesh; the surfels lie on the face (the samples are exactly on it).
+    assert!(px < 0.005, "motion off by {px} px");
+    assert!(dist < 2e-3, "previous distance off by {dist}");
+    assert!(
+        still < 0.005,
+        "a cloud that stopped still moves by {still} px"
+    );
+}
+
+/// `scene`'s cube (at `cube_at(0.0)`) moved by `move_to` up and to the right between two frames
+/// of the motion view: the motion errors over its front face (`motion_error`), and the
+/// vectors' error a frame later, nothing having moved.
+fn motion_after_move(scene: &Scene, move_to: impl Fn(&mut Renderer, Mat4)) -> ((f32, f32), f32) {
     let cam = front_camera();
-    let mut r = renderer(&scene, &small(false));
+    let mut r = renderer(scene, &small(false));
     let params = FrameParams {
         view: ViewMode::Motion,
         ..clamped(&cam)
     };
     frame(&mut r, &params, SIZE, SIZE);
     let d = Vec3::new(0.1, 0.06, 0.0);
-    r.set_cloud_transform(cloud, Mat4::from_translation(d) * cube_at(0.0))
-        .expect("dynamic cloud");
-    let out = frame(&mut r, &params, SIZE, SIZE);
-    let (px, dist) = motion_error(&out, &cam, d, 0.75);
-    // As for the mesh; the surfels lie on the face to within their spread (none: the samples
-    // are exactly on it).
-    assert!(px < 0.005, "motion off by {px} px");
-    assert!(dist < 2e-3, "previous distance off by {dist}");
-    let still = frame(&mut r, &params, SIZE, SIZE);
-    let (px, _) = motion_error(&still, &cam, Vec3::ZERO, 0.75);
-    assert!(px < 0.005, "a cloud that stopped still moves by {px} px");
+    move_to(&mut r, Mat4::from_translation(d) * cube_at(0.0));
+    let moved = motion_error(&frame(&mut r, &params, SIZE, SIZE), &cam, d, 0.75);
+    let still = motion_error(&frame(&mut r, &params, SIZE, SIZE), &cam, Vec3::ZERO, 0.75);
+    (moved, still.0)
 }
 
 /// The largest error, over the 7x7 pixels around the centre of a cube's front face at depth
