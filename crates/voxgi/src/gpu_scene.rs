@@ -579,7 +579,7 @@ impl GpuScene {
                 "point motion",
                 &[],
                 if scene.point_clouds.iter().any(|pc| pc.dynamic) {
-                    points.len() * 16
+                    (points.len() * 16).max(16)
                 } else {
                     16
                 },

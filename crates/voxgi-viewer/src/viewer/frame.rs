@@ -301,18 +301,21 @@ impl Viewer {
                 self.moving = last.is_some_and(|l| Some(l) != shows);
             }
             let still = images.shows == shows;
-            if !still {
+            // A light edited or a rebuild coming: the image changes and accumulates afresh.
+            let settled = self.renderer.voxels_settled();
+            if !still || !settled {
                 self.still_frames = 0;
             }
-            // A still view stops accumulating while a new renderer's voxel work runs (it is
-            // about to be replaced, and its frames would come between that work's passes),
-            // after `still_cap` frames, and, on a CPU driver, for a frame that answers input
-            // (the panel's answer then comes in a frame of its own, not after another
-            // accumulation of half a second).
+            // A still view whose voxels are settled stops accumulating while a new renderer's
+            // voxel work runs (it is about to be replaced, and its frames would come between
+            // that work's passes), after `still_cap` frames, and, on a CPU driver, for a frame
+            // that answers input (the panel's answer then comes in a frame of its own, not
+            // after another accumulation of half a second).
             let hold = self.renderer.is_idle()
-                || self.handover.is_some()
-                || self.still_frames >= self.still_cap
-                || (self.cpu && self.stats.input_waiting());
+                || (settled
+                    && (self.handover.is_some()
+                        || self.still_frames >= self.still_cap
+                        || (self.cpu && self.stats.input_waiting())));
             if exporting || (still && hold) {
                 self.reused |= accumulate;
             } else {

@@ -428,7 +428,11 @@ pub(super) fn wheel_at_once(events: &mut Vec<egui::Event>, line: f32, page: f32)
             egui::MouseWheelUnit::Line => delta * line,
             egui::MouseWheelUnit::Page => delta * page,
         };
-        let steps = (points.length() / UNEASED_STEP).ceil().max(1.0);
+        if !points.is_finite() {
+            continue;
+        }
+        // A notch of a few lines is a handful of steps; a page at most 64.
+        let steps = (points.length() / UNEASED_STEP).ceil().clamp(1.0, 64.0);
         for _ in 0..steps as usize {
             out.push(egui::Event::MouseWheel {
                 unit: egui::MouseWheelUnit::Point,

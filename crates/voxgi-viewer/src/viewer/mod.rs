@@ -259,6 +259,10 @@ struct Viewer {
     ground: GroundTruth,
     // Background work, each shown in the window while it runs.
     rebuild: Option<Job<(Renderer, RendererOptions)>>,
+    /// Counts the scenes opened: a renderer made for new options of an earlier scene is not
+    /// taken when it arrives (`rebuild_scene`, the scene it was made for).
+    scene_generation: u64,
+    rebuild_scene: u64,
     opening: Option<Job<Opened>>,
     handover: Option<Handover>,
     /// A file being written (an export): the message to show when it is done.
@@ -506,6 +510,8 @@ impl Viewer {
             last_time: 0.0,
             ground,
             rebuild: None,
+            scene_generation: 0,
+            rebuild_scene: 0,
             opening: None,
             handover: None,
             saving: None,

@@ -28,6 +28,11 @@ enum Taking {
 }
 
 impl Handover {
+    /// Whether it brings a newly opened scene.
+    fn opens(&self) -> bool {
+        matches!(self.taking, Taking::Opened(..))
+    }
+
     pub(super) fn label(&self) -> String {
         let what = match self.taking {
             Taking::Rebuilt(..) => "the voxels for the new options",
@@ -87,6 +92,7 @@ impl Viewer {
 
     /// The loaded file replaces the scene.
     fn opened(&mut self, o: Opened) {
+        self.scene_generation += 1;
         let mut renderer = o.renderer;
         renderer.enable_timing(self.timestamps);
         self.renderer = renderer;
@@ -127,6 +133,11 @@ impl Viewer {
     /// that shapes the uploaded scene, by building a new renderer in the background while the
     /// current one draws.
     pub(super) fn apply(&mut self) {
+        if self.opening.is_some() || self.handover.as_ref().is_some_and(Handover::opens) {
+            self.toasts
+                .info("a scene is being opened: apply the options once it shows");
+            return;
+        }
         if !crate::settings::needs_new_renderer(&self.options, &self.draft) {
             match self.renderer.set_options(&self.draft) {
                 Ok(()) => {
@@ -141,6 +152,7 @@ impl Viewer {
         }
         let (device, queue) = (self.device.clone(), self.queue.clone());
         let (scene, options) = (self.scene.clone(), self.draft.clone());
+        self.rebuild_scene = self.scene_generation;
         self.rebuild = Some(Job::spawn("rebuilding for the new options", move || {
             Ok((Renderer::new(&device, &queue, &scene, &options)?, options))
         }));
@@ -213,6 +225,13 @@ impl Viewer {
             }
         }
         match take(&mut self.rebuild) {
+            Some(Ok(_))
+                if self.rebuild_scene != self.scene_generation
+                    || self.handover.as_ref().is_some_and(Handover::opens) =>
+            {
+                self.toasts
+                    .info("the new options were for the scene open before: apply them again");
+            }
             Some(Ok((mut renderer, options))) => {
                 self.adopt_state(&mut renderer);
                 match Pieces::new(&mut renderer, &self.params) {

@@ -49,9 +49,13 @@ impl Pieces {
         params: &FrameParams,
     ) -> voxgi::Result<Step> {
         if self.left.is_empty() {
-            renderer.receive_feedback()?;
+            let rebuild = renderer.receive_feedback()?;
             if renderer.feedback_in_flight() {
                 return Ok(Step::Waiting);
+            }
+            // Only a rebuild waits: progressive bounces go on converging in the frames.
+            if !rebuild {
+                return Ok(Step::Done);
             }
             let more = renderer.prepare(params)?;
             if more.is_empty() {

@@ -269,7 +269,13 @@ impl Renderer {
         let rebuild = self.pending.rebuild;
         let relit = self.record_voxels(&mut encoder, work, &mut cut);
         self.timer = timed;
-        // The blend step and the history's restart belong to the frame.
+        // The blend step and the history's restart belong to the frame (with what an earlier
+        // `prepare` for it did).
+        let relit = match (relit, self.prepared.and_then(|p| p.relit)) {
+            (Some(a), Some(b)) => Some(a || b),
+            (a, b) => a.or(b),
+        };
+        let rebuild = rebuild || self.prepared.is_some_and(|p| p.rebuild);
         self.prepared = Some(Prepared { rebuild, relit });
         Ok(pieces)
     }

@@ -135,6 +135,10 @@ impl Renderer {
             let moved = old.union(&new);
             self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
             self.pending.geometry = true;
+        } else {
+            // An area light's surface: not voxelized, but it shadows the other lights, whose
+            // light in the voxels follows.
+            self.pending.lights = true;
         }
         Ok(())
     }
