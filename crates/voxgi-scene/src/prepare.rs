@@ -1,7 +1,7 @@
 //! Point preparation: the attributes a point cloud needs for rendering (normals, regions of
 //! influence, disc radii), estimated where the file gave none.
 
-use crate::{Aabb, Scene, pointcloud};
+use crate::{Aabb, PointCloud, Scene, pointcloud};
 use glam::Vec3;
 use std::borrow::Cow;
 use web_time::{Duration, Instant};
@@ -39,54 +39,66 @@ pub fn prepare_points(scene: &mut Scene) -> PointPreparation {
     let mut timing = PointPreparation::default();
     let camera = scene.default_camera().position;
     for pc in &mut scene.point_clouds {
-        if pc.positions.is_empty()
-            || (!pc.normals.is_empty() && !pc.radii.is_empty() && !pc.regions.is_empty())
-        {
-            continue;
-        }
-        let start = Instant::now();
-        let mut local = Aabb::EMPTY;
-        for &p in &pc.positions {
-            local.grow(p);
-        }
-        let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
-        // `estimate_normals` takes the viewpoint in world space.
-        let viewpoint = if origin_outside {
-            pc.transform.transform_point3(Vec3::ZERO)
-        } else {
-            camera
-        };
-        let what: Vec<&str> = [
-            (pc.normals.is_empty(), "normals"),
-            (pc.radii.is_empty(), "radii"),
-            (pc.regions.is_empty(), "regions of influence"),
-        ]
-        .into_iter()
-        .filter_map(|(missing, name)| missing.then_some(name))
-        .collect();
-        let what = what.join(", ");
-        timing.points += pc.positions.len();
-        let t = Instant::now();
-        pointcloud::estimate_normals(pc, 16, viewpoint);
-        timing.normals += t.elapsed();
-        // Regions first: they take the file's radii, not estimated ones.
-        let t = Instant::now();
-        pointcloud::estimate_regions(pc, 8);
-        timing.regions += t.elapsed();
-        let t = Instant::now();
-        pointcloud::estimate_radii(pc, 8);
-        timing.radii += t.elapsed();
-        log::info!(
-            "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
-            pc.name,
-            pc.positions.len(),
-            start.elapsed().as_secs_f64(),
-            if origin_outside {
-                "the cloud's origin"
-            } else {
-                "the default camera"
-            }
-        );
+        let t = prepare_cloud(pc, camera);
+        timing.points += t.points;
+        timing.normals += t.normals;
+        timing.regions += t.regions;
+        timing.radii += t.radii;
     }
+    timing
+}
+
+/// `prepare_points` for one cloud, `camera` the scene's default camera's position (where
+/// normals face when the cloud's origin lies inside it): nothing when it has every attribute.
+pub fn prepare_cloud(pc: &mut PointCloud, camera: Vec3) -> PointPreparation {
+    let mut timing = PointPreparation::default();
+    if pc.positions.is_empty()
+        || (!pc.normals.is_empty() && !pc.radii.is_empty() && !pc.regions.is_empty())
+    {
+        return timing;
+    }
+    let start = Instant::now();
+    let mut local = Aabb::EMPTY;
+    for &p in &pc.positions {
+        local.grow(p);
+    }
+    let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
+    // `estimate_normals` takes the viewpoint in world space.
+    let viewpoint = if origin_outside {
+        pc.transform.transform_point3(Vec3::ZERO)
+    } else {
+        camera
+    };
+    let what: Vec<&str> = [
+        (pc.normals.is_empty(), "normals"),
+        (pc.radii.is_empty(), "radii"),
+        (pc.regions.is_empty(), "regions of influence"),
+    ]
+    .into_iter()
+    .filter_map(|(missing, name)| missing.then_some(name))
+    .collect();
+    let what = what.join(", ");
+    timing.points += pc.positions.len();
+    let t = Instant::now();
+    pointcloud::estimate_normals(pc, 16, viewpoint);
+    timing.normals += t.elapsed();
+    // Regions first: they take the file's radii, not estimated ones.
+    let t = Instant::now();
+    pointcloud::estimate_regions(pc, 8);
+    timing.regions += t.elapsed();
+    let t = Instant::now();
+    pointcloud::estimate_radii(pc, 8);
+    timing.radii += t.elapsed();
+    log::info!(
+        "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
+        pc.name,
+        pc.positions.len(),
+        start.elapsed().as_secs_f64(),
+        if origin_outside {
+            "the cloud's origin"
+        } else {
+            "the default camera"
+        }
+    );
     timing
 }

@@ -634,6 +634,34 @@ impl GpuScene {
         }
     }
 
+    /// Gives dynamic cloud `cloud` new points (`pc`, placed by its transform, at most as many
+    /// as its range holds): they are written from its range's start, with their surface
+    /// spread computed anew; the slots left over get points that nothing draws or splats (no
+    /// disc, at `park`: a place outside the voxels).
+    pub fn set_cloud_points(
+        &mut self,
+        queue: &wgpu::Queue,
+        cloud: usize,
+        pc: &voxgi_scene::PointCloud,
+        park: Vec3,
+    ) {
+        let Some(range) = self.cloud_ranges.get(cloud).cloned() else {
+            return;
+        };
+        let n = pc.positions.len().min(range.len());
+        self.local_spread[cloud] = pointcloud::surface_spread(pc, 24);
+        self.set_cloud(queue, cloud, pc);
+        let left = range.len() - n;
+        if left > 0 {
+            let at = (range.start as usize + n) as u64;
+            let parked = vec![GpuPoint::new(park, 0.0, Vec3::ZERO, [0.0; 3], [0.0; 3]); left];
+            let zeros = vec![0f32; left];
+            queue.write_buffer(&self.points, at * 32, bytemuck::cast_slice(&parked));
+            queue.write_buffer(&self.point_regions, at * 4, bytemuck::cast_slice(&zeros));
+            queue.write_buffer(&self.point_spread, at * 4, bytemuck::cast_slice(&zeros));
+        }
+    }
+
     /// Writes point cloud `cloud` (an index into the scene's clouds, uploaded dynamic) anew
     /// where `pc` (the cloud as uploaded, with its new transform) puts it: its surfels, their
     /// regions and spread, as a fresh upload computes them.
@@ -641,8 +669,13 @@ impl GpuScene {
         let Some(range) = self.cloud_ranges.get(cloud).filter(|r| !r.is_empty()) else {
             return;
         };
-        let (points, regions) = cloud_points(pc);
-        let spread = scaled_spread(pc, &self.local_spread[cloud]);
+        let (mut points, mut regions) = cloud_points(pc);
+        let mut spread = scaled_spread(pc, &self.local_spread[cloud]);
+        // Never past its range (`set_cloud_points` keeps new points within it).
+        for v in [&mut regions, &mut spread] {
+            v.truncate(range.len());
+        }
+        points.truncate(range.len());
         let at = range.start as u64;
         queue.write_buffer(&self.points, at * 32, bytemuck::cast_slice(&points));
         queue.write_buffer(&self.point_regions, at * 4, bytemuck::cast_slice(&regions));

@@ -143,6 +143,104 @@ impl Renderer {
         Ok(())
     }
 
+    /// Gives dynamic point cloud `cloud` new points: `points`' positions and attributes, in
+    /// the cloud's own space (it stays where `set_cloud_transform` or its animation put it;
+    /// `points.transform` is not read). At most as many points as the cloud had when the
+    /// renderer was made (upload a cloud that grows at its largest); attributes it lacks
+    /// (normals, radii, regions of influence) are estimated as at upload, on the CPU. The
+    /// next voxel update splats them; a changed cloud has no motion vectors (its points are
+    /// not the last frame's). Returns how long the estimation took.
+    pub fn set_points(
+        &mut self,
+        cloud: usize,
+        points: &voxgi_scene::PointCloud,
+    ) -> Result<voxgi_scene::prepare::PointPreparation> {
+        let count = self.state.clouds.len();
+        let c = self.state.clouds.get(cloud).ok_or_else(|| {
+            Error::Setting(format!(
+                "point cloud {cloud} does not exist (the scene has {count})"
+            ))
+        })?;
+        let Some(old) = c.points.clone().filter(|_| c.dynamic) else {
+            return Err(Error::Setting(format!(
+                "point cloud '{}' is static: only dynamic clouds change (mark it dynamic in \
+                 the scene: `dynamic = true` on its include)",
+                c.name
+            )));
+        };
+        let n = points.positions.len();
+        let room = self.scene.cloud_ranges[cloud].len();
+        if n > room {
+            return Err(Error::Setting(format!(
+                "point cloud '{}': {n} points, more than the {room} it was uploaded with (upload \
+                 it at its largest)",
+                c.name
+            )));
+        }
+        let attribute = |what: &str, len: usize| {
+            if len == 0 || len == n {
+                Ok(())
+            } else {
+                Err(Error::Setting(format!(
+                    "point cloud '{}': {len} {what} for {n} points",
+                    c.name
+                )))
+            }
+        };
+        attribute("colours", points.colors.len())?;
+        attribute("normals", points.normals.len())?;
+        attribute("radii", points.radii.len())?;
+        attribute("regions", points.regions.len())?;
+        attribute("emissions", points.emission.len())?;
+        if let Some(i) = points.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::Setting(format!(
+                "point cloud '{}': point {i} is not finite",
+                c.name
+            )));
+        }
+        let mut pc = points.clone();
+        pc.transform = c.transform;
+        pc.dynamic = true;
+        pc.light = old.light;
+        pc.name = old.name.clone();
+        let prepared = voxgi_scene::prepare::prepare_cloud(&mut pc, self.default_camera.position);
+        let (transform, old_local) = (c.transform, c.local);
+        let mut local = Aabb::EMPTY;
+        for &p in &pc.positions {
+            local.grow(p);
+        }
+        let grid = self.volume.grid();
+        // Outside the voxels (the splat makes no fragment there) and drawn as nothing.
+        let park = grid.origin - glam::Vec3::splat(4.0 * grid.voxel_size);
+        self.scene.set_cloud_points(&self.queue, cloud, &pc, park);
+        let zero = vec![[0.0f32; 4]; room];
+        self.scene.set_cloud_motion(&self.queue, cloud, &zero);
+        let geometry = pc.light.is_none();
+        let cs = &mut self.state.clouds[cloud];
+        cs.points = Some(std::sync::Arc::new(pc));
+        cs.local = local;
+        cs.drawn = transform;
+        cs.moving = false;
+        let (old, new) = (
+            old_local.transformed(transform),
+            local.transformed(transform),
+        );
+        for v in 0..self.atlas.views.len() {
+            let view = &self.atlas.views[v];
+            let dirt = shadow::box_dirt(view, old.min, old.max)
+                .merge(shadow::box_dirt(view, new.min, new.max));
+            self.pending.view(v, dirt);
+        }
+        if geometry {
+            let moved = old.union(&new);
+            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
+            self.pending.geometry = true;
+        } else {
+            self.pending.lights = true;
+        }
+        Ok(prepared)
+    }
+
     /// Changes light `index` (into the scene's lights) to `light`: its position, direction,
     /// colour, intensity, range, cone angles or area shape. Its kind (directional, point,
     /// spot, area) and whether it casts shadows are fixed once uploaded (an error: make a new
@@ -253,7 +351,7 @@ impl Renderer {
                 continue;
             }
             let (then, now) = (cs.drawn, cs.transform);
-            let motion: Vec<[f32; 4]> = points
+            let mut motion: Vec<[f32; 4]> = points
                 .positions
                 .iter()
                 .map(|&p| {
@@ -265,6 +363,8 @@ impl Renderer {
                     [d.x, d.y, d.z, 0.0]
                 })
                 .collect();
+            // Slots a smaller set of points (`set_points`) left empty do not move.
+            motion.resize(self.scene.cloud_ranges[c].len(), [0.0; 4]);
             self.scene.set_cloud_motion(&self.queue, c, &motion);
             let cs = &mut self.state.clouds[c];
             cs.drawn = now;

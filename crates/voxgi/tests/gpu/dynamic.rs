@@ -245,6 +245,76 @@ fn a_moving_point_cloud_renders_like_a_fresh_renderer() {
     }
 }
 
+/// A dynamic cloud given new points (`set_points`: the cube's surface sampled more coarsely,
+/// then turned and squashed, without normals, radii or regions, which are estimated) renders as a
+/// renderer made with those points where the cloud is: the same voxels, and the same image but
+/// for the octree's bricks, which lie elsewhere in atlases sized for more points (as when a
+/// cube moves away, below). More points than it was uploaded with is an error.
+#[test]
+fn a_point_cloud_given_new_points_renders_like_a_fresh_renderer() {
+    let coarse = voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.3, 0.3, 0.8]), 0.08);
+    // The cube turned 30° about its vertical axis and squashed, without its attributes.
+    let mut turned =
+        voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.8, 0.3, 0.3]), 0.06)
+            .point_clouds
+            .remove(0);
+    let m = Mat4::from_rotation_y(0.5) * Mat4::from_scale(Vec3::new(1.0, 0.6, 1.0));
+    for p in &mut turned.positions {
+        *p = m.transform_point3(*p);
+    }
+    turned.normals.clear();
+    turned.radii.clear();
+    turned.regions.clear();
+    for options in both_paths() {
+        let (mut scene, cloud) = cornell_with_point_cube((0.40, 0.15));
+        let mut r = renderer(&scene, &options);
+        let p = params(&r);
+        frame(&mut r, &p, SIZE, SIZE);
+        for (step, new) in [coarse.point_clouds[0].clone(), turned.clone()]
+            .into_iter()
+            .enumerate()
+        {
+            r.set_points(cloud, &new)
+                .expect("fewer points than uploaded");
+            let placed = &mut scene.point_clouds[cloud];
+            let transform = placed.transform;
+            *placed = new.clone();
+            placed.transform = transform;
+            placed.dynamic = true;
+            let what = format!(
+                "new points {step} ({:?}, {} bounces)",
+                options.voxels, options.bounces
+            );
+            let got = frame(&mut r, &p, SIZE, SIZE);
+            let mut fresh = renderer(&scene, &options);
+            let want = frame(&mut fresh, &p, SIZE, SIZE);
+            let tolerance = if options.voxels == voxgi::VoxelKind::OCTREE {
+                1e-4
+            } else {
+                0.0
+            };
+            assert_close_image(&got, &want, tolerance, &what);
+            assert_eq!(
+                r.voxel_counts().expect("counts").occupied,
+                fresh.voxel_counts().expect("counts").occupied,
+                "{what}: occupied voxels"
+            );
+            for ((name, a), (_, b)) in volume_bytes(&r).iter().zip(volume_bytes(&fresh).iter()) {
+                assert!(
+                    a == b,
+                    "{what}: the volume's {name} differs from a fresh build"
+                );
+            }
+        }
+        let too_many = voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.3; 3]), 0.02);
+        let e = r
+            .set_points(cloud, &too_many.point_clouds[0])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("more than"), "{e}");
+    }
+}
+
 /// A static cloud does not move: an error naming it, as for a static instance.
 #[test]
 fn static_clouds_do_not_move() {
