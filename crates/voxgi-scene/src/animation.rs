@@ -654,6 +654,7 @@ impl Scene {
                     crate::set_light(
                         &mut self.lights,
                         &mut self.instances,
+                        &mut self.point_clouds,
                         *light,
                         tracks.apply(rest, *outer, t),
                     );

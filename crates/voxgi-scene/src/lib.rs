@@ -108,10 +108,16 @@ impl Scene {
     }
 
     /// Replaces light `index` with `light`; an area light's visible surfaces (the instances
-    /// whose `light` it is) move with it, from its old frame to its new
+    /// and point clouds whose `light` it is) move with it, from its old frame to its new
     /// (`Light::emitter_frame`), as `Renderer::set_light` moves them. Out of range: nothing.
     pub fn set_light(&mut self, index: usize, light: Light) {
-        set_light(&mut self.lights, &mut self.instances, index, light);
+        set_light(
+            &mut self.lights,
+            &mut self.instances,
+            &mut self.point_clouds,
+            index,
+            light,
+        );
     }
 
     /// Adds an area light together with the emissive surface that shows it, so the light is
@@ -748,6 +754,7 @@ impl Scene {
 pub(crate) fn set_light(
     lights: &mut [Light],
     instances: &mut [Instance],
+    clouds: &mut [PointCloud],
     index: usize,
     light: Light,
 ) {
@@ -757,6 +764,9 @@ pub(crate) fn set_light(
     if let Some(m) = old.emitter_move(&light) {
         for inst in instances.iter_mut().filter(|i| i.light == Some(index)) {
             inst.transform = m * inst.transform;
+        }
+        for pc in clouds.iter_mut().filter(|pc| pc.light == Some(index)) {
+            pc.transform = m * pc.transform;
         }
     }
     lights[index] = light;

@@ -311,8 +311,9 @@ pub struct GpuScene {
     /// With dynamic clouds, one vec4 per point: where it was drawn at the last frame less
     /// where it is (the motion vectors' share of the points); one element without.
     pub point_motion: wgpu::Buffer,
-    /// The dynamic clouds' surface spread in their own units (`pointcloud::surface_spread`),
-    /// by cloud index (empty for the others), for writing them again where they move.
+    /// The surface spread in their own units (`pointcloud::surface_spread`) of the clouds that
+    /// may move (dynamic ones, area lights' surfaces), by cloud index (empty for the others),
+    /// for writing them again where they move.
     local_spread: Vec<Vec<f32>>,
     /// The points showing each area light: a range of `points` and the light's index. They
     /// are drawn and shadow the other lights, but not their own.
@@ -845,7 +846,8 @@ pub struct GpuPoints {
 
 /// Each point's world-space surface spread (see `GpuScene::point_spread`), in `gpu_points`'
 /// order: a k-nearest-neighbour search per cloud, so only the rasterizer's upload pays for it.
-/// Also the dynamic clouds' spreads in their own units, by cloud index (empty for the others).
+/// Also the spreads in their own units of the clouds that may move, by cloud index (empty for
+/// the others).
 pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
     let mut out = Vec::with_capacity(scene.point_count());
     let mut local = vec![Vec::new(); scene.point_clouds.len()];
@@ -864,7 +866,8 @@ pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
             start.elapsed().as_secs_f64()
         );
         out.extend(scaled_spread(pc, &spread));
-        if pc.dynamic {
+        // The clouds that may move: dynamic ones, and area lights' surfaces.
+        if pc.dynamic || pc.light.is_some() {
             local[c] = spread;
         }
     }

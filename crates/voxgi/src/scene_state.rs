@@ -43,7 +43,8 @@ pub struct CloudState {
     pub light: Option<usize>,
     /// Its points' bounds in its own space.
     pub local: Aabb,
-    /// A dynamic cloud as uploaded (its points in its own space), to place it again.
+    /// A dynamic cloud or an area light's surface as uploaded (its points in its own space),
+    /// to place it again.
     pub points: Option<Arc<PointCloud>>,
     /// The cloud's name, for messages.
     pub name: String,
@@ -73,6 +74,11 @@ pub struct SceneState {
 }
 
 impl SceneState {
+    /// Whether an animation moves point cloud `c`.
+    pub fn animates_cloud(&self, c: usize) -> bool {
+        self.animated_clouds.binary_search(&c).is_ok()
+    }
+
     /// Whether an animation moves instance `i`.
     pub fn animates_instance(&self, i: usize) -> bool {
         self.animated_instances.binary_search(&i).is_ok()
@@ -138,7 +144,9 @@ impl SceneState {
                     dynamic: pc.dynamic,
                     light: pc.light,
                     local,
-                    points: pc.dynamic.then(|| Arc::new(pc.clone())),
+                    // To place it again: a dynamic cloud, or an area light's surface (which
+                    // moves with its light).
+                    points: (pc.dynamic || pc.light.is_some()).then(|| Arc::new(pc.clone())),
                     name: pc.name.clone(),
                     transform: pc.transform,
                     drawn: pc.transform,

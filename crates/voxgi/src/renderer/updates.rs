@@ -109,30 +109,18 @@ impl Renderer {
         if transform == c.transform {
             return Ok(());
         }
-        let Some(points) = c.points.clone().filter(|_| c.dynamic) else {
+        if !c.dynamic {
             return Err(Error::Setting(format!(
                 "point cloud '{}' is static: only dynamic clouds move (mark it dynamic in the \
                  scene: `dynamic = true` on its include)",
                 c.name
             )));
-        };
-        let (old, new) = (
-            c.local.transformed(c.transform),
-            c.local.transformed(transform),
-        );
-        let geometry = c.light.is_none();
-        let mut placed = (*points).clone();
-        placed.transform = transform;
-        self.scene.set_cloud(&self.queue, cloud, &placed);
-        self.state.clouds[cloud].transform = transform;
-        for v in 0..self.atlas.views.len() {
-            let view = &self.atlas.views[v];
-            let dirt = shadow::box_dirt(view, old.min, old.max)
-                .merge(shadow::box_dirt(view, new.min, new.max));
-            self.pending.view(v, dirt);
         }
+        let geometry = c.light.is_none();
+        let Some(moved) = self.place_cloud(cloud, transform) else {
+            return Ok(());
+        };
         if geometry {
-            let moved = old.union(&new);
             self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
             self.pending.geometry = true;
         } else {
@@ -141,6 +129,29 @@ impl Renderer {
             self.pending.lights = true;
         }
         Ok(())
+    }
+
+    /// Puts point cloud `c` at `transform`: its surfels written anew there, and the shadow
+    /// views that saw its old place or see its new one out of date. Returns where it was and
+    /// is (world space); `None` for a cloud the renderer keeps no points of (a static one).
+    fn place_cloud(&mut self, c: usize, transform: Mat4) -> Option<Aabb> {
+        let cs = &self.state.clouds[c];
+        let points = cs.points.clone()?;
+        let (old, new) = (
+            cs.local.transformed(cs.transform),
+            cs.local.transformed(transform),
+        );
+        let mut placed = (*points).clone();
+        placed.transform = transform;
+        self.scene.set_cloud(&self.queue, c, &placed);
+        self.state.clouds[c].transform = transform;
+        for v in 0..self.atlas.views.len() {
+            let view = &self.atlas.views[v];
+            let dirt = shadow::box_dirt(view, old.min, old.max)
+                .merge(shadow::box_dirt(view, new.min, new.max));
+            self.pending.view(v, dirt);
+        }
+        Some(old.union(&new))
     }
 
     /// Gives dynamic point cloud `cloud` new points: `points`' positions and attributes, in
@@ -310,6 +321,12 @@ impl Renderer {
             let inst = &self.state.instances[i];
             if inst.light == Some(light) && !self.state.animates_instance(i) {
                 self.place(i, m * inst.transform);
+            }
+        }
+        for c in 0..self.state.clouds.len() {
+            let cloud = &self.state.clouds[c];
+            if cloud.light == Some(light) && !self.state.animates_cloud(c) {
+                self.place_cloud(c, m * cloud.transform);
             }
         }
     }

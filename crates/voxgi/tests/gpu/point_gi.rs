@@ -408,7 +408,7 @@ fn the_bunnys_vertices_bounce_light_as_its_mesh_does() {
 /// A 30 cm square lamp 6 cm above a 4 m floor, facing down, emitting 8 W/(m² sr): a quad mesh,
 /// or a grid of 30 x 30 emissive points 1 cm apart, each promoted to an area light when
 /// `promote`.
-fn lamp_over_a_floor(points: bool, promote: bool) -> Scene {
+pub(crate) fn lamp_over_a_floor(points: bool, promote: bool) -> Scene {
     let mut s = Scene::default();
     s.add_mesh(
         quad_mesh("floor", Vec3::ZERO, 4.0),
