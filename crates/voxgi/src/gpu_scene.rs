@@ -651,7 +651,7 @@ impl GpuScene {
         };
         let n = pc.positions.len().min(range.len());
         self.local_spread[cloud] = pointcloud::surface_spread(pc, 24);
-        self.set_cloud(queue, cloud, pc);
+        self.set_cloud(queue, cloud, pc, pc.transform);
         let left = range.len() - n;
         if left > 0 {
             let at = (range.start as usize + n) as u64;
@@ -663,15 +663,21 @@ impl GpuScene {
         }
     }
 
-    /// Writes point cloud `cloud` (an index into the scene's clouds, uploaded dynamic) anew
-    /// where `pc` (the cloud as uploaded, with its new transform) puts it: its surfels, their
-    /// regions and spread, as a fresh upload computes them.
-    pub fn set_cloud(&self, queue: &wgpu::Queue, cloud: usize, pc: &voxgi_scene::PointCloud) {
+    /// Writes point cloud `cloud` (an index into the scene's clouds, one that may move) anew
+    /// where `transform` puts `pc` (its points as uploaded): its surfels, their regions and
+    /// spread, as a fresh upload computes them.
+    pub fn set_cloud(
+        &self,
+        queue: &wgpu::Queue,
+        cloud: usize,
+        pc: &voxgi_scene::PointCloud,
+        transform: Mat4,
+    ) {
         let Some(range) = self.cloud_ranges.get(cloud).filter(|r| !r.is_empty()) else {
             return;
         };
-        let (mut points, mut regions) = cloud_points(pc);
-        let mut spread = scaled_spread(pc, &self.local_spread[cloud]);
+        let (mut points, mut regions) = cloud_points(pc, transform);
+        let mut spread = scaled_spread(pc, transform, &self.local_spread[cloud]);
         // Never past its range (`set_cloud_points` keeps new points within it).
         for v in [&mut regions, &mut spread] {
             v.truncate(range.len());
@@ -759,7 +765,7 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
             Some(l) => emitters.push((range.clone(), l)),
         }
         clouds[c] = range;
-        let (p, r) = cloud_points(pc);
+        let (p, r) = cloud_points(pc, pc.transform);
         points.extend(p);
         regions.extend(r);
     }
@@ -773,18 +779,18 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
     }
 }
 
-/// One cloud's surfels in world space and their regions (see `gpu_points`).
-pub fn cloud_points(pc: &voxgi_scene::PointCloud) -> (Vec<GpuPoint>, Vec<f32>) {
+/// One cloud's surfels in world space and their regions (see `gpu_points`), placed by `m`
+/// (its transform, or where it moves to).
+pub fn cloud_points(pc: &voxgi_scene::PointCloud, m: Mat4) -> (Vec<GpuPoint>, Vec<f32>) {
     let mut points = Vec::with_capacity(pc.positions.len());
     let mut regions = Vec::with_capacity(pc.positions.len());
-    let m = pc.transform;
     let normal_matrix = m.inverse().transpose();
     let normal_matrix = if normal_matrix.is_finite() {
         normal_matrix
     } else {
         Mat4::IDENTITY
     };
-    let scale = cloud_scale(pc);
+    let scale = cloud_scale(m);
     let length = |v: Option<&f32>, s: f32| v.map_or(0.0, |&v| finite_or_zero(v * s).max(0.0));
     for (i, &p) in pc.positions.iter().enumerate() {
         let local_n = pc
@@ -865,7 +871,7 @@ pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
             pc.positions.len(),
             start.elapsed().as_secs_f64()
         );
-        out.extend(scaled_spread(pc, &spread));
+        out.extend(scaled_spread(pc, pc.transform, &spread));
         // The clouds that may move: dynamic ones, and area lights' surfaces.
         if pc.dynamic || pc.light.is_some() {
             local[c] = spread;
@@ -874,9 +880,9 @@ pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
     (out, local)
 }
 
-/// `pc`'s surface spread (in its own units, by point) in the world: by the cloud's scale.
-fn scaled_spread(pc: &voxgi_scene::PointCloud, spread: &[f32]) -> Vec<f32> {
-    let scale = cloud_scale(pc);
+/// `pc`'s surface spread (in its own units, by point) in the world: by the scale of `m`.
+fn scaled_spread(pc: &voxgi_scene::PointCloud, m: Mat4, spread: &[f32]) -> Vec<f32> {
+    let scale = cloud_scale(m);
     (0..pc.positions.len())
         .map(|i| spread.get(i).map_or(0.0, |&s| finite_or_zero(s * scale)))
         .collect()
@@ -893,10 +899,10 @@ fn largest_stretch(m: Mat4, n: Vec3) -> f32 {
     if s.is_finite() { s } else { 1.0 }
 }
 
-/// A cloud's mean scale: the cube root of its transform's volume scale (|det| of the linear
-/// part), 1 when that is not finite.
-fn cloud_scale(pc: &voxgi_scene::PointCloud) -> f32 {
-    let scale = pc.transform.determinant().abs().cbrt();
+/// A cloud's mean scale under transform `m`: the cube root of its volume scale (|det| of the
+/// linear part), 1 when that is not finite.
+fn cloud_scale(m: Mat4) -> f32 {
+    let scale = m.determinant().abs().cbrt();
     if scale.is_finite() { scale } else { 1.0 }
 }
 

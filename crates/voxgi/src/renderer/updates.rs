@@ -81,8 +81,7 @@ impl Renderer {
             )));
         }
         if let Some(moved) = self.place(instance, transform) {
-            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
-            self.pending.geometry = true;
+            self.geometry_moved(moved);
         }
         Ok(())
     }
@@ -121,14 +120,31 @@ impl Renderer {
             return Ok(());
         };
         if geometry {
-            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
-            self.pending.geometry = true;
+            self.geometry_moved(moved);
         } else {
             // An area light's surface: not voxelized, but it shadows the other lights, whose
             // light in the voxels follows.
             self.pending.lights = true;
         }
         Ok(())
+    }
+
+    /// Marks out of date the shadow views (and their injection) that saw `old` or see `new`
+    /// (world boxes): where something moved or changed.
+    fn dirty_views(&mut self, old: Aabb, new: Aabb) {
+        for v in 0..self.atlas.views.len() {
+            let view = &self.atlas.views[v];
+            let dirt = shadow::box_dirt(view, old.min, old.max)
+                .merge(shadow::box_dirt(view, new.min, new.max));
+            self.pending.view(v, dirt);
+        }
+    }
+
+    /// Dynamic geometry changed within `moved` (world space): the next voxel update redoes it
+    /// and re-injects the leaves there.
+    fn geometry_moved(&mut self, moved: Aabb) {
+        self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
+        self.pending.geometry = true;
     }
 
     /// Puts point cloud `c` at `transform`: its surfels written anew there, and the shadow
@@ -141,16 +157,9 @@ impl Renderer {
             cs.local.transformed(cs.transform),
             cs.local.transformed(transform),
         );
-        let mut placed = (*points).clone();
-        placed.transform = transform;
-        self.scene.set_cloud(&self.queue, c, &placed);
+        self.scene.set_cloud(&self.queue, c, &points, transform);
         self.state.clouds[c].transform = transform;
-        for v in 0..self.atlas.views.len() {
-            let view = &self.atlas.views[v];
-            let dirt = shadow::box_dirt(view, old.min, old.max)
-                .merge(shadow::box_dirt(view, new.min, new.max));
-            self.pending.view(v, dirt);
-        }
+        self.dirty_views(old, new);
         Some(old.union(&new))
     }
 
@@ -236,16 +245,9 @@ impl Renderer {
             old_local.transformed(transform),
             local.transformed(transform),
         );
-        for v in 0..self.atlas.views.len() {
-            let view = &self.atlas.views[v];
-            let dirt = shadow::box_dirt(view, old.min, old.max)
-                .merge(shadow::box_dirt(view, new.min, new.max));
-            self.pending.view(v, dirt);
-        }
+        self.dirty_views(old, new);
         if geometry {
-            let moved = old.union(&new);
-            self.pending.moved = Some(self.pending.moved.map_or(moved, |m| m.union(&moved)));
-            self.pending.geometry = true;
+            self.geometry_moved(old.union(&new));
         } else {
             self.pending.lights = true;
         }
@@ -344,12 +346,7 @@ impl Renderer {
         self.state.instances[i].transform = transform;
         let draw = draw?;
         self.scene.set_transform(&self.queue, draw, transform);
-        for v in 0..self.atlas.views.len() {
-            let view = &self.atlas.views[v];
-            let dirt = shadow::box_dirt(view, old.min, old.max)
-                .merge(shadow::box_dirt(view, new.min, new.max));
-            self.pending.view(v, dirt);
-        }
+        self.dirty_views(old, new);
         Some(old.union(&new))
     }
 
