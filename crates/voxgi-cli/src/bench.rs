@@ -244,9 +244,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     println!("scene upload (CPU and GPU): {upload:.0} ms");
     if let Some(p) = &points {
         println!(
-            "points: {} estimated; normals {:.0} ms, regions {:.0} ms, radii {:.0} ms (CPU, {} \
-             threads)",
+            "points: {} estimated; neighbours {:.0} ms, normals {:.0} ms, regions {:.0} ms, radii \
+             {:.0} ms (CPU, {} threads)",
             p.points,
+            p.neighbours.as_secs_f64() * 1e3,
             p.normals.as_secs_f64() * 1e3,
             p.regions.as_secs_f64() * 1e3,
             p.radii.as_secs_f64() * 1e3,
@@ -273,6 +274,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "upload_ms": upload,
             "points": points.map(|p| serde_json::json!({
                 "estimated": p.points,
+                "neighbours_ms": p.neighbours.as_secs_f64() * 1e3,
                 "normals_ms": p.normals.as_secs_f64() * 1e3,
                 "regions_ms": p.regions.as_secs_f64() * 1e3,
                 "radii_ms": p.radii.as_secs_f64() * 1e3,

@@ -1,7 +1,8 @@
 //! Point preparation: the attributes a point cloud needs for rendering (normals, regions of
 //! influence, disc radii), estimated where the file gave none.
 
-use crate::{Aabb, PointCloud, Scene, pointcloud};
+use crate::pointcloud::{self, Neighbours};
+use crate::{Aabb, PointCloud, Scene};
 use glam::Vec3;
 use std::borrow::Cow;
 use web_time::{Duration, Instant};
@@ -10,10 +11,7 @@ use web_time::{Duration, Instant};
 /// scenes that need nothing are not copied). voxgi's renderer and path tracer both call it, so
 /// both see the same points.
 pub fn complete_point_attributes(scene: &mut Cow<'_, Scene>) {
-    if scene.point_clouds.iter().any(|pc| {
-        !pc.positions.is_empty()
-            && (pc.normals.is_empty() || pc.radii.is_empty() || pc.regions.is_empty())
-    }) {
+    if scene.point_clouds.iter().any(needs_preparation) {
         prepare_points(scene.to_mut());
     }
 }
@@ -23,6 +21,8 @@ pub fn complete_point_attributes(scene: &mut Cow<'_, Scene>) {
 pub struct PointPreparation {
     /// Points whose attributes were estimated.
     pub points: usize,
+    /// Finding each point's nearest neighbours (once for all the attributes).
+    pub neighbours: Duration,
     /// Normal estimation (PCA over 16 neighbours).
     pub normals: Duration,
     /// Regions of influence (8 neighbours).
@@ -41,6 +41,7 @@ pub fn prepare_points(scene: &mut Scene) -> PointPreparation {
     for pc in &mut scene.point_clouds {
         let t = prepare_cloud(pc, camera);
         timing.points += t.points;
+        timing.neighbours += t.neighbours;
         timing.normals += t.normals;
         timing.regions += t.regions;
         timing.radii += t.radii;
@@ -48,13 +49,39 @@ pub fn prepare_points(scene: &mut Scene) -> PointPreparation {
     timing
 }
 
+/// Neighbours each estimate reads: normals by PCA over 16, regions and radii from 8.
+pub const NORMAL_NEIGHBOURS: usize = 16;
+pub const REGION_NEIGHBOURS: usize = 8;
+pub const RADIUS_NEIGHBOURS: usize = 8;
+
+/// Whether `prepare_cloud` has anything to estimate.
+pub fn needs_preparation(pc: &PointCloud) -> bool {
+    !pc.positions.is_empty()
+        && (pc.normals.is_empty() || pc.radii.is_empty() || pc.regions.is_empty())
+}
+
 /// `prepare_points` for one cloud, `camera` the scene's default camera's position (where
 /// normals face when the cloud's origin lies inside it): nothing when it has every attribute.
 pub fn prepare_cloud(pc: &mut PointCloud, camera: Vec3) -> PointPreparation {
+    if !needs_preparation(pc) {
+        return PointPreparation::default();
+    }
+    // As many as the renderer's surface spread reads, so that a cloud prepared here and one
+    // given to `Renderer::set_points` (one search for both) take the same neighbours when
+    // several lie at the same distance (points on a grid).
+    let t = Instant::now();
+    let nb = Neighbours::find(&pc.positions, pointcloud::SPREAD_NEIGHBOURS);
+    let neighbours = t.elapsed();
+    let mut timing = prepare_cloud_with(pc, camera, &nb);
+    timing.neighbours = neighbours;
+    timing
+}
+
+/// `prepare_cloud` from neighbours already found (`pointcloud::SPREAD_NEIGHBOURS` of them,
+/// as `prepare_cloud` finds).
+pub fn prepare_cloud_with(pc: &mut PointCloud, camera: Vec3, nb: &Neighbours) -> PointPreparation {
     let mut timing = PointPreparation::default();
-    if pc.positions.is_empty()
-        || (!pc.normals.is_empty() && !pc.radii.is_empty() && !pc.regions.is_empty())
-    {
+    if !needs_preparation(pc) {
         return timing;
     }
     let start = Instant::now();
@@ -80,14 +107,14 @@ pub fn prepare_cloud(pc: &mut PointCloud, camera: Vec3) -> PointPreparation {
     let what = what.join(", ");
     timing.points += pc.positions.len();
     let t = Instant::now();
-    pointcloud::estimate_normals(pc, 16, viewpoint);
+    pointcloud::estimate_normals_from(pc, nb, NORMAL_NEIGHBOURS, viewpoint);
     timing.normals += t.elapsed();
     // Regions first: they take the file's radii, not estimated ones.
     let t = Instant::now();
-    pointcloud::estimate_regions(pc, 8);
+    pointcloud::estimate_regions_from(pc, nb, REGION_NEIGHBOURS);
     timing.regions += t.elapsed();
     let t = Instant::now();
-    pointcloud::estimate_radii(pc, 8);
+    pointcloud::estimate_radii_from(pc, nb, RADIUS_NEIGHBOURS);
     timing.radii += t.elapsed();
     log::info!(
         "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",

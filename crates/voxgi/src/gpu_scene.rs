@@ -644,13 +644,15 @@ impl GpuScene {
         queue: &wgpu::Queue,
         cloud: usize,
         pc: &voxgi_scene::PointCloud,
+        neighbours: &pointcloud::Neighbours,
         park: Vec3,
     ) {
         let Some(range) = self.cloud_ranges.get(cloud).cloned() else {
             return;
         };
         let n = pc.positions.len().min(range.len());
-        self.local_spread[cloud] = pointcloud::surface_spread(pc, 24);
+        self.local_spread[cloud] =
+            pointcloud::surface_spread_from(pc, neighbours, pointcloud::SPREAD_NEIGHBOURS);
         self.set_cloud(queue, cloud, pc, pc.transform);
         let left = range.len() - n;
         if left > 0 {
@@ -863,8 +865,7 @@ pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
             continue;
         }
         let start = web_time::Instant::now();
-        // 24 neighbours (then dilated over 24 more) span a few point spacings each way.
-        let spread = pointcloud::surface_spread(pc, 24);
+        let spread = pointcloud::surface_spread(pc, pointcloud::SPREAD_NEIGHBOURS);
         log::info!(
             "point cloud '{}': surface spread of {} points in {:.2} s",
             pc.name,

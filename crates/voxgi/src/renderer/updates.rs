@@ -223,7 +223,19 @@ impl Renderer {
         pc.dynamic = true;
         pc.light = old.light;
         pc.name = old.name.clone();
-        let prepared = voxgi_scene::prepare::prepare_cloud(&mut pc, self.default_camera.position);
+        // One neighbour search for the attributes and the surface spread.
+        let t = web_time::Instant::now();
+        let neighbours = voxgi_scene::pointcloud::Neighbours::find(
+            &pc.positions,
+            voxgi_scene::pointcloud::SPREAD_NEIGHBOURS,
+        );
+        let found = t.elapsed();
+        let mut prepared = voxgi_scene::prepare::prepare_cloud_with(
+            &mut pc,
+            self.default_camera.position,
+            &neighbours,
+        );
+        prepared.neighbours = found;
         let (transform, old_local) = (c.transform, c.local);
         let mut local = Aabb::EMPTY;
         for &p in &pc.positions {
@@ -232,7 +244,8 @@ impl Renderer {
         let grid = self.volume.grid();
         // Outside the voxels (the splat makes no fragment there) and drawn as nothing.
         let park = grid.origin - glam::Vec3::splat(4.0 * grid.voxel_size);
-        self.scene.set_cloud_points(&self.queue, cloud, &pc, park);
+        self.scene
+            .set_cloud_points(&self.queue, cloud, &pc, &neighbours, park);
         let zero = vec![[0.0f32; 4]; room];
         self.scene.set_cloud_motion(&self.queue, cloud, &zero);
         let geometry = pc.light.is_none();
