@@ -565,7 +565,7 @@ mod tests {
                 }
             })
             .collect();
-        pts.extend_from_slice(&pts[..20].to_vec());
+        pts.extend_from_within(..20);
         for (cloud, k) in [(&pts[..], 24), (&pts[..], 8), (&pts[..5], 24)] {
             let nb = Neighbours::find(cloud, k);
             assert_eq!(nb.k(), k.min(cloud.len() - 1));
