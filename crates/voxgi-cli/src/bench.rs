@@ -61,10 +61,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if !(args.fps.is_finite() && args.fps > 0.0 && args.time.is_finite()) {
         bail!("--fps must be positive and --time finite");
     }
-    if args.animate && scene.animations.is_empty() {
-        bail!("{label} has no animations to play (--animate)");
+    if args.animate && scene.animations.is_empty() && scene.sequences.is_empty() {
+        bail!("{label} has no animations or point sequences to play (--animate)");
     }
     scene.set_time(args.time);
+    scene
+        .load_frames_at(args.time)
+        .with_context(|| label.clone())?;
     let camera = scene.default_camera();
     let (settings, frame) = args
         .settings
@@ -122,6 +125,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut totals = Vec::new();
     let (mut voxel_sums, mut screen_sums) = (Vec::new(), Vec::new());
     let mut walls = Vec::new();
+    let mut sequence_frames: Vec<voxgi::SequenceFrame> = Vec::new();
     let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
     let voxel_passes = voxgi::voxel_passes();
     for i in 0..args.warmup + args.frames {
@@ -135,7 +139,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             renderer.invalidate();
         }
         if args.animate {
-            renderer.set_time(args.time + i as f32 / args.fps)?;
+            let frames = renderer.set_time(args.time + i as f32 / args.fps)?;
+            if i >= args.warmup {
+                sequence_frames.extend(frames);
+            }
         }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         renderer.render(&mut encoder, &target, &frame)?;
@@ -254,6 +261,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             std::thread::available_parallelism().map_or(1, |n| n.get())
         );
     }
+    let sequences = sequence_summary(&sequence_frames);
     if let Some(path) = &args.json {
         let json = serde_json::json!({
             "adapter": ctx.info.name,
@@ -279,6 +287,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 "regions_ms": p.regions.as_secs_f64() * 1e3,
                 "radii_ms": p.radii.as_secs_f64() * 1e3,
             })),
+            "sequence_frames": sequences,
         });
         let text = serde_json::to_string_pretty(&json)? + "\n";
         voxgi::scene::io::atomic::replace_with(path, |w| w.write_all(text.as_bytes()))
@@ -286,6 +295,43 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The point sequences' frames the measured frames loaded (`Renderer::set_time`): printed as
+/// medians per new frame, and returned for the JSON (null when none changed).
+fn sequence_summary(frames: &[voxgi::SequenceFrame]) -> serde_json::Value {
+    if frames.is_empty() {
+        return serde_json::Value::Null;
+    }
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let median = |f: &dyn Fn(&voxgi::SequenceFrame) -> f64| {
+        let mut v: Vec<f64> = frames.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        percentile(&v, 0.5)
+    };
+    let points = median(&|f| f.points as f64);
+    let waited = median(&|f| ms(f.waited));
+    let neighbours = median(&|f| ms(f.prepared.neighbours));
+    let normals = median(&|f| ms(f.prepared.normals));
+    let regions = median(&|f| ms(f.prepared.regions));
+    let radii = median(&|f| ms(f.prepared.radii));
+    let set = median(&|f| ms(f.set));
+    println!(
+        "point sequences: {} new frames of {points:.0} points (medians, CPU): waiting for the \
+         file {waited:.1} ms; set_points {set:.0} ms, of which neighbours {neighbours:.0}, \
+         normals {normals:.0}, regions {regions:.0}, radii {radii:.0}",
+        frames.len()
+    );
+    serde_json::json!({
+        "count": frames.len(),
+        "points": points,
+        "waited_ms": waited,
+        "set_points_ms": set,
+        "neighbours_ms": neighbours,
+        "normals_ms": normals,
+        "regions_ms": regions,
+        "radii_ms": radii,
+    })
 }
 
 /// Every setting of the table with its value in this run (as the scene file writes it), and

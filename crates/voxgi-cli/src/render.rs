@@ -155,6 +155,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let mut scene = scene;
     scene.set_time(times[0]);
+    scene
+        .load_frames_at(times[0])
+        .with_context(|| label.clone())?;
     let default = scene.default_camera();
     let camera = pick_camera(&scene, &default, args)?;
     let (options, frame) = args
@@ -285,6 +288,7 @@ fn render_sequence(
             }
             None => {
                 scene.set_time(t);
+                scene.load_frames_at(t)?;
                 ctx.watch.check()?;
                 let mut tracer =
                     ctx.watch

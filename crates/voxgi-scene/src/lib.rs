@@ -11,6 +11,7 @@ pub mod io;
 mod model;
 pub mod pointcloud;
 pub mod prepare;
+pub mod sequence;
 mod util;
 
 pub use error::SceneError;
@@ -222,6 +223,11 @@ impl Scene {
             .extend(other.lights.into_iter().map(|l| l.transformed(transform)));
         let inst0 = self.instances.len() - other_instances;
         let cloud0 = self.point_clouds.len() - other_clouds;
+        self.sequences
+            .extend(other.sequences.into_iter().map(|mut s| {
+                s.cloud += cloud0;
+                s
+            }));
         self.animations
             .extend(other.animations.into_iter().map(|mut a| {
                 match &mut a.target {
@@ -444,6 +450,32 @@ impl Scene {
                 ));
             }
         }
+        for (i, s) in self.sequences.iter().enumerate() {
+            let Some(pc) = self.point_clouds.get(s.cloud) else {
+                return bad(format!(
+                    "point sequence {i}: cloud {} out of range",
+                    s.cloud
+                ));
+            };
+            if !pc.dynamic || pc.light.is_some() {
+                return bad(format!(
+                    "point sequence {i}: its cloud '{}' must be dynamic geometry (not static, \
+                     not a light's surface)",
+                    pc.name
+                ));
+            }
+            if s.files.is_empty()
+                || !(s.fps.is_finite() && s.fps > 0.0)
+                || pc.positions.len() > s.capacity
+                || self.sequences[..i].iter().any(|o| o.cloud == s.cloud)
+            {
+                return bad(format!(
+                    "point sequence {i} of cloud '{}': no frames, an fps that is not > 0, more \
+                     points than its capacity, or a second sequence on one cloud",
+                    pc.name
+                ));
+            }
+        }
         let b = self.bounds();
         if !b.is_empty() && !(b.max - b.min).is_finite() {
             let e = |v: Vec3| format!("({:e}, {:e}, {:e})", v.x, v.y, v.z);
@@ -525,19 +557,27 @@ impl Scene {
         let animated_clouds = self.animated_clouds();
         let mut cloud_sweep: Vec<(usize, usize, Aabb)> = Vec::new();
         for (c, pc) in self.point_clouds.iter().enumerate() {
-            let mut b = Aabb::EMPTY;
-            if animated_clouds.binary_search(&c).is_ok() {
-                for &p in &pc.positions {
+            // A sequence's cloud: every frame's points, whichever it shows now.
+            let sequence = self.sequences.iter().find(|s| s.cloud == c);
+            let local = || match sequence {
+                Some(s) => s.bounds,
+                None => pc.positions.iter().fold(Aabb::EMPTY, |mut b, &p| {
                     b.grow(p);
-                }
-                cloud_sweep.push((out.len(), c, b));
-                b = Aabb::EMPTY;
+                    b
+                }),
+            };
+            if animated_clouds.binary_search(&c).is_ok() {
+                cloud_sweep.push((out.len(), c, local()));
+                out.push((pc.name.clone(), Aabb::EMPTY));
+            } else if sequence.is_some() {
+                out.push((pc.name.clone(), local().transformed(pc.transform)));
             } else {
+                let mut b = Aabb::EMPTY;
                 for &p in &pc.positions {
                     b.grow(pc.transform.transform_point3(p));
                 }
+                out.push((pc.name.clone(), b));
             }
-            out.push((pc.name.clone(), b));
         }
         if sweep.is_empty() && cloud_sweep.is_empty() {
             return out;
@@ -700,6 +740,41 @@ impl Scene {
             animations: self.animations.clone(),
             ..Default::default()
         }
+    }
+
+    /// The points cloud `c` may hold at any time: its own, or the largest frame of the point
+    /// sequence that plays in it. Renderers keep room for them.
+    pub fn cloud_capacity(&self, c: usize) -> usize {
+        let n = self.point_clouds.get(c).map_or(0, |pc| pc.positions.len());
+        self.sequences
+            .iter()
+            .filter(|s| s.cloud == c)
+            .fold(n, |n, s| n.max(s.capacity))
+    }
+
+    /// Loads each point sequence's frame at time `t` (seconds) into its cloud, where it is
+    /// not the frame the cloud holds: the file's points replace the cloud's (its placement
+    /// stays; `set_time` moves it). Call it with `set_time` where a scene must show time `t`
+    /// fully (a fresh renderer, the path tracer); a renderer plays sequences itself
+    /// (`Renderer::set_time`). An error names the file.
+    pub fn load_frames_at(&mut self, t: f32) -> Result<()> {
+        for s in &mut self.sequences {
+            let frame = s.frame_at(t);
+            if frame == s.shown {
+                continue;
+            }
+            let points = s.load(frame)?;
+            let pc = &mut self.point_clouds[s.cloud];
+            *pc = PointCloud {
+                name: std::mem::take(&mut pc.name),
+                transform: pc.transform,
+                dynamic: pc.dynamic,
+                light: pc.light,
+                ..points
+            };
+            s.shown = frame;
+        }
+        Ok(())
     }
 
     /// The point clouds some animation moves, sorted, each once.

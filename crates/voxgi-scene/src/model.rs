@@ -20,6 +20,9 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// What moves over time (`Scene::set_time` applies them).
     pub animations: Vec<crate::animation::Animation>,
+    /// Point clouds whose points come from a file per frame (`Scene::load_frames_at` loads
+    /// them; `Scene::set_time` does not, as it touches no files).
+    pub sequences: Vec<crate::sequence::PointSequence>,
 }
 
 /// One triangle list with one material (a glTF primitive, an OBJ group).

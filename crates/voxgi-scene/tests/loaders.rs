@@ -1334,3 +1334,124 @@ target = [0.0, 0.0, 0.0]
     let e = io::load(&named).unwrap_err().to_string();
     assert!(e.contains("[[view]]"), "{e}");
 }
+
+/// An ASCII PLY of points (no attributes) for sequence tests.
+fn points_ply(points: &[[f32; 3]]) -> String {
+    let mut s = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nend_header\n",
+        points.len()
+    );
+    for p in points {
+        s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    s
+}
+
+#[test]
+fn a_sequence_of_point_files_plays_at_its_frame_rate() {
+    let dir = tmp("sequence");
+    std::fs::create_dir_all(dir.join("scan")).unwrap();
+    // Frame k: k + 2 points along x at height k; frame 2 is the largest and reaches farthest.
+    for k in 0..3 {
+        let pts: Vec<[f32; 3]> = (0..k + 2).map(|i| [i as f32, k as f32, 0.0]).collect();
+        write(
+            &dir.join("scan"),
+            &format!("f_{k:03}.ply"),
+            points_ply(&pts),
+        );
+    }
+    let toml = |extra: &str| {
+        format!(
+            "[[include]]\nname = \"scan\"\nfile = \"scan/f_%03d.ply\"\ndynamic = true\n\
+             translate = [10.0, 0.0, 0.0]\n{extra}\n"
+        )
+    };
+    let file = write(&dir, "seq.toml", toml("fps = 2.0\nrepeat = \"loop\""));
+    let mut scene = io::load(&file).unwrap();
+    assert_eq!(scene.sequences.len(), 1);
+    let seq = scene.sequences[0].clone();
+    assert_eq!((seq.cloud, seq.files.len(), seq.capacity), (0, 3, 4));
+    assert_eq!(seq.duration(), 1.5);
+    // The first frame is loaded, placed by the include.
+    let pc = &scene.point_clouds[0];
+    assert!(pc.dynamic);
+    assert_eq!(pc.positions, vec![Vec3::ZERO, Vec3::X]);
+    assert_eq!(
+        pc.transform,
+        Mat4::from_translation(Vec3::new(10.0, 0.0, 0.0))
+    );
+    // Every frame's points are inside the bounds, whichever frame the cloud holds.
+    let b = scene.swept_bounds();
+    assert_eq!(
+        (b.min, b.max),
+        (Vec3::new(10.0, 0.0, 0.0), Vec3::new(13.0, 2.0, 0.0))
+    );
+    // 2 fps: t = 0.5 is frame 1, t = 1.2 frame 2, and looping, t = 1.5 frame 0 again.
+    for (t, frame) in [(0.5, 1usize), (1.2, 2), (1.5, 0), (-0.1, 2), (3.6, 1)] {
+        scene.load_frames_at(t).unwrap();
+        let pc = &scene.point_clouds[0];
+        assert_eq!(pc.positions.len(), frame + 2, "t = {t}");
+        assert_eq!(
+            pc.positions[1],
+            Vec3::new(1.0, frame as f32, 0.0),
+            "t = {t}"
+        );
+        assert_eq!(
+            pc.transform,
+            Mat4::from_translation(Vec3::new(10.0, 0.0, 0.0))
+        );
+        assert_eq!(scene.swept_bounds(), b, "t = {t}");
+    }
+    scene.validate().unwrap();
+    // Clamped (the default), past the end holds the last frame.
+    let file = write(&dir, "clamp.toml", toml("fps = 2.0"));
+    let mut scene = io::load(&file).unwrap();
+    scene.load_frames_at(100.0).unwrap();
+    assert_eq!(scene.point_clouds[0].positions.len(), 4);
+    // Appended into another scene, the sequence follows its cloud.
+    let outer = write(
+        &dir,
+        "outer.toml",
+        "[[include]]\nbuiltin = \"cornell-box\"\n[[include]]\nfile = \"clamp.toml\"\n",
+    );
+    let scene = io::load(&outer).unwrap();
+    assert_eq!(scene.sequences[0].cloud, scene.point_clouds.len() - 1);
+    assert_eq!(
+        scene.point_clouds[scene.sequences[0].cloud].positions.len(),
+        2
+    );
+
+    // What is wrong is said, with the key or the file.
+    let error = |name: &str, extra: &str| {
+        let f = write(&dir, name, extra);
+        io::load(&f).unwrap_err().to_string()
+    };
+    let static_seq = error(
+        "static.toml",
+        "[[include]]\nfile = \"scan/f_%03d.ply\"\nfps = 2.0\n",
+    );
+    assert!(static_seq.contains("dynamic = true"), "{static_seq}");
+    let no_fps = error("nofps.toml", &toml(""));
+    assert!(no_fps.contains("`fps`"), "{no_fps}");
+    let bad_fps = error("badfps.toml", &toml("fps = 0.0"));
+    assert!(bad_fps.contains("fps"), "{bad_fps}");
+    let missing = error(
+        "missing.toml",
+        "[[include]]\nfile = \"scan/g_%03d.ply\"\ndynamic = true\nfps = 2.0\n",
+    );
+    assert!(missing.contains("g_000.ply"), "{missing}");
+    let not_seq = error(
+        "notseq.toml",
+        "[[include]]\nfile = \"scan/f_000.ply\"\nfps = 2.0\n",
+    );
+    assert!(not_seq.contains("frame number"), "{not_seq}");
+    // A frame that is not a point cloud names its file.
+    write(
+        &dir.join("scan"),
+        "f_003.ply",
+        "ply\nformat ascii 1.0\nend_header\n",
+    );
+    let bad_frame = error("badframe.toml", &toml("fps = 2.0"));
+    assert!(bad_frame.contains("f_003.ply"), "{bad_frame}");
+}

@@ -204,6 +204,7 @@ impl GroundTruth {
             move || -> Result<Built> {
                 let mut scene = (*scene).clone();
                 scene.set_time(time);
+                scene.load_frames_at(time)?;
                 // The lights as the renderer has them now: animated, then edited in the window.
                 if lights.len() == scene.lights.len() {
                     scene.lights = lights.clone();

@@ -66,6 +66,17 @@ const _: () = assert!(size_of::<GpuPoint>() == 32);
 pub const POINT_NO_NORMAL: u32 = 0x8000_8000;
 
 impl GpuPoint {
+    /// A slot a cloud keeps for more points than it has now: no disc (nothing draws it), no
+    /// normal, no colour; `GpuScene::park_spare` moves it outside the voxels.
+    pub const SPARE: GpuPoint = GpuPoint {
+        position: [0.0; 3],
+        radius: 0.0,
+        normal: POINT_NO_NORMAL,
+        albedo_rg: 0,
+        albedo_b_emission_r: 0,
+        emission_gb: 0,
+    };
+
     /// Packs one surfel: albedo and emission (linear, W/(m² sr)) as f16, the normal
     /// octahedral-encoded (`POINT_NO_NORMAL` for a zero or non-finite normal).
     pub fn new(
@@ -526,7 +537,7 @@ impl GpuScene {
             static_geometry,
             emitters,
             clouds,
-        } = gpu_points(scene);
+        } = gpu_points(scene, true);
         let (spread, local_spread) = point_spread(scene);
 
         let storage = |label: &str, bytes: &[u8], min: usize| {
@@ -654,9 +665,19 @@ impl GpuScene {
         self.local_spread[cloud] =
             pointcloud::surface_spread_from(pc, neighbours, pointcloud::SPREAD_NEIGHBOURS);
         self.set_cloud(queue, cloud, pc, pc.transform);
-        let left = range.len() - n;
+        self.park_spare(queue, cloud, n, park);
+    }
+
+    /// Puts the slots of cloud `cloud` past its first `used` at `park` (a place outside the
+    /// voxels, where the splat makes no fragment), with no disc, region or spread: nothing
+    /// draws or splats them, and no other point's index moves.
+    pub fn park_spare(&self, queue: &wgpu::Queue, cloud: usize, used: usize, park: Vec3) {
+        let Some(range) = self.cloud_ranges.get(cloud) else {
+            return;
+        };
+        let left = range.len().saturating_sub(used);
         if left > 0 {
-            let at = (range.start as usize + n) as u64;
+            let at = (range.start as usize + used) as u64;
             let parked = vec![GpuPoint::new(park, 0.0, Vec3::ZERO, [0.0; 3], [0.0; 3]); left];
             let zeros = vec![0f32; left];
             queue.write_buffer(&self.points, at * 32, bytemuck::cast_slice(&parked));
@@ -748,8 +769,10 @@ impl GpuScene {
 /// its inverse transpose, radii and regions by its mean scale. Attributes a cloud lacks get
 /// defaults here (no normal: the disc faces the viewer; radius 0: not drawn; region 0: one
 /// voxel; grey albedo; no emission); the renderer estimates normals, radii and regions before
-/// uploading.
-pub fn gpu_points(scene: &Scene) -> GpuPoints {
+/// uploading. With `room`, each cloud's range holds the most points it may hold
+/// (`Scene::cloud_capacity`: a point sequence's largest frame), the slots past its points
+/// without a disc or a region (`GpuScene::park_spare` puts them outside the voxels).
+pub fn gpu_points(scene: &Scene, room: bool) -> GpuPoints {
     let mut points = Vec::with_capacity(scene.point_count());
     let mut regions = Vec::with_capacity(scene.point_count());
     let mut emitters = Vec::new();
@@ -757,19 +780,26 @@ pub fn gpu_points(scene: &Scene) -> GpuPoints {
     let (mut geometry, mut static_geometry) = (0, 0);
     for c in gpu_cloud_order(scene) {
         let pc = &scene.point_clouds[c];
-        let range = points.len()..points.len() + pc.positions.len();
+        let n = if room {
+            scene.cloud_capacity(c)
+        } else {
+            pc.positions.len()
+        };
+        let range = points.len()..points.len() + n;
         match pc.light {
-            None if pc.dynamic => geometry += pc.positions.len(),
+            None if pc.dynamic => geometry += n,
             None => {
                 geometry += pc.positions.len();
                 static_geometry += pc.positions.len();
             }
             Some(l) => emitters.push((range.clone(), l)),
         }
-        clouds[c] = range;
         let (p, r) = cloud_points(pc, pc.transform);
         points.extend(p);
         regions.extend(r);
+        points.resize(range.end, GpuPoint::SPARE);
+        regions.resize(range.end, 0.0);
+        clouds[c] = range;
     }
     GpuPoints {
         points,
@@ -861,7 +891,9 @@ pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
     let mut local = vec![Vec::new(); scene.point_clouds.len()];
     for c in gpu_cloud_order(scene) {
         let pc = &scene.point_clouds[c];
+        let spare = scene.cloud_capacity(c) - pc.positions.len();
         if pc.positions.is_empty() {
+            out.resize(out.len() + spare, 0.0);
             continue;
         }
         let start = web_time::Instant::now();
@@ -873,6 +905,7 @@ pub fn point_spread(scene: &Scene) -> (Vec<f32>, Vec<Vec<f32>>) {
             start.elapsed().as_secs_f64()
         );
         out.extend(scaled_spread(pc, pc.transform, &spread));
+        out.resize(out.len() + spare, 0.0);
         // The clouds that may move: dynamic ones, and area lights' surfaces.
         if pc.dynamic || pc.light.is_some() {
             local[c] = spread;

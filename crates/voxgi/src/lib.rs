@@ -66,7 +66,7 @@ pub use options::{
 pub use output::RenderOutput;
 #[cfg(feature = "reference")]
 pub use reference::{Bounces, PathTracer, ReferenceMode, ReferenceOptions};
-pub use renderer::{PreparedStep, Renderer, TEMPORAL_STILL_FRAMES, VoxelCounts};
+pub use renderer::{PreparedStep, Renderer, SequenceFrame, TEMPORAL_STILL_FRAMES, VoxelCounts};
 pub use settings::{SceneSettings, Setting, parse_bounces};
 pub use voxel::{VoxelKind, voxel_passes};
 /// The scene model and loaders (re-exported from `voxgi-scene`).

@@ -7,6 +7,7 @@ use crate::{Error, Result};
 use glam::Mat4;
 use std::sync::Arc;
 use voxgi_scene::animation::{Animation, AnimationTarget};
+use voxgi_scene::sequence::{NewFrame, SequencePlayer};
 use voxgi_scene::{Aabb, Light, PointCloud, Scene};
 
 /// One instance as the renderer knows it.
@@ -71,6 +72,8 @@ pub struct SceneState {
     animated_instances: Vec<usize>,
     animated_clouds: Vec<usize>,
     animated_lights: Vec<usize>,
+    /// The point sequences, playing in their clouds.
+    player: SequencePlayer,
 }
 
 impl SceneState {
@@ -108,6 +111,8 @@ pub struct TimeChanges {
     pub clouds: Vec<(usize, Mat4)>,
     /// Lights with new values: (index, light).
     pub lights: Vec<(usize, Light)>,
+    /// Point sequences' clouds with a new frame, loaded.
+    pub frames: Vec<NewFrame>,
 }
 
 impl SceneState {
@@ -180,6 +185,7 @@ impl SceneState {
             animated_instances,
             animated_clouds,
             animated_lights,
+            player: SequencePlayer::new(&scene.sequences),
         }
     }
 
@@ -188,7 +194,8 @@ impl SceneState {
         &self.animated.animations
     }
 
-    /// Samples the animations at time `t` and lists what changed since the last state set.
+    /// Samples the animations at time `t` and lists what changed since the last state set,
+    /// with the point sequences' frames that changed, loaded (an error names a bad file).
     pub fn set_time(&mut self, t: f32) -> Result<TimeChanges> {
         if !t.is_finite() {
             return Err(Error::Setting(format!("time {t} is not a finite number")));
@@ -222,6 +229,7 @@ impl SceneState {
             instances,
             clouds,
             lights,
+            frames: self.player.frames_at(t)?,
         })
     }
 }

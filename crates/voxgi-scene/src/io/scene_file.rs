@@ -14,6 +14,8 @@
 //! rotate = [0.0, 90.0, 0.0]        # degrees about X, then Y, then Z (default 0)
 //! scale = 0.01                     # number or [x, y, z], non-zero (default 1)
 //! dynamic = false                  # the included instances may move (default false)
+//! # fps = 30.0                     # a sequence of point files (see below), frames a second
+//! # repeat = "loop"                #   past its last frame: "clamp" (hold it, default) | "loop"
 //! [include.material]               # optional; overrides every material of this include
 //! base_color = [0.8, 0.8, 0.8]     # linear RGB; also drops the base-colour texture
 //! emissive = [0.0, 0.0, 0.0]       # linear radiance; also drops the emissive texture
@@ -78,6 +80,15 @@
 //! An include's motion is applied in world space on top of its placement (keyframe values are
 //! offsets from the rest pose); a light's keyframes replace its position, direction, colour or
 //! intensity. `Scene::set_time` applies them.
+//!
+//! A point cloud that changes every frame (a live scan, a simulation's output) is an include
+//! whose `file` holds a frame number, printf-style: `file = "scan/frame_%04d.ply"` names
+//! `frame_0000.ply`, `frame_0001.ply` … (`%d` for unpadded numbers, `%%` for a `%`), from 0
+//! (or 1) to the last consecutive file, played at `fps` from time 0. It needs
+//! `dynamic = true` (and may be moved by an animation too); each file must hold one point
+//! cloud without emission, and all are read once at load, so that a bad frame is an error
+//! then and the renderer keeps room for the largest. `Scene::load_frames_at` loads a time's
+//! frames into the scene; a renderer plays them itself (`Renderer::set_time`).
 //!
 //! Included scenes keep their own lights and cameras; without a `[camera]` the first included
 //! camera is the default view. Include cycles are reported as errors.
@@ -159,6 +170,10 @@ struct Include {
     dynamic: bool,
     material: Option<MaterialOverride>,
     points: Option<AsPoints>,
+    /// A sequence's frames per second (its `file` holds a frame number).
+    fps: Option<f32>,
+    /// Past a sequence's last frame: "clamp" or "loop".
+    repeat: Option<String>,
 }
 
 /// An include's meshes as point clouds: `"vertices"` (the meshes' vertices) or a number (the
@@ -310,7 +325,28 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     let mut include_instances: Vec<IncludeRange> = Vec::new();
     for (i, inc) in file.include.iter().enumerate() {
         let what = format!("include {}", i + 1);
+        let sequence = inc
+            .file
+            .as_deref()
+            .filter(|f| crate::sequence::is_pattern(f));
+        if sequence.is_none() && (inc.fps.is_some() || inc.repeat.is_some()) {
+            return Err(err(format!(
+                "{what}: `fps` and `repeat` are for a sequence of point files, whose `file` \
+                 holds a frame number (`scan_%04d.ply`)"
+            )));
+        }
+        let mut played = None;
         let mut sub = match (&inc.file, &inc.builtin) {
+            (Some(f), None) if sequence.is_some() => {
+                let (seq, first) = open_sequence(&dir.join(f), inc)
+                    .map_err(|r| err(format!("{what} ('{f}'): {r}")))?;
+                played = Some(seq);
+                Scene {
+                    name: first.name.clone(),
+                    point_clouds: vec![first],
+                    ..Default::default()
+                }
+            }
             (Some(f), None) => {
                 crate::io::load(&dir.join(f)).map_err(|e| err(format!("{what} ('{f}'): {e}")))?
             }
@@ -381,6 +417,10 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         crate::io::emitters::promote_emissive_points(&mut sub);
         let (first, first_cloud) = (scene.instances.len(), scene.point_clouds.len());
         scene.append(sub, transform, inc.dynamic);
+        if let Some(mut seq) = played {
+            seq.cloud = first_cloud;
+            scene.sequences.push(seq);
+        }
         include_instances.push(IncludeRange {
             name: inc.name.as_deref(),
             instances: first..scene.instances.len(),
@@ -427,6 +467,57 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         scene.cameras.push(cam);
     }
     Ok((scene, file.settings))
+}
+
+/// An include's sequence of point files (`file` holds a frame number) and its first frame.
+fn open_sequence(
+    pattern: &Path,
+    inc: &Include,
+) -> std::result::Result<(crate::sequence::PointSequence, crate::PointCloud), String> {
+    if !inc.dynamic {
+        return Err(
+            "a sequence of point files changes over time: it needs `dynamic = true`".into(),
+        );
+    }
+    let Some(fps) = inc.fps else {
+        return Err("a sequence of point files needs `fps`, its frames per second".into());
+    };
+    if inc.points.is_some() {
+        return Err("`points` makes points of meshes: a sequence's files are points".into());
+    }
+    let base_color = match &inc.material {
+        None => None,
+        Some(o) if o.emissive.is_some() => {
+            return Err("a sequence's points cannot emit (`material.emissive`)".into());
+        }
+        Some(o) => {
+            if o.base_color
+                .is_some_and(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0))
+            {
+                return Err("material colours must be finite and >= 0".into());
+            }
+            o.base_color
+        }
+    };
+    let repeat = parse_repeat(inc.repeat.as_deref())?;
+    let start = web_time::Instant::now();
+    let (seq, mut first) =
+        crate::sequence::PointSequence::open(pattern, fps, repeat, base_color, &mut |n| {
+            log::info!("{}: {n} frames read", pattern.display())
+        })
+        .map_err(|e| e.to_string())?;
+    log::info!(
+        "{}: {} frames of up to {} points read in {:.2} s",
+        pattern.display(),
+        seq.files.len(),
+        seq.capacity,
+        start.elapsed().as_secs_f64()
+    );
+    first.name = pattern
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok((seq, first))
 }
 
 /// A `[camera]` or a `[[view]]`.

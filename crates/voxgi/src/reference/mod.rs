@@ -242,7 +242,7 @@ pub fn flatten(scene: &Scene) -> FlatScene {
     }
     // The discs the rasterizer draws: the same points, normals, radii and colours.
     let mut faceless = 0usize;
-    let points = crate::gpu_scene::gpu_points(scene);
+    let points = crate::gpu_scene::gpu_points(scene, false);
     let mut light_of = vec![NO_INDEX; points.points.len()];
     for (range, l) in &points.emitters {
         light_of[range.clone()].fill(*l as u32);

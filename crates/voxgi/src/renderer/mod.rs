@@ -17,6 +17,7 @@ mod temporal;
 
 pub use temporal::STILL_FRAMES as TEMPORAL_STILL_FRAMES;
 mod updates;
+pub use updates::SequenceFrame;
 
 use crate::brdf::BrdfTables;
 use crate::fragments::splat::SplatPass;
@@ -265,6 +266,9 @@ impl Renderer {
             radius,
         )?;
         let grid = grid(&facts, options);
+        for (c, pc) in scene.point_clouds.iter().enumerate() {
+            gpu_scene.park_spare(queue, c, pc.positions.len(), parking(&grid));
+        }
         let fragments = fragments::allocate(device, grid, facts.fragments_wanted(options, &grid))?;
         let mut volume =
             (options.voxels.info().create)(device, &facts.structure_desc(options, grid), None)?;
@@ -769,6 +773,13 @@ impl Renderer {
 /// The volume's grid around the scene.
 fn grid(facts: &SceneFacts, options: &RendererOptions) -> Grid {
     Grid::around(facts.bounds.min, facts.bounds.max, options.voxel_resolution)
+}
+
+/// Where a cloud's unused point slots wait: a grid's side below its corner, outside the voxels
+/// of every resolution on the same bounds (a coarser grid reaches farther out, by at most
+/// half of this side), so the splat makes no fragment of them.
+pub(crate) fn parking(grid: &Grid) -> glam::Vec3 {
+    grid.origin - glam::Vec3::splat(grid.extent())
 }
 
 fn composite_pass(

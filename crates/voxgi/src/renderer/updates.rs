@@ -241,9 +241,7 @@ impl Renderer {
         for &p in &pc.positions {
             local.grow(p);
         }
-        let grid = self.volume.grid();
-        // Outside the voxels (the splat makes no fragment there) and drawn as nothing.
-        let park = grid.origin - glam::Vec3::splat(4.0 * grid.voxel_size);
+        let park = super::parking(&self.volume.grid());
         self.scene
             .set_cloud_points(&self.queue, cloud, &pc, &neighbours, park);
         let zero = vec![[0.0f32; 4]; room];
@@ -403,8 +401,12 @@ impl Renderer {
 
     /// Sets the scene's time, in seconds: every animation moves its instances, point clouds
     /// and lights to their state at `t` (`Scene::set_time`), through `set_instance_transform`,
-    /// `set_cloud_transform` and `set_light`. Only what changed is updated.
-    pub fn set_time(&mut self, t: f32) -> Result<()> {
+    /// `set_cloud_transform` and `set_light`, and every point sequence whose frame changes
+    /// gives its cloud the new frame's points (`set_points`; the next frame is read ahead in
+    /// the background, so playing forward seldom waits for a file). Only what changed is
+    /// updated. Returns the sequences' new frames and what each cost; an unreadable frame is
+    /// an error naming its file.
+    pub fn set_time(&mut self, t: f32) -> Result<Vec<SequenceFrame>> {
         let changes = self.state.set_time(t)?;
         for (i, m) in changes.instances {
             self.set_instance_transform(i, m)?;
@@ -415,7 +417,20 @@ impl Renderer {
         for (l, light) in changes.lights {
             self.set_light(l, &light)?;
         }
-        Ok(())
+        let mut frames = Vec::with_capacity(changes.frames.len());
+        for f in changes.frames {
+            let start = web_time::Instant::now();
+            let prepared = self.set_points(f.cloud, &f.points)?;
+            frames.push(SequenceFrame {
+                cloud: f.cloud,
+                frame: f.frame,
+                points: f.points.positions.len(),
+                waited: f.waited,
+                prepared,
+                set: start.elapsed(),
+            });
+        }
+        Ok(frames)
     }
 
     /// The lights as last set (the scene's, and the default sun when one was added), in the
@@ -428,4 +443,22 @@ impl Renderer {
     pub fn animations(&self) -> &[voxgi_scene::animation::Animation] {
         self.state.animations()
     }
+}
+
+/// A point sequence's frame that `Renderer::set_time` gave its cloud, and what it cost on the
+/// CPU (the splat is the next voxel update's).
+#[derive(Clone, Debug)]
+pub struct SequenceFrame {
+    /// The cloud (an index into the scene's point clouds).
+    pub cloud: usize,
+    /// The frame it shows now.
+    pub frame: usize,
+    /// Its points.
+    pub points: usize,
+    /// Waiting for the file (near zero when it was read ahead).
+    pub waited: web_time::Duration,
+    /// The attribute estimation (`set_points`' share of `set`).
+    pub prepared: voxgi_scene::prepare::PointPreparation,
+    /// `set_points` whole: estimation, surfels and their upload.
+    pub set: web_time::Duration,
 }

@@ -878,3 +878,110 @@ fn a_moved_area_light_takes_its_visible_surface_along() {
     let stale = largest_difference(&got.ldr, &left_behind);
     assert!(stale > 50, "a panel left in place differs by only {stale}");
 }
+
+/// A point sequence (a file per frame, positions only: every attribute is estimated) played by
+/// `Renderer::set_time` renders as a renderer made on the scene at that time
+/// (`Scene::load_frames_at`): the same voxels, and the same image but for the octree's bricks
+/// (as with `set_points`, above). The frames differ in size (the renderer keeps room for the
+/// largest from the start); one step also moves the cloud, so its new points land where it is.
+#[test]
+fn a_point_sequence_plays_like_a_fresh_renderer() {
+    let dir = std::env::temp_dir().join(format!("voxgi-gpu-sequence-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let cube = |spacing: f32, m: Mat4| {
+        let pc = voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.5; 3]), spacing)
+            .point_clouds
+            .remove(0);
+        let mut ply = format!(
+            "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+             property float z\nend_header\n",
+            pc.positions.len()
+        );
+        for p in &pc.positions {
+            let p = m.transform_point3(*p);
+            ply += &format!("{} {} {}\n", p.x, p.y, p.z);
+        }
+        (ply, pc.positions.len())
+    };
+    let turned = Mat4::from_rotation_y(0.5) * Mat4::from_scale(Vec3::new(1.0, 0.6, 1.0));
+    let frames = [
+        cube(0.08, Mat4::IDENTITY),
+        cube(0.04, Mat4::IDENTITY),
+        cube(0.06, turned),
+    ];
+    for (k, (ply, _)) in frames.iter().enumerate() {
+        std::fs::write(dir.join(format!("cube_{k:02}.ply")), ply).expect("frame file");
+    }
+    let (seq, first) = voxgi::scene::sequence::PointSequence::open(
+        &dir.join("cube_%02d.ply"),
+        1.0,
+        voxgi::scene::animation::Repeat::Clamp,
+        None,
+        &mut |_| {},
+    )
+    .expect("three frames");
+    assert_eq!((seq.files.len(), seq.capacity), (3, frames[1].1));
+    let mut scene = builtin::cornell_box();
+    let cloud = scene.point_clouds.len();
+    scene.append(
+        Scene {
+            point_clouds: vec![first],
+            ..Default::default()
+        },
+        cube_at((0.40, 0.15)),
+        true,
+    );
+    scene
+        .sequences
+        .push(voxgi::scene::sequence::PointSequence { cloud, ..seq });
+    scene.validate().expect("a valid sequence");
+    for options in both_paths().into_iter().filter(|o| o.bounces == 2) {
+        let mut scene = scene.clone();
+        let mut r = renderer(&scene, &options);
+        let p = params(&r);
+        frame(&mut r, &p, SIZE, SIZE);
+        for (t, want_frame, moved) in [(1.5, 1, None), (2.0, 2, Some((0.25, 0.40))), (0.2, 2, None)]
+        {
+            if let Some(at) = moved {
+                r.set_cloud_transform(cloud, cube_at(at)).expect("dynamic");
+                scene.point_clouds[cloud].transform = cube_at(at);
+            }
+            let played = r.set_time(t).expect("frames load");
+            // Clamped: before the start is frame 0, which t = 0.2 reaches from frame 2.
+            let want_frame = if t < 1.0 { 0 } else { want_frame };
+            assert_eq!(played.len(), 1, "t = {t}");
+            assert_eq!((played[0].cloud, played[0].frame), (cloud, want_frame));
+            assert_eq!(played[0].points, frames[want_frame].1);
+            scene.load_frames_at(t).expect("frames load");
+            assert_eq!(
+                scene.point_clouds[cloud].positions.len(),
+                frames[want_frame].1
+            );
+            let what = format!("t = {t} ({:?})", options.voxels);
+            let got = frame(&mut r, &p, SIZE, SIZE);
+            let mut fresh = renderer(&scene, &options);
+            let want = frame(&mut fresh, &p, SIZE, SIZE);
+            let tolerance = if options.voxels == voxgi::VoxelKind::OCTREE {
+                1e-4
+            } else {
+                0.0
+            };
+            assert_close_image(&got, &want, tolerance, &what);
+            assert_eq!(
+                r.voxel_counts().expect("counts").occupied,
+                fresh.voxel_counts().expect("counts").occupied,
+                "{what}: occupied voxels"
+            );
+            for ((name, a), (_, b)) in volume_bytes(&r).iter().zip(volume_bytes(&fresh).iter()) {
+                assert!(
+                    a == b,
+                    "{what}: the volume's {name} differs from a fresh build"
+                );
+            }
+        }
+        // The same time again loads nothing.
+        assert!(r.set_time(0.2).expect("no change").is_empty());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
