@@ -122,5 +122,18 @@ fn describe(s: &Scene, label: &str) -> String {
             a.duration()
         );
     }
+    let _ = writeln!(o, "point sequences  {}", s.sequences.len());
+    for (i, q) in s.sequences.iter().enumerate() {
+        let _ = writeln!(
+            o,
+            "  [{i}] {:<20} {} frames at {} fps ({:?}), up to {} points, {:.3} s",
+            s.point_clouds.get(q.cloud).map_or("?", |c| c.name.as_str()),
+            q.files.len(),
+            q.fps,
+            q.repeat,
+            q.capacity,
+            q.duration()
+        );
+    }
     o
 }

@@ -742,6 +742,14 @@ impl Scene {
         }
     }
 
+    /// How long the scene plays before it repeats or holds: its longest animation or point
+    /// sequence, seconds (0 for a still scene).
+    pub fn duration(&self) -> f32 {
+        let a = self.animations.iter().map(animation::Animation::duration);
+        let s = self.sequences.iter().map(sequence::PointSequence::duration);
+        a.chain(s).fold(0.0f32, f32::max)
+    }
+
     /// The points cloud `c` may hold at any time: its own, or the largest frame of the point
     /// sequence that plays in it. Renderers keep room for them.
     pub fn cloud_capacity(&self, c: usize) -> usize {

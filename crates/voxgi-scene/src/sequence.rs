@@ -100,10 +100,12 @@ impl PointSequence {
         self.files.len() as f32 / self.fps
     }
 
-    /// The frame shown at time `t` (seconds; frame 0 from t = 0).
+    /// The frame shown at time `t` (seconds; frame 0 from t = 0). A time a ten-thousandth of
+    /// a frame short of a frame's start counts as that frame, so that times computed as
+    /// k / fps in single precision (4.9999995 frames) show frame k.
     pub fn frame_at(&self, t: f32) -> usize {
         let n = self.files.len().max(1) as i64;
-        let f = (t as f64 * self.fps as f64).floor();
+        let f = (t as f64 * self.fps as f64 + 1e-4).floor();
         let f = if f.is_finite() {
             f.clamp(i64::MIN as f64, i64::MAX as f64) as i64
         } else {
@@ -345,5 +347,33 @@ mod tests {
             assert!(FrameNumber::parse(bad).is_err(), "{bad}");
         }
         assert!(is_pattern("a_%04d.ply") && !is_pattern("100%%.ply") && !is_pattern("a.ply"));
+    }
+
+    #[test]
+    fn frames_at_times_computed_from_the_frame_rate() {
+        let s = PointSequence {
+            cloud: 0,
+            files: vec![PathBuf::new(); 24],
+            fps: 12.0,
+            repeat: Repeat::Clamp,
+            capacity: 0,
+            bounds: Aabb::EMPTY,
+            base_color: None,
+            shown: 0,
+        };
+        // 5 / 12 in single precision times 12 is 4.99999992: still frame 5.
+        for k in 0..24 {
+            assert_eq!(s.frame_at(k as f32 / 12.0), k);
+            assert_eq!(s.frame_at((k as f32 + 0.99) / 12.0), k);
+        }
+        assert_eq!(s.frame_at(-1.0), 0);
+        assert_eq!(s.frame_at(f32::NAN), 0);
+        assert_eq!(s.frame_at(1e30), 23);
+        let looped = PointSequence {
+            repeat: Repeat::Loop,
+            ..s
+        };
+        assert_eq!(looped.frame_at(2.0 + 3.0 / 12.0), 3);
+        assert_eq!(looped.frame_at(-1.0 / 12.0), 23);
     }
 }

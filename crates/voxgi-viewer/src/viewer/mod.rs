@@ -451,11 +451,7 @@ impl Viewer {
         } else {
             (bounds.size().length() * 0.5).max(1e-3)
         };
-        let duration = scene
-            .animations
-            .iter()
-            .map(|a| a.duration())
-            .fold(0.0f32, f32::max);
+        let duration = scene.duration();
         let panel_px = if args.screenshot.is_none() || args.with_ui {
             let scale = window.scale_factor() as f32;
             let points = window.inner_size().width as f32 / scale;

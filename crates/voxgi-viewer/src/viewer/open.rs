@@ -105,12 +105,7 @@ impl Viewer {
         self.scene_center = bounds.center();
         self.scene_floor = super::grid::height(&o.scene);
         self.selected_light = None;
-        self.duration = o
-            .scene
-            .animations
-            .iter()
-            .map(|a| a.duration())
-            .fold(0.0f32, f32::max);
+        self.duration = o.scene.duration();
         self.time = 0.0;
         self.playing = self.duration > 0.0 && self.ground.display == Display::ConeTraced;
         self.scene_name = scene_label(&o.scene);
