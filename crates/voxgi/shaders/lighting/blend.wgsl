@@ -12,7 +12,10 @@ struct Blend {
     restart: u32,
     // 1: the update's light is the last bounce's (`leaf_next`); 0: the direct light.
     from_bounce: u32,
-    _pad: u32,
+    // 1: every leaf is stored; 0: only those whose shown light moves (nothing else wrote the
+    // structure since the last step, so it holds the rest already, and the filter after
+    // redoes only around what moved).
+    store_all: u32,
 }
 
 @group(0) @binding(0) var<uniform> blend: Blend;
@@ -35,6 +38,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         // mix(a, b, 1) is b exactly: the last step lands on the update's light to the bit.
         now = mix(shown[s], goal, blend.weight);
     }
+    let was = shown[s];
     shown[s] = now;
-    store_leaf_radiance(s, now);
+    if blend.store_all != 0u || blend.restart != 0u || leaf_is_new(s) || any(now != was) {
+        store_leaf_radiance(s, now);
+    }
 }

@@ -25,8 +25,9 @@ pub struct GpuBlend {
     pub restart: u32,
     /// 1: the update's light is the last bounce's; 0: the direct light.
     pub from_bounce: u32,
-    /// Padding; zero.
-    pub _pad: u32,
+    /// 1: every leaf is stored; 0: only those whose shown light moves (the structure holds
+    /// the others since the last step: nothing else wrote it).
+    pub store_all: u32,
 }
 
 /// The blend pass's pipeline and layout.

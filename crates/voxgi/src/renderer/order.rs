@@ -623,7 +623,8 @@ impl Renderer {
             },
             restart: restart as u32,
             from_bounce: (bounces::stored_bounces(o, self.voxel_bounces) > 0) as u32,
-            _pad: 0,
+            // This frame's voxel update wrote the structure: all of it is shown anew.
+            store_all: relit.is_some() as u32,
         };
         let state = self.blend.as_ref().expect("made above");
         self.passes.blend.record(

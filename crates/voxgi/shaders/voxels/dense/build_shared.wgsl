@@ -31,6 +31,9 @@
 // the static ones), resolved now and restored by the next update. (Eight storage buffers per
 // stage is the minimum limit: the flag and the list share this one.)
 @group(0) @binding(11) var<storage, read_write> dyn_accum: array<atomic<u32>>;
+// The box of voxels written since the last filter, for the filter (counters[8..16]).
+//!include voxels/changed.wgsl
+
 // Indirect dispatch arguments: [0..3] over slots, [3..6] over fragments, [6..9] over
 // `touched`. Only the prepare kernels bind them (a buffer cannot be storage and indirect in
 // one dispatch).
@@ -112,6 +115,8 @@ fn resolve_slot(s: u32, dynamic: bool) {
     textureStore(normal_out, c, a.normal);
     // Alpha: where the surface lies (leaves.wgsl's leaf_surface).
     textureStore(emission_out, c, vec4<f32>(a.emission, a.surface));
+    // The normals feed the first level's NDF weights.
+    mark_changed(c);
 }
 
 // Empties voxel `c` of the finest level.
@@ -120,5 +125,6 @@ fn clear_voxel(c: vec3<u32>) {
     textureStore(normal_out, c, vec4<f32>(0.0));
     textureStore(emission_out, c, vec4<f32>(0.0));
     textureStore(radiance_out, c, vec4<f32>(0.0));
+    mark_changed(c);
 }
 

@@ -4,9 +4,14 @@
 //!include voxels/leaves.wgsl
 //!include shared/half.wgsl
 
+//!include voxels/changed.wgsl
+
 @group(3) @binding(0) var leaf_radiance_out: texture_storage_3d<rgba16float, write>;
 
-// `v`: premultiplied radiance (rgb) and opacity.
+// `v`: premultiplied radiance (rgb) and opacity. The voxel joins the box the next filter
+// redoes.
 fn store_leaf_radiance(i: u32, v: vec4<f32>) {
-    textureStore(leaf_radiance_out, leaf_coord(i), to_half(to_depth(v)));
+    let c = leaf_coord(i);
+    textureStore(leaf_radiance_out, c, to_half(to_depth(v)));
+    mark_changed(c);
 }

@@ -24,19 +24,20 @@
 // Per slot: the voxel's linear index.
 @group(2) @binding(4) var<storage, read> slot_voxel: array<u32>;
 // [0]: slots of the last build (counted past the capacity).
-@group(2) @binding(5) var<storage, read> counters: array<u32>;
+// Read-write: the leaf stores grow the box of written voxels in it (changed.wgsl).
+@group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>>;
 // Per leaf: direct radiance (rgb) and opacity, kept for the bounces.
 @group(2) @binding(6) var<storage, read_write> leaf_direct: array<vec4<f32>>;
 // Per leaf: the last bounce's outgoing radiance and opacity.
 @group(2) @binding(7) var<storage, read_write> leaf_next: array<vec4<f32>>;
 
 fn leaf_count() -> u32 {
-    return min(counters[0], arrayLength(&slot_voxel));
+    return min(atomicLoad(&counters[0]), arrayLength(&slot_voxel));
 }
 
 // Slots above the static geometry's are handed out anew by every update (dense_update).
 fn leaf_is_new(i: u32) -> bool {
-    return i >= counters[2];
+    return i >= atomicLoad(&counters[2]);
 }
 
 fn leaf_coord(i: u32) -> vec3<u32> {

@@ -60,6 +60,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/dense/sample.wgsl",
             "voxels/dense/leaves.wgsl",
             "voxels/dense/leaf_store.wgsl",
+            "voxels/dense/changed.wgsl",
             "voxels/dense/irradiance.wgsl",
             "voxels/dense/build_shared.wgsl",
             "voxels/dense/dense_build.wgsl",
@@ -150,7 +151,8 @@ pub struct DenseVolume {
     pub slot_capacity: u32,
     /// `[0]` occupied voxels (slots, counted past the capacity), `[1]` slots of the previous
     /// build, `[2]` slots of the static geometry, `[3]` and `[4]` slots the dynamic geometry
-    /// touched in this and the previous update (see dense_update.wgsl).
+    /// touched in this and the previous update (see dense_update.wgsl), `[8..16]` the box of
+    /// voxels the build and update wrote since the last filter.
     pub counters: wgpu::Buffer,
     /// Per finest voxel (x fastest): 0 empty, 2 + slot once allocated, or a lock value while
     /// allocating or past the capacity.
@@ -192,6 +194,8 @@ pub struct DenseVolume {
     irradiance: wgpu::BindGroup,
     /// The filter's bind groups for this volume's textures.
     filter_binds: filter::FilterBinds,
+    /// A build since the last filter: the next filter redoes every voxel.
+    built: std::sync::atomic::AtomicBool,
     /// dense_build's and dense_update's bind group over the fragments (`bind_fragments`).
     fragment_bind: FragmentBind,
     /// The build steps' dispatch sizes, bound for the steps that write them.
@@ -445,7 +449,8 @@ impl DenseVolume {
         let normal = texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT);
         let emission = texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT);
         let slot_voxel = storage_buffer(device, "voxel slots", slots * 4, no);
-        let counters = storage_buffer(device, "voxel counters", 32, no);
+        // Words 8 to 15: the box the build and update wrote (build_shared.wgsl).
+        let counters = storage_buffer(device, "voxel counters", 64, no);
         let dyn_slots = if dynamic { slots } else { 1 };
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
@@ -485,10 +490,13 @@ impl DenseVolume {
             9 * 4,
             wgpu::BufferUsages::INDIRECT,
         );
-        let filter_binds =
-            pipelines
-                .filter
-                .bind(device, grid, filtering, [&radiance, &chains, &normal]);
+        let filter_binds = pipelines.filter.bind(
+            device,
+            grid,
+            filtering,
+            [&radiance, &chains, &normal],
+            &counters,
+        );
         DenseVolume {
             grid,
             anisotropic,
@@ -521,8 +529,15 @@ impl DenseVolume {
             leaf_store,
             irradiance,
             filter_binds,
+            built: true.into(),
             pipelines: pipelines.clone(),
         }
+    }
+
+    /// The last filter's workgroups of 4³ voxels per level (x, y, z as u32, the level above
+    /// the finest first; z counts every block): how much of each level it redid.
+    pub fn filter_dispatch(&self) -> &wgpu::Buffer {
+        &self.filter_binds.args
     }
 
     /// Blocks (directions) of `chains`: six, or one in isotropic mode.
@@ -604,7 +619,7 @@ impl DenseVolume {
                 layout::texture_3d_load(2, c),
                 layout::texture_3d_load(3, c),
                 layout::storage(4, c, true),
-                layout::storage(5, c, true),
+                layout::storage(5, c, false),
                 layout::storage(6, c, false),
                 layout::storage(7, c, false),
             ],
@@ -657,6 +672,7 @@ impl DenseVolume {
             (&b.resolve, Run::Indirect(0)),
         ];
         self.run_steps(encoder, "dense_build", &bind, &steps, timer);
+        self.built.store(true, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// Records an update by the dynamic fragments (those past the build's): undo the
@@ -802,9 +818,11 @@ impl VoxelStructure for DenseVolume {
     }
 
     fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
+        // Recorded in the order the GPU runs it: the build this flag saw comes first.
+        let all = self.built.swap(false, std::sync::atomic::Ordering::Relaxed);
         self.pipelines
             .filter
-            .record(encoder, self, &self.filter_binds, timer);
+            .record(encoder, &self.filter_binds, all, timer);
     }
 
     fn pool_counter(&self) -> &wgpu::Buffer {
