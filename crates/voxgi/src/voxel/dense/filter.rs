@@ -209,9 +209,15 @@ impl FilterPass {
                 })
             })
             .collect();
+        let blocks = if filtering.anisotropic { 6 } else { 1 };
+        let whole = steps
+            .iter()
+            .map(|s| [s.params[1].div_ceil(4), (s.params[1] * blocks).div_ceil(4)])
+            .collect();
         FilterBinds {
             _params: params,
             binds,
+            whole,
             region,
             args,
         }
@@ -246,7 +252,14 @@ impl FilterPass {
         pass.set_pipeline(&self.pipeline);
         for (i, b) in binds.binds.iter().enumerate() {
             pass.set_bind_group(0, b, &[(i as u64 * STRIDE) as u32]);
-            pass.dispatch_workgroups_indirect(&binds.args, i as u64 * 12);
+            if all {
+                // The whole level, sized here: an indirect dispatch makes a CPU driver wait
+                // for `region` before it starts, for nothing.
+                let [n, depth] = binds.whole[i];
+                pass.dispatch_workgroups(n, n, depth);
+            } else {
+                pass.dispatch_workgroups_indirect(&binds.args, i as u64 * 12);
+            }
         }
     }
 }
@@ -256,6 +269,8 @@ pub struct FilterBinds {
     /// Every step's parameters at its dynamic offset; bound by `binds`.
     _params: wgpu::Buffer,
     binds: Vec<wgpu::BindGroup>,
+    /// Each level's workgroups when it is filtered whole: across, and along z (every block).
+    whole: Vec<[u32; 2]>,
     /// `region`'s bind group: `[0]` the written box, `[1]` the whole volume.
     region: [wgpu::BindGroup; 2],
     /// Each level's dispatch size, written by `region`.
