@@ -1,16 +1,17 @@
 //! Point-cloud attribute estimation: normals by PCA over nearest neighbours, and disc radii.
 //!
 //! Both work in the cloud's local (file) coordinates and fill an attribute only when it is
-//! empty, so values from the file win. Neighbour queries use a `kiddo` immutable k-d tree (which,
-//! unlike its mutable tree, copes with many identical points) and run on all cores.
+//! empty, so values from the file win. Neighbour queries search a uniform grid of cells ring by
+//! ring, with a `kiddo` immutable k-d tree (which, unlike its mutable tree, copes with many
+//! identical points) for the few points far from the rest, and run on all cores.
 
 use crate::{Instance, PointCloud, Scene};
 use glam::{DVec3, Mat4, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
 
-/// The nearest neighbours of every point of a cloud, found once (one k-d tree, one query per
-/// point) and shared by the estimates, each reading the nearest few it needs: normals 16,
+/// The nearest neighbours of every point of a cloud, found once (one query per point) and
+/// shared by the estimates, each reading the nearest few it needs: normals 16,
 /// regions and radii 8, the surface spread 24. Five separate queries took three times as long.
 #[derive(Clone, Debug, Default)]
 pub struct Neighbours {
@@ -21,32 +22,49 @@ pub struct Neighbours {
 }
 
 impl Neighbours {
-    /// The `k` nearest neighbours of each of `positions`, on all cores.
+    /// The `k` nearest neighbours of each of `positions`, on all cores: searched ring by ring
+    /// in a uniform grid of cells holding a few points each, where a query runs out after a
+    /// few rings (a point far from the rest) by a k-d tree.
     pub fn find(positions: &[Vec3], k: usize) -> Self {
         let stride = (k + 1).min(positions.len());
         if stride == 0 {
             return Self::default();
         }
-        let pts: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
-        let tree: ImmutableKdTree<f32, 3> = ImmutableKdTree::new_from_slice(&pts);
-        let qty = NonZero::new(stride).unwrap();
-        // Queries in Morton order: neighbouring queries walk the same branches of the tree.
+        let grid = CellGrid::new(positions);
+        let tree = std::sync::OnceLock::new();
+        // Queries in Morton order: neighbouring queries read the same cells.
         let order = morton_order(positions);
-        let sorted = par_chunks(pts.len(), |range, out: &mut Vec<u32>| {
-            let mut found = Vec::with_capacity(stride);
+        let sorted = par_chunks(positions.len(), |range, out: &mut Vec<u32>| {
+            let mut found = Vec::with_capacity(stride + 1);
             for &i in &order[range] {
-                let q = &pts[i as usize];
-                // Unsorted (heap) results sorted here: kiddo's sorted path was 2.4x slower.
+                let q = positions[i as usize];
                 found.clear();
-                found.extend(
-                    tree.nearest_n_within::<SquaredEuclidean>(q, f32::INFINITY, qty, false)
+                if !grid.nearest(positions, q, stride, &mut found) {
+                    found.clear();
+                    let tree = tree.get_or_init(|| {
+                        let pts: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
+                        ImmutableKdTree::<f32, 3>::new_from_slice(&pts)
+                    });
+                    found.extend(
+                        tree.nearest_n_within::<SquaredEuclidean>(
+                            &q.to_array(),
+                            f32::INFINITY,
+                            NonZero::new(stride).unwrap(),
+                            false,
+                        )
                         .iter()
-                        .map(|n| (n.distance, n.item as u32)),
-                );
-                // A query finds `stride` points (all lie within infinity); the padding only
-                // keeps the layout should it not.
-                found.resize(stride, (f32::INFINITY, i));
-                found.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                        .map(|n| {
+                            (
+                                positions[n.item as usize].distance_squared(q),
+                                n.item as u32,
+                            )
+                        }),
+                    );
+                    // A query finds `stride` points (all lie within infinity); the padding
+                    // only keeps the layout should it not.
+                    found.resize(stride, (f32::INFINITY, i));
+                    found.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                }
                 out.extend(found.iter().map(|n| n.1));
             }
         });
@@ -75,6 +93,161 @@ impl Neighbours {
         par_chunks(n, |range, out| {
             out.extend(range.map(|i| f(i, self.of(i, k))))
         })
+    }
+}
+
+/// Points sorted into cubic cells of side `h` (a few points each where the points are), found
+/// by an open-addressing table from cell to range: the exact k nearest by searching rings of
+/// cells outwards until no unsearched cell can hold a nearer point.
+struct CellGrid {
+    lo: Vec3,
+    h: f32,
+    /// Point indices, grouped by cell.
+    sorted: Vec<u32>,
+    /// (cell key, start, end) into `sorted`; `u64::MAX`: empty.
+    table: Vec<(u64, u32, u32)>,
+    mask: usize,
+}
+
+/// Points a non-empty cell aims to hold: the k = 24 nearest then mostly lie in the first ring.
+const TARGET: f32 = 8.0;
+/// Rings searched before a query goes to the k-d tree (a point far from the others).
+const MAX_RINGS: i32 = 4;
+
+impl CellGrid {
+    fn new(positions: &[Vec3]) -> Self {
+        let (lo, hi) = positions
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        let extent = (hi - lo).max_element();
+        let n = positions.len().max(1) as f32;
+        // A first guess as if the points filled their box, then corrected towards `TARGET`
+        // points a non-empty cell as if they lay on surfaces (the count grows with h²).
+        let mut h = if extent > 0.0 && extent.is_finite() {
+            extent / n.cbrt()
+        } else {
+            1.0
+        };
+        let mut keys: Vec<(u64, u32)> = Vec::new();
+        for attempt in 0..4 {
+            keys.clear();
+            keys.extend(
+                positions
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &p)| (Self::key_of(Self::cell_of(lo, h, p)), i as u32)),
+            );
+            keys.sort_unstable();
+            let cells = 1 + keys.windows(2).filter(|w| w[0].0 != w[1].0).count();
+            let mean = n / cells as f32;
+            if (TARGET / 2.0..=TARGET * 2.0).contains(&mean) || attempt == 3 || n < 16.0 {
+                break;
+            }
+            h *= (TARGET / mean).sqrt().clamp(0.25, 4.0);
+        }
+        let cells = 1 + keys.windows(2).filter(|w| w[0].0 != w[1].0).count();
+        let size = (cells * 2).next_power_of_two();
+        let mut grid = CellGrid {
+            lo,
+            h,
+            sorted: keys.iter().map(|k| k.1).collect(),
+            table: vec![(u64::MAX, 0, 0); size],
+            mask: size - 1,
+        };
+        let mut start = 0;
+        while start < keys.len() {
+            let key = keys[start].0;
+            let end = start + keys[start..].iter().take_while(|k| k.0 == key).count();
+            let mut slot = Self::hash(key) & grid.mask;
+            while grid.table[slot].0 != u64::MAX {
+                slot = (slot + 1) & grid.mask;
+            }
+            grid.table[slot] = (key, start as u32, end as u32);
+            start = end;
+        }
+        grid
+    }
+
+    /// Cell coordinates of `p`, offset so that every neighbour within the rings stays positive.
+    fn cell_of(lo: Vec3, h: f32, p: Vec3) -> [i64; 3] {
+        let c = ((p - lo) / h).floor();
+        [c.x as i64, c.y as i64, c.z as i64].map(|v| v.clamp(0, (1 << 20) - 1) + 8)
+    }
+
+    fn key_of(c: [i64; 3]) -> u64 {
+        (c[0] as u64) | ((c[1] as u64) << 21) | ((c[2] as u64) << 42)
+    }
+
+    fn hash(key: u64) -> usize {
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as usize
+    }
+
+    fn cell(&self, c: [i64; 3]) -> &[u32] {
+        let key = Self::key_of(c);
+        let mut slot = Self::hash(key) & self.mask;
+        loop {
+            let (k, start, end) = self.table[slot];
+            if k == key {
+                return &self.sorted[start as usize..end as usize];
+            }
+            if k == u64::MAX {
+                return &[];
+            }
+            slot = (slot + 1) & self.mask;
+        }
+    }
+
+    /// The `count` nearest points to `q` (itself among them), nearest first, ties by index,
+    /// into `found`; false when they were not found within `MAX_RINGS` rings.
+    fn nearest(
+        &self,
+        positions: &[Vec3],
+        q: Vec3,
+        count: usize,
+        found: &mut Vec<(f32, u32)>,
+    ) -> bool {
+        let c = Self::cell_of(self.lo, self.h, q);
+        let order = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        // How far q lies inside its cell from the nearest face: the searched cube's faces lie
+        // r cells' sides beyond it.
+        let f = (q - self.lo) / self.h
+            - Vec3::new((c[0] - 8) as f32, (c[1] - 8) as f32, (c[2] - 8) as f32);
+        let inside = f.min(Vec3::ONE - f).min_element().max(0.0) * self.h;
+        for r in 0..=MAX_RINGS as i64 {
+            for dz in -r..=r {
+                for dy in -r..=r {
+                    // Only the ring's shell: the inner cells were searched already.
+                    let step = if dz.abs() < r && dy.abs() < r {
+                        2 * r
+                    } else {
+                        1
+                    };
+                    let mut dx = -r;
+                    while dx <= r {
+                        found.extend(
+                            self.cell([c[0] + dx, c[1] + dy, c[2] + dz])
+                                .iter()
+                                .map(|&j| (positions[j as usize].distance_squared(q), j)),
+                        );
+                        dx += step;
+                    }
+                }
+            }
+            if found.len() >= count {
+                let (_, kth, _) = found.select_nth_unstable_by(count - 1, order);
+                // No point in an unsearched cell is nearer than this (a little less, for
+                // rounding).
+                let reach = (r as f32 * self.h + inside) * (1.0 - 1e-5);
+                if kth.0 < reach * reach {
+                    found.truncate(count);
+                    found.sort_unstable_by(order);
+                    return true;
+                }
+            }
+        }
+        false
     }
 }
 
@@ -566,7 +739,19 @@ mod tests {
             })
             .collect();
         pts.extend_from_within(..20);
-        for (cloud, k) in [(&pts[..], 24), (&pts[..], 8), (&pts[..5], 24)] {
+        // A wavy surface of 3000 points: queries that need the second ring of cells.
+        let surface: Vec<Vec3> = (0..3000)
+            .map(|_| {
+                let (x, z) = (r() * 4.0, r() * 2.0);
+                Vec3::new(x, (x * 3.0).sin() * 0.3, z)
+            })
+            .collect();
+        for (cloud, k) in [
+            (&pts[..], 24),
+            (&pts[..], 8),
+            (&pts[..5], 24),
+            (&surface[..], 24),
+        ] {
             let nb = Neighbours::find(cloud, k);
             assert_eq!(nb.k(), k.min(cloud.len() - 1));
             for (i, &p) in cloud.iter().enumerate() {
