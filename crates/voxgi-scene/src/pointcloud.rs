@@ -17,7 +17,9 @@ use std::num::NonZero;
 pub struct Neighbours {
     /// Indices per point: `k + 1` (or all the points, when fewer).
     stride: usize,
-    /// Each point's neighbours, nearest first (ties by index), the point itself among them.
+    /// Each point's neighbours, nearest first (ties by index from the grid; the k-d tree, for
+    /// points far from the rest, may take another of equally near points), the point itself
+    /// among them.
     idx: Vec<u32>,
 }
 
@@ -170,10 +172,15 @@ impl CellGrid {
         grid
     }
 
-    /// Cell coordinates of `p`, offset so that every neighbour within the rings stays positive.
+    /// Cell coordinates of `p` (in double precision, so that a cell's faces lie where the
+    /// search's bound assumes), offset so that every neighbour within the rings stays positive.
     fn cell_of(lo: Vec3, h: f32, p: Vec3) -> [i64; 3] {
-        let c = ((p - lo) / h).floor();
+        let c = Self::cell_space(lo, h, p).floor();
         [c.x as i64, c.y as i64, c.z as i64].map(|v| v.clamp(0, (1 << 20) - 1) + 8)
+    }
+
+    fn cell_space(lo: Vec3, h: f32, p: Vec3) -> DVec3 {
+        (p.as_dvec3() - lo.as_dvec3()) / h as f64
     }
 
     fn key_of(c: [i64; 3]) -> u64 {
@@ -212,9 +219,9 @@ impl CellGrid {
         let order = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
         // How far q lies inside its cell from the nearest face: the searched cube's faces lie
         // r cells' sides beyond it.
-        let f = (q - self.lo) / self.h
-            - Vec3::new((c[0] - 8) as f32, (c[1] - 8) as f32, (c[2] - 8) as f32);
-        let inside = f.min(Vec3::ONE - f).min_element().max(0.0) * self.h;
+        let f = Self::cell_space(self.lo, self.h, q)
+            - DVec3::new((c[0] - 8) as f64, (c[1] - 8) as f64, (c[2] - 8) as f64);
+        let inside = (f.min(DVec3::ONE - f).min_element().max(0.0) * self.h as f64) as f32;
         for r in 0..=MAX_RINGS as i64 {
             for dz in -r..=r {
                 for dy in -r..=r {
@@ -234,6 +241,10 @@ impl CellGrid {
                         dx += step;
                     }
                 }
+            }
+            // Many points in few cells (repeated points, a dense spot): the tree's turn.
+            if found.len() > 64 * count.max(8) {
+                return false;
             }
             if found.len() >= count {
                 let (_, kth, _) = found.select_nth_unstable_by(count - 1, order);

@@ -237,9 +237,13 @@ impl FrameNumber {
     }
 }
 
-/// Whether a file name asks for a sequence: it holds a `%` that is not `%%`.
+/// Whether a file asks for a sequence: its name (not its folders) holds one frame number
+/// (`%d`, `%04d`). Any other `%` is part of the name.
 pub fn is_pattern(file: &str) -> bool {
-    file.replace("%%", "").contains('%')
+    Path::new(file)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| FrameNumber::parse(n).is_ok())
 }
 
 /// Plays a scene's sequences: says which clouds get a new frame at a time, loading the frame
@@ -280,8 +284,25 @@ impl SequencePlayer {
     }
 
     /// The frames that change at time `t`, loaded (from the background when the last call
-    /// started loading them). An error names the file.
+    /// started loading them). An error names the file; the frames this call loaded before it
+    /// are loaded again by the next call (`forget`).
     pub fn frames_at(&mut self, t: f32) -> Result<Vec<NewFrame>> {
+        let result = self.load_at(t);
+        if result.is_err() {
+            self.forget();
+        }
+        result
+    }
+
+    /// Forgets which frames the clouds show: the next `frames_at` loads every sequence's (for
+    /// a caller that could not show the frames it was given).
+    pub fn forget(&mut self) {
+        for s in &mut self.sequences {
+            s.shown = usize::MAX;
+        }
+    }
+
+    fn load_at(&mut self, t: f32) -> Result<Vec<NewFrame>> {
         let mut out = Vec::new();
         for (s, ahead) in self.sequences.iter_mut().zip(&mut self.ahead) {
             let frame = s.frame_at(t);
@@ -346,7 +367,16 @@ mod tests {
         ] {
             assert!(FrameNumber::parse(bad).is_err(), "{bad}");
         }
-        assert!(is_pattern("a_%04d.ply") && !is_pattern("100%%.ply") && !is_pattern("a.ply"));
+        assert!(is_pattern("a_%04d.ply") && is_pattern("100%/a_%d.ply"));
+        for plain in [
+            "100%%.ply",
+            "a.ply",
+            "50%_off.ply",
+            "100%/room.ply",
+            "a_%s.ply",
+        ] {
+            assert!(!is_pattern(plain), "{plain}");
+        }
     }
 
     #[test]

@@ -189,6 +189,11 @@ impl SceneState {
         }
     }
 
+    /// Forgets which frames the point sequences' clouds show: the next `set_time` loads them.
+    pub fn forget_frames(&mut self) {
+        self.player.forget();
+    }
+
     /// The animations.
     pub fn animations(&self) -> &[Animation] {
         &self.animated.animations

@@ -142,7 +142,12 @@ fn every_twin_has_the_wgsl_layout() {
         ]
     );
     twin!(m, GpuVertex, "Vertex", [position, u, normal, v]);
-    twin!(m, GpuBlend, "Blend", [weight, restart, from_bounce]);
+    twin!(
+        m,
+        GpuBlend,
+        "Blend",
+        [weight, restart, from_bounce, store_all]
+    );
     twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
     twin!(
         m,

@@ -362,6 +362,12 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         if let Some(o) = &inc.material {
             apply_override(&mut sub, o).map_err(|r| err(format!("{what}: {r}")))?;
         }
+        if inc.points.is_some() && !sub.sequences.is_empty() {
+            return Err(err(format!(
+                "{what}: `points` makes points of meshes; the file's point sequences are points \
+                 already"
+            )));
+        }
         let scale = match inc.scale {
             None => Vec3::ONE,
             Some(Scale::Uniform(s)) => Vec3::splat(s),
@@ -561,6 +567,12 @@ fn apply_override(scene: &mut Scene, o: &MaterialOverride) -> std::result::Resul
         if v.is_some_and(|v| !(0.0..=1.0).contains(&v)) {
             return Err(format!("material {k} must be in [0, 1]"));
         }
+    }
+    if o.emissive.is_some() && !scene.sequences.is_empty() {
+        return Err("a point sequence's points cannot emit (`material.emissive`)".into());
+    }
+    for s in &mut scene.sequences {
+        s.base_color = o.base_color.or(s.base_color);
     }
     for pc in &mut scene.point_clouds {
         if let Some(c) = o.base_color {

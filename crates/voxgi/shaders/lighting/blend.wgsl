@@ -40,7 +40,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let was = shown[s];
     shown[s] = now;
-    if blend.store_all != 0u || blend.restart != 0u || leaf_is_new(s) || any(now != was) {
+    if blend.store_all != 0u || blend.restart != 0u || any(now != was) {
         store_leaf_radiance(s, now);
     }
 }

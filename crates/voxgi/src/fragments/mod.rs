@@ -206,15 +206,21 @@ impl FragmentEstimate {
                 e.triangles += k as u64;
             }
         }
-        for pc in scene.point_clouds.iter().filter(|pc| pc.light.is_none()) {
+        for (c, pc) in scene.point_clouds.iter().enumerate() {
+            if pc.light.is_some() {
+                continue;
+            }
             let scale = pc.transform.determinant().abs().cbrt() as f64;
-            e.points += pc.positions.len() as u64;
+            // A point sequence's largest frame, as so many points like these.
+            let room = scene.cloud_capacity(c);
+            let grow = room as f64 / pc.positions.len().max(1) as f64;
+            e.points += room as u64;
             for &r in &pc.regions {
                 let r = r as f64 * scale;
                 if r.is_finite() {
-                    e.edges[0] += r;
-                    e.edges[1] += r * r;
-                    e.edges[2] += r * r * r;
+                    e.edges[0] += grow * r;
+                    e.edges[1] += grow * r * r;
+                    e.edges[2] += grow * r * r * r;
                 }
             }
         }

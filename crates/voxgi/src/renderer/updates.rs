@@ -420,7 +420,14 @@ impl Renderer {
         let mut frames = Vec::with_capacity(changes.frames.len());
         for f in changes.frames {
             let start = web_time::Instant::now();
-            let prepared = self.set_points(f.cloud, &f.points)?;
+            let prepared = match self.set_points(f.cloud, &f.points) {
+                Ok(p) => p,
+                Err(e) => {
+                    // The frames not shown are loaded again by the next call.
+                    self.state.forget_frames();
+                    return Err(e);
+                }
+            };
             frames.push(SequenceFrame {
                 cloud: f.cloud,
                 frame: f.frame,
