@@ -335,37 +335,30 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
                  holds a frame number (`scan_%04d.ply`)"
             )));
         }
-        let mut played = None;
-        let mut sub = match (&inc.file, &inc.builtin) {
-            (Some(f), None) if sequence.is_some() => {
-                let (seq, first) = open_sequence(&dir.join(f), inc)
-                    .map_err(|r| err(format!("{what} ('{f}'): {r}")))?;
-                played = Some(seq);
-                Scene {
-                    name: first.name.clone(),
-                    point_clouds: vec![first],
-                    ..Default::default()
+        let mut sub =
+            match (&inc.file, &inc.builtin) {
+                // Its cloud is the sub-scene's first: `append` moves the index with the cloud, and
+                // the material override, `points` and `dynamic` are checked below as for a file
+                // that holds sequences.
+                (Some(f), None) if sequence.is_some() => open_sequence(&dir.join(f), inc)
+                    .map_err(|r| err(format!("{what} ('{f}'): {r}")))?,
+                (Some(f), None) => crate::io::load(&dir.join(f))
+                    .map_err(|e| err(format!("{what} ('{f}'): {e}")))?,
+                (None, Some(b)) => {
+                    crate::builtin::by_name(b).map_err(|e| err(format!("{what}: {e}")))?
                 }
-            }
-            (Some(f), None) => {
-                crate::io::load(&dir.join(f)).map_err(|e| err(format!("{what} ('{f}'): {e}")))?
-            }
-            (None, Some(b)) => {
-                crate::builtin::by_name(b).map_err(|e| err(format!("{what}: {e}")))?
-            }
-            _ => {
-                return Err(err(format!(
-                    "{what}: needs exactly one of `file` and `builtin`"
-                )));
-            }
-        };
+                _ => {
+                    return Err(err(format!(
+                        "{what}: needs exactly one of `file` and `builtin`"
+                    )));
+                }
+            };
         if let Some(o) = &inc.material {
             apply_override(&mut sub, o).map_err(|r| err(format!("{what}: {r}")))?;
         }
         if inc.points.is_some() && !sub.sequences.is_empty() {
             return Err(err(format!(
-                "{what}: `points` makes points of meshes; the file's point sequences are points \
-                 already"
+                "{what}: `points` makes points of meshes; point sequences are points already"
             )));
         }
         let scale = match inc.scale {
@@ -423,10 +416,6 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         crate::io::emitters::promote_emissive_points(&mut sub);
         let (first, first_cloud) = (scene.instances.len(), scene.point_clouds.len());
         scene.append(sub, transform, inc.dynamic);
-        if let Some(mut seq) = played {
-            seq.cloud = first_cloud;
-            scene.sequences.push(seq);
-        }
         include_instances.push(IncludeRange {
             name: inc.name.as_deref(),
             instances: first..scene.instances.len(),
@@ -475,11 +464,9 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     Ok((scene, file.settings))
 }
 
-/// An include's sequence of point files (`file` holds a frame number) and its first frame.
-fn open_sequence(
-    pattern: &Path,
-    inc: &Include,
-) -> std::result::Result<(crate::sequence::PointSequence, crate::PointCloud), String> {
+/// An include's sequence of point files (`file` holds a frame number): a scene of its first
+/// frame's cloud, with the sequence playing in it.
+fn open_sequence(pattern: &Path, inc: &Include) -> std::result::Result<Scene, String> {
     if !inc.dynamic {
         return Err(
             "a sequence of point files changes over time: it needs `dynamic = true`".into(),
@@ -488,27 +475,10 @@ fn open_sequence(
     let Some(fps) = inc.fps else {
         return Err("a sequence of point files needs `fps`, its frames per second".into());
     };
-    if inc.points.is_some() {
-        return Err("`points` makes points of meshes: a sequence's files are points".into());
-    }
-    let base_color = match &inc.material {
-        None => None,
-        Some(o) if o.emissive.is_some() => {
-            return Err("a sequence's points cannot emit (`material.emissive`)".into());
-        }
-        Some(o) => {
-            if o.base_color
-                .is_some_and(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0))
-            {
-                return Err("material colours must be finite and >= 0".into());
-            }
-            o.base_color
-        }
-    };
     let repeat = parse_repeat(inc.repeat.as_deref())?;
     let start = web_time::Instant::now();
     let (seq, mut first) =
-        crate::sequence::PointSequence::open(pattern, fps, repeat, base_color, &mut |n| {
+        crate::sequence::PointSequence::open(pattern, fps, repeat, None, &mut |n| {
             log::info!("{}: {n} frames read", pattern.display())
         })
         .map_err(|e| e.to_string())?;
@@ -523,7 +493,12 @@ fn open_sequence(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    Ok((seq, first))
+    Ok(Scene {
+        name: first.name.clone(),
+        point_clouds: vec![first],
+        sequences: vec![seq],
+        ..Default::default()
+    })
 }
 
 /// A `[camera]` or a `[[view]]`.

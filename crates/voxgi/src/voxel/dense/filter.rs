@@ -2,7 +2,7 @@
 
 use super::{RADIANCE_FORMAT, mip_view};
 use crate::gpu::layout;
-use crate::gpu::shader::voxel_pipeline;
+use crate::gpu::shader::module_for;
 use crate::gpu::timer::GpuTimer;
 use crate::voxel::{Filtering, Grid};
 use wgpu::util::DeviceExt;
@@ -29,7 +29,7 @@ struct Step {
 }
 
 impl FilterPass {
-    /// Compiles the pipeline and creates its bind group layout.
+    /// Compiles the pipelines (one module, two entry points) and creates their layouts.
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -52,35 +52,26 @@ impl FilterPass {
                 layout::storage(8, c, false),
             ],
         });
-        let module = crate::gpu::shader::module_for(
-            device,
-            "voxels/dense/filter.wgsl",
-            &super::KIND.shaders,
-        );
-        let region_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let module = module_for(device, "voxels/dense/filter.wgsl", &super::KIND.shaders);
+        let pipeline = |entry: &str, layout: &wgpu::BindGroupLayout| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("filter"),
-                bind_group_layouts: &[Some(&region_layout)],
+                bind_group_layouts: &[Some(layout)],
                 immediate_size: 0,
             });
-        FilterPass {
-            pipeline: voxel_pipeline(
-                device,
-                "filter",
-                "voxels/dense/filter.wgsl",
-                &super::KIND.shaders,
-                &[Some(&layout)],
-                &[],
-            ),
-            layout,
-            region: device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("filter"),
-                layout: Some(&region_pipeline_layout),
+                layout: Some(&pipeline_layout),
                 module: &module,
-                entry_point: Some("region"),
+                entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
-            }),
+            })
+        };
+        FilterPass {
+            pipeline: pipeline("main", &layout),
+            region: pipeline("region", &region_layout),
+            layout,
             region_layout,
         }
     }
@@ -146,8 +137,8 @@ impl FilterPass {
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
+        let blocks = super::chain_blocks(filtering.anisotropic);
         let region = |all: bool| {
-            let blocks = if filtering.anisotropic { 6 } else { 1 };
             let params = [grid.resolution, steps.len() as u32, blocks, all as u32];
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("filter region"),
@@ -209,7 +200,6 @@ impl FilterPass {
                 })
             })
             .collect();
-        let blocks = if filtering.anisotropic { 6 } else { 1 };
         let whole = steps
             .iter()
             .map(|s| [s.params[1].div_ceil(4), (s.params[1] * blocks).div_ceil(4)])
