@@ -35,8 +35,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     // A leaf the last update made (a moved instance's) has no light of its own to come from.
     var now = goal;
     if blend.restart == 0u && !leaf_is_new(s) {
-        // mix(a, b, 1) is b exactly: the last step lands on the update's light to the bit.
-        now = mix(shown[s], goal, blend.weight);
+        // The last step lands on the update's light to the bit: mix(a, b, 1) need not be b
+        // (a + 1 * (b - a) with a fused multiply-add on NVIDIA rounds in b - a).
+        now = select(mix(shown[s], goal, blend.weight), goal, blend.weight >= 1.0);
     }
     let was = shown[s];
     shown[s] = now;

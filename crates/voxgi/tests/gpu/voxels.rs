@@ -600,7 +600,17 @@ fn octree_build_matches_its_cpu_twin() {
         let word =
             |bytes: &[u8], at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
         assert_eq!(s[2], word(&albedo, 4 * i), "albedo of {c:?}");
-        assert_eq!(s[3], word(&normal, 4 * i), "normal of {c:?}");
+        // The octree packs its normal in the shader (pack4x8snorm: WGSL rounds half to even);
+        // the dense volume stores to an rgba8snorm texture, whose conversion Vulkan leaves to
+        // the hardware ("should round to nearest"): an H200 rounds a tie the other way. One
+        // step (1/127) apart at most.
+        let (a, b) = (s[3].to_le_bytes(), word(&normal, 4 * i).to_le_bytes());
+        assert!(
+            a.iter()
+                .zip(&b)
+                .all(|(x, y)| (*x as i8).abs_diff(*y as i8) <= 1),
+            "normal of {c:?}: {a:?} in the octree, {b:?} in the dense volume"
+        );
         assert_eq!(s[4], word(&emission, 8 * i), "emission (rg) of {c:?}");
         assert_eq!(
             s[5] & 0xffff,
