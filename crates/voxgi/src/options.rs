@@ -339,6 +339,12 @@ pub struct RendererOptions {
     /// only (1..=64); the frames between reuse the voxels, which then trail the meshes by up
     /// to k - 1 frames. Shadow maps follow every frame. Default 1.
     pub voxel_update_interval: u32,
+    /// Voxel bounces gather at one leaf in k per update (1..=16), the leaves taking turns by a
+    /// hash of their voxel; the others re-emit the irradiance they last gathered on top of
+    /// their direct light of now. After a change stops, the light equals a full bounce's
+    /// within k updates per voxel bounce. A moving light or object then costs a k-th of the
+    /// bounces, and the bounced light lags by up to k - 1 updates. Default 1 (every leaf).
+    pub bounce_slices: u32,
     /// Temporal accumulation: each frame's camera is jittered within the pixel and its cone
     /// bundle turned, and the frames are accumulated into a history reprojected by motion
     /// vectors (anti-aliased edges, many more cone directions than one frame traces; a still
@@ -373,6 +379,7 @@ impl Default for RendererOptions {
             voxel_capacity: None,
             progressive: false,
             voxel_update_interval: 1,
+            bounce_slices: 1,
             temporal: true,
         }
     }

@@ -9,6 +9,7 @@ use crate::gpu::shader::compose;
 use crate::gpu_scene::{GpuDraw, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
 use crate::lighting::atlas::GpuShadowView;
 use crate::lighting::blend::GpuBlend;
+use crate::lighting::bounce::GpuSlices;
 use crate::lighting::cones::GpuCones;
 use crate::lighting::inject::GpuInjectParams;
 use crate::lighting::moments::GpuMomentRect;
@@ -34,6 +35,8 @@ fn modules() -> Vec<naga::Module> {
         crate::gpu::shader::compose_with("screen/gather.wgsl", Some(VoxelKind::DENSE.shaders()));
     let blend =
         crate::gpu::shader::compose_with("lighting/blend.wgsl", Some(VoxelKind::DENSE.shaders()));
+    let bounce =
+        crate::gpu::shader::compose_with("lighting/bounce.wgsl", Some(VoxelKind::DENSE.shaders()));
     [
         compose("screen/composite.wgsl"),
         compose("screen/gbuffer.wgsl"),
@@ -43,6 +46,7 @@ fn modules() -> Vec<naga::Module> {
         compose("reference_display.wgsl"),
         gather,
         blend,
+        bounce,
         inject,
         octree,
     ]
@@ -148,6 +152,7 @@ fn every_twin_has_the_wgsl_layout() {
         "Blend",
         [weight, restart, from_bounce, store_all]
     );
+    twin!(m, GpuSlices, "Slices", [count, turn, all, capacity]);
     twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
     twin!(
         m,

@@ -10,17 +10,98 @@
 //!include voxels/leaves.wgsl
 //!include shared/irradiance_record.wgsl
 
+// Which leaves gather this update (`bounce_slices`). With `count` > 1 and not `all`, `mark`
+// lists those whose slice is `turn` (and the new ones) and re-emits, at every other leaf, the
+// irradiance it last gathered in this bounce of an update on top of its direct light of now;
+// `list` sizes the gather's dispatch to the list, and `main` gathers at the listed leaves only.
+// Listing them keeps a SIMD group's lanes on one kind of work: with the slices mixed in a
+// group, nearly every group would pay for a whole gather.
+struct Slices {
+    count: u32,
+    turn: u32,
+    all: u32,
+    // Leaf slots of the structure: where the list begins in `gathered`.
+    capacity: u32,
+}
+
 @group(0) @binding(0) var<uniform> cones: Cones;
 // Per leaf slot (shared/irradiance_record.wgsl); written when IRRADIANCE.
 @group(0) @binding(1) var<storage, read_write> leaf_irradiance: array<vec4<u32>>;
+@group(0) @binding(2) var<uniform> slices: Slices;
+// This bounce's (each bounce of an update binds its own range), used when `slices.count` > 1:
+// per leaf slot, four words (the irradiance it last gathered, f32 rgb, and one unused); then
+// the listed leaves' count and the list.
+@group(0) @binding(3) var<storage, read_write> gathered: array<u32>;
+// `mark` and `list` only: [0] the leaves listed so far, [1..4) the gather's dispatch size.
+@group(0) @binding(4) var<storage, read_write> listing: array<atomic<u32>>;
+
+fn kept(s: u32) -> vec3<f32> {
+    return bitcast<vec3<f32>>(vec3<u32>(gathered[4u * s], gathered[4u * s + 1u], gathered[4u * s + 2u]));
+}
+
+fn keep(s: u32, e: vec3<f32>) {
+    let w = bitcast<vec3<u32>>(e);
+    gathered[4u * s] = w.x;
+    gathered[4u * s + 1u] = w.y;
+    gathered[4u * s + 2u] = w.z;
+}
+
+fn list_start() -> u32 {
+    return 4u * slices.capacity;
+}
+
+// A leaf's slice: a hash of its voxel (not its slot, which atomics hand out in any order, so
+// that renders are the same from run to run), spreading a turn's leaves through the scene.
+fn slice_of(c: vec3<u32>) -> u32 {
+    var h = c.x * 73856093u ^ c.y * 19349663u ^ c.z * 83492791u;
+    h = (h ^ (h >> 16u)) * 0x45d9f3bu;
+    h = (h ^ (h >> 16u)) * 0x45d9f3bu;
+    h = h ^ (h >> 16u);
+    return h % slices.count;
+}
+
+fn flat_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * 64u;
+}
+
+@compute @workgroup_size(64)
+fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = flat_index(gid, nwg);
+    if s >= leaf_count() {
+        return;
+    }
+    if leaf_is_new(s) || slice_of(leaf_coord(s)) == slices.turn {
+        let k = atomicAdd(&listing[0], 1u);
+        gathered[list_start() + 1u + k] = s;
+    } else {
+        leaf_next[s] = re_emit(leaf_direct[s], leaf_albedo(s), kept(s));
+    }
+}
+
+@compute @workgroup_size(1)
+fn list() {
+    let n = atomicLoad(&listing[0]);
+    gathered[list_start()] = n;
+    let groups = (n + 63u) / 64u;
+    atomicStore(&listing[1], max(min(groups, 65535u), 1u));
+    atomicStore(&listing[2], max((groups + 65534u) / 65535u, 1u));
+    atomicStore(&listing[3], 1u);
+    // Ready for the next bounce's `mark`.
+    atomicStore(&listing[0], 0u);
+}
 
 override IRRADIANCE: bool = false;
 // Group 1: the voxel structure's sampling, group 2: its leaves.
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = gid.x + gid.y * nwg.x * 64u;
-    if s >= leaf_count() {
+    var s = flat_index(gid, nwg);
+    if slices.count > 1u && slices.all == 0u {
+        if s >= gathered[list_start()] {
+            return;
+        }
+        s = gathered[list_start() + 1u + s];
+    } else if s >= leaf_count() {
         return;
     }
     let c = leaf_coord(s);
@@ -54,6 +135,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if IRRADIANCE {
         leaf_irradiance[s] = pack_irradiance(e, ao, nw);
     }
-    let direct = leaf_direct[s];
-    leaf_next[s] = vec4<f32>(direct.rgb + albedo.rgb / PI * e * direct.a, direct.a);
+    if slices.count > 1u {
+        keep(s, e);
+    }
+    leaf_next[s] = re_emit(leaf_direct[s], albedo, e);
+}
+
+// A leaf's light after a bounce: its direct light and albedo/pi of irradiance `e`, premultiplied
+// by opacity. One function for gathered and kept irradiance, so both round alike.
+fn re_emit(direct: vec4<f32>, albedo: vec4<f32>, e: vec3<f32>) -> vec4<f32> {
+    return vec4<f32>(direct.rgb + albedo.rgb / PI * e * direct.a, direct.a);
 }

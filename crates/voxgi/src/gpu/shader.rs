@@ -197,7 +197,7 @@ pub fn grouped_pipeline(
     layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    pipeline_with(device, label, file, None, layouts, constants)
+    pipeline_with(device, label, file, None, "main", layouts, constants)
 }
 
 /// `grouped_pipeline` for a shader that reaches voxel structure `kind` (`voxels/` includes).
@@ -209,7 +209,19 @@ pub fn voxel_pipeline(
     layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    pipeline_with(device, label, file, Some(kind), layouts, constants)
+    pipeline_with(device, label, file, Some(kind), "main", layouts, constants)
+}
+
+/// `voxel_pipeline` of entry point `entry` (a pass of several steps in one file).
+pub fn voxel_pipeline_entry(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    kind: &StructureShaders,
+    entry: &str,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::ComputePipeline {
+    pipeline_with(device, label, file, Some(kind), entry, layouts, &[])
 }
 
 fn pipeline_with(
@@ -217,6 +229,7 @@ fn pipeline_with(
     label: &str,
     file: &str,
     kind: Option<&StructureShaders>,
+    entry: &str,
     layouts: &[Option<&wgpu::BindGroupLayout>],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
@@ -230,7 +243,7 @@ fn pipeline_with(
         label: Some(label),
         layout: Some(&pipeline_layout),
         module: &module,
-        entry_point: Some("main"),
+        entry_point: Some(entry),
         compilation_options: wgpu::PipelineCompilationOptions {
             constants,
             ..Default::default()

@@ -3,9 +3,10 @@
 //! and written in one). For the fast shading the gather also keeps every leaf's irradiance.
 
 use crate::gpu::layout;
-use crate::gpu::shader::voxel_pipeline;
+use crate::gpu::shader::{voxel_pipeline, voxel_pipeline_entry};
 use crate::gpu::timer::GpuTimer;
 use crate::voxel::{VoxelKind, VoxelStructure};
+use bytemuck::{Pod, Zeroable};
 
 /// What one bounce records.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,6 +18,64 @@ pub struct BounceSteps {
     pub store: bool,
 }
 
+/// Mirrors `Slices` in shaders/lighting/bounce.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSlices {
+    /// Slices of the leaves, one gathered per update (1: every leaf every update).
+    pub count: u32,
+    /// The slice that gathers this update.
+    pub turn: u32,
+    /// 1: every leaf gathers (nothing kept yet, or the slots hold other leaves now).
+    pub all: u32,
+    /// Leaf slots of the structure (where the list begins in the kept words).
+    pub capacity: u32,
+}
+
+/// The bounce pass's `@group(0)` for one structure (`BouncePass::bind`): per bounce of an
+/// update, the gather's bind group and `mark`'s, each with its range of the kept irradiance.
+pub struct BounceGlobals {
+    levels: Vec<(wgpu::BindGroup, wgpu::BindGroup)>,
+    uniform: wgpu::Buffer,
+    gathered: wgpu::Buffer,
+    /// `mark`'s count and the gather's dispatch size.
+    listing: wgpu::Buffer,
+    capacity: u32,
+    /// `bounce_slices` it was made for.
+    slices: u32,
+    /// Nothing is kept yet: the next update's bounces gather at every leaf.
+    fresh: bool,
+    /// The next update's bounces gather at a list of leaves (`prepare`).
+    listed: bool,
+}
+
+impl BounceGlobals {
+    /// Sets which leaves gather in the next update's bounces: those of slice `turn`, or all of
+    /// them when nothing is kept yet or `all`.
+    pub fn prepare(&mut self, queue: &wgpu::Queue, turn: u32, all: bool) {
+        let count = self.slices.max(1);
+        let all = all || self.fresh;
+        let s = GpuSlices {
+            count,
+            turn: turn % count,
+            all: all as u32,
+            capacity: self.capacity,
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&s));
+        self.fresh = false;
+        self.listed = count > 1 && !all;
+    }
+
+    /// Bytes of the kept irradiance and the lists (none with one slice).
+    pub fn memory(&self) -> u64 {
+        if self.slices > 1 {
+            self.gathered.size()
+        } else {
+            0
+        }
+    }
+}
+
 /// The bounce pass (shaders/bounce.wgsl and bounce_store.wgsl): the gather and store pipelines
 /// and the layout of their cone uniform and irradiance records.
 pub struct BouncePass {
@@ -25,6 +84,10 @@ pub struct BouncePass {
     gather_irradiance: Option<wgpu::ComputePipeline>,
     globals: wgpu::BindGroupLayout,
     store: wgpu::ComputePipeline,
+    /// `mark` and `list` (bounce slices) and their `@group(0)`.
+    mark: wgpu::ComputePipeline,
+    list: wgpu::ComputePipeline,
+    mark_globals: wgpu::BindGroupLayout,
 }
 
 impl BouncePass {
@@ -40,7 +103,20 @@ impl BouncePass {
         let c = wgpu::ShaderStages::COMPUTE;
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bounce globals"),
-            entries: &[layout::uniform(0, c, false), layout::storage(1, c, false)],
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::storage(1, c, false),
+                layout::uniform(2, c, false),
+                layout::storage(3, c, false),
+            ],
+        });
+        let mark_globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bounce mark"),
+            entries: &[
+                layout::uniform(2, c, false),
+                layout::storage(3, c, false),
+                layout::storage(4, c, false),
+            ],
         });
         let voxels = kind.sampling_layout(device);
         let leaves = kind.leaves_layout(device);
@@ -67,26 +143,112 @@ impl BouncePass {
                 &[None, None, Some(&leaves), Some(&store)],
                 &[],
             ),
+            mark: voxel_pipeline_entry(
+                device,
+                "bounce",
+                "lighting/bounce.wgsl",
+                kind.shaders(),
+                "mark",
+                &[Some(&mark_globals), None, Some(&leaves)],
+            ),
+            list: voxel_pipeline_entry(
+                device,
+                "bounce",
+                "lighting/bounce.wgsl",
+                kind.shaders(),
+                "list",
+                &[Some(&mark_globals)],
+            ),
             globals,
+            mark_globals,
         }
     }
 
-    /// The pass's `@group(0)`: the diffuse cones in `cones` (`Cones` in shared/volume.wgsl) and
-    /// the leaves' records of `voxels`; made once per structure.
+    /// The pass's `@group(0)` for `voxels`, made once per structure: the diffuse cones in
+    /// `cones` (`Cones` in shared/volume.wgsl), the leaves' records, and with `slices` > 1 the
+    /// irradiance each leaf last gathered in each of `bounces` bounces of an update.
     pub fn bind(
         &self,
         device: &wgpu::Device,
         voxels: &dyn VoxelStructure,
         cones: &wgpu::Buffer,
-    ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("bounce globals"),
-            layout: &self.globals,
-            entries: &layout::entries(vec![
-                cones.as_entire_binding(),
-                voxels.bindings().leaf_irradiance.as_entire_binding(),
-            ]),
-        })
+        slices: u32,
+        bounces: u32,
+    ) -> BounceGlobals {
+        let buffer = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let uniform = buffer(
+            "bounce slices",
+            std::mem::size_of::<GpuSlices>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let listing = buffer(
+            "bounce listing",
+            16,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+        );
+        let capacity = voxels.leaf_capacity().max(1);
+        // Per bounce: four words a slot, the count, a word a slot; each bounce's range starts
+        // on the storage-offset alignment (256 bytes at most).
+        let range = (5 * capacity + 1) * 4;
+        let (levels, stride) = if slices > 1 {
+            (bounces.max(1), range.next_multiple_of(256))
+        } else {
+            (1, 256)
+        };
+        let gathered = buffer(
+            "bounce gathered",
+            stride * u64::from(levels),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let levels = (0..u64::from(levels))
+            .map(|i| {
+                let part = || {
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &gathered,
+                        offset: i * stride,
+                        size: std::num::NonZeroU64::new(stride.min(range)),
+                    })
+                };
+                let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+                let gather = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("bounce globals"),
+                    layout: &self.globals,
+                    entries: &[
+                        entry(0, cones.as_entire_binding()),
+                        entry(1, voxels.bindings().leaf_irradiance.as_entire_binding()),
+                        entry(2, uniform.as_entire_binding()),
+                        entry(3, part()),
+                    ],
+                });
+                let mark = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("bounce mark"),
+                    layout: &self.mark_globals,
+                    entries: &[
+                        entry(2, uniform.as_entire_binding()),
+                        entry(3, part()),
+                        entry(4, listing.as_entire_binding()),
+                    ],
+                });
+                (gather, mark)
+            })
+            .collect();
+        BounceGlobals {
+            levels,
+            uniform,
+            gathered,
+            listing,
+            capacity: u32::try_from(capacity).unwrap_or(u32::MAX),
+            slices,
+            fresh: true,
+            listed: false,
+        }
     }
 
     /// Records one bounce over the leaves of `voxels` with the cones `globals` binds (`bind`),
@@ -97,26 +259,54 @@ impl BouncePass {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         voxels: &dyn VoxelStructure,
-        globals: &wgpu::BindGroup,
+        globals: &BounceGlobals,
+        bounce: u32,
         steps: BounceSteps,
         timer: &mut GpuTimer,
     ) {
         let bound = voxels.bindings();
         let (args, offset) = bound.leaf_dispatch;
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("bounce"),
-            timestamp_writes: timer.compute("bounce"),
-        });
+        let (gather_globals, mark_globals) =
+            &globals.levels[(bounce as usize).min(globals.levels.len() - 1)];
         let gather = match (&self.gather_irradiance, steps.irradiance) {
             (Some(p), true) => p,
             (None, true) => panic!("BouncePass::new was not asked for the irradiance gather"),
             (_, false) => &self.gather,
         };
+        fn pass<'a>(
+            encoder: &'a mut wgpu::CommandEncoder,
+            timer: &mut GpuTimer,
+        ) -> wgpu::ComputePass<'a> {
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("bounce"),
+                timestamp_writes: timer.compute("bounce"),
+            })
+        }
+        // With slices: `mark` lists the leaves that gather and re-emits the others' kept
+        // light, `list` sizes the gather to the list; each step reads what the last wrote.
+        if globals.listed {
+            {
+                let mut pass = pass(encoder, timer);
+                pass.set_pipeline(&self.mark);
+                pass.set_bind_group(0, mark_globals, &[]);
+                pass.set_bind_group(2, bound.leaves, &[]);
+                pass.dispatch_workgroups_indirect(args, offset);
+            }
+            let mut pass = pass(encoder, timer);
+            pass.set_pipeline(&self.list);
+            pass.set_bind_group(0, mark_globals, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        let mut pass = pass(encoder, timer);
         pass.set_pipeline(gather);
-        pass.set_bind_group(0, globals, &[]);
+        pass.set_bind_group(0, gather_globals, &[]);
         pass.set_bind_group(1, bound.sampling, &[]);
         pass.set_bind_group(2, bound.leaves, &[]);
-        pass.dispatch_workgroups_indirect(args, offset);
+        if globals.listed {
+            pass.dispatch_workgroups_indirect(&globals.listing, 4);
+        } else {
+            pass.dispatch_workgroups_indirect(args, offset);
+        }
         if !steps.store {
             return;
         }

@@ -30,7 +30,7 @@ use crate::gpu::{checked, readback, requirements};
 use crate::gpu_scene::{GpuScene, bounding_sphere};
 use crate::lighting::atlas::{self as shadow, ShadowAtlas, plan_atlas};
 use crate::lighting::blend::{BlendPass, BlendState};
-use crate::lighting::bounce::BouncePass;
+use crate::lighting::bounce::{BounceGlobals, BouncePass};
 use crate::lighting::bounces::{leaves, voxel_bounce_count};
 use crate::lighting::cones::cone_uniforms;
 use crate::lighting::inject::InjectPass;
@@ -97,9 +97,9 @@ pub struct Renderer {
     /// The screen passes' bind groups, made on the first frame after what they bind was
     /// replaced.
     binds: Option<order::FrameBinds>,
-    /// The bounce pass's bind group, made on the first bounce after the structure or the pass
-    /// was made anew.
-    bounce_globals: Option<wgpu::BindGroup>,
+    /// The bounce pass's bind groups and the leaves' kept irradiance, made on the first bounce
+    /// after the structure, the pass or the options were made anew.
+    bounce_globals: Option<BounceGlobals>,
     /// The bind groups of voxelize and splat, made on the first voxel update after the
     /// fragments were made anew.
     fragment_binds: Option<order::FragmentBinds>,
@@ -121,6 +121,11 @@ pub struct Renderer {
     pending: Pending,
     /// Progressive bounces still to run before the voxel light has converged.
     progressive_left: u32,
+    /// With `bounce_slices` > 1: updates still to run after the last change before every leaf
+    /// has gathered again (in each bounce, after the bounce before it had).
+    slices_left: u32,
+    /// The slice of leaves whose bounces gather in the next update.
+    bounce_turn: u32,
     /// The leaves' shown light (`lighting::blend`); `None` until a blend step needs it.
     blend: Option<BlendState>,
     /// Blend steps left before the shown light is the last update's.
@@ -350,6 +355,8 @@ impl Renderer {
                 ..Pending::everything(views)
             },
             progressive_left: 0,
+            slices_left: 0,
+            bounce_turn: 0,
             blend: None,
             blend_left: 0,
             frame_index: 0,
@@ -552,6 +559,9 @@ impl Renderer {
         // The passes, the structure and the atlas may be new: their bind groups are made again.
         self.binds = None;
         self.bounce_globals = None;
+        // Made anew, the bounces keep nothing: one more update (if the last change was still
+        // spreading over slices) gathers at every leaf.
+        self.slices_left = self.slices_left.min(1);
         self.fragment_binds = None;
         self.shadow_binds = None;
         // What the history holds was rendered with the old options, and the voxels' light
@@ -608,6 +618,9 @@ impl Renderer {
         m.push(("shadow atlas", self.atlas.bytes()));
         m.extend(self.fragments.memory());
         m.extend(self.volume.memory());
+        if let Some(b) = self.bounce_globals.as_ref().filter(|b| b.memory() > 0) {
+            m.push(("bounce kept irradiance", b.memory()));
+        }
         if let Some(b) = &self.blend {
             m.push(("voxel blend", b.bytes()));
         }

@@ -405,7 +405,12 @@ impl Renderer {
     /// have not converged.
     pub(super) fn voxel_work_pending(&self) -> bool {
         let p = &self.pending;
-        p.rebuild || p.geometry || p.lights || self.progressive_left > 0 || self.blend_left > 0
+        p.rebuild
+            || p.geometry
+            || p.lights
+            || self.progressive_left > 0
+            || self.slices_left > 0
+            || self.blend_left > 0
     }
 
     /// Records what the changes since the last voxel update need, in the fixed order:
@@ -426,13 +431,17 @@ impl Renderer {
     ) -> Option<bool> {
         let pending = std::mem::take(&mut self.pending);
         let geometry = !work.is_empty();
-        let relit = (geometry || pending.lights).then_some(pending.rebuild);
+        // With bounce slices, the updates after a change that gather the slices still due:
+        // the direct light is stored again (bounces overwrote it), filtered, and bounced.
+        let follow_up = !(geometry || pending.lights) && self.slices_left > 0;
+        let relight = geometry || pending.lights || follow_up;
+        let relit = relight.then_some(pending.rebuild);
         self.fragments.set_regions(
             &self.queue,
             work.build.unwrap_or(Region::EMPTY),
             work.update.unwrap_or(Region::EMPTY),
         );
-        if geometry || pending.lights {
+        if relight {
             self.passes.inject.prepare(
                 &self.device,
                 &self.queue,
@@ -519,26 +528,43 @@ impl Renderer {
             }
         }
         let progressive = self.options.progressive;
-        // Made once per structure and set of passes (cleared where either is made anew).
-        let bounce_globals = self
-            .bounce_globals
-            .get_or_insert_with(|| p.bounce.bind(&self.device, &*self.volume, &self.cones));
-        // One bounce, and the filtering its stored light needs.
+        let slices = self.options.bounce_slices.max(1);
+        // Made once per structure, set of passes and options (cleared where any is made anew).
+        // Progressive bounces keep one irradiance per leaf: each builds on the last.
+        let levels = if progressive { 1 } else { self.voxel_bounces };
+        let bounce_globals = self.bounce_globals.get_or_insert_with(|| {
+            p.bounce
+                .bind(&self.device, &*self.volume, &self.cones, slices, levels)
+        });
+        // This update's bounces gather at one slice of the leaves (all of them after a rebuild:
+        // the slots hold other leaves).
+        let bounces_run = if progressive {
+            self.progressive_left > 0 || relight
+        } else {
+            relight && self.voxel_bounces > 0
+        };
+        if bounces_run {
+            bounce_globals.prepare(&self.queue, self.bounce_turn, pending.rebuild);
+            self.bounce_turn = self.bounce_turn.wrapping_add(1);
+        }
+        let bounce_globals = &*bounce_globals;
+        // One bounce (the update's `i`th), and the filtering its stored light needs.
         let bounce =
             |encoder: &mut wgpu::CommandEncoder,
              timer: &mut GpuTimer,
+             i: u32,
              steps: BounceSteps,
              cut: &mut dyn FnMut(&mut wgpu::CommandEncoder, &'static str)| {
                 let volume = &*self.volume;
                 p.bounce
-                    .record(encoder, volume, bounce_globals, steps, timer);
+                    .record(encoder, volume, bounce_globals, i, steps, timer);
                 cut(encoder, "bounce");
                 if steps.store {
                     volume.record_filter(encoder, timer);
                     cut(encoder, "filter");
                 }
             };
-        if geometry || pending.lights {
+        if relight {
             let inject = if progressive {
                 InjectPass::record_direct_only
             } else {
@@ -549,8 +575,9 @@ impl Renderer {
             if progressive {
                 // One bounce per update from the previous update's light; after a change
                 // this many updates make every leaf's light converge again (the first from
-                // a cleared volume only reproduces the direct light).
-                self.progressive_left = self.voxel_bounces + 1;
+                // a cleared volume only reproduces the direct light), each slice of leaves
+                // gathering once in `slices` updates.
+                self.progressive_left = (self.voxel_bounces + 1) * slices;
             } else {
                 self.volume.record_filter(encoder, timer);
                 cut(encoder, "filter");
@@ -564,8 +591,18 @@ impl Renderer {
                         irradiance: last,
                         store: !last,
                     };
-                    bounce(encoder, timer, steps, cut);
+                    bounce(encoder, timer, i, steps, cut);
                 }
+                // After a change, every leaf gathers its first bounce within `slices` updates,
+                // its second within the `slices` after those (from first bounces all made
+                // after the change), and so on: then the light equals a full update's.
+                self.slices_left = if follow_up {
+                    self.slices_left - 1
+                } else if slices > 1 && n > 0 {
+                    n * slices - 1
+                } else {
+                    0
+                };
             }
         }
         if progressive && self.progressive_left > 0 {
@@ -577,7 +614,7 @@ impl Renderer {
                 irradiance: bounces::leaves(&self.options),
                 store: true,
             };
-            bounce(encoder, timer, steps, cut);
+            bounce(encoder, timer, 0, steps, cut);
             self.progressive_left -= 1;
         }
         // The shadow views were consumed by `record_shadows` this frame; injection's start over.
