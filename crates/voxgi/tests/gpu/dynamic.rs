@@ -445,7 +445,7 @@ fn moved_object_leaves_nothing(options: &RendererOptions) {
     }
     // The renderer with the cube sized its octree's pools for more geometry: its bricks lie
     // elsewhere in larger atlases (the tree and every leaf are equal above).
-    let tolerance = placement_tolerance(&options);
+    let tolerance = placement_tolerance(options);
     assert_close_image(
         &got,
         &want,
