@@ -384,27 +384,22 @@ fn probe_matches_cpu(anisotropic: bool) {
         radiance0: &radiance0,
         chains: &chains,
     };
-    let (mut worst, mut nonzero) = (0.0f32, 0);
+    let mut errors = Errors::default();
+    let mut nonzero = 0;
     for (q, g) in probes.iter().zip(gpu) {
         let p = Vec3::new(q[0], q[1], q[2]);
         let dir = Vec3::new(q[4], q[5], q[6]);
         let want = cpu.sample_voxels(p, q[3], dir);
-        let got = g;
-        // Filtering hardware rounds its weights (opacity steps span 0..1; radiance is a tenth
-        // of that scale here).
-        let err = (got - want).abs().max_element();
-        worst = worst.max(err);
+        errors.add((g - want).abs().max_element(), || {
+            format!("sample_voxels({p}, {}, {dir}): GPU {g}, CPU {want}", q[3])
+        });
         if want.w > 0.01 {
             nonzero += 1;
         }
-        assert!(
-            err <= filtering_tolerance(),
-            "sample_voxels({p}, {}, {dir}): GPU {got}, CPU {want}",
-            q[3]
-        );
     }
-    eprintln!(
-        "probe (anisotropic {anisotropic}): worst difference {worst:.2e}, {nonzero} of {n} samples see voxels"
+    errors.check(
+        filtering_tolerance(),
+        &format!("probe (anisotropic {anisotropic})"),
     );
     // The probe must look at something: most samples inside the box see its walls.
     assert!(nonzero > n / 4, "only {nonzero} of {n} samples see voxels");
@@ -445,7 +440,8 @@ fn octree_matches_dense(anisotropic: bool) {
     let grid = grid.unwrap();
     let (probes, want) = &results[0];
     let got = &results[1].1;
-    let (mut worst, mut nonzero, mut compared) = (0.0f32, 0, 0);
+    let mut errors = Errors::default();
+    let (mut nonzero, mut compared) = (0, 0);
     for ((q, w), g) in probes.iter().zip(want).zip(got) {
         // The dense volume keeps its chain fetches half a texel inside the volume along z at
         // the coarser level it reads (its six blocks are stacked along z); the octree clamps
@@ -459,21 +455,22 @@ fn octree_matches_dense(anisotropic: bool) {
         }
         compared += 1;
         // Both structures' fetches are filtered by the hardware (the H200 measured 1.4e-2).
-        let err = (*g - *w).abs().max_element();
-        worst = worst.max(err);
+        errors.add((*g - *w).abs().max_element(), || {
+            format!(
+                "sample_voxels({:?}, {}, {:?}): octree {g}, dense {w}",
+                &q[0..3],
+                q[3],
+                &q[4..7]
+            )
+        });
         if w.w > 0.01 {
             nonzero += 1;
         }
-        assert!(
-            err <= 2.0 * filtering_tolerance(),
-            "sample_voxels({:?}, {}, {:?}): octree {g}, dense {w}",
-            &q[0..3],
-            q[3],
-            &q[4..7]
-        );
     }
-    eprintln!(
-        "octree vs dense (anisotropic {anisotropic}): worst difference {worst:.2e}, {nonzero} of {compared} samples see voxels"
+    let (worst, mean) = filtering_tolerance();
+    errors.check(
+        (2.0 * worst, 2.0 * mean),
+        &format!("octree vs dense (anisotropic {anisotropic})"),
     );
     assert!(
         nonzero > compared / 4,
@@ -517,26 +514,26 @@ fn octree_probe_matches_cpu(anisotropic: bool) {
         even: &even,
         odd: &odd,
     };
-    let (mut worst, mut nonzero) = (0.0f32, 0);
+    let mut errors = Errors::default();
+    let mut nonzero = 0;
     for (q, got) in probes.iter().zip(gpu) {
         let p = Vec3::new(q[0], q[1], q[2]);
         let dir = Vec3::new(q[4], q[5], q[6]);
         let want = cpu.sample_voxels(p, q[3], dir);
         // As for the dense twin: the hardware's filtering weights.
-        let err = (got - want).abs().max_element();
-        worst = worst.max(err);
+        errors.add((got - want).abs().max_element(), || {
+            format!(
+                "octree sample_voxels({p}, {}, {dir}): GPU {got}, CPU {want}",
+                q[3]
+            )
+        });
         if want.w > 0.01 {
             nonzero += 1;
         }
-        assert!(
-            err <= filtering_tolerance(),
-            "octree sample_voxels({p}, {}, {dir}): GPU {got}, CPU {want}",
-            q[3]
-        );
     }
-    eprintln!(
-        "octree probe (anisotropic {anisotropic}): worst difference {worst:.2e}, {nonzero} of {} samples see voxels",
-        probes.len()
+    errors.check(
+        filtering_tolerance(),
+        &format!("octree probe (anisotropic {anisotropic})"),
     );
     assert!(
         nonzero > probes.len() / 4,
@@ -622,4 +619,40 @@ fn octree_interpolation_is_continuous_across_bricks() {
         got.len() / 2
     );
     assert!(seen > got.len() / 8, "only {seen} pairs see voxels");
+}
+
+/// The differences of many probes from their twins: the worst (with what it was) and the mean.
+#[derive(Default)]
+struct Errors {
+    worst: f32,
+    at: String,
+    sum: f64,
+    count: usize,
+}
+
+impl Errors {
+    fn add(&mut self, err: f32, what: impl FnOnce() -> String) {
+        if err > self.worst || self.count == 0 {
+            self.worst = err;
+            self.at = what();
+        }
+        self.sum += f64::from(err);
+        self.count += 1;
+    }
+
+    /// Asserts the worst and the mean within `(worst, mean)`.
+    fn check(&self, (worst, mean): (f32, f32), what: &str) {
+        let m = (self.sum / self.count.max(1) as f64) as f32;
+        eprintln!(
+            "{what}: worst difference {:.2e}, mean {m:.2e} over {} probes",
+            self.worst, self.count
+        );
+        assert!(
+            self.worst <= worst,
+            "{what}: worst {}: {}",
+            self.worst,
+            self.at
+        );
+        assert!(m <= mean, "{what}: mean difference {m}");
+    }
 }
