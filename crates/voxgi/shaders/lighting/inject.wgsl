@@ -24,9 +24,17 @@ struct InjectParams {
 @group(0) @binding(2) var<storage, read> shadow_views: array<ShadowView>;
 @group(0) @binding(3) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(4) var shadow_moments: texture_2d_array<f32>;
-// Per shadow view: the rectangle of texels (x, y from xy inclusive to zw exclusive) that
-// changed since the last injection (empty when none did).
-@group(0) @binding(5) var<storage, read> view_dirt: array<vec4<f32>>;
+// What of a shadow view changed since the last injection (`GpuViewDirt` is the twin): the
+// rectangle of texels re-rendered (x, y from xy inclusive to zw exclusive; empty when none
+// was), and whether `shadow_previous` holds their values from before (`saved.x` = 1).
+struct ViewDirt {
+    rect: vec4<f32>,
+    saved: vec4<u32>,
+}
+
+@group(0) @binding(5) var<storage, read> view_dirt: array<ViewDirt>;
+// The atlas's texels as they were at the last injection, where `view_dirt` says so.
+@group(0) @binding(7) var shadow_previous: texture_2d_array<f32>;
 // Group 2: the structure's leaves, group 3: their radiance (voxels/<kind>/leaf_store.wgsl).
 
 // false for progressive bounces: the leaves keep last frame's radiance for the bounce to build
@@ -101,11 +109,25 @@ fn leaf_inputs_changed(i: u32) -> bool {
         if nw.w > 0.3 {
             n = normalize(nw.xyz);
         }
-        if irradiance_reads(light, p, n, 1.5, view_dirt[shadow_view_index(light, p)]) {
+        let v = shadow_view_index(light, p);
+        if irradiance_reads(light, p, n, 1.5, view_dirt[v], moved_distance(shadow_views[v])) {
             return true;
         }
     }
     return false;
+}
+
+// How near view `view` can see what moved: texels change only where moved geometry was or is
+// in front, so a changed texel held or holds this distance or more. Less by a voxel for the
+// rasterizer's rounding and surfels' discs (which lie behind their points from the light).
+// With nothing moved (dirt from elsewhere), no bound.
+fn moved_distance(view: ShadowView) -> f32 {
+    let lo = params.moved_min.xyz;
+    let hi = params.moved_max.xyz;
+    if any(lo > hi) {
+        return -3.0e38;
+    }
+    return box_distance(view, lo, hi) - leaf_size();
 }
 
 // The leaves `mark` found changed: [0] how many, then their indices. `main` recomputes only
@@ -154,4 +176,119 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if STORE_RADIANCE {
         store_leaf_radiance(s, r);
     }
+}
+
+// Whether `light_visibility(light, p, n, softness)` reads a texel of the shadow view
+// `shadow_view_index(light, p)` inside the texel rectangle `dirt` (x, y from xy inclusive to
+// zw exclusive) that can change what it computes. Follows its reads tap by tap: the blocker
+// search's texels and, when it found blockers, each filter tap's 2x2 texels (the radius
+// depends on the blockers, which are then what they were).
+//
+// `near`: no texel of `dirt` held or holds an occluder nearer than this (the view's distance
+// of what moved). A texel counts in a tap only where it lies nearer than the receiver plane
+// there (a blocker, a shadowing comparison): a changed texel read where the plane is no
+// farther than `near` was and is neither, and changes nothing. The moments (VSM/ESM) average
+// every texel: there any changed texel read counts.
+fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: ViewDirt, near: f32) -> bool {
+    let s = shadow_setup(light, p, n);
+    let view = s.view;
+    var radius = softness * s.texel_uv;
+    var taps = PCF_TAPS;
+    if is_area_light(light) {
+        let search = pcss_search(light, view, s.d0);
+        for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
+            let o = s.uv + vogel(i, PCSS_SEARCH_TAPS) * search;
+            if texel_dirty(view, vec2<i32>(floor(o * view.resolution)), dirt) && may_block(s, o, near) {
+                return true;
+            }
+        }
+        let blockers = pcss_blockers(s, search);
+        if blockers.x == 0.0 {
+            return false;
+        }
+        radius = pcss_radius(light, s, blockers);
+        taps = PCSS_TAPS;
+    } else if SHADOW_MOMENTS {
+        // One bilinear lookup of moments, each the 5x5 disc around its texel.
+        // A moment texel changes where any depth texel of its disc did: the rectangle grown.
+        let grown = ViewDirt(dirt.rect + vec4<f32>(-MOMENT_RADIUS, -MOMENT_RADIUS, MOMENT_RADIUS, MOMENT_RADIUS), vec4<u32>(0u));
+        return tap_dirty(view, s.uv, grown);
+    }
+    for (var i = 0u; i < taps; i++) {
+        let o = s.uv + vogel(i, taps) * radius;
+        if tap_dirty(view, o, dirt) && may_block(s, o, near) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Whether a texel at `near` or farther can be a blocker or shadow a comparison at uv: whether
+// the receiver plane there, less the bias, lies beyond it (with a margin for the rounding of
+// the lookup's own sum).
+fn may_block(s: ShadowSetup, uv: vec2<f32>, near: f32) -> bool {
+    let d = plane_at(s.rp, uv) - s.bias;
+    return d + abs(d) * 1e-5 > near;
+}
+
+// Whether `shadow_texel(view, t)` reads a texel that changed: one inside `dirt`'s rectangle
+// and, where the texels there were saved before their re-render, one that differs from its
+// saved value.
+fn texel_dirty(view: ShadowView, t: vec2<i32>, dirt: ViewDirt) -> bool {
+    let r = i32(view.resolution);
+    let i = clamp(t, vec2<i32>(0), vec2<i32>(r - 1));
+    let c = vec2<f32>(i);
+    if any(c < dirt.rect.xy) || any(c >= dirt.rect.zw) {
+        return false;
+    }
+    if dirt.saved.x == 0u {
+        return true;
+    }
+    let a = i + vec2<i32>(view.offset);
+    return textureLoad(shadow_previous, a, i32(view.layer), 0).r != textureLoad(shadow_maps, a, i32(view.layer), 0).r;
+}
+
+// Whether `shadow_tap(view, uv, ..)` reads inside `dirt`.
+fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: ViewDirt) -> bool {
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+        return false;
+    }
+    let i = vec2<i32>(floor(uv * view.resolution - 0.5));
+    return texel_dirty(view, i, dirt)
+        || texel_dirty(view, i + vec2<i32>(1, 0), dirt)
+        || texel_dirty(view, i + vec2<i32>(0, 1), dirt)
+        || texel_dirty(view, i + vec2<i32>(1, 1), dirt);
+}
+
+// Whether `light_irradiance(light, p, n, softness)` reads a texel inside `dirt` of the view
+// it looks up (see `shadow_reads`); false when it returns before any lookup.
+fn irradiance_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: ViewDirt, near: f32) -> bool {
+    if light.shadow_count == 0u || dirt.rect.x >= dirt.rect.z {
+        return false;
+    }
+    // (Area lights: the polygon integral that could rule the light out costs more than the
+    // lookups' test.)
+    if !is_area_light(light) {
+        var l = -light.direction;
+        if light.kind != LIGHT_DIRECTIONAL {
+            l = normalize(light.position - p);
+        }
+        // Clearly facing away only: light_irradiance's own test rounds differently.
+        if dot(n, l) < -1e-4 {
+            return false;
+        }
+    }
+    return shadow_reads(light, p, n, softness, dirt, near);
+}
+
+// The nearest distance view `view` stores (`occluder_distance` in lighting/shadow.wgsl) of
+// anything inside the world box lo..hi: the box's nearest corner along an orthographic view's
+// direction, the box's nearest point to a perspective view's origin.
+fn box_distance(view: ShadowView, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
+    if view.kind == SHADOW_ORTHO {
+        let d = view.dir;
+        let corner = select(hi, lo, d >= vec3<f32>(0.0));
+        return dot(corner - view.origin, d);
+    }
+    return length(clamp(view.origin, lo, hi) - view.origin);
 }

@@ -34,6 +34,18 @@ pub struct InjectPass {
     dirt: wgpu::Buffer,
 }
 
+/// Mirrors `ViewDirt` in shaders/lighting/inject.wgsl: what of a shadow view changed since the
+/// last injection.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct GpuViewDirt {
+    /// The texels re-rendered (`ViewDirt::to_gpu`).
+    pub(crate) rect: [f32; 4],
+    /// [0]: 1 when the atlas's `previous` holds the rectangle's texels as they were at the
+    /// last injection (then only those that differ changed).
+    pub(crate) saved: [u32; 4],
+}
+
 /// Mirrors `InjectParams` in shaders/lighting/inject.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -62,6 +74,12 @@ impl InjectPass {
         entries.extend(ShadowAtlas::lighting_layout(c));
         entries.push(layout::storage(5, c, true));
         entries.push(layout::storage(6, c, false));
+        entries.push(layout::texture(
+            7,
+            c,
+            wgpu::TextureSampleType::Float { filterable: false },
+            wgpu::TextureViewDimension::D2Array,
+        ));
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("inject globals"),
             entries: &entries,
@@ -124,7 +142,7 @@ impl InjectPass {
             }),
             dirt: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("inject view dirt"),
-                contents: &vec![0u8; 16 * views.max(1)],
+                contents: &vec![0u8; size_of::<GpuViewDirt>() * views.max(1)],
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }),
         }
@@ -147,6 +165,7 @@ impl InjectPass {
         store_all: bool,
         moved: Option<voxgi_scene::Aabb>,
         views: &[ViewDirt],
+        saved: &[Option<bool>],
         res: u32,
     ) {
         let (lo, hi) = moved.map_or(([1.0, 1.0, 1.0, 0.0], [-1.0, -1.0, -1.0, 0.0]), |b| {
@@ -171,6 +190,7 @@ impl InjectPass {
             resources.extend(atlas.lighting_resources(scene));
             resources.push(self.dirt.as_entire_binding());
             resources.push(self.todo.as_entire_binding());
+            resources.push(wgpu::BindingResource::TextureView(&atlas.previous_view));
             let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("inject globals"),
                 layout: &self.globals,
@@ -178,7 +198,14 @@ impl InjectPass {
             });
             self.bound = Some((atlas.texture.clone(), globals));
         }
-        let dirt: Vec<[f32; 4]> = views.iter().map(|v| v.to_gpu(res)).collect();
+        let dirt: Vec<GpuViewDirt> = views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| GpuViewDirt {
+                rect: v.to_gpu(res),
+                saved: [u32::from(saved.get(i) == Some(&Some(true))), 0, 0, 0],
+            })
+            .collect();
         if !dirt.is_empty() {
             queue.write_buffer(&self.dirt, 0, bytemuck::cast_slice(&dirt));
         }
@@ -262,6 +289,13 @@ impl InjectPass {
     }
 }
 
+impl InjectPass {
+    /// The list of leaves the last injection recomputed: a count, then their slots.
+    pub fn recomputed(&self) -> &wgpu::Buffer {
+        &self.todo
+    }
+}
+
 /// Bytes of the list of leaves to recompute: a count and a slot per leaf.
 fn todo_bytes(voxels: &dyn VoxelStructure) -> u64 {
     (voxels.leaf_capacity() + 1) * 4
@@ -271,7 +305,9 @@ fn todo_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("inject todo"),
         size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     })
 }

@@ -267,8 +267,8 @@ impl Renderer {
             &mut gpu_scene,
             &facts.casts,
             options,
-            center,
-            radius,
+            (center, radius),
+            facts.dynamic,
         )?;
         let grid = grid(&facts, options);
         for (c, pc) in scene.point_clouds.iter().enumerate() {
@@ -429,8 +429,8 @@ impl Renderer {
                 &mut self.scene,
                 &self.facts.casts,
                 new,
-                self.center,
-                self.radius,
+                (self.center, self.radius),
+                self.facts.dynamic,
             )?)
         } else {
             None
@@ -706,6 +706,14 @@ impl Renderer {
             fragments: read(&self.fragments.count)?,
             occupied: read(self.volume.pool_counter())?,
         })
+    }
+
+    /// How many leaves the last voxel update's injection lit anew (those whose direct light
+    /// may have changed), read back now. This waits for the GPU: it is for tools and tests.
+    pub fn relit_leaves(&self) -> Result<u64> {
+        let bytes =
+            readback::read_buffer_copy(&self.device, &self.queue, self.passes.inject.recomputed())?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[0] as u64)
     }
 
     /// The fragments of the last build, for tests and debugging.
