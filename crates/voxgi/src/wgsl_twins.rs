@@ -11,7 +11,7 @@ use crate::lighting::atlas::GpuShadowView;
 use crate::lighting::blend::GpuBlend;
 use crate::lighting::bounce::GpuSlices;
 use crate::lighting::cones::GpuCones;
-use crate::lighting::inject::{GpuInjectParams, GpuViewDirt};
+use crate::lighting::inject::GpuInjectParams;
 use crate::lighting::moments::GpuMomentRect;
 use crate::reference::progressive::GpuDisplay;
 use crate::reference::{GpuNode, GpuParams, GpuTri, GpuTriShading};
@@ -153,7 +153,6 @@ fn every_twin_has_the_wgsl_layout() {
         [weight, restart, from_bounce, store_all]
     );
     twin!(m, GpuSlices, "Slices", [count, turn, all, capacity]);
-    twin!(m, GpuViewDirt, "ViewDirt", [rect, saved]);
     twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
     twin!(
         m,

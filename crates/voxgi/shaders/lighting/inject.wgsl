@@ -24,17 +24,9 @@ struct InjectParams {
 @group(0) @binding(2) var<storage, read> shadow_views: array<ShadowView>;
 @group(0) @binding(3) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(4) var shadow_moments: texture_2d_array<f32>;
-// What of a shadow view changed since the last injection (`GpuViewDirt` is the twin): the
-// rectangle of texels re-rendered (x, y from xy inclusive to zw exclusive; empty when none
-// was), and whether `shadow_previous` holds their values from before (`saved.x` = 1).
-struct ViewDirt {
-    rect: vec4<f32>,
-    saved: vec4<u32>,
-}
-
-@group(0) @binding(5) var<storage, read> view_dirt: array<ViewDirt>;
-// The atlas's texels as they were at the last injection, where `view_dirt` says so.
-@group(0) @binding(7) var shadow_previous: texture_2d_array<f32>;
+// Per shadow view: the rectangle of texels (x, y from xy inclusive to zw exclusive) that
+// changed since the last injection (empty when none did).
+@group(0) @binding(5) var<storage, read> view_dirt: array<vec4<f32>>;
 // Group 2: the structure's leaves, group 3: their radiance (voxels/<kind>/leaf_store.wgsl).
 
 // false for progressive bounces: the leaves keep last frame's radiance for the bounce to build
@@ -189,16 +181,26 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 // there (a blocker, a shadowing comparison): a changed texel read where the plane is no
 // farther than `near` was and is neither, and changes nothing. The moments (VSM/ESM) average
 // every texel: there any changed texel read counts.
-fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: ViewDirt, near: f32) -> bool {
+fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>, near: f32) -> bool {
+    // First whether the lookup can reach the rectangle at all (PCSS's search and filter radii
+    // are at most 0.25, PCF's is `softness` texels; a bilinear tap a texel more, the moments'
+    // disc MOMENT_RADIUS more): most leaves are far from it, and the rest of the test costs a
+    // lookup's setup.
+    let view = shadow_views[shadow_view_index(light, p)];
+    let res = view.resolution;
+    let reach = select(softness, 0.25 * res, is_area_light(light)) + 2.0 + MOMENT_RADIUS;
+    let at = shadow_uv(view, p).xy * res;
+    if any(at + reach < dirt.xy) || any(at - reach >= dirt.zw) {
+        return false;
+    }
     let s = shadow_setup(light, p, n);
-    let view = s.view;
     var radius = softness * s.texel_uv;
     var taps = PCF_TAPS;
     if is_area_light(light) {
         let search = pcss_search(light, view, s.d0);
         for (var i = 0u; i < PCSS_SEARCH_TAPS; i++) {
             let o = s.uv + vogel(i, PCSS_SEARCH_TAPS) * search;
-            if texel_dirty(view, vec2<i32>(floor(o * view.resolution)), dirt) && may_block(s, o, near) {
+            if may_block(s, o, near) && texel_dirty(view, vec2<i32>(floor(o * view.resolution)), dirt) {
                 return true;
             }
         }
@@ -209,14 +211,14 @@ fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: V
         radius = pcss_radius(light, s, blockers);
         taps = PCSS_TAPS;
     } else if SHADOW_MOMENTS {
-        // One bilinear lookup of moments, each the 5x5 disc around its texel.
-        // A moment texel changes where any depth texel of its disc did: the rectangle grown.
-        let grown = ViewDirt(dirt.rect + vec4<f32>(-MOMENT_RADIUS, -MOMENT_RADIUS, MOMENT_RADIUS, MOMENT_RADIUS), vec4<u32>(0u));
+        // One bilinear lookup of moments, each the 5x5 disc around its texel: a moment texel
+        // changes where any depth texel of its disc did.
+        let grown = dirt + vec4<f32>(-MOMENT_RADIUS, -MOMENT_RADIUS, MOMENT_RADIUS, MOMENT_RADIUS);
         return tap_dirty(view, s.uv, grown);
     }
     for (var i = 0u; i < taps; i++) {
         let o = s.uv + vogel(i, taps) * radius;
-        if tap_dirty(view, o, dirt) && may_block(s, o, near) {
+        if may_block(s, o, near) && tap_dirty(view, o, dirt) {
             return true;
         }
     }
@@ -231,25 +233,15 @@ fn may_block(s: ShadowSetup, uv: vec2<f32>, near: f32) -> bool {
     return d + abs(d) * 1e-5 > near;
 }
 
-// Whether `shadow_texel(view, t)` reads a texel that changed: one inside `dirt`'s rectangle
-// and, where the texels there were saved before their re-render, one that differs from its
-// saved value.
-fn texel_dirty(view: ShadowView, t: vec2<i32>, dirt: ViewDirt) -> bool {
+// Whether `shadow_texel(view, t)` reads inside `dirt`.
+fn texel_dirty(view: ShadowView, t: vec2<i32>, dirt: vec4<f32>) -> bool {
     let r = i32(view.resolution);
-    let i = clamp(t, vec2<i32>(0), vec2<i32>(r - 1));
-    let c = vec2<f32>(i);
-    if any(c < dirt.rect.xy) || any(c >= dirt.rect.zw) {
-        return false;
-    }
-    if dirt.saved.x == 0u {
-        return true;
-    }
-    let a = i + vec2<i32>(view.offset);
-    return textureLoad(shadow_previous, a, i32(view.layer), 0).r != textureLoad(shadow_maps, a, i32(view.layer), 0).r;
+    let c = vec2<f32>(clamp(t, vec2<i32>(0), vec2<i32>(r - 1)));
+    return all(c >= dirt.xy) && all(c < dirt.zw);
 }
 
 // Whether `shadow_tap(view, uv, ..)` reads inside `dirt`.
-fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: ViewDirt) -> bool {
+fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: vec4<f32>) -> bool {
     if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
         return false;
     }
@@ -262,8 +254,8 @@ fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: ViewDirt) -> bool {
 
 // Whether `light_irradiance(light, p, n, softness)` reads a texel inside `dirt` of the view
 // it looks up (see `shadow_reads`); false when it returns before any lookup.
-fn irradiance_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: ViewDirt, near: f32) -> bool {
-    if light.shadow_count == 0u || dirt.rect.x >= dirt.rect.z {
+fn irradiance_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>, near: f32) -> bool {
+    if light.shadow_count == 0u || dirt.x >= dirt.z {
         return false;
     }
     // (Area lights: the polygon integral that could rule the light out costs more than the

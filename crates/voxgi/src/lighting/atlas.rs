@@ -77,12 +77,6 @@ pub struct ShadowAtlas {
     /// `moments` as a 2D-array view.
     pub moments_view: wgpu::TextureView,
     pub(crate) depth_view: wgpu::TextureView,
-    /// For scenes with dynamic geometry: the texels of `texture` as they were before the
-    /// re-renders since the last injection, inside each view's rectangle that `save_previous`
-    /// copied (injection compares them to tell the texels that changed); otherwise one texel.
-    pub previous: wgpu::Texture,
-    /// `previous` as a 2D-array view.
-    pub previous_view: wgpu::TextureView,
     /// `views` as a storage buffer (binding 2 of `lighting_layout`).
     pub views_buffer: wgpu::Buffer,
     /// Each view's `GpuShadowView` at a `UNIFORM_STRIDE` offset (the shadow pass's dynamic
@@ -501,7 +495,6 @@ impl ShadowAtlas {
         res: u32,
         moments: bool,
         samples: bool,
-        dynamic: bool,
     ) -> Self {
         let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
         // Sample views are the quarter-size ones, after all the others (`plan_views`).
@@ -539,9 +532,7 @@ impl ShadowAtlas {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: ATLAS_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
         let layer_views = (0..layers)
@@ -556,25 +547,6 @@ impl ShadowAtlas {
             })
             .collect();
         let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let (pres, players) = if dynamic { (res, layers) } else { (1, 1) };
-        let previous = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow previous"),
-            size: wgpu::Extent3d {
-                width: pres,
-                height: pres,
-                depth_or_array_layers: players,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: ATLAS_FORMAT,
-            usage: wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let previous_view = previous.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
@@ -618,8 +590,6 @@ impl ShadowAtlas {
             moments,
             moments_view,
             depth_view: depth.create_view(&Default::default()),
-            previous,
-            previous_view,
             samples,
             first_sample,
         }
@@ -659,51 +629,6 @@ impl ShadowAtlas {
             );
             self.views[first..first + views.len()].copy_from_slice(&views);
         }
-    }
-
-    /// Copies the texels view `v` re-renders for `dirt` into `previous` (before the render):
-    /// what they were, for injection to tell the changed ones. Whether it did: only a
-    /// rectangle of an atlas that keeps them (a scene with dynamic geometry).
-    pub fn save_previous(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        v: usize,
-        dirt: ViewDirt,
-    ) -> bool {
-        let view = &self.views[v];
-        let (ViewDirt::Rect { .. }, Some((x, y, w, h))) =
-            (dirt, dirt.scissor(view.resolution as u32))
-        else {
-            return false;
-        };
-        if self.previous.width() != self.texture.width() {
-            return false;
-        }
-        let origin = wgpu::Origin3d {
-            x: x + view.offset[0] as u32,
-            y: y + view.offset[1] as u32,
-            z: view.layer,
-        };
-        encoder.copy_texture_to_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &self.texture,
-                mip_level: 0,
-                origin,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyTextureInfo {
-                texture: &self.previous,
-                mip_level: 0,
-                origin,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        true
     }
 
     /// Replaces the views by `views` (re-planned after lights moved: the same number, owned by
@@ -755,26 +680,25 @@ impl ShadowAtlas {
 
     /// GPU memory of the atlas in bytes, counted as 8 bytes per texel of every layer (the R32F
     /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound),
-    /// plus the moments and the previous texels.
+    /// plus the moments.
     pub fn bytes(&self) -> u64 {
         let texels = |t: &wgpu::Texture| {
             t.width() as u64 * t.height() as u64 * t.depth_or_array_layers() as u64
         };
-        texels(&self.texture) * 8 + texels(&self.moments) * 16 + texels(&self.previous) * 4
+        texels(&self.texture) * 8 + texels(&self.moments) * 16
     }
 }
 
 /// Plans the shadow views for the options (writing each light's views into `scene`'s
-/// lights) and makes the atlas that holds them, for a scene within the sphere `(center,
-/// radius)`; `dynamic`: it has moving geometry (the atlas keeps the texels re-renders replace).
+/// lights) and makes the atlas that holds them.
 pub fn plan_atlas(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     scene: &mut GpuScene,
     casts: &[bool],
     options: &RendererOptions,
-    (center, radius): (Vec3, f32),
-    dynamic: bool,
+    center: Vec3,
+    radius: f32,
 ) -> Result<ShadowAtlas> {
     let res = atlas_resolution(options, &scene.gpu_lights);
     // Area-light shadows sampled over frames need the frames' accumulation.
@@ -784,7 +708,7 @@ pub fn plan_atlas(
     check_atlas(&views, casts, res, moments, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
-        ShadowAtlas::new(device, views, owners, res, moments, samples, dynamic)
+        ShadowAtlas::new(device, views, owners, res, moments, samples)
     })
 }
 

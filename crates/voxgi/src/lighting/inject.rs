@@ -34,18 +34,6 @@ pub struct InjectPass {
     dirt: wgpu::Buffer,
 }
 
-/// Mirrors `ViewDirt` in shaders/lighting/inject.wgsl: what of a shadow view changed since the
-/// last injection.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct GpuViewDirt {
-    /// The texels re-rendered (`ViewDirt::to_gpu`).
-    pub(crate) rect: [f32; 4],
-    /// [0]: 1 when the atlas's `previous` holds the rectangle's texels as they were at the
-    /// last injection (then only those that differ changed).
-    pub(crate) saved: [u32; 4],
-}
-
 /// Mirrors `InjectParams` in shaders/lighting/inject.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -74,12 +62,6 @@ impl InjectPass {
         entries.extend(ShadowAtlas::lighting_layout(c));
         entries.push(layout::storage(5, c, true));
         entries.push(layout::storage(6, c, false));
-        entries.push(layout::texture(
-            7,
-            c,
-            wgpu::TextureSampleType::Float { filterable: false },
-            wgpu::TextureViewDimension::D2Array,
-        ));
         let globals = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("inject globals"),
             entries: &entries,
@@ -142,7 +124,7 @@ impl InjectPass {
             }),
             dirt: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("inject view dirt"),
-                contents: &vec![0u8; size_of::<GpuViewDirt>() * views.max(1)],
+                contents: &vec![0u8; 16 * views.max(1)],
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }),
         }
@@ -165,7 +147,6 @@ impl InjectPass {
         store_all: bool,
         moved: Option<voxgi_scene::Aabb>,
         views: &[ViewDirt],
-        saved: &[Option<bool>],
         res: u32,
     ) {
         let (lo, hi) = moved.map_or(([1.0, 1.0, 1.0, 0.0], [-1.0, -1.0, -1.0, 0.0]), |b| {
@@ -190,7 +171,6 @@ impl InjectPass {
             resources.extend(atlas.lighting_resources(scene));
             resources.push(self.dirt.as_entire_binding());
             resources.push(self.todo.as_entire_binding());
-            resources.push(wgpu::BindingResource::TextureView(&atlas.previous_view));
             let globals = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("inject globals"),
                 layout: &self.globals,
@@ -198,14 +178,7 @@ impl InjectPass {
             });
             self.bound = Some((atlas.texture.clone(), globals));
         }
-        let dirt: Vec<GpuViewDirt> = views
-            .iter()
-            .enumerate()
-            .map(|(i, v)| GpuViewDirt {
-                rect: v.to_gpu(res),
-                saved: [u32::from(saved.get(i) == Some(&Some(true))), 0, 0, 0],
-            })
-            .collect();
+        let dirt: Vec<[f32; 4]> = views.iter().map(|v| v.to_gpu(res)).collect();
         if !dirt.is_empty() {
             queue.write_buffer(&self.dirt, 0, bytemuck::cast_slice(&dirt));
         }

@@ -267,8 +267,8 @@ impl Renderer {
             &mut gpu_scene,
             &facts.casts,
             options,
-            (center, radius),
-            facts.dynamic,
+            center,
+            radius,
         )?;
         let grid = grid(&facts, options);
         for (c, pc) in scene.point_clouds.iter().enumerate() {
@@ -429,8 +429,8 @@ impl Renderer {
                 &mut self.scene,
                 &self.facts.casts,
                 new,
-                (self.center, self.radius),
-                self.facts.dynamic,
+                self.center,
+                self.radius,
             )?)
         } else {
             None

@@ -371,16 +371,6 @@ impl Renderer {
         if let Some(samples) = views.get_mut(self.atlas.sample_views()) {
             samples.fill(dirt);
         }
-        // The texels the first re-render since the last injection overwrites, as they were
-        // (its rectangle is then all that changed since); after a second one, the texels
-        // saved no longer tell what changed since the injection.
-        self.pending.saved.resize(views.len(), None);
-        for (v, &dirt) in views.iter().enumerate() {
-            if dirt != ViewDirt::Clean {
-                let first = self.pending.saved[v].is_none();
-                self.pending.saved[v] = Some(first && self.atlas.save_previous(encoder, v, dirt));
-            }
-        }
         if views.iter().any(|&v| v != ViewDirt::Clean) {
             let p = &self.passes;
             let vsm = self.options.shadow_filter == ShadowFilter::VsmEsm;
@@ -464,7 +454,6 @@ impl Renderer {
                 bounces::stored_bounces(&self.options, self.voxel_bounces) > 0,
                 pending.moved,
                 &pending.inject_views,
-                &pending.saved,
                 self.atlas.texture.width(),
             );
         }

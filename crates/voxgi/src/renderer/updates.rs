@@ -27,11 +27,6 @@ pub(super) struct Pending {
     /// What of each view changed since the last injection: the leaves reading only texels
     /// outside it keep their direct light.
     pub(super) inject_views: Vec<ViewDirt>,
-    /// Per view, once re-rendered since the last injection: whether the atlas's `previous`
-    /// holds the texels of `inject_views`' rectangle as they were at the last injection
-    /// (saved before that one re-render, and no other since), so that injection can tell
-    /// which changed. `None` (or missing): not re-rendered since.
-    pub(super) saved: Vec<Option<bool>>,
     /// Where dynamic geometry was or is now since the last injection (world space): leaves
     /// there are re-injected, their voxels may have changed.
     pub(super) moved: Option<Aabb>,

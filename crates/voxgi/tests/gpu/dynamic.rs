@@ -1123,14 +1123,14 @@ fn bounce_slices_end_like_a_full_bounce() {
     }
 }
 
-/// Injection re-lights a leaf only where its shadow lookup reads a texel that changed (one of
-/// the re-rendered rectangle whose value differs from what it was at the last injection) and
-/// can matter there: a changed texel lies at least as far as the moved geometry's nearest
-/// point, and counts only where it lies nearer the light than the receiver plane (a blocker,
-/// a shadowing tap). The Cornell box's area light searches up to a quarter of its map for
-/// blockers, and the rectangle spans the cube's old and new places: before these tests more
-/// than half the leaves were re-lit when the cube slid on the floor; now under two fifths.
-/// Exact, as the sequences above check; here the count, for both structures.
+/// Injection re-lights a leaf only where its shadow lookup reads a texel of the re-rendered
+/// rectangle that can matter there: a changed texel lies at least as far as the moved
+/// geometry's nearest point, and counts only where it lies nearer the light than the receiver
+/// plane (a blocker, a shadowing tap). The Cornell box's area light searches up to a quarter
+/// of its map for blockers, and the rectangle spans the cube's old and new places: by the
+/// rectangle alone 52 % of the leaves were re-lit when the cube slid on the floor; the leaves
+/// nearer the light than the cube keep their light now, under half. Exact, as the sequences
+/// above check; here the count, for both structures.
 #[test]
 fn injection_relights_only_what_can_see_the_move() {
     for &voxels in voxgi::VoxelKind::ALL {
@@ -1159,7 +1159,7 @@ fn injection_relights_only_what_can_see_the_move() {
         eprintln!("{what}: {relit} of {leaves} leaves re-lit after the cube slid");
         assert!(relit > 0, "{what}: the cube's own leaves are new");
         assert!(
-            relit * 5 < leaves * 2,
+            relit * 2 < leaves,
             "{what}: {relit} of {leaves} leaves re-lit"
         );
     }
