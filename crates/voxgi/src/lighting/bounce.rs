@@ -37,7 +37,7 @@ pub struct GpuSlices {
 pub struct BounceGlobals {
     levels: Vec<(wgpu::BindGroup, wgpu::BindGroup)>,
     uniform: wgpu::Buffer,
-    gathered: wgpu::Buffer,
+    gathered: Vec<wgpu::Buffer>,
     /// `mark`'s count and the gather's dispatch size.
     listing: wgpu::Buffer,
     capacity: u32,
@@ -69,7 +69,7 @@ impl BounceGlobals {
     /// Bytes of the kept irradiance and the lists (none with one slice).
     pub fn memory(&self) -> u64 {
         if self.slices > 1 {
-            self.gathered.size()
+            self.gathered.iter().map(|b| b.size()).sum()
         } else {
             0
         }
@@ -194,28 +194,20 @@ impl BouncePass {
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
         );
         let capacity = voxels.leaf_capacity().max(1);
-        // Per bounce: four words a slot, the count, a word a slot; each bounce's range starts
-        // on the storage-offset alignment (256 bytes at most).
-        let range = (5 * capacity + 1) * 4;
-        let (levels, stride) = if slices > 1 {
-            (bounces.max(1), range.next_multiple_of(256))
+        // Per bounce (a buffer each: many bounces of a large structure would pass the largest
+        // buffer a device makes): four words a slot, the count, a word a slot.
+        let (levels, size) = if slices > 1 {
+            (bounces.max(1), (5 * capacity + 1) * 4)
         } else {
-            (1, 256)
+            (1, 16)
         };
-        let gathered = buffer(
-            "bounce gathered",
-            stride * u64::from(levels),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let levels = (0..u64::from(levels))
-            .map(|i| {
-                let part = || {
-                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &gathered,
-                        offset: i * stride,
-                        size: std::num::NonZeroU64::new(stride.min(range)),
-                    })
-                };
+        let gathered: Vec<wgpu::Buffer> = (0..levels)
+            .map(|_| buffer("bounce gathered", size, wgpu::BufferUsages::STORAGE))
+            .collect();
+        let levels = gathered
+            .iter()
+            .map(|part| {
+                let part = || part.as_entire_binding();
                 let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
                 let gather = device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("bounce globals"),
