@@ -123,7 +123,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     );
     let mut per_pass: Vec<(&'static str, Vec<f64>)> = Vec::new();
     let mut totals = Vec::new();
-    let (mut voxel_sums, mut screen_sums) = (Vec::new(), Vec::new());
+    let (mut voxel_sums, mut screen_sums, mut gi_sums) = (Vec::new(), Vec::new(), Vec::new());
+    // The indirect light's passes: the voxel update, the blend of its light and the per-pixel
+    // gather with its upsample (not the G-buffer, the composite, accumulation or tone mapping).
+    let gi_passes: Vec<&str> = voxgi::voxel_passes()
+        .iter()
+        .copied()
+        .chain(["blend", "gather", "upsample"])
+        .collect();
     let mut walls = Vec::new();
     let mut sequence_frames: Vec<voxgi::SequenceFrame> = Vec::new();
     let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
@@ -163,6 +170,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             .map(|(_, ms)| ms)
             .sum();
         voxel_sums.push(voxel);
+        gi_sums.push(
+            times
+                .iter()
+                .filter(|(n, _)| gi_passes.contains(n))
+                .map(|(_, ms)| ms)
+                .sum::<f64>(),
+        );
         screen_sums.push(totals[totals.len() - 1] - voxel);
         walls.push(wall);
         for (name, ms) in times {
@@ -209,6 +223,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for (name, v) in [
         ("voxel update", &mut voxel_sums),
         ("screen", &mut screen_sums),
+        ("GI", &mut gi_sums),
     ] {
         v.sort_by(f64::total_cmp);
         let (med, p95) = (percentile(v, 0.5), percentile(v, 0.95));
