@@ -60,13 +60,9 @@ fn slice_of(c: vec3<u32>) -> u32 {
     return h % slices.count;
 }
 
-fn flat_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
-    return gid.x + gid.y * nwg.x * 64u;
-}
-
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = flat_index(gid, nwg);
+    let s = dispatch_index(gid, nwg);
     if s >= leaf_count() {
         return;
     }
@@ -95,7 +91,7 @@ override IRRADIANCE: bool = false;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    var s = flat_index(gid, nwg);
+    var s = dispatch_index(gid, nwg);
     if slices.count > 1u && slices.all == 0u {
         if s >= gathered[list_start()] {
             return;

@@ -5,7 +5,7 @@
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = gid.x + gid.y * nwg.x * 64u;
+    let s = dispatch_index(gid, nwg);
     if s >= leaf_count() {
         return;
     }

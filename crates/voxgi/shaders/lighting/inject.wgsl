@@ -129,13 +129,9 @@ fn moved_distance(view: ShadowView) -> f32 {
 // Group 1, `prepare` only: `main`'s indirect dispatch size.
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
 
-fn flat_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
-    return gid.x + gid.y * nwg.x * 64u;
-}
-
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = flat_index(gid, nwg);
+    let s = dispatch_index(gid, nwg);
     if s >= leaf_count() {
         return;
     }
@@ -158,7 +154,7 @@ fn prepare() {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let i = flat_index(gid, nwg);
+    let i = dispatch_index(gid, nwg);
     if i >= atomicLoad(&todo[0]) {
         return;
     }

@@ -48,6 +48,12 @@ fn ndf_weight(normal: vec4<f32>, dir: u32) -> f32 {
     return select(w, 1.0, len < 1e-4);
 }
 
+// The leaf slot (or list entry) a thread of a leaf dispatch takes: workgroups of 64 in rows of
+// at most 65535 (`VoxelStructure::bindings().leaf_dispatch` and the lists sized like it).
+fn dispatch_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * 64u;
+}
+
 // Voxel linear index <-> coordinates (x fastest).
 fn voxel_coord(i: u32, res: u32) -> vec3<u32> {
     return vec3<u32>(i % res, (i / res) % res, i / (res * res));

@@ -106,6 +106,14 @@ fn assert_same_image(a: &voxgi::RenderOutput, b: &voxgi::RenderOutput, what: &st
     assert_close_image(a, b, 0.0, what);
 }
 
+fn largest_hdr_difference(a: &voxgi::RenderOutput, b: &voxgi::RenderOutput) -> f32 {
+    a.hdr
+        .iter()
+        .zip(&b.hdr)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f32, f32::max)
+}
+
 /// `assert_same_image` with HDR values allowed `tolerance` apart; the 8-bit images then equal
 /// but for a value rounded the other way (one code value), and exactly without a tolerance.
 fn assert_close_image(
@@ -114,12 +122,7 @@ fn assert_close_image(
     tolerance: f32,
     what: &str,
 ) {
-    let worst = a
-        .hdr
-        .iter()
-        .zip(&b.hdr)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0f32, f32::max);
+    let worst = largest_hdr_difference(a, b);
     assert!(worst <= tolerance, "{what}: HDR differs by up to {worst}");
     if tolerance == 0.0 {
         assert!(a.ldr == b.ldr, "{what}: 8-bit image differs");
@@ -1033,6 +1036,20 @@ fn the_dense_filter_redoes_only_what_changed() {
     }
 }
 
+/// The Cornell box with the dynamic cube at (0.40, 0.15), rendered once by a renderer with
+/// `options`, then moved to (0.25, 0.40) in both: the scene as it is now, the renderer (its
+/// next frame updates the voxels) and the frame parameters.
+fn cube_slid(options: &RendererOptions) -> (Scene, Renderer, FrameParams) {
+    let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
+    let mut r = renderer(&scene, options);
+    let p = params(&r);
+    frame(&mut r, &p, SIZE, SIZE);
+    let m = cube_at((0.25, 0.40));
+    r.set_instance_transform(cube, m).expect("dynamic");
+    scene.instances[cube].transform = m;
+    (scene, r, p)
+}
+
 /// With temporal accumulation the voxels' light blends towards a change over a few frames,
 /// storing only the leaves whose light still moves, and the filter after each step redoes
 /// only around them: once the blend lands, the volume (every mip level) equals a fresh
@@ -1046,13 +1063,7 @@ fn a_blended_change_ends_like_a_fresh_build() {
             temporal: true,
             ..options()
         };
-        let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
-        let mut r = renderer(&scene, &options);
-        let p = params(&r);
-        frame(&mut r, &p, SIZE, SIZE);
-        let m = cube_at((0.25, 0.40));
-        r.set_instance_transform(cube, m).expect("dynamic");
-        scene.instances[cube].transform = m;
+        let (scene, mut r, p) = cube_slid(&options);
         for _ in 0..6 {
             frame(&mut r, &p, SIZE, SIZE);
         }
@@ -1084,23 +1095,12 @@ fn bounce_slices_end_like_a_full_bounce() {
                 ..options()
             };
             let what = format!("{voxels:?}, {bounces} bounces");
-            let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
-            let mut r = renderer(&scene, &options);
-            let p = params(&r);
-            frame(&mut r, &p, SIZE, SIZE);
-            let m = cube_at((0.25, 0.40));
-            r.set_instance_transform(cube, m).expect("dynamic");
-            scene.instances[cube].transform = m;
+            let (scene, mut r, p) = cube_slid(&options);
             let first = frame(&mut r, &p, SIZE, SIZE);
             let mut fresh = renderer(&scene, &options);
             let want = frame(&mut fresh, &p, SIZE, SIZE);
             // The octree's radiance lies in atlases placed by its pools: the picture tells.
-            let held_back = first
-                .hdr
-                .iter()
-                .zip(&want.hdr)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0f32, f32::max);
+            let held_back = largest_hdr_difference(&first, &want);
             eprintln!("{what}: the first update is up to {held_back} from a full bounce");
             assert!(
                 held_back > 10.0 * placement_tolerance(&options).max(1e-4),
@@ -1139,14 +1139,8 @@ fn injection_relights_only_what_can_see_the_move() {
             bounces: 1,
             ..options()
         };
-        let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
-        let mut r = renderer(&scene, &options);
-        let p = params(&r);
-        frame(&mut r, &p, SIZE, SIZE);
+        let (scene, mut r, _) = cube_slid(&options);
         let leaves = r.voxel_counts().expect("counts").occupied;
-        let m = cube_at((0.25, 0.40));
-        r.set_instance_transform(cube, m).expect("dynamic");
-        scene.instances[cube].transform = m;
         let what = format!("{voxels:?}");
         assert_like_fresh_within(
             &mut r,
