@@ -254,6 +254,9 @@ pub struct SequencePlayer {
     ahead: Vec<Option<Ahead>>,
 }
 
+/// The frame a thread is loading ahead. The web build has no threads: it loads each frame
+/// when it is due, and never makes one.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 struct Ahead {
     frame: usize,
     #[cfg(not(target_arch = "wasm32"))]
