@@ -101,8 +101,7 @@ fn leaf_inputs_changed(i: u32) -> bool {
         if nw.w > 0.3 {
             n = normalize(nw.xyz);
         }
-        let v = shadow_view_index(light, p);
-        if irradiance_reads(light, p, n, 1.5, view_dirt[v], moved_distance(shadow_views[v])) {
+        if irradiance_reads(light, shadow_view_index(light, p), p, n, 1.5) {
             return true;
         }
     }
@@ -166,30 +165,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
 }
 
-// Whether `light_visibility(light, p, n, softness)` reads a texel of the shadow view
-// `shadow_view_index(light, p)` inside the texel rectangle `dirt` (x, y from xy inclusive to
-// zw exclusive) that can change what it computes. Follows its reads tap by tap: the blocker
+// Whether `light_visibility(light, p, n, softness)` reads a texel of the shadow view it looks
+// up, `view`, inside the texel rectangle `dirt` (x, y from xy inclusive to zw exclusive) that
+// can change what it computes. Follows its reads tap by tap: the blocker
 // search's texels and, when it found blockers, each filter tap's 2x2 texels (the radius
 // depends on the blockers, which are then what they were).
 //
-// `near`: no texel of `dirt` held or holds an occluder nearer than this (the view's distance
-// of what moved). A texel counts in a tap only where it lies nearer than the receiver plane
-// there (a blocker, a shadowing comparison): a changed texel read where the plane is no
-// farther than `near` was and is neither, and changes nothing. The moments (VSM/ESM) average
+// No texel of `dirt` held or holds an occluder nearer than `near` (`moved_distance`). A texel
+// counts in a tap only where it lies nearer than the receiver plane there (a blocker, a
+// shadowing comparison): a changed texel read where the plane is no farther than `near` was
+// and is neither, and changes nothing. The moments (VSM/ESM) average
 // every texel: there any changed texel read counts.
-fn shadow_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>, near: f32) -> bool {
+fn shadow_reads(light: Light, view: ShadowView, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>) -> bool {
     // First whether the lookup can reach the rectangle at all (PCSS's search and filter radii
     // are at most 0.25, PCF's is `softness` texels; a bilinear tap a texel more, the moments'
     // disc MOMENT_RADIUS more): most leaves are far from it, and the rest of the test costs a
     // lookup's setup.
-    let view = shadow_views[shadow_view_index(light, p)];
     let res = view.resolution;
     let reach = select(softness, 0.25 * res, is_area_light(light)) + 2.0 + MOMENT_RADIUS;
     let at = shadow_uv(view, p).xy * res;
     if any(at + reach < dirt.xy) || any(at - reach >= dirt.zw) {
         return false;
     }
-    let s = shadow_setup(light, p, n);
+    let s = view_setup(view, p, n);
+    let near = moved_distance(view);
     var radius = softness * s.texel_uv;
     var taps = PCF_TAPS;
     if is_area_light(light) {
@@ -248,9 +247,10 @@ fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: vec4<f32>) -> bool {
         || texel_dirty(view, i + vec2<i32>(1, 1), dirt);
 }
 
-// Whether `light_irradiance(light, p, n, softness)` reads a texel inside `dirt` of the view
-// it looks up (see `shadow_reads`); false when it returns before any lookup.
-fn irradiance_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dirt: vec4<f32>, near: f32) -> bool {
+// Whether `light_irradiance(light, p, n, softness)` reads a changed texel of the view it
+// looks up, `v` (see `shadow_reads`); false when it returns before any lookup.
+fn irradiance_reads(light: Light, v: u32, p: vec3<f32>, n: vec3<f32>, softness: f32) -> bool {
+    let dirt = view_dirt[v];
     if light.shadow_count == 0u || dirt.x >= dirt.z {
         return false;
     }
@@ -266,7 +266,7 @@ fn irradiance_reads(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32, dir
             return false;
         }
     }
-    return shadow_reads(light, p, n, softness, dirt, near);
+    return shadow_reads(light, shadow_views[v], p, n, softness, dirt);
 }
 
 // The nearest distance view `view` stores (`occluder_distance` in lighting/shadow.wgsl) of

@@ -41,7 +41,7 @@ pub struct BounceGlobals {
     /// `mark`'s count and the gather's dispatch size.
     listing: wgpu::Buffer,
     capacity: u32,
-    /// `bounce_slices` it was made for.
+    /// `bounce_slices` it was made for (at least 1).
     slices: u32,
     /// Nothing is kept yet: the next update's bounces gather at every leaf.
     fresh: bool,
@@ -53,7 +53,7 @@ impl BounceGlobals {
     /// Sets which leaves gather in the next update's bounces: those of slice `turn`, or all of
     /// them when nothing is kept yet or `all`.
     pub fn prepare(&mut self, queue: &wgpu::Queue, turn: u32, all: bool) {
-        let count = self.slices.max(1);
+        let count = self.slices;
         let all = all || self.fresh;
         let s = GpuSlices {
             count,
@@ -237,7 +237,7 @@ impl BouncePass {
             gathered,
             listing,
             capacity: u32::try_from(capacity).unwrap_or(u32::MAX),
-            slices,
+            slices: slices.max(1),
             fresh: true,
             listed: false,
         }

@@ -184,6 +184,11 @@ impl InjectPass {
         }
     }
 
+    /// The list of leaves the last injection recomputed: a count, then their slots.
+    pub fn recomputed(&self) -> &wgpu::Buffer {
+        &self.todo
+    }
+
     /// Records the injection of direct light (shadowed by `atlas`) and emission into every leaf of
     /// `voxels` as an indirect dispatch: the leaves' direct light and their radiance. Timed as
     /// "inject".
@@ -259,13 +264,6 @@ impl InjectPass {
         pass.set_bind_group(2, bound.leaves, &[]);
         pass.set_bind_group(3, bound.leaf_store, &[]);
         pass.dispatch_workgroups_indirect(&self.args, 0);
-    }
-}
-
-impl InjectPass {
-    /// The list of leaves the last injection recomputed: a count, then their slots.
-    pub fn recomputed(&self) -> &wgpu::Buffer {
-        &self.todo
     }
 }
 

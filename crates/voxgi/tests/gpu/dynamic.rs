@@ -204,6 +204,17 @@ fn assert_like_fresh(
     assert_like_fresh_within(r, scene, options, 0.0, what)
 }
 
+/// `assert_like_fresh` with the images allowed `placement_tolerance` apart (the octree's bricks
+/// may lie at other places of atlases sized for other geometry).
+fn assert_like_fresh_placed(
+    r: &mut Renderer,
+    scene: &Scene,
+    options: &RendererOptions,
+    what: &str,
+) -> voxgi::RenderOutput {
+    assert_like_fresh_within(r, scene, options, placement_tolerance(options), what)
+}
+
 /// `assert_like_fresh` with the images' HDR values allowed `tolerance` apart.
 fn assert_like_fresh_within(
     r: &mut Renderer,
@@ -327,8 +338,7 @@ fn a_point_cloud_given_new_points_renders_like_a_fresh_renderer() {
                 options.voxels, options.bounces
             );
             // The octree's bricks lie elsewhere in pools sized for other points.
-            let tolerance = placement_tolerance(&options);
-            assert_like_fresh_within(&mut r, &scene, &options, tolerance, &what);
+            assert_like_fresh_placed(&mut r, &scene, &options, &what);
         }
         let too_many = voxgi::scene::pointcloud::sample_surfaces(&builtin::cube([0.3; 3]), 0.02);
         let e = r
@@ -979,8 +989,7 @@ fn a_point_sequence_plays_like_a_fresh_renderer() {
             );
             let what = format!("t = {t} ({:?})", options.voxels);
             // The octree's bricks lie elsewhere in pools sized for other points.
-            let tolerance = placement_tolerance(&options);
-            assert_like_fresh_within(&mut r, &scene, &options, tolerance, &what);
+            assert_like_fresh_placed(&mut r, &scene, &options, &what);
         }
         // The same time again loads nothing.
         assert!(r.set_time(0.2).expect("no change").is_empty());
@@ -1117,13 +1126,7 @@ fn bounce_slices_end_like_a_full_bounce() {
                 frame(&mut r, &p, SIZE, SIZE);
             }
             assert!(!r.voxels_settled(), "{what}: stopped early");
-            assert_like_fresh_within(
-                &mut r,
-                &scene,
-                &options,
-                placement_tolerance(&options),
-                &what,
-            );
+            assert_like_fresh_placed(&mut r, &scene, &options, &what);
             assert!(r.voxels_settled(), "{what}: still updating after {updates}");
         }
     }
@@ -1148,13 +1151,7 @@ fn injection_relights_only_what_can_see_the_move() {
         let (scene, mut r, _) = cube_slid(&options);
         let leaves = r.voxel_counts().expect("counts").occupied;
         let what = format!("{voxels:?}");
-        assert_like_fresh_within(
-            &mut r,
-            &scene,
-            &options,
-            placement_tolerance(&options),
-            &what,
-        );
+        assert_like_fresh_placed(&mut r, &scene, &options, &what);
         let relit = r.relit_leaves().expect("count");
         eprintln!("{what}: {relit} of {leaves} leaves re-lit after the cube slid");
         assert!(relit > 0, "{what}: the cube's own leaves are new");
