@@ -26,6 +26,8 @@ struct Level {
 // The top grid (voxels/octree/tree.wgsl): per depth down to GRID_DEPTH, the node at each
 // position, 0 where none.
 @group(0) @binding(10) var<storage, read_write> grid: array<u32>;
+// The filter's flags (voxels/octree/tree.wgsl's FLAG_SHIFT).
+@group(0) @binding(11) var filter_flags: texture_storage_2d<r32uint, write>;
 // Indirect dispatch sizes: [0..3] over fragments, [3..6] over leaf slots, from [6] per depth
 // t over the nodes of depth t. Only the one-thread kernels bind them.
 @group(1) @binding(0) var<storage, read_write> args: array<u32>;
@@ -278,7 +280,15 @@ fn clear_brick(tile: u32, lvl: u32, o: u32) {
     }
 }
 
-// The nodes of depth level.t, just allocated.
+// Node n's value is out of date: the next filter redoes it and the levels above.
+fn flag_node(n: u32) {
+    textureStore(filter_flags, flag_texel(n), vec4<u32>(1u));
+}
+
+// The nodes of depth level.t, just allocated. Each is flagged for the filter, and so is its
+// parent (whose brick this is). An update's new brick also takes in its positive border the
+// values of nodes that were there before it (static ones, which nothing else flags): those
+// are flagged too, so that the filter pushes them into it.
 @compute @workgroup_size(64)
 fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let u = level.t;
@@ -290,6 +300,13 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let o = n % 8u;
     atomicStore(&nodes[child_word(tree, n)], 0u);
     let parent = tiles[tile * TILE_WORDS];
+    flag_node(parent);
+    if u < tree.depth {
+        flag_node(n);
+        if atomicLoad(&nodes[UPDATING]) != 0u {
+            flag_border_sources(n, u);
+        }
+    }
     if u <= grid_depth(tree) {
         grid[grid_index(node_coord(n), u)] = n;
     }
@@ -310,6 +327,27 @@ fn init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         atomicStore(&nodes[NODE_HEADER + n * NODE_STRIDE + 1u + a], nb);
     }
     clear_brick(tile, tree.depth - u, o);
+}
+
+// The nodes of depth u whose values lie in the positive border of new node n's tile: n's
+// neighbours along the axes of each nonempty s where n lies on its tile's positive face.
+fn flag_border_sources(n: u32, u: u32) {
+    let o = n % 8u;
+    let c = node_coord(n);
+    let side = 1u << u;
+    for (var s = 1u; s < 8u; s++) {
+        if (o & s) != s {
+            continue;
+        }
+        let p = c + octant_offset(s);
+        if any(p >= vec3<u32>(side)) {
+            continue;
+        }
+        let m = node_at(p, u);
+        if m != NONE {
+            flag_node(m);
+        }
+    }
 }
 
 // Depth D: one leaf slot per newly occupied finest voxel, by rank.

@@ -6,6 +6,7 @@
 //!include shared/half.wgsl
 
 @group(3) @binding(0) var leaf_atlas_out: texture_storage_3d<rgba16float, write>;
+@group(3) @binding(1) var leaf_filter_flags: texture_storage_2d<r32uint, write>;
 
 fn leaf_node_child(n: u32) -> u32 {
     return leaf_nodes[NODE_HEADER + n * NODE_STRIDE];
@@ -15,12 +16,14 @@ fn leaf_neighbour(n: u32, axis: u32) -> u32 {
     return leaf_nodes[NODE_HEADER + n * NODE_STRIDE + 1u + axis];
 }
 
-// `v`: premultiplied radiance (rgb) and opacity.
+// `v`: premultiplied radiance (rgb) and opacity. The parent node is flagged for the filter
+// (the neighbours' bricks take the value only in their borders, which nothing filters).
 fn store_leaf_radiance(i: u32, v: vec4<f32>) {
     let info = leaf_slots[i * SLOT_STRIDE + 1u];
     let m = info & 0x1fffffffu;
     let o = info >> 29u;
     let d = to_half(to_depth(v));
+    textureStore(leaf_filter_flags, flag_texel(m), vec4<u32>(1u));
     // Node 0 (the root) has no neighbours, so a missing one stays 0 down the chain.
     let x = leaf_neighbour(m, 0u);
     let y = leaf_neighbour(m, 1u);

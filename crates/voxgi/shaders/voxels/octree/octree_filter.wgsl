@@ -5,6 +5,12 @@
 // (voxels/dense/filter.wgsl) applied to the eight voxels of c's brick: the mean in isotropic
 // mode; per direction, front-to-back pairs along it averaged, otherwise. Level k - 1 is read
 // from one atlas and level k written into the other (they alternate by level).
+//
+// Only flagged nodes are redone (voxels/octree/tree.wgsl's FLAG_SHIFT): a node's value
+// depends on its children's brick alone (and, for the first level, their leaves' normals,
+// which change only with their radiance), so an unflagged node's stored value is what the
+// filter would write. A redone node flags its parent; an unchanged value written again
+// changes nothing, so flagging more than changed costs time, never exactness.
 
 //!include shared/volume.wgsl
 //!include voxels/tree.wgsl
@@ -23,6 +29,9 @@ struct Level {
 @group(0) @binding(5) var<uniform> level: Level;
 // Per leaf slot, SLOT_STRIDE u32: word 3 its normal and agreement (for `tree.ndf`).
 @group(0) @binding(6) var<storage, read> slots: array<u32>;
+@group(0) @binding(7) var flags: texture_storage_2d<r32uint, read_write>;
+// [0]: the nodes the filter redid since the host last cleared it.
+@group(0) @binding(8) var<storage, read_write> redone: array<atomic<u32>>;
 
 fn child(n: u32) -> u32 {
     return nodes[NODE_HEADER + n * NODE_STRIDE];
@@ -50,17 +59,33 @@ fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
     return w * source(base, o);
 }
 
+// The redone nodes of this workgroup, added to `redone` once (one global atomic per node
+// would cost more than a node's filtering).
+var<workgroup> group_redone: atomic<u32>;
+
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
     // Nodes of depth u = t + 1, whose values are level k = D - u.
     let u = level.t + 1u;
     let i = gid.x + gid.y * nwg.x * 64u;
     // The static build's nodes of depth u, then the last update's.
     let s_count = nodes[RANGES + 2u * u + 1u] * 8u;
-    if i >= s_count + nodes[DYN_RANGES + 2u * u + 1u] * 8u {
+    let c = select(nodes[DYN_RANGES + 2u * u] * 8u + (i - s_count), nodes[RANGES + 2u * u] * 8u + i, i < s_count);
+    let todo = i < s_count + nodes[DYN_RANGES + 2u * u + 1u] * 8u && textureLoad(flags, flag_texel(c)).x != 0u;
+    if todo {
+        atomicAdd(&group_redone, 1u);
+    }
+    workgroupBarrier();
+    if lid == 0u {
+        let n = atomicLoad(&group_redone);
+        if n != 0u {
+            atomicAdd(&redone[0], n);
+        }
+    }
+    if !todo {
         return;
     }
-    let c = select(nodes[DYN_RANGES + 2u * u] * 8u + (i - s_count), nodes[RANGES + 2u * u] * 8u + i, i < s_count);
+    textureStore(flags, flag_texel(c), vec4<u32>(0u));
     // No brick below: c and its positive neighbours are empty, and so is its value, which is
     // written all the same (an update may have taken c's children away).
     let below = child(c);
@@ -68,6 +93,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let o = c % 8u;
     let k = tree.depth - u;
     let m = tiles[tile * TILE_WORDS];
+    textureStore(flags, flag_texel(m), vec4<u32>(1u));
     let x = neighbour(m, 0u);
     let y = neighbour(m, 1u);
     let xy = neighbour(x, 1u);
@@ -131,8 +157,10 @@ fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
 
 // Level D, the volume as one voxel, from the root's brick, into the brick TOP_NODE names (its
 // texel 0: level D is sampled at exactly that texel's centre).
+// Runs after every filter (one thread): the root's flag, set by depth 1, is cleared.
 @compute @workgroup_size(1)
 fn top() {
+    textureStore(flags, flag_texel(0u), vec4<u32>(0u));
     let below = child(0u);
     let top = child(TOP_NODE);
     if below == 0u || top == 0u {

@@ -28,13 +28,13 @@ fn begin_clear() {
     let slots_now = min(atomicLoad(&nodes[0]), tree.slots);
     let static_slots = atomicLoad(&nodes[STATIC_SLOTS]);
     write_args(ARGS_CLEAR, select(0u, slots_now - static_slots, slots_now > static_slots));
-    for (var t = 1u; t < tree.depth; t++) {
+    for (var t = 1u; t <= tree.depth; t++) {
         write_args(ARGS_NEW + 3u * t, atomicLoad(&nodes[DYN_RANGES + 2u * t + 1u]) * 8u);
     }
 }
 
 // The last update's leaves: each zeroes its texel in its parent's level-0 brick and in the
-// borders of the neighbours' bricks (the parent may be static).
+// borders of the neighbours' bricks (the parent may be static), and flags the parent.
 @compute @workgroup_size(64)
 fn clear_leaves(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = atomicLoad(&nodes[STATIC_SLOTS]) + flat(gid, nwg);
@@ -43,10 +43,14 @@ fn clear_leaves(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     let info = atomicLoad(&slots[s * SLOT_STRIDE + 1u]);
     store_value(info & 0x1fffffffu, info >> 29u, 0u, 0u, vec4<f32>(0.0));
+    flag_node(info & 0x1fffffffu);
 }
 
 // The last update's nodes of depth level.t: each zeroes its value, every direction, in its
-// parent's brick and the borders it pushed into the neighbours' (static ones among them).
+// parent's brick and the borders it pushed into the neighbours' (static ones among them), and
+// flags the parent. At the leaves' depth only the flag: clear_leaves zeroed what the leaves
+// wrote, and a tile whose voxels hold no leaf (made for a neighbour's sake) still leaves its
+// parent childless.
 @compute @workgroup_size(64)
 fn clear_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let u = level.t;
@@ -57,9 +61,11 @@ fn clear_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let c = atomicLoad(&nodes[DYN_RANGES + 2u * u]) * 8u + i;
     let m = tiles[(c / 8u) * TILE_WORDS];
     let k = tree.depth - u;
-    for (var d = 0u; d < tree.dirs; d++) {
+    for (var d = 0u; d < tree.dirs * u32(k > 0u); d++) {
         store_value(m, c % 8u, k, d, vec4<f32>(0.0));
     }
+    // m may be a static node that keeps no children now: its value is to be redone.
+    flag_node(m);
 }
 
 @compute @workgroup_size(1)

@@ -30,6 +30,7 @@ impl OctreeVolume {
                 }),
                 self.block_sums.as_entire_binding(),
                 self.top_grid.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view(&self.filter_flags)),
             ]),
         })
     }
@@ -144,7 +145,7 @@ impl OctreeVolume {
             (&u.begin_clear, 0, Run::Prepare),
             (&u.clear_leaves, 0, Run::Indirect(ARGS_CLEAR * 4)),
         ];
-        for t in 1..depth {
+        for t in 1..=depth {
             clear.push((&u.clear_nodes, t, over_new(t)));
         }
         self.run_steps(encoder, "octree_update", &bind, args, &clear, timer);

@@ -3,10 +3,12 @@
 use super::*;
 
 impl OctreeVolume {
-    /// Records the filtering of every level above the leaves, finest first: one dispatch per
-    /// depth (octree_filter.wgsl), timed as "octree_filter".
+    /// Records the filtering of the levels above the leaves, finest first: one dispatch per
+    /// depth (octree_filter.wgsl), timed as "octree_filter". Only the nodes flagged since the
+    /// last filter, and their ancestors, are redone.
     pub(super) fn filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
         let depth = self.depth();
+        encoder.clear_buffer(&self.filter_redone, 0, None);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("octree_filter"),
             timestamp_writes: timer.compute("octree_filter"),
@@ -23,5 +25,22 @@ impl OctreeVolume {
         pass.set_pipeline(&self.pipelines.filter_top);
         pass.set_bind_group(0, &self.filter[(depth & 1) as usize], &[0]);
         pass.dispatch_workgroups(1, 1, 1);
+    }
+
+    /// Flags every node, so that the next filter redoes the whole tree (what a region filter
+    /// must equal).
+    pub fn flag_all_for_filter(&self, queue: &wgpu::Queue) {
+        let size = self.filter_flags.size();
+        let ones = vec![1u32; size.width as usize * size.height as usize];
+        queue.write_texture(
+            self.filter_flags.as_image_copy(),
+            bytemuck::cast_slice(&ones),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(size.width * 4),
+                rows_per_image: None,
+            },
+            size,
+        );
     }
 }

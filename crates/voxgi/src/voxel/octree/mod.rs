@@ -26,7 +26,10 @@ pub use pipelines::OctreePipelines;
 pub use pools::OctreePools;
 #[cfg(test)]
 pub(crate) use tree::SHARED_CONSTANTS;
-use tree::{ARGS_WORDS, GRID_DEPTH, LEVEL_STRIDE, NODE_HEADER, TILE_WORDS, atlas, storage_buffer};
+use tree::{
+    ARGS_WORDS, FLAG_FORMAT, FLAG_SHIFT, GRID_DEPTH, LEVEL_STRIDE, NODE_HEADER, TILE_WORDS, atlas,
+    storage_buffer,
+};
 pub use tree::{ATLAS_FORMAT, GpuAtlasShape, GpuOctree, NODE_WORDS, SLOT_BYTES, SLOT_WORDS};
 
 use super::registry::{KindInfo, StructureDesc};
@@ -149,6 +152,11 @@ pub struct OctreeVolume {
     pub even_atlas: wgpu::Texture,
     /// Bricks of the odd levels.
     pub odd_atlas: wgpu::Texture,
+    /// One r32uint per node above the leaves, `1 << FLAG_SHIFT` a row: 1 where the node's
+    /// value is out of date (tree.wgsl's FLAG_SHIFT); the filter redoes only those.
+    pub filter_flags: wgpu::Texture,
+    /// [0]: the nodes the last filter redid.
+    pub filter_redone: wgpu::Buffer,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
     leaf_store: wgpu::BindGroup,
@@ -205,6 +213,15 @@ impl OctreeVolume {
             Ok(())
         };
         too_big("nodes", node_words * 4)?;
+        let flag_rows = (8 * base_v).div_ceil(1 << FLAG_SHIFT);
+        if flag_rows > limits.max_texture_dimension_2d as u64 {
+            return Err(crate::Error::Setting(format!(
+                "the octree needs {} nodes above its leaves, more than the filter's flags hold \
+                 in a {}-texel-high texture; lower the voxel resolution",
+                8 * base_v,
+                limits.max_texture_dimension_2d
+            )));
+        }
         too_big("leaf slots", pools.slots as u64 * SLOT_WORDS * 4)?;
         let max_dim = limits.max_texture_dimension_3d;
         let too_many = |bricks: u64| {
@@ -278,6 +295,23 @@ impl OctreeVolume {
         });
         let even_atlas = atlas(device, "octree even atlas", &even_shape);
         let odd_atlas = atlas(device, "octree odd atlas", &odd_shape);
+        let filter_flags = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("octree filter flags"),
+            size: wgpu::Extent3d {
+                width: 1 << FLAG_SHIFT,
+                height: flag_rows.max(1) as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FLAG_FORMAT,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let filter_redone = storage_buffer(device, "octree filter redone", 16);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("octree bricks"),
@@ -311,7 +345,10 @@ impl OctreeVolume {
         let leaf_store = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel leaf store"),
             layout: &Self::leaf_store_layout(device),
-            entries: &layout::entries(vec![wgpu::BindingResource::TextureView(&view(&even_atlas))]),
+            entries: &layout::entries(vec![
+                wgpu::BindingResource::TextureView(&view(&even_atlas)),
+                wgpu::BindingResource::TextureView(&view(&filter_flags)),
+            ]),
         });
         let irradiance = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel irradiance"),
@@ -335,6 +372,8 @@ impl OctreeVolume {
                     wgpu::BindingResource::TextureView(&view(dst)),
                     level.clone(),
                     slot_buf.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&view(&filter_flags)),
+                    filter_redone.as_entire_binding(),
                 ]),
             })
         };
@@ -369,6 +408,8 @@ impl OctreeVolume {
             levels,
             even_atlas,
             odd_atlas,
+            filter_flags,
+            filter_redone,
             sampling,
             leaves,
             leaf_store,
@@ -448,7 +489,10 @@ impl OctreeVolume {
     pub fn leaf_store_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("voxel leaf store"),
-            entries: &[layout::storage_texture_3d(0, ATLAS_FORMAT)],
+            entries: &[
+                layout::storage_texture_3d(0, ATLAS_FORMAT),
+                layout::storage_texture(1, FLAG_FORMAT),
+            ],
         })
     }
 
@@ -463,7 +507,8 @@ impl OctreeVolume {
                 self.nodes.size()
                     + self.tiles.size()
                     + self.block_sums.size()
-                    + self.top_grid.size(),
+                    + self.top_grid.size()
+                    + self.filter_flags.width() as u64 * self.filter_flags.height() as u64 * 4,
             ),
             (
                 "octree leaf slots",

@@ -73,6 +73,7 @@ impl OctreePipelines {
                 layout::uniform(8, c, true),
                 layout::storage(9, c, false),
                 layout::storage(10, c, false),
+                layout::storage_texture(11, super::tree::FLAG_FORMAT),
             ],
         });
         let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -150,6 +151,17 @@ impl OctreePipelines {
                 layout::storage_texture_3d(4, ATLAS_FORMAT),
                 layout::uniform(5, c, true),
                 layout::storage(6, c, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: c,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::ReadWrite,
+                        format: super::tree::FLAG_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+                layout::storage(8, c, false),
             ],
         });
         let filter_module =

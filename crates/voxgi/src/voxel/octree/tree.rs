@@ -27,6 +27,10 @@ pub(super) const GRID_DEPTH: u32 = 6;
 pub(super) const LEVEL_STRIDE: u64 = 256;
 /// Texels per brick side.
 pub(super) const BRICK: u32 = 3;
+/// The filter's flags: one r32uint texel per node above the leaves, `1 << FLAG_SHIFT` a row
+/// (`FLAG_SHIFT` in tree.wgsl).
+pub(super) const FLAG_SHIFT: u32 = 12;
+pub(super) const FLAG_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
 /// The constants above that octree_update.wgsl (and tree.wgsl, which it includes) defines
 /// too, by their WGSL names: a test holds the two sides equal.
@@ -39,6 +43,7 @@ pub(crate) const SHARED_CONSTANTS: &[(&str, u64)] = &[
     ("GRID_DEPTH", GRID_DEPTH as u64),
     ("ARGS_NEW", ARGS_NEW),
     ("ARGS_CLEAR", ARGS_CLEAR),
+    ("FLAG_SHIFT", FLAG_SHIFT as u64),
 ];
 
 /// Mirrors `Octree` in shaders/voxels/octree/tree.wgsl.
