@@ -5,7 +5,8 @@
 //   begin_clear, clear_leaves, clear_nodes
 //            zero the texels the last update's leaves and nodes wrote into the static bricks
 //            (their own bricks go with them); the host then copies the static build's nodes,
-//            tiles, leaves and top grid back over the last update's
+//            leaves and top grid back over the last update's (the static tiles' records
+//            are never written)
 //   begin_update, bounds
 //            the ranges and dispatch sizes of this update, and the box of its fragments
 // then per depth t as octree_build, but from the dynamic fragments only:

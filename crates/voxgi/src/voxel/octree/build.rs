@@ -83,9 +83,10 @@ impl OctreeVolume {
         }
     }
 
-    /// The buffers an update starts from the static build's copy of.
-    fn snapshotted(&self) -> [&wgpu::Buffer; 4] {
-        [&self.nodes, &self.tiles, &self.slots, &self.top_grid]
+    /// The buffers an update starts from the static build's copy of. (Not the tiles: an
+    /// update writes only the records of its own tiles, after the static ones.)
+    fn snapshotted(&self) -> [&wgpu::Buffer; 3] {
+        [&self.nodes, &self.slots, &self.top_grid]
     }
 
     /// Records `steps` in one compute pass timed as `label`: each dispatch reads what the one
@@ -118,8 +119,8 @@ impl OctreeVolume {
     }
 
     /// Records an update by the dynamic fragments (those after the static build's): the last
-    /// update's texels in the static bricks are zeroed, the static build's nodes, tiles, leaves
-    /// and top grid come back from their copy, and the dynamic fragments are merged in depth by
+    /// update's texels in the static bricks are zeroed, the static build's nodes, leaves and
+    /// top grid come back from their copy, and the dynamic fragments are merged in depth by
     /// depth (octree_update.wgsl). Without a copy (a scene with no dynamic instances) it is a
     /// build.
     pub(super) fn update(

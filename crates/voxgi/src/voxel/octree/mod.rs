@@ -164,9 +164,9 @@ pub struct OctreeVolume {
     /// Filter bind groups: [0] writes the even atlas (reads the odd), [1] the odd (reads the
     /// even).
     filter: [wgpu::BindGroup; 2],
-    /// The static build's nodes, tiles, leaves and top grid, which every update starts from;
+    /// The static build's nodes, leaves and top grid, which every update starts from;
     /// None for a scene without dynamic instances.
-    snapshot: Option<[wgpu::Buffer; 4]>,
+    snapshot: Option<[wgpu::Buffer; 3]>,
     /// octree_build's and octree_update's bind group over the fragments (`bind_fragments`).
     fragment_bind: FragmentBind,
     /// The build steps' dispatch sizes, bound for the steps that write them.
@@ -382,7 +382,7 @@ impl OctreeVolume {
             filter_group(&even_atlas, &odd_atlas),
         ];
         let snapshot = dynamic.then(|| {
-            [&nodes, &tile_buf, &slot_buf, &top_grid]
+            [&nodes, &slot_buf, &top_grid]
                 .map(|b| storage_buffer(device, "octree static snapshot", b.size()))
         });
         let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {

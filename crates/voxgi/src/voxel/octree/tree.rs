@@ -101,32 +101,51 @@ pub struct GpuAtlasShape {
 
 impl GpuAtlasShape {
     /// The regions of one atlas texture within `max_dim` texels a side, each `(bricks, blocks)`
-    /// (bricks in `blocks` direction blocks), one after another along z: rows and layers of a
-    /// power of two bricks, the texture as close to a cube as that allows.
+    /// (bricks in `blocks` direction blocks), one after another along z. Each block rounds its
+    /// bricks up to whole layers of `2^k` bricks (rows of `2^ceil(k/2)`), so the layers are made
+    /// as small as the texture's depth allows: a region of a few thousand bricks then wastes
+    /// little of its last layer in each of its six blocks.
     pub fn regions<const N: usize>(regions: [(u64, u32); N], max_dim: u32) -> Option<[Self; N]> {
-        let total: u64 = regions.iter().map(|(b, k)| b.max(&1) * *k as u64).sum();
         let max_shift = (max_dim / BRICK).max(1).ilog2();
-        let side = (total as f64).cbrt().ceil() as u64;
-        let shift = side.next_power_of_two().ilog2().min(max_shift);
-        let per_layer = 1u64 << (2 * shift);
-        let mut z0 = 0u64;
-        let mut out = [(0u64, 0u64); N];
-        for (o, (bricks, blocks)) in out.iter_mut().zip(regions) {
-            let block = bricks.max(1).div_ceil(per_layer) * BRICK as u64;
-            *o = (z0, block);
-            z0 += block * blocks as u64;
+        let layers = |k: u32| -> Vec<(u64, u64)> {
+            let mut z0 = 0u64;
+            regions
+                .iter()
+                .map(|&(bricks, blocks)| {
+                    let block = bricks.max(1).div_ceil(1 << k) * BRICK as u64;
+                    let at = (z0, block);
+                    z0 += block * blocks as u64;
+                    at
+                })
+                .collect()
+        };
+        let depth = |at: &[(u64, u64)]| {
+            at.iter()
+                .zip(&regions)
+                .map(|(&(z0, block), &(_, blocks))| z0 + block * blocks as u64)
+                .max()
+                .unwrap_or(0)
+        };
+        let k = (0..=2 * max_shift).find(|&k| depth(&layers(k)) <= max_dim as u64)?;
+        let at = layers(k);
+        let shift = [k.div_ceil(2), k / 2];
+        let size = [BRICK << shift[0], BRICK << shift[1], depth(&at) as u32];
+        let inv_size = [
+            1.0 / size[0] as f32,
+            1.0 / size[1] as f32,
+            1.0 / size[2] as f32,
+            0.0,
+        ];
+        let mut out = [GpuAtlasShape::zeroed(); N];
+        for (o, &(z0, block)) in out.iter_mut().zip(&at) {
+            *o = GpuAtlasShape {
+                shift,
+                block: block as u32,
+                z0: z0 as u32,
+                inv_size,
+            };
         }
-        if z0 > max_dim as u64 {
-            return None;
-        }
-        let width = (BRICK << shift) as f32;
-        let inv_size = [1.0 / width, 1.0 / width, 1.0 / z0 as f32, 0.0];
-        Some(out.map(|(z0, block)| GpuAtlasShape {
-            shift: [shift, shift],
-            block: block as u32,
-            z0: z0 as u32,
-            inv_size,
-        }))
+        Some(out)
     }
 
     /// The atlas texture's size in texels.
@@ -189,7 +208,17 @@ mod tests {
         let [one] = GpuAtlasShape::regions([(1, 6)], 2048).unwrap();
         assert_eq!(
             (one.shift, one.block, one.z0, one.size()),
-            ([1, 1], 3, 0, [6, 6, 18])
+            ([0, 0], 3, 0, [3, 3, 18])
+        );
+        // Layers as small as the depth allows: 215,638 leaf bricks and 8,755 of six blocks
+        // (Sponza at 256³) take layers of 512 (2^9 > 3 * 1,053 layers of 256 would not fit), and
+        // waste under a layer per block.
+        let [leaf, even] = GpuAtlasShape::regions([(215_638, 1), (8_755, 6)], 2048).unwrap();
+        assert_eq!(leaf.shift, [5, 4]);
+        assert_eq!(even.size(), [96, 48, 3 * (422 + 6 * 18)]);
+        assert_eq!(
+            (leaf.block, even.z0, even.block),
+            (3 * 422, 3 * 422, 3 * 18)
         );
         // 512 bricks of 3 texels a row fit 2048; six blocks of 113 layers do, 114 do not.
         let [big] = GpuAtlasShape::regions([(512 * 512 * 113, 6)], 2048).unwrap();
