@@ -102,14 +102,19 @@ pub struct GpuAtlasShape {
 impl GpuAtlasShape {
     /// The regions of one atlas texture within `max_dim` texels a side, each `(bricks, blocks)`
     /// (bricks in `blocks` direction blocks), one after another along z. Each block rounds its
-    /// bricks up to whole layers of `2^k` bricks (rows of `2^ceil(k/2)`), so the layers are made
-    /// as small as the texture's depth allows: a region of a few thousand bricks then wastes
-    /// little of its last layer in each of its six blocks.
+    /// bricks up to whole layers of `2^k` bricks (rows of `2^ceil(k/2)`). The layers start as
+    /// large as a cube of the bricks asks and shrink until the rounding wastes at most a
+    /// sixteenth of the bricks (or 4096, which small atlases may waste to stay near a cube: a
+    /// long texture costs precision in CPU drivers' f32 filtering), as far as the texture's
+    /// depth allows.
     pub fn regions<const N: usize>(regions: [(u64, u32); N], max_dim: u32) -> Option<[Self; N]> {
         let max_shift = (max_dim / BRICK).max(1).ilog2();
-        let layers = |k: u32| -> Vec<(u64, u64)> {
+        let used: u64 = regions.iter().map(|(b, k)| b.max(&1) * *k as u64).sum();
+        // Each block's first texel along z and its texels along z, with layers of 2^k bricks;
+        // and the texture's depth.
+        let layout = |k: u32| -> (Vec<(u64, u64)>, u64) {
             let mut z0 = 0u64;
-            regions
+            let at = regions
                 .iter()
                 .map(|&(bricks, blocks)| {
                     let block = bricks.max(1).div_ceil(1 << k) * BRICK as u64;
@@ -117,19 +122,23 @@ impl GpuAtlasShape {
                     z0 += block * blocks as u64;
                     at
                 })
-                .collect()
+                .collect();
+            (at, z0)
         };
-        let depth = |at: &[(u64, u64)]| {
-            at.iter()
-                .zip(&regions)
-                .map(|(&(z0, block), &(_, blocks))| z0 + block * blocks as u64)
-                .max()
-                .unwrap_or(0)
-        };
-        let k = (0..=2 * max_shift).find(|&k| depth(&layers(k)) <= max_dim as u64)?;
-        let at = layers(k);
+        let fits = |k: u32| layout(k).1 <= max_dim as u64;
+        let wasted = |k: u32| ((layout(k).1 / BRICK as u64) << k) - used;
+        let cube = ((used as f64).cbrt().ceil() as u64)
+            .next_power_of_two()
+            .ilog2()
+            .min(max_shift)
+            * 2;
+        let k = (0..=cube)
+            .rev()
+            .find(|&k| fits(k) && wasted(k) <= (used / 16).max(4096))
+            .or_else(|| (0..=2 * max_shift).find(|&k| fits(k)))?;
+        let (at, depth) = layout(k);
         let shift = [k.div_ceil(2), k / 2];
-        let size = [BRICK << shift[0], BRICK << shift[1], depth(&at) as u32];
+        let size = [BRICK << shift[0], BRICK << shift[1], depth as u32];
         let inv_size = [
             1.0 / size[0] as f32,
             1.0 / size[1] as f32,
@@ -208,18 +217,15 @@ mod tests {
         let [one] = GpuAtlasShape::regions([(1, 6)], 2048).unwrap();
         assert_eq!(
             (one.shift, one.block, one.z0, one.size()),
-            ([0, 0], 3, 0, [3, 3, 18])
+            ([1, 1], 3, 0, [6, 6, 18])
         );
-        // Layers as small as the depth allows: 215,638 leaf bricks and 8,755 of six blocks
-        // (Sponza at 256³) take layers of 512 (2^9 > 3 * 1,053 layers of 256 would not fit), and
-        // waste under a layer per block.
+        // 215,638 leaf bricks and 8,755 of six blocks (Sponza at 256³): a cube's layers of
+        // 128² bricks would leave 6 * (16,384 - 8,755) empty, layers of 64 x 32 bricks leave
+        // 1,450 + 6 * 1,485, under a sixteenth.
         let [leaf, even] = GpuAtlasShape::regions([(215_638, 1), (8_755, 6)], 2048).unwrap();
-        assert_eq!(leaf.shift, [5, 4]);
-        assert_eq!(even.size(), [96, 48, 3 * (422 + 6 * 18)]);
-        assert_eq!(
-            (leaf.block, even.z0, even.block),
-            (3 * 422, 3 * 422, 3 * 18)
-        );
+        assert_eq!(leaf.shift, [6, 5]);
+        assert_eq!(even.size(), [192, 96, 3 * (106 + 6 * 5)]);
+        assert_eq!((leaf.block, even.z0, even.block), (3 * 106, 3 * 106, 3 * 5));
         // 512 bricks of 3 texels a row fit 2048; six blocks of 113 layers do, 114 do not.
         let [big] = GpuAtlasShape::regions([(512 * 512 * 113, 6)], 2048).unwrap();
         assert_eq!(big.size(), [1536, 1536, 6 * 3 * 113]);
