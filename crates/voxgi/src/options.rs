@@ -341,7 +341,8 @@ pub struct RendererOptions {
     pub voxel_update_interval: u32,
     /// Voxel bounces gather at one leaf in k per update (1..=16), the leaves taking turns by a
     /// hash of their voxel; the others re-emit the irradiance they last gathered on top of
-    /// their direct light of now. After a change stops, the light equals a full bounce's
+    /// their direct light of now. Leaves near moved geometry gather at once
+    /// (`lighting::bounce::near_change`). After a change stops, the light equals a full bounce's
     /// within k updates per voxel bounce. A moving light or object then costs a k-th of the
     /// bounces, and the bounced light lags by up to k - 1 updates. Default 1 (every leaf).
     pub bounce_slices: u32,

@@ -152,7 +152,12 @@ fn every_twin_has_the_wgsl_layout() {
         "Blend",
         [weight, restart, from_bounce, store_all]
     );
-    twin!(m, GpuSlices, "Slices", [count, turn, all, capacity]);
+    twin!(
+        m,
+        GpuSlices,
+        "Slices",
+        [count, turn, all, capacity, near_min, near_max]
+    );
     twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
     twin!(
         m,

@@ -11,7 +11,7 @@
 //!include shared/irradiance_record.wgsl
 
 // Which leaves gather this update (`bounce_slices`). With `count` > 1 and not `all`, `mark`
-// lists those whose slice is `turn` (and the new ones) and re-emits, at every other leaf, the
+// lists those whose slice is `turn` (and the new ones, and those near moved geometry) and re-emits, at every other leaf, the
 // irradiance it last gathered in this bounce of an update on top of its direct light of now;
 // `list` sizes the gather's dispatch to the list, and `main` gathers at the listed leaves only.
 // Listing them keeps a SIMD group's lanes on one kind of work: with the slices mixed in a
@@ -22,6 +22,11 @@ struct Slices {
     all: u32,
     // Leaf slots of the structure: where the list begins in `gathered`.
     capacity: u32,
+    // Leaves inside this world box gather whatever their slice (`near_change` in
+    // lighting/bounce.rs: where moved geometry spans half a cone's width or more); empty
+    // (min above max) when nothing moved.
+    near_min: vec4<f32>,
+    near_max: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> cones: Cones;
@@ -66,7 +71,9 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if s >= leaf_count() {
         return;
     }
-    if leaf_is_new(s) || slice_of(leaf_coord(s)) == slices.turn {
+    let p = leaf_center(s);
+    let near = all(p >= slices.near_min.xyz) && all(p <= slices.near_max.xyz);
+    if leaf_is_new(s) || near || slice_of(leaf_coord(s)) == slices.turn {
         let k = atomicAdd(&listing[0], 1u);
         gathered[list_start() + 1u + k] = s;
     } else {

@@ -30,6 +30,25 @@ pub struct GpuSlices {
     pub all: u32,
     /// Leaf slots of the structure (where the list begins in the kept words).
     pub capacity: u32,
+    /// The lowest corner of the world box whose leaves gather at once, whatever their slice
+    /// (`near_change`); the box is empty (min above max) when no geometry moved.
+    pub near_min: [f32; 4],
+    /// The box's highest corner.
+    pub near_max: [f32; 4],
+}
+
+/// Where leaves gather at once after dynamic geometry moved within `moved` (world space), with
+/// diffuse cones of half-angle tangent `diffuse_tan`: within `s / diffuse_tan` of the box, `s`
+/// its largest side. A diffuse cone is `2 d tan` wide at distance `d`, so there the box spans
+/// at least half a cone's width and its change enters a gather at no less than a quarter of
+/// a cone's cross-section; farther, it is diluted more, and the slices amortise it.
+pub fn near_change(moved: voxgi_scene::Aabb, diffuse_tan: f32) -> voxgi_scene::Aabb {
+    let size = moved.max - moved.min;
+    let reach = size.max_element() / diffuse_tan.max(1e-3);
+    voxgi_scene::Aabb {
+        min: moved.min - glam::Vec3::splat(reach),
+        max: moved.max + glam::Vec3::splat(reach),
+    }
 }
 
 /// The bounce pass's `@group(0)` for one structure (`BouncePass::bind`): per bounce of an
@@ -50,16 +69,27 @@ pub struct BounceGlobals {
 }
 
 impl BounceGlobals {
-    /// Sets which leaves gather in the next update's bounces: those of slice `turn`, or all of
-    /// them when nothing is kept yet or `all`.
-    pub fn prepare(&mut self, queue: &wgpu::Queue, turn: u32, all: bool) {
+    /// Sets which leaves gather in the next update's bounces: those of slice `turn` and those
+    /// inside `near` (`near_change`), or all of them when nothing is kept yet or `all`.
+    pub fn prepare(
+        &mut self,
+        queue: &wgpu::Queue,
+        turn: u32,
+        all: bool,
+        near: Option<voxgi_scene::Aabb>,
+    ) {
         let count = self.slices;
         let all = all || self.fresh;
+        let (near_min, near_max) = near.map_or(([1.0; 4], [-1.0; 4]), |b| {
+            (b.min.extend(0.0).to_array(), b.max.extend(0.0).to_array())
+        });
         let s = GpuSlices {
             count,
             turn: turn % count,
             all: all as u32,
             capacity: self.capacity,
+            near_min,
+            near_max,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&s));
         self.fresh = false;

@@ -544,7 +544,12 @@ impl Renderer {
             relight && self.voxel_bounces > 0
         };
         if bounces_run {
-            bounce_globals.prepare(&self.queue, self.bounce_turn, pending.rebuild);
+            // Leaves near moved geometry gather at once, whatever their turn.
+            let tan = (self.options.cones.aperture() * 0.5).tan();
+            let near = pending
+                .moved
+                .map(|m| crate::lighting::bounce::near_change(m, tan));
+            bounce_globals.prepare(&self.queue, self.bounce_turn, pending.rebuild, near);
             self.bounce_turn = self.bounce_turn.wrapping_add(1);
         }
         let bounce_globals = &*bounce_globals;

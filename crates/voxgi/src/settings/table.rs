@@ -300,9 +300,10 @@ pub static SETTINGS: &[Setting] = &[
         key: "bounce_slices",
         label: "bounce: leaves gathering, 1 in k",
         help: "Voxel bounces gather at one leaf in k per update, in turns; the others keep the \
-               light they last gathered. A moving light costs a k-th of the bounces; the \
-               bounced light lags by up to k - 1 updates and equals a full bounce's k updates \
-               (per voxel bounce) after the last change.",
+               light they last gathered; leaves near moved geometry gather at once. A moving \
+               light costs a k-th of the bounces; the bounced light lags by up to k - 1 \
+               updates and equals a full bounce's k updates (per voxel bounce) after the last \
+               change.",
         domain: Domain::Int { min: 1, max: 16 },
         changes: Changes::Frame,
         access: access!(options int bounce_slices),

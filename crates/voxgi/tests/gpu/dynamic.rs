@@ -1152,6 +1152,48 @@ fn cube_slid(options: &RendererOptions) -> (Scene, Renderer, FrameParams) {
     (scene, r, p)
 }
 
+/// The Cornell box with the dynamic cube at (0.40, 0.15), rendered once by a renderer with
+/// `options`, then its ceiling light moved 14 cm in both: the scene, the renderer (its next
+/// frame updates the voxels) and the frame parameters.
+fn light_moved(options: &RendererOptions) -> (Scene, Renderer, FrameParams) {
+    let (mut scene, _) = cornell_with_cube((0.40, 0.15));
+    let light = scene
+        .lights
+        .iter()
+        .position(|l| l.name == "ceiling light")
+        .expect("the Cornell box's light");
+    let mut r = renderer(&scene, options);
+    let p = params(&r);
+    frame(&mut r, &p, SIZE, SIZE);
+    let mut moved = scene.lights[light].clone();
+    moved.position += Vec3::new(-0.12, 0.0, 0.08);
+    r.set_light(light, &moved).expect("same kind of light");
+    scene.set_light(light, moved);
+    (scene, r, p)
+}
+
+/// A 4 cm dynamic cube on the Cornell box's floor at x = `x` (z = 0.30).
+fn small_cube(x: f32) -> Mat4 {
+    Mat4::from_translation(Vec3::new(x, 0.021, 0.30)) * Mat4::from_scale(Vec3::splat(0.04))
+}
+
+/// The Cornell box with the 4 cm cube at x = 0.30, rendered once by a renderer with `options`,
+/// then nudged to x = 0.34 in both (small beside the box: most leaves lie beyond the reach
+/// where bounce slices gather at once): the scene, the renderer (its next frame updates the
+/// voxels) and the frame parameters.
+fn small_cube_nudged(options: &RendererOptions) -> (Scene, Renderer, FrameParams) {
+    let mut scene = builtin::cornell_box();
+    let index = scene.instances.len();
+    scene.append(builtin::cube([0.3, 0.3, 0.8]), small_cube(0.30), true);
+    let mut r = renderer(&scene, options);
+    let p = params(&r);
+    frame(&mut r, &p, SIZE, SIZE);
+    r.set_instance_transform(index, small_cube(0.34))
+        .expect("dynamic");
+    scene.instances[index].transform = small_cube(0.34);
+    (scene, r, p)
+}
+
 /// With temporal accumulation the voxels' light blends towards a change over a few frames,
 /// storing only the leaves whose light still moves, and the filter after each step redoes
 /// only around them: once the blend lands, the volume (every mip level) equals a fresh
@@ -1194,7 +1236,9 @@ fn a_blended_change_ends_like_a_fresh_build() {
 /// others keeping what they last gathered: right after the change the volume is not yet a
 /// full bounce's (the slices hold back work at all), and k updates per voxel bounce after it
 /// it is, to the bit, as the option promises; then the updates stop. Both structures, one and
-/// two voxel bounces.
+/// two voxel bounces. The change is the Cornell light moving: every leaf's light changes (a
+/// moved object has the leaves near it gather at once instead:
+/// `bounce_slices_gather_at_once_near_a_move`).
 #[test]
 fn bounce_slices_end_like_a_full_bounce() {
     let slices = 3;
@@ -1207,7 +1251,7 @@ fn bounce_slices_end_like_a_full_bounce() {
                 ..options()
             };
             let what = format!("{voxels:?}, {bounces} bounces");
-            let (scene, mut r, p) = cube_slid(&options);
+            let (scene, mut r, p) = light_moved(&options);
             let first = frame(&mut r, &p, SIZE, SIZE);
             let mut fresh = renderer(&scene, &options);
             let want = frame(&mut fresh, &p, SIZE, SIZE);
@@ -1219,9 +1263,10 @@ fn bounce_slices_end_like_a_full_bounce() {
                 "{what}: the first update after the change bounced every leaf"
             );
             // The rule's error here, stated in docs/QUALITY.md: the leaves that kept their
-            // irradiance hold the light from before the cube moved.
+            // irradiance hold the light from before the light moved (measured 0.018-0.023 on
+            // lavapipe, both structures; twice that allows for other drivers' rounding).
             assert!(
-                held_back < 0.02,
+                held_back < 0.05,
                 "{what}: the first update is {held_back} from a full bounce"
             );
             let updates = (bounces - 1) * slices;
@@ -1233,6 +1278,66 @@ fn bounce_slices_end_like_a_full_bounce() {
             assert!(r.voxels_settled(), "{what}: still updating after {updates}");
         }
     }
+}
+
+/// With bounce slices the leaves near moved geometry gather at once (within the reach
+/// `lighting::bounce::near_change` states): a small cube nudged across the Cornell box's
+/// floor, the first update's radiance equals a full bounce's to the bit at every voxel inside
+/// that reach, and differs outside it (the slices held those back).
+#[test]
+fn bounce_slices_gather_at_once_near_a_move() {
+    let c = ctx();
+    let radiance = |k: u32| {
+        let options = RendererOptions {
+            voxels: voxgi::VoxelKind::DENSE,
+            bounces: 2,
+            bounce_slices: k,
+            ..options()
+        };
+        let (_, mut r, p) = small_cube_nudged(&options);
+        frame(&mut r, &p, SIZE, SIZE);
+        let v = r.structure::<voxgi::voxel::dense::DenseVolume>().unwrap();
+        let bytes = readback::read_texture_3d(&c.device, &c.queue, &v.radiance, 0).unwrap();
+        (bytes, v.grid)
+    };
+    let (sliced, grid) = radiance(4);
+    let (full, _) = radiance(1);
+    // Where the cube was and is (its unit cube scaled by 4 cm at x = 0.30 and 0.34).
+    let moved = voxgi::scene::Aabb {
+        min: Vec3::new(0.28, 0.001, 0.28),
+        max: Vec3::new(0.36, 0.041, 0.32),
+    };
+    let tan = (RendererOptions::default().cones.aperture() * 0.5).tan();
+    let near = voxgi::lighting::bounce::near_change(moved, tan);
+    let n = grid.resolution as usize;
+    let (mut inside, mut outside_differ) = (0, 0);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let centre =
+                    grid.origin + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * grid.voxel_size;
+                let i = 8 * (x + n * (y + n * z));
+                let same = sliced[i..i + 8] == full[i..i + 8];
+                // A voxel's width of margin: the renderer's moved box is the instance's
+                // bounds, which may reach a little past the cube's faces.
+                let margin = Vec3::splat(grid.voxel_size);
+                let leaf = full[i..i + 8].iter().any(|&b| b != 0);
+                if centre.cmpge(near.min + margin).all() && centre.cmple(near.max - margin).all() {
+                    inside += leaf as usize;
+                    assert!(same, "voxel ({x}, {y}, {z}) near the move kept old light");
+                } else if !same {
+                    outside_differ += 1;
+                }
+            }
+        }
+    }
+    eprintln!("{inside} leaves near the move, {outside_differ} voxels outside differ");
+    // The floor and the cube within about 14 cm: hundreds of the 32³ box's leaves.
+    assert!(inside > 100, "only {inside} leaves near the move");
+    assert!(
+        outside_differ > 0,
+        "every leaf gathered: the slices held nothing back"
+    );
 }
 
 /// Injection re-lights a leaf only where its shadow lookup reads a texel of the re-rendered
