@@ -11,9 +11,10 @@
 //!include shared/irradiance_record.wgsl
 
 // Which leaves gather this update (`bounce_slices`). With `count` > 1 and not `all`, `mark`
-// lists those whose slice is `turn` (and the new ones, and those near moved geometry) and re-emits, at every other leaf, the
-// irradiance it last gathered in this bounce of an update on top of its direct light of now;
-// `list` sizes the gather's dispatch to the list, and `main` gathers at the listed leaves only.
+// lists those whose slice is `turn` (and the new ones, and those near moved geometry) and
+// re-emits, at every other leaf, the irradiance it last gathered in this bounce of an update
+// on top of its direct light of now; `list` sizes the gather's dispatch to the list, and
+// `main` gathers at the listed leaves only.
 // Listing them keeps a SIMD group's lanes on one kind of work: with the slices mixed in a
 // group, nearly every group would pay for a whole gather.
 struct Slices {

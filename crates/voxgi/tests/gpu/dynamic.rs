@@ -143,13 +143,18 @@ fn a_sequence_of_moves_renders_like_a_fresh_renderer() {
     }
 }
 
-fn sequence_of_moves(options: &RendererOptions) {
-    let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
-    let light = scene
+/// The index of the Cornell box's ceiling light in `scene`.
+fn ceiling_light(scene: &Scene) -> usize {
+    scene
         .lights
         .iter()
         .position(|l| l.name == "ceiling light")
-        .expect("the Cornell box's light");
+        .expect("the Cornell box's light")
+}
+
+fn sequence_of_moves(options: &RendererOptions) {
+    let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
+    let light = ceiling_light(&scene);
     let mut r = renderer(&scene, options);
     let p = params(&r);
     frame(&mut r, &p, SIZE, SIZE);
@@ -1157,11 +1162,7 @@ fn cube_slid(options: &RendererOptions) -> (Scene, Renderer, FrameParams) {
 /// frame updates the voxels) and the frame parameters.
 fn light_moved(options: &RendererOptions) -> (Scene, Renderer, FrameParams) {
     let (mut scene, _) = cornell_with_cube((0.40, 0.15));
-    let light = scene
-        .lights
-        .iter()
-        .position(|l| l.name == "ceiling light")
-        .expect("the Cornell box's light");
+    let light = ceiling_light(&scene);
     let mut r = renderer(&scene, options);
     let p = params(&r);
     frame(&mut r, &p, SIZE, SIZE);

@@ -98,11 +98,12 @@ const TOP_NODE: u32 = 2u;
 // u32 per tile in the tile buffer: the parent node, and the parent's packed coordinate.
 const TILE_WORDS: u32 = 2u;
 
-// The filter's flags (an r32uint 2D storage texture, FLAG_ROW texels a row, one per node above
-// the leaves): 1 where a node's value is out of date, so the filter redoes only those nodes and
-// the levels above them. Whatever writes a brick's texels flags the brick's node (the parent
-// of the tile the brick belongs to): the leaf store, an update's clears; an update's new nodes
-// flag themselves, their parents and the nodes whose values lie in their bricks' borders.
+// The filter's flags (an r32uint 2D storage texture, 1 << FLAG_SHIFT texels a row, one per
+// node above the leaves): 1 where a node's value is out of date, so the filter redoes only
+// those nodes and the levels above them. Whatever writes a brick's texels flags the brick's
+// node (the parent of the tile the brick belongs to): the leaf store, an update's clears; an
+// update's new nodes flag themselves, their parents and the nodes whose values lie in their
+// bricks' borders.
 const FLAG_SHIFT: u32 = 12u;
 
 fn flag_texel(n: u32) -> vec2<u32> {
