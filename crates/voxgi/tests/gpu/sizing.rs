@@ -41,9 +41,10 @@ fn an_impossible_resolution_is_refused_before_the_first_frame() {
         bounces: 0,
         ..Default::default()
     };
-    // The octree keeps 76 bytes per leaf slot (`SLOT_WORDS`), the fragments 20 each.
+    // The octree's largest per-slot buffer is the build's sums (`ACCUM_WORDS`), the fragments
+    // take 20 bytes each.
     let fragments = binding / FRAGMENT_BYTES / columns + 1;
-    let slots = binding / 76 / columns + 1;
+    let slots = binding / (voxgi::voxel::octree::ACCUM_WORDS * 4) / columns + 1;
     if fragments > 16 {
         eprintln!("skipped: this device's storage-buffer limit needs too large a scene");
         return;
@@ -82,8 +83,10 @@ fn an_impossible_resolution_is_refused_before_the_first_frame() {
 fn a_scene_counted_before_its_first_frame_renders_as_a_full_rebuild() {
     let ctx = ctx();
     let binding = ctx.device.limits().max_storage_buffer_binding_size;
-    // Past the dense volume's 60 and the octree's 76 bytes per leaf, as 8 fragments a point.
-    let n = (binding / 60 / 8 + 1) as usize;
+    // Past the dense volume's 60 and the octree's build sums' 52 bytes per leaf
+    // (`ACCUM_WORDS`), as 8 fragments a point.
+    let per_leaf = 60.min(voxgi::voxel::octree::ACCUM_WORDS * 4);
+    let n = (binding / per_leaf / 8 + 1) as usize;
     if n > 4_000_000 {
         eprintln!("skipped: this device's storage-buffer limit needs too large a cloud");
         return;

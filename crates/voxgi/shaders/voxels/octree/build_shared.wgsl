@@ -21,8 +21,11 @@ struct Level {
 @group(0) @binding(6) var even_out: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(7) var odd_out: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(8) var<uniform> level: Level;
-// Per workgroup of `count`: its marked nodes, then (after `scan`) the marked nodes before it.
-@group(0) @binding(9) var<storage, read_write> block_sums: array<u32>;
+// The build's scratch: first, per workgroup of `count`, its marked nodes, then (after `scan`)
+// the marked nodes before it (`block_words()` of them); then per leaf slot ACCUM_STRIDE sums of
+// its fragments. A static scene's build makes it and drops it after; a dynamic scene keeps it
+// (its updates add to the static leaves' sums).
+@group(0) @binding(9) var<storage, read_write> scratch: array<atomic<u32>>;
 // The top grid (voxels/octree/tree.wgsl): per depth down to GRID_DEPTH, the node at each
 // position, 0 where none.
 @group(0) @binding(10) var<storage, read_write> grid: array<u32>;
@@ -43,6 +46,17 @@ fn write_args(offset: u32, count: u32) {
     args[offset] = max(min(groups, 65535u), 1u);
     args[offset + 1u] = max((groups + 65534u) / 65535u, 1u);
     args[offset + 2u] = 1u;
+}
+
+// Words of the scratch's per-workgroup counts (`OctreeVolume::scratch_bytes` agrees): a depth
+// has at most eight nodes per tile of the pool, one count per 64 of them.
+fn block_words() -> u32 {
+    return tree.tiles / 8u + 2u;
+}
+
+// Where slot s's sums begin in the scratch.
+fn sums_of(s: u32) -> u32 {
+    return block_words() + s * ACCUM_STRIDE;
 }
 
 fn stored_fragments() -> u32 {
@@ -206,7 +220,7 @@ fn count(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocatio
     let n = node_for_thread(flat(gid, nwg), level.t);
     let total = workgroup_scan(lid, u32(marked(n)));
     if lid == 63u {
-        block_sums[block_index(wid, nwg)] = total;
+        atomicStore(&scratch[block_index(wid, nwg)], total);
     }
 }
 
@@ -224,11 +238,11 @@ fn scan(@builtin(local_invocation_index) lid: u32) {
         let i = base + lid;
         var v = 0u;
         if i < blocks {
-            v = block_sums[i];
+            v = atomicLoad(&scratch[i]);
         }
         let inclusive = workgroup_scan(lid, v);
         if i < blocks {
-            block_sums[i] = offset + inclusive - v;
+            atomicStore(&scratch[i], offset + inclusive - v);
         }
         offset += ranks[63];
         workgroupBarrier();
@@ -238,7 +252,7 @@ fn scan(@builtin(local_invocation_index) lid: u32) {
 // The rank of node n among the marked nodes of its depth (every thread must call it).
 fn rank(n: u32, lid: u32, wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     let m = u32(marked(n));
-    return block_sums[block_index(wid, nwg)] + workgroup_scan(lid, m) - m;
+    return atomicLoad(&scratch[block_index(wid, nwg)]) + workgroup_scan(lid, m) - m;
 }
 
 @compute @workgroup_size(64)
@@ -368,7 +382,7 @@ fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_
     atomicStore(&slots[s * SLOT_STRIDE], pack_coord(node_coord(n)));
     atomicStore(&slots[s * SLOT_STRIDE + 1u], tiles[(n / 8u) * TILE_WORDS] | ((n % 8u) << 29u));
     for (var k = 0u; k < ACCUM_STRIDE; k++) {
-        atomicStore(&slots[s * SLOT_STRIDE + SLOT_ACCUM + k], 0u);
+        atomicStore(&scratch[sums_of(s) + k], 0u);
     }
 }
 
@@ -388,12 +402,12 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if v == 0u || v >= NEEDED {
         return;
     }
-    let base = (v - 1u) * SLOT_STRIDE;
+    let base = sums_of(v - 1u);
     let sums = fragment_sums(f);
     for (var k = 0u; k < FRAGMENT_SUMS; k++) {
-        atomicAdd(&slots[base + SLOT_ACCUM + k], sums[k]);
+        atomicAdd(&scratch[base + k], sums[k]);
     }
-    atomicMax(&slots[base + SLOT_ACCUM + FRAGMENT_SUMS], fragment_coverage(f));
+    atomicMax(&scratch[base + FRAGMENT_SUMS], fragment_coverage(f));
 }
 
 @compute @workgroup_size(1)
@@ -415,11 +429,12 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let base = s * SLOT_STRIDE;
+    let sums = sums_of(s);
     var sum = array<u32, FRAGMENT_SUMS>();
     for (var k = 0u; k < FRAGMENT_SUMS; k++) {
-        sum[k] = atomicLoad(&slots[base + SLOT_ACCUM + k]);
+        sum[k] = atomicLoad(&scratch[sums + k]);
     }
-    let a = resolve_sums(sum, atomicLoad(&slots[base + SLOT_ACCUM + FRAGMENT_SUMS]));
+    let a = resolve_sums(sum, atomicLoad(&scratch[sums + FRAGMENT_SUMS]));
     atomicStore(&slots[base + 2u], pack4x8unorm(a.albedo));
     atomicStore(&slots[base + 3u], pack4x8snorm(a.normal));
     atomicStore(&slots[base + 4u], pack2x16float(a.emission.rg));

@@ -132,10 +132,10 @@ const CONTENT: u32 = 0xffffffffu;
 const NEEDED: u32 = 0xfffffffeu;
 const NONE: u32 = 0xffffffffu;
 // Per leaf slot, u32: packed coordinate, parent node | octant << 29, albedo (rgba8unorm),
-// normal (rgba8snorm), emission and the surface's distance (2 x f16 each), then ACCUM_STRIDE
-// sums of the build.
-const SLOT_STRIDE: u32 = 19u;
-const SLOT_ACCUM: u32 = 6u;
+// normal (rgba8snorm), emission and the surface's distance (2 x f16 each).
+const SLOT_STRIDE: u32 = 6u;
+// Per leaf slot, the build's sums of its fragments (voxels/octree/build_shared.wgsl's
+// `scratch`, which only builds and updates bind).
 const ACCUM_STRIDE: u32 = 13u;
 
 fn octant_of(c: vec3<u32>, shift: u32) -> u32 {

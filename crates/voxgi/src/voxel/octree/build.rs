@@ -9,6 +9,7 @@ impl OctreeVolume {
         &self,
         device: &wgpu::Device,
         fragments: &Fragments,
+        scratch: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -28,7 +29,7 @@ impl OctreeVolume {
                     offset: 0,
                     size: wgpu::BufferSize::new(16),
                 }),
-                self.block_sums.as_entire_binding(),
+                scratch.as_entire_binding(),
                 self.top_grid.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&view(&self.filter_flags)),
             ]),
@@ -43,9 +44,18 @@ impl OctreeVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let bind = self
-            .fragment_bind
-            .get(fragments, || self.build_bind_group(device, fragments));
+        // A dynamic scene keeps its scratch for the updates; a static scene's lives for this
+        // build (wgpu keeps it until the GPU is done with it).
+        let bind = match &self.scratch {
+            Some(scratch) => self.fragment_bind.get(fragments, || {
+                self.build_bind_group(device, fragments, scratch)
+            }),
+            None => {
+                let bytes = scratch_bytes(self.layout.tiles as u64, self.pools.slots as u64);
+                let scratch = storage_buffer(device, "octree build sums", bytes);
+                self.build_bind_group(device, fragments, &scratch)
+            }
+        };
         let args = &self.args_bind;
         let b = &self.pipelines.build;
         let depth = self.depth();
@@ -83,10 +93,12 @@ impl OctreeVolume {
         }
     }
 
-    /// The buffers an update starts from the static build's copy of. (Not the tiles: an
-    /// update writes only the records of its own tiles, after the static ones.)
-    fn snapshotted(&self) -> [&wgpu::Buffer; 3] {
-        [&self.nodes, &self.slots, &self.top_grid]
+    /// The buffers an update starts from the static build's copy of (only a dynamic scene
+    /// takes one, and keeps its scratch). Not the tiles: an update writes only the records of
+    /// its own tiles, after the static ones.
+    fn snapshotted(&self) -> [&wgpu::Buffer; 4] {
+        let scratch = self.scratch.as_ref().expect("a dynamic scene's scratch");
+        [&self.nodes, &self.slots, &self.top_grid, scratch]
     }
 
     /// Records `steps` in one compute pass timed as `label`: each dispatch reads what the one
@@ -130,13 +142,13 @@ impl OctreeVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let Some(snapshot) = &self.snapshot else {
+        let (Some(snapshot), Some(scratch)) = (&self.snapshot, &self.scratch) else {
             self.build(device, encoder, fragments, timer);
             return;
         };
-        let bind = self
-            .fragment_bind
-            .get(fragments, || self.build_bind_group(device, fragments));
+        let bind = self.fragment_bind.get(fragments, || {
+            self.build_bind_group(device, fragments, scratch)
+        });
         let args = &self.args_bind;
         let u = &self.pipelines.update;
         let depth = self.depth();

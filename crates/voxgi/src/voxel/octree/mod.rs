@@ -26,11 +26,13 @@ pub use pipelines::OctreePipelines;
 pub use pools::OctreePools;
 #[cfg(test)]
 pub(crate) use tree::SHARED_CONSTANTS;
+pub use tree::{
+    ACCUM_WORDS, ATLAS_FORMAT, GpuAtlasShape, GpuOctree, NODE_WORDS, SLOT_BYTES, SLOT_WORDS,
+};
 use tree::{
     ARGS_WORDS, FLAG_FORMAT, FLAG_SHIFT, GRID_DEPTH, LEVEL_STRIDE, NODE_HEADER, TILE_WORDS, atlas,
     storage_buffer,
 };
-pub use tree::{ATLAS_FORMAT, GpuAtlasShape, GpuOctree, NODE_WORDS, SLOT_BYTES, SLOT_WORDS};
 
 use super::registry::{KindInfo, StructureDesc};
 use super::{
@@ -131,8 +133,11 @@ pub struct OctreeVolume {
     pub nodes: wgpu::Buffer,
     /// Per tile, `TILE_WORDS` u32: its parent node and the parent's packed coordinate.
     pub tiles: wgpu::Buffer,
-    /// The build's per-workgroup counts and their prefix sums (deterministic allocation).
-    block_sums: wgpu::Buffer,
+    /// The build's scratch (`scratch` in build_shared.wgsl: the per-workgroup counts of the
+    /// allocation, then per leaf slot the sums of its fragments), kept only in a dynamic scene,
+    /// whose updates add to the static leaves' sums; a static scene's build makes its own and
+    /// drops it.
+    scratch: Option<wgpu::Buffer>,
     /// The top grid: per depth down to the grid's, the node at every position.
     pub top_grid: wgpu::Buffer,
     /// Per leaf slot, `SLOT_WORDS` u32.
@@ -166,7 +171,7 @@ pub struct OctreeVolume {
     filter: [wgpu::BindGroup; 2],
     /// The static build's nodes, leaves and top grid, which every update starts from;
     /// None for a scene without dynamic instances.
-    snapshot: Option<[wgpu::Buffer; 3]>,
+    snapshot: Option<[wgpu::Buffer; 4]>,
     /// octree_build's and octree_update's bind group over the fragments (`bind_fragments`).
     fragment_bind: FragmentBind,
     /// The build steps' dispatch sizes, bound for the steps that write them.
@@ -222,7 +227,8 @@ impl OctreeVolume {
                 limits.max_texture_dimension_2d
             )));
         }
-        too_big("leaf slots", pools.slots as u64 * SLOT_WORDS * 4)?;
+        // The build's sums are the larger per-slot buffer.
+        too_big("leaf slots", pools.slots as u64 * ACCUM_WORDS * 4)?;
         let max_dim = limits.max_texture_dimension_3d;
         let too_many = |bricks: u64| {
             crate::Error::Setting(format!(
@@ -276,8 +282,8 @@ impl OctreeVolume {
         let slots = pools.slots as u64;
         let nodes = storage_buffer(device, "octree nodes", node_words * 4);
         let tile_buf = storage_buffer(device, "octree tiles", tiles * TILE_WORDS * 4);
-        // A depth has at most eight nodes per tile of the pool: a count per 64 of them.
-        let block_sums = storage_buffer(device, "octree block sums", (tiles / 8 + 2) * 4);
+        let scratch = dynamic
+            .then(|| storage_buffer(device, "octree build sums", scratch_bytes(tiles, slots)));
         let g = (depth - 1).min(GRID_DEPTH);
         let grid_words = ((1u64 << (3 * (g + 1))) - 1) / 7;
         let top_grid = storage_buffer(device, "octree top grid", grid_words * 4);
@@ -382,8 +388,13 @@ impl OctreeVolume {
             filter_group(&even_atlas, &odd_atlas),
         ];
         let snapshot = dynamic.then(|| {
-            [&nodes, &slot_buf, &top_grid]
-                .map(|b| storage_buffer(device, "octree static snapshot", b.size()))
+            [
+                &nodes,
+                &slot_buf,
+                &top_grid,
+                scratch.as_ref().expect("made with dynamic"),
+            ]
+            .map(|b| storage_buffer(device, "octree static snapshot", b.size()))
         });
         let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("octree_build args"),
@@ -398,7 +409,7 @@ impl OctreeVolume {
             layout,
             nodes,
             tiles: tile_buf,
-            block_sums,
+            scratch,
             top_grid,
             slots: slot_buf,
             leaf_direct,
@@ -506,7 +517,6 @@ impl OctreeVolume {
                 "octree nodes",
                 self.nodes.size()
                     + self.tiles.size()
-                    + self.block_sums.size()
                     + self.top_grid.size()
                     + self.filter_flags.width() as u64 * self.filter_flags.height() as u64 * 4,
             ),
@@ -516,6 +526,10 @@ impl OctreeVolume {
                     + self.leaf_direct.size()
                     + self.leaf_next.size()
                     + self.leaf_irradiance.size(),
+            ),
+            (
+                "octree build sums (dynamic scenes)",
+                self.scratch.as_ref().map_or(0, |b| b.size()),
             ),
             (
                 "octree static copy (dynamic scenes)",
@@ -541,8 +555,11 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments) {
-        let bind = self.build_bind_group(device, fragments);
-        self.fragment_bind.set(fragments, bind);
+        // A static scene's scratch lives for one build: its bind group is made with it.
+        if let Some(scratch) = &self.scratch {
+            let bind = self.build_bind_group(device, fragments, scratch);
+            self.fragment_bind.set(fragments, bind);
+        }
     }
 
     fn record_build(
@@ -578,7 +595,7 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn leaf_limit(&self, device: &wgpu::Device) -> u64 {
-        max_binding(device) / (SLOT_WORDS * 4)
+        max_binding(device) / (ACCUM_WORDS * 4)
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
@@ -645,4 +662,10 @@ impl VoxelStructure for OctreeVolume {
             .debug
             .record(device, encoder, targets, self, view, timer);
     }
+}
+
+/// Bytes of the build's scratch for `tiles` tiles and `slots` leaf slots (`block_words` and
+/// `sums_of` in build_shared.wgsl).
+fn scratch_bytes(tiles: u64, slots: u64) -> u64 {
+    (tiles / 8 + 2 + slots * ACCUM_WORDS) * 4
 }

@@ -37,7 +37,7 @@ impl OctreePools {
         let mut p = self;
         p.slots = p
             .slots
-            .min((max_binding / (SLOT_WORDS * 4)).min(u32::MAX as u64) as u32);
+            .min((max_binding / (ACCUM_WORDS * 4)).min(u32::MAX as u64) as u32);
         while p.node_bytes() > max_binding && p.leaf_tiles > 64 {
             p.leaf_tiles /= 2;
             p.even_tiles = (p.even_tiles / 2).max(64);

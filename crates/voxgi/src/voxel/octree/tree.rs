@@ -8,8 +8,11 @@ pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// u32 per node above the leaves: child pointer and the -x, -y, -z neighbours (`NODE_STRIDE`;
 /// a leaf voxel keeps its child word only).
 pub const NODE_WORDS: u64 = 4;
-/// u32 per leaf slot (`SLOT_STRIDE` in tree.wgsl): what the leaf is, and the build's sums.
-pub const SLOT_WORDS: u64 = 19;
+/// u32 per leaf slot (`SLOT_STRIDE` in tree.wgsl): what the leaf is.
+pub const SLOT_WORDS: u64 = 6;
+/// u32 per leaf slot of the build's sums (`ACCUM_STRIDE` in tree.wgsl), in the scratch buffer
+/// only builds and updates bind.
+pub const ACCUM_WORDS: u64 = 13;
 /// Bytes per leaf slot across the slot, direct-light and bounce buffers.
 pub const SLOT_BYTES: u64 = SLOT_WORDS * 4 + 32;
 /// Words of counters before the nodes in the node buffer (`NODE_HEADER` in tree.wgsl).
@@ -38,6 +41,7 @@ pub(super) const FLAG_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint
 pub(crate) const SHARED_CONSTANTS: &[(&str, u64)] = &[
     ("NODE_STRIDE", NODE_WORDS),
     ("SLOT_STRIDE", SLOT_WORDS),
+    ("ACCUM_STRIDE", ACCUM_WORDS),
     ("NODE_HEADER", NODE_HEADER),
     ("TILE_WORDS", TILE_WORDS),
     ("GRID_DEPTH", GRID_DEPTH as u64),
