@@ -40,6 +40,11 @@ impl ConeSet {
         }
     }
 
+    /// Tangent of each cone's half-angle.
+    pub fn half_angle_tan(&self) -> f32 {
+        (self.aperture() * 0.5).tan()
+    }
+
     /// Tangent-space axes (z = normal).
     pub fn axes(&self) -> Vec<Vec3> {
         let (ring, tilt) = match self {
@@ -100,7 +105,7 @@ pub fn cone_uniforms(options: &RendererOptions, grid: &Grid) -> GpuCones {
     GpuCones {
         dirs,
         count: axes.len().min(16) as u32,
-        diffuse_tan: (options.cones.aperture() * 0.5).tan(),
+        diffuse_tan: options.cones.half_angle_tan(),
         step_factor: options.step_factor,
         max_distance: options.max_distance.unwrap_or(grid.extent() * 3f32.sqrt()),
         ao_lambda: options.ao_lambda,

@@ -545,7 +545,7 @@ impl Renderer {
         };
         if bounces_run {
             // Leaves near moved geometry gather at once, whatever their turn.
-            let tan = (self.options.cones.aperture() * 0.5).tan();
+            let tan = self.options.cones.half_angle_tan();
             let near = pending
                 .moved
                 .map(|m| crate::lighting::bounce::near_change(m, tan));

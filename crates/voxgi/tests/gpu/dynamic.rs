@@ -1308,7 +1308,7 @@ fn bounce_slices_gather_at_once_near_a_move() {
         min: Vec3::new(0.28, 0.001, 0.28),
         max: Vec3::new(0.36, 0.041, 0.32),
     };
-    let tan = (RendererOptions::default().cones.aperture() * 0.5).tan();
+    let tan = RendererOptions::default().cones.half_angle_tan();
     let near = voxgi::lighting::bounce::near_change(moved, tan);
     let n = grid.resolution as usize;
     let (mut inside, mut outside_differ) = (0, 0);

@@ -46,9 +46,9 @@ impl OctreeVolume {
     ) {
         // A dynamic scene keeps its scratch for the updates; a static scene's lives for this
         // build (wgpu keeps it until the GPU is done with it).
-        let bind = match &self.scratch {
-            Some(scratch) => self.fragment_bind.get(fragments, || {
-                self.build_bind_group(device, fragments, scratch)
+        let bind = match &self.updates {
+            Some(u) => self.fragment_bind.get(fragments, || {
+                self.build_bind_group(device, fragments, &u.scratch)
             }),
             None => {
                 let bytes = scratch_bytes(self.layout.tiles as u64, self.pools.slots as u64);
@@ -86,18 +86,17 @@ impl OctreeVolume {
         // Positions the previous build filled and this one may not.
         encoder.clear_buffer(&self.top_grid, 0, None);
         self.run_steps(encoder, "octree_build", &bind, args, &steps, timer);
-        if let Some(snapshot) = &self.snapshot {
-            for (live, copy) in self.snapshotted().iter().zip(snapshot) {
+        if let Some(u) = &self.updates {
+            for (live, copy) in self.base_buffers(&u.scratch).iter().zip(&u.snapshot) {
                 encoder.copy_buffer_to_buffer(live, 0, copy, 0, live.size());
             }
         }
     }
 
-    /// The buffers an update starts from the static build's copy of (only a dynamic scene
-    /// takes one, and keeps its scratch). Not the tiles: an update writes only the records of
-    /// its own tiles, after the static ones.
-    fn snapshotted(&self) -> [&wgpu::Buffer; 4] {
-        let scratch = self.scratch.as_ref().expect("a dynamic scene's scratch");
+    /// The buffers an update starts from the static build's copy of, with the dynamic
+    /// scene's `scratch`. Not the tiles: an update writes only the records of its own tiles,
+    /// after the static ones.
+    fn base_buffers<'a>(&'a self, scratch: &'a wgpu::Buffer) -> [&'a wgpu::Buffer; 4] {
         [&self.nodes, &self.slots, &self.top_grid, scratch]
     }
 
@@ -142,12 +141,12 @@ impl OctreeVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        let (Some(snapshot), Some(scratch)) = (&self.snapshot, &self.scratch) else {
+        let Some(base) = &self.updates else {
             self.build(device, encoder, fragments, timer);
             return;
         };
         let bind = self.fragment_bind.get(fragments, || {
-            self.build_bind_group(device, fragments, scratch)
+            self.build_bind_group(device, fragments, &base.scratch)
         });
         let args = &self.args_bind;
         let u = &self.pipelines.update;
@@ -162,7 +161,7 @@ impl OctreeVolume {
             clear.push((&u.clear_nodes, t, over_new(t)));
         }
         self.run_steps(encoder, "octree_update", &bind, args, &clear, timer);
-        for (live, copy) in self.snapshotted().iter().zip(snapshot) {
+        for (live, copy) in self.base_buffers(&base.scratch).iter().zip(&base.snapshot) {
             encoder.copy_buffer_to_buffer(copy, 0, live, 0, live.size());
         }
         let mut steps: Vec<(&wgpu::ComputePipeline, u32, Run)> = vec![

@@ -133,11 +133,6 @@ pub struct OctreeVolume {
     pub nodes: wgpu::Buffer,
     /// Per tile, `TILE_WORDS` u32: its parent node and the parent's packed coordinate.
     pub tiles: wgpu::Buffer,
-    /// The build's scratch (`scratch` in build_shared.wgsl: the per-workgroup counts of the
-    /// allocation, then per leaf slot the sums of its fragments), kept only in a dynamic scene,
-    /// whose updates add to the static leaves' sums; a static scene's build makes its own and
-    /// drops it.
-    scratch: Option<wgpu::Buffer>,
     /// The top grid: per depth down to the grid's, the node at every position.
     pub top_grid: wgpu::Buffer,
     /// Per leaf slot, `SLOT_WORDS` u32.
@@ -169,9 +164,9 @@ pub struct OctreeVolume {
     /// Filter bind groups: [0] writes the even atlas (reads the odd), [1] the odd (reads the
     /// even).
     filter: [wgpu::BindGroup; 2],
-    /// The static build's nodes, leaves and top grid, which every update starts from;
-    /// None for a scene without dynamic instances.
-    snapshot: Option<[wgpu::Buffer; 4]>,
+    /// What a dynamic scene's updates start from; None for a scene without dynamic instances
+    /// (its build makes its scratch and drops it).
+    updates: Option<UpdateBase>,
     /// octree_build's and octree_update's bind group over the fragments (`bind_fragments`).
     fragment_bind: FragmentBind,
     /// The build steps' dispatch sizes, bound for the steps that write them.
@@ -282,8 +277,6 @@ impl OctreeVolume {
         let slots = pools.slots as u64;
         let nodes = storage_buffer(device, "octree nodes", node_words * 4);
         let tile_buf = storage_buffer(device, "octree tiles", tiles * TILE_WORDS * 4);
-        let scratch = dynamic
-            .then(|| storage_buffer(device, "octree build sums", scratch_bytes(tiles, slots)));
         let g = (depth - 1).min(GRID_DEPTH);
         let grid_words = ((1u64 << (3 * (g + 1))) - 1) / 7;
         let top_grid = storage_buffer(device, "octree top grid", grid_words * 4);
@@ -387,14 +380,11 @@ impl OctreeVolume {
             filter_group(&odd_atlas, &even_atlas),
             filter_group(&even_atlas, &odd_atlas),
         ];
-        let snapshot = dynamic.then(|| {
-            [
-                &nodes,
-                &slot_buf,
-                &top_grid,
-                scratch.as_ref().expect("made with dynamic"),
-            ]
-            .map(|b| storage_buffer(device, "octree static snapshot", b.size()))
+        let updates = dynamic.then(|| {
+            let scratch = storage_buffer(device, "octree build sums", scratch_bytes(tiles, slots));
+            let snapshot = [&nodes, &slot_buf, &top_grid, &scratch]
+                .map(|b| storage_buffer(device, "octree static snapshot", b.size()));
+            UpdateBase { scratch, snapshot }
         });
         let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("octree_build args"),
@@ -409,7 +399,6 @@ impl OctreeVolume {
             layout,
             nodes,
             tiles: tile_buf,
-            scratch,
             top_grid,
             slots: slot_buf,
             leaf_direct,
@@ -426,7 +415,7 @@ impl OctreeVolume {
             leaf_store,
             irradiance,
             filter,
-            snapshot,
+            updates,
             fragment_bind: FragmentBind::default(),
             args_bind,
             pipelines: pipelines.clone(),
@@ -529,11 +518,15 @@ impl OctreeVolume {
             ),
             (
                 "octree build sums (dynamic scenes)",
-                self.scratch.as_ref().map_or(0, |b| b.size()),
+                self.updates.as_ref().map_or(0, |u| u.scratch.size()),
             ),
             (
                 "octree static copy (dynamic scenes)",
-                self.snapshot.iter().flatten().map(|b| b.size()).sum(),
+                self.updates
+                    .iter()
+                    .flat_map(|u| &u.snapshot)
+                    .map(|b| b.size())
+                    .sum(),
             ),
             ("octree even atlas", texels(&self.even_atlas)),
             ("octree odd atlas", texels(&self.odd_atlas)),
@@ -556,8 +549,8 @@ impl VoxelStructure for OctreeVolume {
 
     fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments) {
         // A static scene's scratch lives for one build: its bind group is made with it.
-        if let Some(scratch) = &self.scratch {
-            let bind = self.build_bind_group(device, fragments, scratch);
+        if let Some(u) = &self.updates {
+            let bind = self.build_bind_group(device, fragments, &u.scratch);
             self.fragment_bind.set(fragments, bind);
         }
     }
@@ -617,7 +610,7 @@ impl VoxelStructure for OctreeVolume {
                         ndf: self.layout.ndf != 0,
                     },
                     pools,
-                    self.snapshot.is_some(),
+                    self.updates.is_some(),
                 )
             })?
         };
@@ -662,6 +655,17 @@ impl VoxelStructure for OctreeVolume {
             .debug
             .record(device, encoder, targets, self, view, timer);
     }
+}
+
+/// What a dynamic scene keeps for its updates.
+struct UpdateBase {
+    /// The build's scratch (`scratch` in build_shared.wgsl: the allocation's per-workgroup
+    /// counts, then per leaf slot the sums of its fragments): the updates add to the static
+    /// leaves' sums.
+    scratch: wgpu::Buffer,
+    /// The static build's copy of `OctreeVolume::base_buffers`, which every update starts
+    /// from.
+    snapshot: [wgpu::Buffer; 4],
 }
 
 /// Bytes of the build's scratch for `tiles` tiles and `slots` leaf slots (`block_words` and
