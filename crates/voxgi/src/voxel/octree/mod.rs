@@ -592,11 +592,11 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
-        self.pools.resized_for(counted).is_some()
+        self.pools.resized_for(counted, self.updates.is_some()).is_some()
     }
 
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {
-        let Some(pools) = self.pools.resized_for(counted) else {
+        let Some(pools) = self.pools.resized_for(counted, self.updates.is_some()) else {
             return Ok(());
         };
         let make = |pools: OctreePools| {
@@ -617,7 +617,7 @@ impl VoxelStructure for OctreeVolume {
         // Growing by half may pass a limit the counts themselves are within: then the counts
         // (and an eighth) are tried, and their error is the one that names the real need.
         let grown = make(pools).or_else(|e| {
-            let fitted = OctreePools::fitting(counted);
+            let fitted = OctreePools::fitting(counted, self.updates.is_some());
             if fitted == pools {
                 Err(e)
             } else {

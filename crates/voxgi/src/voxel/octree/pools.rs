@@ -60,9 +60,10 @@ impl OctreePools {
             + (self.even_tiles as u64 + self.odd_tiles as u64) * (6 * brick + 8 * 16 + 8)
     }
 
-    /// Pools for what a build counted, and an eighth more.
-    pub fn fitting(counted: &[u32]) -> Self {
-        let need = |n: u32| n.saturating_add(n / 8).max(64);
+    /// Pools for what a build counted, and an eighth more where dynamic geometry can add to
+    /// it (`room`); a static scene's counts are what every later build of it counts.
+    pub fn fitting(counted: &[u32], room: bool) -> Self {
+        let need = |n: u32| n.saturating_add(if room { n / 8 } else { 0 }).max(64);
         OctreePools {
             slots: need(counted[0]),
             leaf_tiles: need(counted[1]),
@@ -75,11 +76,12 @@ impl OctreePools {
     /// first four words), or None to keep these. A pool that overflowed hides what the levels
     /// below it would have needed, so every pool grows at least by half once one overflows.
     /// Pools more than twice what the build needed (the first guess comes from an upper bound
-    /// on the fragments) shrink to the counts and an eighth: the octree's point is its memory.
-    pub fn resized_for(&self, counted: &[u32]) -> Option<Self> {
+    /// on the fragments) shrink to the counts, and an eighth with `room` (`fitting`): the
+    /// octree's point is its memory.
+    pub fn resized_for(&self, counted: &[u32], room: bool) -> Option<Self> {
         let have = [self.slots, self.leaf_tiles, self.even_tiles, self.odd_tiles];
         if counted.iter().zip(have).all(|(&n, h)| n <= h) {
-            let fit = Self::fitting(counted);
+            let fit = Self::fitting(counted, room);
             // Below a few MiB a shrink is not worth a rebuild.
             let oversized = self.bytes() > 2 * fit.bytes() && self.bytes() > 8 << 20;
             return oversized.then_some(fit);
@@ -109,8 +111,8 @@ mod tests {
             even_tiles: 10,
             odd_tiles: 10,
         };
-        assert_eq!(p.resized_for(&[1000, 100, 10, 10]), None);
-        let g = p.resized_for(&[5000, 100, 10, 11]).unwrap();
+        assert_eq!(p.resized_for(&[1000, 100, 10, 10], true), None);
+        let g = p.resized_for(&[5000, 100, 10, 11], true).unwrap();
         assert_eq!(
             (g.slots, g.leaf_tiles, g.even_tiles, g.odd_tiles),
             (5000, 150, 64, 64)
@@ -122,13 +124,20 @@ mod tests {
         let big = OctreePools::for_leaves(4_000_000);
         let counted = [400_000, 150_000, 6_000, 25_000];
         let fit = big
-            .resized_for(&counted)
+            .resized_for(&counted, true)
             .expect("a tenth of the pools is used");
         assert_eq!(
             (fit.slots, fit.leaf_tiles, fit.even_tiles, fit.odd_tiles),
             (450_000, 168_750, 6_750, 28_125)
         );
         // Sized so, the next build keeps them.
-        assert_eq!(fit.resized_for(&counted), None);
+        assert_eq!(fit.resized_for(&counted, true), None);
+        // A static scene's pools hold the counts exactly, and keep them.
+        let exact = big.resized_for(&counted, false).expect("shrinks");
+        assert_eq!(
+            [exact.slots, exact.leaf_tiles, exact.even_tiles, exact.odd_tiles],
+            counted
+        );
+        assert_eq!(exact.resized_for(&counted, false), None);
     }
 }
