@@ -333,8 +333,9 @@ fn sequence_summary(frames: &[voxgi::SequenceFrame]) -> serde_json::Value {
     let set = median(&|f| ms(f.set));
     println!(
         "point sequences: {} new frames of {points:.0} points (medians, CPU): waiting for the \
-         file {waited:.1} ms; set_points {set:.0} ms, of which neighbours {neighbours:.0}, \
-         normals {normals:.0}, regions {regions:.0}, radii {radii:.0}",
+         file {waited:.1} ms; set_points {set:.1} ms; estimated ahead (on the reading thread): \
+         neighbours {neighbours:.0}, normals {normals:.0}, regions {regions:.0}, radii \
+         {radii:.0}",
         frames.len()
     );
     serde_json::json!({

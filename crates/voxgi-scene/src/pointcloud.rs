@@ -24,9 +24,11 @@ pub struct Neighbours {
 }
 
 impl Neighbours {
-    /// The `k` nearest neighbours of each of `positions`, on all cores: searched ring by ring
-    /// in a uniform grid of cells holding a few points each, where a query runs out after a
-    /// few rings (a point far from the rest) by a k-d tree.
+    /// The `k` nearest neighbours of each of `positions`, on all cores: the points of a cell of
+    /// a uniform grid (a few points each) share one candidate list, their cell and its 26
+    /// neighbours, which holds the answer unless a point lies near its cell's face in a sparse
+    /// spot; those search ring by ring outwards, and a query that runs out after a few rings
+    /// (a point far from the rest) asks a k-d tree.
     pub fn find(positions: &[Vec3], k: usize) -> Self {
         let stride = (k + 1).min(positions.len());
         if stride == 0 {
@@ -34,44 +36,85 @@ impl Neighbours {
         }
         let grid = CellGrid::new(positions);
         let tree = std::sync::OnceLock::new();
-        // Queries in Morton order: neighbouring queries read the same cells.
-        let order = morton_order(positions);
-        let sorted = par_chunks(positions.len(), |range, out: &mut Vec<u32>| {
-            let mut found = Vec::with_capacity(stride + 1);
-            for &i in &order[range] {
-                let q = positions[i as usize];
-                found.clear();
-                if !grid.nearest(positions, q, stride, &mut found) {
-                    found.clear();
-                    let tree = tree.get_or_init(|| {
-                        let pts: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
-                        ImmutableKdTree::<f32, 3>::new_from_slice(&pts)
-                    });
-                    found.extend(
-                        tree.nearest_n_within::<SquaredEuclidean>(
-                            &q.to_array(),
-                            f32::INFINITY,
-                            NonZero::new(stride).unwrap(),
-                            false,
-                        )
-                        .iter()
-                        .map(|n| {
-                            (
-                                positions[n.item as usize].distance_squared(q),
-                                n.item as u32,
-                            )
-                        }),
-                    );
-                    // A query finds `stride` points (all lie within infinity); the padding
-                    // only keeps the layout should it not.
-                    found.resize(stride, (f32::INFINITY, i));
-                    found.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let order = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        // Rings outwards, then the tree: into `found`, `stride` of them, nearest first.
+        let search = |i: u32, found: &mut Vec<(f32, u32)>| {
+            let q = positions[i as usize];
+            found.clear();
+            if grid.nearest(positions, q, stride, found) {
+                return;
+            }
+            found.clear();
+            let tree = tree.get_or_init(|| {
+                let pts: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
+                ImmutableKdTree::<f32, 3>::new_from_slice(&pts)
+            });
+            found.extend(
+                tree.nearest_n_within::<SquaredEuclidean>(
+                    &q.to_array(),
+                    f32::INFINITY,
+                    NonZero::new(stride).unwrap(),
+                    false,
+                )
+                .iter()
+                .map(|n| {
+                    (
+                        positions[n.item as usize].distance_squared(q),
+                        n.item as u32,
+                    )
+                }),
+            );
+            // A query finds `stride` points (all lie within infinity); the padding only keeps
+            // the layout should it not.
+            found.resize(stride, (f32::INFINITY, i));
+            found.sort_unstable_by(order);
+        };
+        // Cell by cell, in the grid's order (neighbouring cells read the same cells).
+        let sorted = par_chunks(grid.runs.len(), |cells, out: &mut Vec<u32>| {
+            let mut candidates: Vec<(Vec3, u32)> = Vec::new();
+            let mut found = Vec::with_capacity(stride * 8);
+            for &(start, end) in &grid.runs[cells] {
+                let members = &grid.sorted[start as usize..end as usize];
+                let c = CellGrid::cell_of(grid.lo, grid.h, positions[members[0] as usize]);
+                candidates.clear();
+                for dz in -1..=1 {
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            candidates.extend(
+                                grid.cell([c[0] + dx, c[1] + dy, c[2] + dz])
+                                    .iter()
+                                    .map(|&j| (positions[j as usize], j)),
+                            );
+                        }
+                    }
                 }
-                out.extend(found.iter().map(|n| n.1));
+                // Many points in few cells (repeated points, a dense spot): one by one.
+                let shared = candidates.len() >= stride && candidates.len() <= 64 * stride.max(8);
+                for &i in members {
+                    let q = positions[i as usize];
+                    let mut done = false;
+                    if shared {
+                        found.clear();
+                        found.extend(candidates.iter().map(|&(p, j)| (p.distance_squared(q), j)));
+                        let (_, kth, _) = found.select_nth_unstable_by(stride - 1, order);
+                        // No point outside the 27 cells is nearer than this (a little less,
+                        // for rounding).
+                        let reach = (grid.h + grid.inside(q, c)) * (1.0 - 1e-5);
+                        if kth.0 < reach * reach {
+                            found.truncate(stride);
+                            found.sort_unstable_by(order);
+                            done = true;
+                        }
+                    }
+                    if !done {
+                        search(i, &mut found);
+                    }
+                    out.extend(found.iter().map(|n| n.1));
+                }
             }
         });
         let mut idx = vec![0u32; sorted.len()];
-        for (rank, &i) in order.iter().enumerate() {
+        for (rank, &i) in grid.sorted.iter().enumerate() {
             let i = i as usize;
             idx[i * stride..][..stride].copy_from_slice(&sorted[rank * stride..][..stride]);
         }
@@ -108,6 +151,8 @@ struct CellGrid {
     sorted: Vec<u32>,
     /// (cell key, start, end) into `sorted`; `u64::MAX`: empty.
     table: Vec<(u64, u32, u32)>,
+    /// Each non-empty cell's (start, end) into `sorted`, in the order of their keys.
+    runs: Vec<(u32, u32)>,
     mask: usize,
 }
 
@@ -156,6 +201,7 @@ impl CellGrid {
             h,
             sorted: keys.iter().map(|k| k.1).collect(),
             table: vec![(u64::MAX, 0, 0); size],
+            runs: Vec::with_capacity(cells),
             mask: size - 1,
         };
         let mut start = 0;
@@ -167,6 +213,7 @@ impl CellGrid {
                 slot = (slot + 1) & grid.mask;
             }
             grid.table[slot] = (key, start as u32, end as u32);
+            grid.runs.push((start as u32, end as u32));
             start = end;
         }
         grid
@@ -206,6 +253,14 @@ impl CellGrid {
         }
     }
 
+    /// How far `q` lies inside its cell `c` from the nearest face: the faces of a cube of
+    /// cells searched r rings outwards lie r cells' sides beyond it.
+    fn inside(&self, q: Vec3, c: [i64; 3]) -> f32 {
+        let f = Self::cell_space(self.lo, self.h, q)
+            - DVec3::new((c[0] - 8) as f64, (c[1] - 8) as f64, (c[2] - 8) as f64);
+        (f.min(DVec3::ONE - f).min_element().max(0.0) * self.h as f64) as f32
+    }
+
     /// The `count` nearest points to `q` (itself among them), nearest first, ties by index,
     /// into `found`; false when they were not found within `MAX_RINGS` rings.
     fn nearest(
@@ -217,11 +272,7 @@ impl CellGrid {
     ) -> bool {
         let c = Self::cell_of(self.lo, self.h, q);
         let order = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-        // How far q lies inside its cell from the nearest face: the searched cube's faces lie
-        // r cells' sides beyond it.
-        let f = Self::cell_space(self.lo, self.h, q)
-            - DVec3::new((c[0] - 8) as f64, (c[1] - 8) as f64, (c[2] - 8) as f64);
-        let inside = (f.min(DVec3::ONE - f).min_element().max(0.0) * self.h as f64) as f32;
+        let inside = self.inside(q, c);
         for r in 0..=MAX_RINGS as i64 {
             for dz in -r..=r {
                 for dy in -r..=r {
@@ -260,36 +311,6 @@ impl CellGrid {
         }
         false
     }
-}
-
-/// The points' indices sorted along a Morton (Z-order) curve over their bounds, 10 bits an
-/// axis.
-fn morton_order(positions: &[Vec3]) -> Vec<u32> {
-    let (lo, hi) = positions
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
-    let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
-    // Spreads 10 bits to every third bit.
-    let spread = |v: u32| {
-        let mut x = v & 0x3ff;
-        x = (x | (x << 16)) & 0x0300_00ff;
-        x = (x | (x << 8)) & 0x0300_f00f;
-        x = (x | (x << 4)) & 0x030c_30c3;
-        (x | (x << 2)) & 0x0924_9249
-    };
-    let mut keyed: Vec<(u32, u32)> = positions
-        .iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            let c = ((p - lo) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
-            let key = spread(c.x as u32) | (spread(c.y as u32) << 1) | (spread(c.z as u32) << 2);
-            (key, i as u32)
-        })
-        .collect();
-    keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
 }
 
 /// Splits `0..n` into one chunk per core and concatenates what `f` writes for each chunk, in
@@ -333,16 +354,24 @@ pub fn estimate_normals(pc: &mut PointCloud, k: usize, viewpoint: Vec3) {
 /// `estimate_normals` from neighbours already found (at least `k` of them for the same
 /// estimate).
 pub fn estimate_normals_from(pc: &mut PointCloud, nb: &Neighbours, k: usize, viewpoint: Vec3) {
+    if pc.normals.is_empty() {
+        fit_normals_from(pc, nb, k);
+        orient_normals(pc, viewpoint);
+    }
+}
+
+/// The first half of `estimate_normals_from`, which needs no viewpoint (so it can run ahead,
+/// on another thread): each point's axis of least variance with either sign, zero where the
+/// neighbourhood is degenerate. Nothing when the cloud has normals.
+pub fn fit_normals_from(pc: &mut PointCloud, nb: &Neighbours, k: usize) {
     if !pc.normals.is_empty() || pc.positions.is_empty() {
         return;
     }
-    let view = pc.transform.inverse().transform_point3(viewpoint);
     let positions = &pc.positions;
     pc.normals = nb.map(k.max(3), |i, nb| {
         let p = positions[i];
-        let towards = (view - p).normalize_or(Vec3::Y);
         if nb.len() < 3 {
-            return towards;
+            return Vec3::ZERO;
         }
         // Covariance about the mean, in f64 relative to the point to avoid cancellation far
         // from the origin.
@@ -360,13 +389,26 @@ pub fn estimate_normals_from(pc: &mut PointCloud, nb: &Neighbours, k: usize, vie
         let (vals, vecs) = symmetric_eigen3(c);
         // Degenerate: all neighbours on a line or a point; the smallest axis is meaningless.
         if vals[1].is_nan() || vals[1] <= 1e-12 * vals[2].max(f64::MIN_POSITIVE) {
-            return towards;
+            return Vec3::ZERO;
         }
-        let n = DVec3::new(vecs[0][0], vecs[1][0], vecs[2][0])
+        DVec3::new(vecs[0][0], vecs[1][0], vecs[2][0])
             .as_vec3()
-            .normalize_or(towards);
-        if n.dot(view - p) < 0.0 { -n } else { n }
+            .normalize_or_zero()
     });
+}
+
+/// The second half of `estimate_normals_from`: every normal turned to face `viewpoint` (world
+/// space), and zero normals (a degenerate neighbourhood) made the direction towards it.
+pub fn orient_normals(pc: &mut PointCloud, viewpoint: Vec3) {
+    let view = pc.transform.inverse().transform_point3(viewpoint);
+    for (n, &p) in pc.normals.iter_mut().zip(&pc.positions) {
+        let towards = (view - p).normalize_or(Vec3::Y);
+        if *n == Vec3::ZERO {
+            *n = towards;
+        } else if n.dot(view - p) < 0.0 {
+            *n = -*n;
+        }
+    }
 }
 
 /// How much larger than the equal-area radius the discs are. Each point owns on average the
@@ -734,7 +776,7 @@ mod tests {
 
     /// The shared neighbour search is an exact k-nearest search: each point's list equals a
     /// brute-force sort by distance (ties by index), also its prefixes, with duplicates, on a
-    /// cloud smaller than k, and for clouds spread very unevenly (the Morton order's cells).
+    /// cloud smaller than k, and for clouds spread very unevenly (cells of very different counts).
     #[test]
     fn neighbours_are_the_nearest() {
         let mut r = rng(7);

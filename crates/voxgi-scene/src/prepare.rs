@@ -3,7 +3,7 @@
 
 use crate::pointcloud::{self, Neighbours};
 use crate::{Aabb, PointCloud, Scene};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use std::borrow::Cow;
 use web_time::{Duration, Instant};
 
@@ -80,22 +80,95 @@ pub fn prepare_cloud(pc: &mut PointCloud, camera: Vec3) -> PointPreparation {
 /// `prepare_cloud` from neighbours already found (`pointcloud::SPREAD_NEIGHBOURS` of them,
 /// as `prepare_cloud` finds).
 pub fn prepare_cloud_with(pc: &mut PointCloud, camera: Vec3, nb: &Neighbours) -> PointPreparation {
-    let mut timing = PointPreparation::default();
     if !needs_preparation(pc) {
-        return timing;
+        return PointPreparation::default();
     }
     let start = Instant::now();
-    let mut local = Aabb::EMPTY;
-    for &p in &pc.positions {
-        local.grow(p);
-    }
-    let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
-    // `estimate_normals` takes the viewpoint in world space.
-    let viewpoint = if origin_outside {
-        pc.transform.transform_point3(Vec3::ZERO)
+    let what = missing(pc);
+    let unoriented = pc.normals.is_empty();
+    let mut timing = estimate_unoriented(pc, nb);
+    let t = Instant::now();
+    let facing = if unoriented {
+        orient(pc, camera)
     } else {
-        camera
+        "the file's"
     };
+    timing.normals += t.elapsed();
+    log::info!(
+        "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {facing})",
+        pc.name,
+        pc.positions.len(),
+        start.elapsed().as_secs_f64(),
+    );
+    timing
+}
+
+/// A cloud's attributes estimated ahead of the frame that shows it, on any thread (the
+/// renderer's point sequences do it on the thread that reads the file): everything but the
+/// normals' orientation, which depends on where the cloud will be (`PointsAhead::finish`).
+#[derive(Clone, Debug, Default)]
+pub struct PointsAhead {
+    /// The points, their missing attributes filled; estimated normals with either sign.
+    pub points: PointCloud,
+    /// Their `pointcloud::SPREAD_NEIGHBOURS` nearest neighbours (the surface spread reads
+    /// them).
+    pub neighbours: Neighbours,
+    /// What the estimation took.
+    pub timing: PointPreparation,
+    /// The normals were estimated and still face either way.
+    unoriented: bool,
+}
+
+impl PointsAhead {
+    /// Finds `points`' neighbours and estimates the attributes they lack, as
+    /// `prepare_cloud` does, except the normals' orientation.
+    pub fn new(mut points: PointCloud) -> Self {
+        // `Renderer::set_points` names a point that is not finite; nothing to estimate.
+        if !points.positions.iter().all(|p| p.is_finite()) {
+            return PointsAhead {
+                points,
+                ..Default::default()
+            };
+        }
+        let t = Instant::now();
+        let neighbours = Neighbours::find(&points.positions, pointcloud::SPREAD_NEIGHBOURS);
+        let found = t.elapsed();
+        let unoriented = !points.positions.is_empty() && points.normals.is_empty();
+        let mut timing = if needs_preparation(&points) {
+            estimate_unoriented(&mut points, &neighbours)
+        } else {
+            PointPreparation::default()
+        };
+        timing.neighbours = found;
+        PointsAhead {
+            points,
+            neighbours,
+            timing,
+            unoriented,
+        }
+    }
+
+    /// Turns the estimated normals as `prepare_cloud` would for the cloud placed by
+    /// `transform` (`camera`: the scene's default camera's position), and returns the
+    /// points, their neighbours and the estimation's times (the orientation's among the
+    /// normals').
+    pub fn finish(
+        mut self,
+        transform: Mat4,
+        camera: Vec3,
+    ) -> (PointCloud, Neighbours, PointPreparation) {
+        self.points.transform = transform;
+        if self.unoriented {
+            let t = Instant::now();
+            orient(&mut self.points, camera);
+            self.timing.normals += t.elapsed();
+        }
+        (self.points, self.neighbours, self.timing)
+    }
+}
+
+/// The attributes `pc` lacks, named for the log.
+fn missing(pc: &PointCloud) -> String {
     let what: Vec<&str> = [
         (pc.normals.is_empty(), "normals"),
         (pc.radii.is_empty(), "radii"),
@@ -104,10 +177,17 @@ pub fn prepare_cloud_with(pc: &mut PointCloud, camera: Vec3, nb: &Neighbours) ->
     .into_iter()
     .filter_map(|(missing, name)| missing.then_some(name))
     .collect();
-    let what = what.join(", ");
-    timing.points += pc.positions.len();
+    what.join(", ")
+}
+
+/// Fills the attributes `pc` lacks from its neighbours, the normals with either sign.
+fn estimate_unoriented(pc: &mut PointCloud, nb: &Neighbours) -> PointPreparation {
+    let mut timing = PointPreparation {
+        points: pc.positions.len(),
+        ..Default::default()
+    };
     let t = Instant::now();
-    pointcloud::estimate_normals_from(pc, nb, NORMAL_NEIGHBOURS, viewpoint);
+    pointcloud::fit_normals_from(pc, nb, NORMAL_NEIGHBOURS);
     timing.normals += t.elapsed();
     // Regions first: they take the file's radii, not estimated ones.
     let t = Instant::now();
@@ -116,16 +196,90 @@ pub fn prepare_cloud_with(pc: &mut PointCloud, camera: Vec3, nb: &Neighbours) ->
     let t = Instant::now();
     pointcloud::estimate_radii_from(pc, nb, RADIUS_NEIGHBOURS);
     timing.radii += t.elapsed();
-    log::info!(
-        "point cloud '{}': estimated {what} of {} points in {:.2} s (normals facing {})",
-        pc.name,
-        pc.positions.len(),
-        start.elapsed().as_secs_f64(),
-        if origin_outside {
-            "the cloud's origin"
-        } else {
-            "the default camera"
-        }
-    );
     timing
+}
+
+/// Turns estimated normals to face the cloud's local origin when that lies outside the
+/// cloud's bounds (scanners put the sensor there), else `camera`; says which.
+fn orient(pc: &mut PointCloud, camera: Vec3) -> &'static str {
+    let mut local = Aabb::EMPTY;
+    for &p in &pc.positions {
+        local.grow(p);
+    }
+    let origin_outside = (0..3).any(|a| local.min[a] > 0.0 || local.max[a] < 0.0);
+    // `orient_normals` takes the viewpoint in world space.
+    if origin_outside {
+        let origin = pc.transform.transform_point3(Vec3::ZERO);
+        pointcloud::orient_normals(pc, origin);
+        "the cloud's origin"
+    } else {
+        pointcloud::orient_normals(pc, camera);
+        "the default camera"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wavy sheet of points with a row of collinear points beside it (degenerate
+    /// neighbourhoods, whose normals face the viewpoint), moved by `offset`.
+    fn sheet(offset: Vec3) -> PointCloud {
+        let mut positions = Vec::new();
+        for i in 0..40 {
+            for j in 0..30 {
+                let (x, z) = (i as f32 * 0.05, j as f32 * 0.05);
+                positions.push(Vec3::new(x, (x * 2.0).sin() * 0.2 + z * 0.1, z) + offset);
+            }
+        }
+        positions.extend((0..20).map(|i| Vec3::new(5.0 + i as f32 * 0.01, 0.0, 0.0) + offset));
+        PointCloud {
+            positions,
+            ..Default::default()
+        }
+    }
+
+    /// Estimating ahead and finishing later gives what the whole estimation gives, to the bit,
+    /// whichever way the normals turn: to the camera (the cloud's origin inside its bounds)
+    /// or to its origin (outside), under a transform that turns the cloud about.
+    #[test]
+    fn estimating_ahead_equals_estimating_at_once() {
+        let transform =
+            Mat4::from_rotation_x(2.5) * Mat4::from_translation(Vec3::new(0.3, 1.0, -2.0));
+        let camera = Vec3::new(0.5, 4.0, 3.0);
+        for offset in [Vec3::new(-1.0, -0.1, -0.7), Vec3::new(2.0, 1.0, 1.0)] {
+            let mut whole = sheet(offset);
+            whole.transform = transform;
+            let nb = Neighbours::find(&whole.positions, pointcloud::SPREAD_NEIGHBOURS);
+            prepare_cloud_with(&mut whole, camera, &nb);
+            let (ahead, ahead_nb, timing) =
+                PointsAhead::new(sheet(offset)).finish(transform, camera);
+            assert_eq!(timing.points, whole.positions.len());
+            assert_eq!(ahead.transform, transform);
+            assert_eq!(ahead.normals, whole.normals, "offset {offset}");
+            assert_eq!(ahead.radii, whole.radii);
+            assert_eq!(ahead.regions, whole.regions);
+            let n = whole.positions.len();
+            assert!((0..n).all(|i| ahead_nb.of(i, 24) == nb.of(i, 24)));
+            // Every normal faces the viewpoint: the camera while the origin lies inside the
+            // cloud's bounds, else the origin.
+            let view = if offset.x < 0.0 {
+                transform.inverse().transform_point3(camera)
+            } else {
+                Vec3::ZERO
+            };
+            for (p, v) in whole.positions.iter().zip(&whole.normals) {
+                assert!((v.length() - 1.0).abs() < 1e-5 && v.dot(view - *p) >= 0.0);
+            }
+        }
+    }
+
+    /// A cloud with a point that is not finite is left for `Renderer::set_points` to name.
+    #[test]
+    fn points_that_are_not_finite_are_not_estimated() {
+        let mut pc = sheet(Vec3::ZERO);
+        pc.positions[7].y = f32::NAN;
+        let ahead = PointsAhead::new(pc);
+        assert!(ahead.points.normals.is_empty() && ahead.points.radii.is_empty());
+    }
 }

@@ -3,6 +3,7 @@
 //! include whose `file` holds a frame number (`scan_%04d.ply`) and an `fps`.
 
 use crate::animation::Repeat;
+use crate::prepare::PointsAhead;
 use crate::{Aabb, PointCloud, Result, SceneError};
 use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
@@ -247,8 +248,9 @@ pub fn is_pattern(file: &str) -> bool {
 }
 
 /// Plays a scene's sequences: says which clouds get a new frame at a time, loading the frame
-/// after it in the background (one thread per sequence, native builds) so that playing
-/// forward finds each frame ready.
+/// after it in the background and estimating the attributes its file lacks there
+/// (`PointsAhead`; one thread per sequence, native builds), so that playing forward finds
+/// each frame ready.
 pub struct SequencePlayer {
     sequences: Vec<PointSequence>,
     ahead: Vec<Option<Ahead>>,
@@ -260,15 +262,16 @@ pub struct SequencePlayer {
 struct Ahead {
     frame: usize,
     #[cfg(not(target_arch = "wasm32"))]
-    job: std::thread::JoinHandle<Result<PointCloud>>,
+    job: std::thread::JoinHandle<Result<PointsAhead>>,
 }
 
-/// A frame a sequence moved to: its cloud, the frame, its points, and how long the caller
-/// waited for them (0 when the background load had them ready).
+/// A frame a sequence moved to: its cloud, the frame, its points (their attributes estimated
+/// but for the normals' orientation), and how long the caller waited for them (near 0 when
+/// the background had them ready; else the file and the estimation).
 pub struct NewFrame {
     pub cloud: usize,
     pub frame: usize,
-    pub points: PointCloud,
+    pub points: PointsAhead,
     pub waited: std::time::Duration,
 }
 
@@ -320,7 +323,7 @@ impl SequencePlayer {
                         "a point sequence's loader panicked".into(),
                     ))
                 })?,
-                _ => s.load(frame)?,
+                _ => PointsAhead::new(s.load(frame)?),
             };
             let waited = start.elapsed();
             s.shown = frame;
@@ -331,7 +334,9 @@ impl SequencePlayer {
                     let (files, colour) = (s.files.clone(), s.base_color);
                     *ahead = Some(Ahead {
                         frame: next,
-                        job: std::thread::spawn(move || load_frame(&files, next, colour)),
+                        job: std::thread::spawn(move || {
+                            load_frame(&files, next, colour).map(PointsAhead::new)
+                        }),
                     });
                 }
             }

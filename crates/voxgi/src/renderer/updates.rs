@@ -7,6 +7,7 @@ use crate::gpu_scene::{check_light, gpu_light};
 use crate::lighting::atlas::{self as shadow, ViewDirt};
 use crate::{Error, Result};
 use glam::Mat4;
+use voxgi_scene::prepare::PointsAhead;
 use voxgi_scene::{Aabb, Light};
 
 /// What changed since the last voxel update.
@@ -167,14 +168,72 @@ impl Renderer {
     /// the cloud's own space (it stays where `set_cloud_transform` or its animation put it;
     /// `points.transform` is not read). At most as many points as the cloud had when the
     /// renderer was made (upload a cloud that grows at its largest); attributes it lacks
-    /// (normals, radii, regions of influence) are estimated as at upload, on the CPU. The
-    /// next voxel update splats them; a changed cloud has no motion vectors (its points are
-    /// not the last frame's). Returns how long the estimation took.
+    /// (normals, radii, regions of influence) are estimated as at upload, on the CPU, here
+    /// (`set_points_ahead` takes them estimated elsewhere, e.g. on another thread). The next
+    /// voxel update splats them; a changed cloud has no motion vectors (its points are not the
+    /// last frame's). Returns how long the estimation took.
     pub fn set_points(
         &mut self,
         cloud: usize,
         points: &voxgi_scene::PointCloud,
     ) -> Result<voxgi_scene::prepare::PointPreparation> {
+        self.check_points(cloud, points)?;
+        self.set_points_ahead(cloud, PointsAhead::new(points.clone()))
+    }
+
+    /// `set_points` for points whose attributes were estimated ahead
+    /// (`voxgi_scene::prepare::PointsAhead::new`, which may run on any thread while frames
+    /// render): here only the normals are turned to face the viewer, and the surfels written.
+    pub fn set_points_ahead(
+        &mut self,
+        cloud: usize,
+        ahead: PointsAhead,
+    ) -> Result<voxgi_scene::prepare::PointPreparation> {
+        let old = self.check_points(cloud, &ahead.points)?;
+        let c = &self.state.clouds[cloud];
+        let (mut pc, neighbours, prepared) =
+            ahead.finish(c.transform, self.default_camera.position);
+        pc.dynamic = true;
+        pc.light = old.light;
+        pc.name = old.name.clone();
+        let (transform, old_local) = (c.transform, c.local);
+        let mut local = Aabb::EMPTY;
+        for &p in &pc.positions {
+            local.grow(p);
+        }
+        let park = super::parking(&self.volume.grid());
+        let room = self.scene.cloud_ranges[cloud].len();
+        self.scene
+            .set_cloud_points(&self.queue, cloud, &pc, &neighbours, park);
+        let zero = vec![[0.0f32; 4]; room];
+        self.scene.set_cloud_motion(&self.queue, cloud, &zero);
+        let geometry = pc.light.is_none();
+        let cs = &mut self.state.clouds[cloud];
+        cs.points = Some(std::sync::Arc::new(pc));
+        cs.local = local;
+        cs.drawn = transform;
+        cs.moving = false;
+        let (old, new) = (
+            old_local.transformed(transform),
+            local.transformed(transform),
+        );
+        self.dirty_views(old, new);
+        if geometry {
+            self.geometry_moved(old.union(&new));
+        } else {
+            self.pending.lights = true;
+        }
+        Ok(prepared)
+    }
+
+    /// Whether `points` may replace cloud `cloud`'s: the cloud exists and is dynamic, they fit
+    /// its room, every attribute has one value a point (or none), every point is finite.
+    /// Returns the cloud's points now.
+    fn check_points(
+        &self,
+        cloud: usize,
+        points: &voxgi_scene::PointCloud,
+    ) -> Result<std::sync::Arc<voxgi_scene::PointCloud>> {
         let count = self.state.clouds.len();
         let c = self.state.clouds.get(cloud).ok_or_else(|| {
             Error::Setting(format!(
@@ -218,51 +277,7 @@ impl Renderer {
                 c.name
             )));
         }
-        let mut pc = points.clone();
-        pc.transform = c.transform;
-        pc.dynamic = true;
-        pc.light = old.light;
-        pc.name = old.name.clone();
-        // One neighbour search for the attributes and the surface spread.
-        let t = web_time::Instant::now();
-        let neighbours = voxgi_scene::pointcloud::Neighbours::find(
-            &pc.positions,
-            voxgi_scene::pointcloud::SPREAD_NEIGHBOURS,
-        );
-        let found = t.elapsed();
-        let mut prepared = voxgi_scene::prepare::prepare_cloud_with(
-            &mut pc,
-            self.default_camera.position,
-            &neighbours,
-        );
-        prepared.neighbours = found;
-        let (transform, old_local) = (c.transform, c.local);
-        let mut local = Aabb::EMPTY;
-        for &p in &pc.positions {
-            local.grow(p);
-        }
-        let park = super::parking(&self.volume.grid());
-        self.scene
-            .set_cloud_points(&self.queue, cloud, &pc, &neighbours, park);
-        let zero = vec![[0.0f32; 4]; room];
-        self.scene.set_cloud_motion(&self.queue, cloud, &zero);
-        let geometry = pc.light.is_none();
-        let cs = &mut self.state.clouds[cloud];
-        cs.points = Some(std::sync::Arc::new(pc));
-        cs.local = local;
-        cs.drawn = transform;
-        cs.moving = false;
-        let (old, new) = (
-            old_local.transformed(transform),
-            local.transformed(transform),
-        );
-        self.dirty_views(old, new);
-        if geometry {
-            self.geometry_moved(old.union(&new));
-        } else {
-            self.pending.lights = true;
-        }
-        Ok(prepared)
+        Ok(old)
     }
 
     /// Changes light `index` (into the scene's lights) to `light`: its position, direction,
@@ -420,7 +435,8 @@ impl Renderer {
         let mut frames = Vec::with_capacity(changes.frames.len());
         for f in changes.frames {
             let start = web_time::Instant::now();
-            let prepared = match self.set_points(f.cloud, &f.points) {
+            let points = f.points.points.positions.len();
+            let prepared = match self.set_points_ahead(f.cloud, f.points) {
                 Ok(p) => p,
                 Err(e) => {
                     // The frames not shown are loaded again by the next call.
@@ -431,7 +447,7 @@ impl Renderer {
             frames.push(SequenceFrame {
                 cloud: f.cloud,
                 frame: f.frame,
-                points: f.points.positions.len(),
+                points,
                 waited: f.waited,
                 prepared,
                 set: start.elapsed(),
@@ -464,8 +480,11 @@ pub struct SequenceFrame {
     pub points: usize,
     /// Waiting for the file (near zero when it was read ahead).
     pub waited: web_time::Duration,
-    /// The attribute estimation (`set_points`' share of `set`).
+    /// The attribute estimation: on the thread that read the file ahead, or while the caller
+    /// waited (`waited`, a frame not read ahead: the first, or after a jump in time).
     pub prepared: voxgi_scene::prepare::PointPreparation,
-    /// `set_points` whole: estimation, surfels and their upload.
+    /// `set_points_ahead` on the caller's thread: the normals' orientation, the surface
+    /// spread, the surfels and their upload (and the estimation when the frame was not read
+    /// ahead).
     pub set: web_time::Duration,
 }

@@ -592,7 +592,9 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
-        self.pools.resized_for(counted, self.updates.is_some()).is_some()
+        self.pools
+            .resized_for(counted, self.updates.is_some())
+            .is_some()
     }
 
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {

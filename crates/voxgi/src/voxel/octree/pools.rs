@@ -135,7 +135,12 @@ mod tests {
         // A static scene's pools hold the counts exactly, and keep them.
         let exact = big.resized_for(&counted, false).expect("shrinks");
         assert_eq!(
-            [exact.slots, exact.leaf_tiles, exact.even_tiles, exact.odd_tiles],
+            [
+                exact.slots,
+                exact.leaf_tiles,
+                exact.even_tiles,
+                exact.odd_tiles
+            ],
             counted
         );
         assert_eq!(exact.resized_for(&counted, false), None);
