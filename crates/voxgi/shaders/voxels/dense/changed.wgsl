@@ -1,20 +1,65 @@
-// The box of finest voxels written since the last filter, in the volume's counters
-// (`counters`, array<atomic<u32>>, declared by the includer): the filter redoes only the
-// levels' voxels above it. Stored so that all zeros is the empty box:
-// counters[CHANGED..CHANGED + 3] hold u32::MAX - the lowest corner,
-// counters[CHANGED + 4..CHANGED + 7] the highest corner + 1; both grow by atomicMax.
+// The voxels the next filter redoes, in the volume's counters (`counters`,
+// array<atomic<u32>>, declared by the includer). For each level above the finest: a bit per
+// voxel, set once a child of it changed, and the list of the voxels whose bits were set (each
+// once), counted in the level's header. The finest level's writers list the level above
+// (`mark_changed`); the filter lists each level's parents as it redoes it (filter.wgsl).
+// DenseVolume's `filter::counter_bytes` is the twin of this layout.
 
-const CHANGED: u32 = 8u;
+// Voxels the last filter redid (one for all its directions; 0 when it redid everything).
+const REDONE: u32 = 6u;
+// Per level above the finest (the first at index 0): how many voxels its list holds.
+const COUNTS: u32 = 8u;
+const MAX_LEVELS: u32 = 10u;
+// The levels' bits, then their lists.
+const BITS: u32 = COUNTS + MAX_LEVELS;
 
-fn mark_changed(c: vec3<u32>) {
-    for (var k = 0u; k < 3u; k++) {
-        // Loads first: once the box holds the voxel, no atomic write contends.
-        let lo = 0xffffffffu - c[k];
-        if atomicLoad(&counters[CHANGED + k]) < lo {
-            atomicMax(&counters[CHANGED + k], lo);
-        }
-        if atomicLoad(&counters[CHANGED + 4u + k]) < c[k] + 1u {
-            atomicMax(&counters[CHANGED + 4u + k], c[k] + 1u);
-        }
+// Levels above the finest of a volume `res` voxels a side (a power of two).
+fn levels_above(res: u32) -> u32 {
+    return firstLeadingBit(res);
+}
+
+fn level_voxels(res: u32, l: u32) -> u32 {
+    let n = res >> l;
+    return n * n * n;
+}
+
+fn bit_words(res: u32, l: u32) -> u32 {
+    return (level_voxels(res, l) + 31u) / 32u;
+}
+
+// Where level `l`'s bits begin.
+fn bits_of(res: u32, l: u32) -> u32 {
+    var b = BITS;
+    for (var j = 1u; j < l; j++) {
+        b += bit_words(res, j);
     }
+    return b;
+}
+
+// Where level `l`'s list begins: after every level's bits.
+fn list_of(res: u32, l: u32) -> u32 {
+    var b = bits_of(res, levels_above(res) + 1u);
+    for (var j = 1u; j < l; j++) {
+        b += level_voxels(res, j);
+    }
+    return b;
+}
+
+// The voxel of level `l` at `c` has a changed child: listed for the filter, once.
+fn mark_level(res: u32, l: u32, c: vec3<u32>) {
+    let n = res >> l;
+    let i = c.x + n * (c.y + n * c.z);
+    let w = bits_of(res, l) + i / 32u;
+    let bit = 1u << (i % 32u);
+    // Loads first: once the bit is set, no atomic write contends.
+    if (atomicLoad(&counters[w]) & bit) != 0u || (atomicOr(&counters[w], bit) & bit) != 0u {
+        return;
+    }
+    let k = atomicAdd(&counters[COUNTS + l - 1u], 1u);
+    atomicStore(&counters[list_of(res, l) + k], i);
+}
+
+// Finest voxel `c` of a volume `res` a side was written.
+fn mark_changed(c: vec3<u32>, res: u32) {
+    mark_level(res, 1u, c >> vec3<u32>(1u));
 }

@@ -5,11 +5,13 @@
 // transparent. One dispatch writes one level of every direction's block (+X, -X, +Y, -Y, +Z,
 // -Z stacked along z: the direction the cone travels).
 
-// Only the voxels above the finest ones written since the last filter are redone (`region`
-// sizes each level's dispatch from that box): the rest have the same children as before, so
-// the result equals a whole filter to the bit.
+// After a build every voxel is redone (`whole`); after a change only the voxels listed as
+// having a changed child (`listed`, one dispatch per level sized by `prepare` from its list;
+// changed.wgsl): the rest have the same children as before, so the result equals a whole
+// filter to the bit.
 
 //!include shared/volume.wgsl
+//!include voxels/changed.wgsl
 
 struct FilterParams {
     // 0: isotropic mean, 1: directional.
@@ -21,17 +23,11 @@ struct FilterParams {
     src_blocked: u32,
     // 1: weigh each finest voxel per direction by its normals (`ndf_weight`; first level only).
     ndf: u32,
-    // This level's index into `boxes` (0: the level above the finest).
+    // The level written, less one (0: the level above the finest).
     step: u32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
-}
-
-// A level's voxels to redo: the box's lowest voxel and its size (z: per block).
-struct LevelBox {
-    lo: vec4<u32>,
-    size: vec4<u32>,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -39,7 +35,8 @@ struct LevelBox {
 @group(0) @binding(2) var dst: texture_storage_3d<rgba16float, write>;
 // The finest level's normals and their agreement (read with `ndf`).
 @group(0) @binding(3) var normals: texture_3d<f32>;
-@group(0) @binding(4) var<storage, read> boxes: array<LevelBox>;
+// The volume's counters: the levels' bits and lists (changed.wgsl).
+@group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
 
 fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
     return from_depth(textureLoad(src, base + o, 0));
@@ -54,15 +51,9 @@ fn leaf_child(base: vec3<i32>, o: vec3<i32>, block: u32) -> vec4<f32> {
     return w * child(base, o);
 }
 
-@compute @workgroup_size(4, 4, 4)
-fn main(@builtin(global_invocation_id) tid: vec3<u32>) {
+// Level `params.step + 1`'s voxel `gid` in direction block `block` from its eight children.
+fn filter_voxel(gid: vec3<u32>, block: u32) {
     let n = params.dst_res;
-    let b = boxes[params.step];
-    let block = tid.z / max(b.size.z, 1u);
-    let gid = b.lo.xyz + vec3<u32>(tid.xy, tid.z % max(b.size.z, 1u));
-    if any(tid.xy >= b.size.xy) || block >= select(1u, 6u, params.mode == 1u) {
-        return;
-    }
     let id = vec3<u32>(gid.xy, block * n + gid.z);
     var base = vec3<i32>(gid) * 2;
     base.z += i32(block * 2u * n * params.src_blocked);
@@ -93,52 +84,67 @@ fn main(@builtin(global_invocation_id) tid: vec3<u32>) {
     textureStore(dst, id, to_depth(sum * 0.25));
 }
 
-// --- region: each level's box and dispatch size from the voxels written since the last
-// filter, then the box emptied. One thread, before the levels.
-
-struct RegionParams {
-    // Finest voxels per side, levels above the finest, blocks per level (6 or 1).
-    resolution: u32,
-    steps: u32,
-    blocks: u32,
-    // 1: the whole volume (after a build), whatever was written.
-    all: u32,
+fn blocks() -> u32 {
+    return select(1u, 6u, params.mode == 1u);
 }
 
-// Bound apart from the levels' (`FilterPass::region_layout`).
-@group(0) @binding(5) var<uniform> region_params: RegionParams;
-// The volume's counters: [8..16] the box of finest voxels written since the last filter
-// (voxels/dense/changed.wgsl).
-@group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
-@group(0) @binding(7) var<storage, read_write> boxes_out: array<LevelBox>;
-// Per level: a dispatch's workgroups (x, y, z).
-@group(0) @binding(8) var<storage, read_write> level_args: array<u32>;
+// Every voxel of the level (after a build); the bits and counts are cleared after
+// (`FilterPass::record`).
+@compute @workgroup_size(4, 4, 4)
+fn whole(@builtin(global_invocation_id) tid: vec3<u32>) {
+    let n = params.dst_res;
+    let block = tid.z / n;
+    if any(tid.xy >= vec2<u32>(n)) || block >= blocks() {
+        return;
+    }
+    filter_voxel(vec3<u32>(tid.xy, tid.z % n), block);
+}
+
+// The voxels the level's list holds: x over the list, y over the direction blocks. Each
+// lists its parent for the next level and clears its own bit (nothing lists this level while
+// it runs).
+@compute @workgroup_size(64)
+fn listed(@builtin(global_invocation_id) tid: vec3<u32>) {
+    let n = params.dst_res;
+    let level = params.step + 1u;
+    let res = n << level;
+    if tid.x >= atomicLoad(&counters[COUNTS + level - 1u]) {
+        return;
+    }
+    let i = atomicLoad(&counters[list_of(res, level) + tid.x]);
+    let gid = vec3<u32>(i % n, (i / n) % n, i / (n * n));
+    if tid.y == 0u {
+        if level < levels_above(res) {
+            mark_level(res, level + 1u, gid >> vec3<u32>(1u));
+        }
+        atomicAnd(&counters[bits_of(res, level) + i / 32u], ~(1u << (i % 32u)));
+        atomicAdd(&counters[REDONE], 1u);
+    }
+    filter_voxel(gid, tid.y);
+}
+
+// --- prepare: one thread before each listed level sizes its dispatch from its list; `done`
+// empties the lists after the last level.
+
+// Per level: a dispatch's workgroups (x, y, z). Bound apart from the levels
+// (`FilterPass::prepare_layout`): a dispatch cannot write the buffer it is sized from.
+@group(0) @binding(7) var<storage, read_write> level_args: array<u32>;
 
 @compute @workgroup_size(1)
-fn region() {
-    var lo = vec3<u32>(0u);
-    var hi1 = vec3<u32>(region_params.resolution);
-    if region_params.all == 0u {
-        for (var k = 0u; k < 3u; k++) {
-            lo[k] = 0xffffffffu - atomicLoad(&counters[8u + k]);
-            hi1[k] = atomicLoad(&counters[12u + k]);
-        }
+fn prepare() {
+    let level = params.step + 1u;
+    if level == 1u {
+        atomicStore(&counters[REDONE], 0u);
     }
-    let empty = any(hi1 == vec3<u32>(0u));
-    for (var i = 0u; i < region_params.steps; i++) {
-        var size = vec3<u32>(0u);
-        var l = vec3<u32>(0u);
-        if !empty {
-            let level = i + 1u;
-            l = lo >> vec3<u32>(level);
-            size = ((hi1 - 1u) >> vec3<u32>(level)) - l + 1u;
-        }
-        boxes_out[i] = LevelBox(vec4<u32>(l, 0u), vec4<u32>(size, 0u));
-        level_args[3u * i] = (size.x + 3u) / 4u;
-        level_args[3u * i + 1u] = (size.y + 3u) / 4u;
-        level_args[3u * i + 2u] = (size.z * region_params.blocks + 3u) / 4u;
-    }
-    for (var k = 0u; k < 8u; k++) {
-        atomicStore(&counters[8u + k], 0u);
+    let count = atomicLoad(&counters[COUNTS + level - 1u]);
+    level_args[3u * params.step] = (count + 63u) / 64u;
+    level_args[3u * params.step + 1u] = blocks();
+    level_args[3u * params.step + 2u] = 1u;
+}
+
+@compute @workgroup_size(1)
+fn done() {
+    for (var k = 0u; k < MAX_LEVELS; k++) {
+        atomicStore(&counters[COUNTS + k], 0u);
     }
 }

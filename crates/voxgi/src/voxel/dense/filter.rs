@@ -8,20 +8,21 @@ use crate::voxel::{Filtering, Grid};
 use wgpu::util::DeviceExt;
 
 const STRIDE: u64 = 256;
-/// Bytes of a level's box (`LevelBox` in filter.wgsl).
-const BOX_BYTES: u64 = 32;
 
-/// The filter compute pass (shaders/voxels/dense/filter.wgsl): its pipelines (`region`, then
-/// `main` once per level) and bind group layouts.
+/// The filter compute pass (shaders/voxels/dense/filter.wgsl): after a build every level
+/// whole (`whole`); after a change, per level, `prepare` sizes a dispatch of `listed` over the
+/// voxels whose children changed, and `done` empties the lists.
 pub struct FilterPass {
-    pipeline: wgpu::ComputePipeline,
+    whole: wgpu::ComputePipeline,
+    listed: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    region: wgpu::ComputePipeline,
-    region_layout: wgpu::BindGroupLayout,
+    prepare: wgpu::ComputePipeline,
+    done: wgpu::ComputePipeline,
+    prepare_layout: wgpu::BindGroupLayout,
 }
 
 /// One dispatch: read mip `src` of the chains (None: the finest level), write mip `dst` of
-/// the chains' blocks, within the box `region` found for it.
+/// the chains' blocks.
 struct Step {
     src: Option<u32>,
     dst: u32,
@@ -29,7 +30,7 @@ struct Step {
 }
 
 impl FilterPass {
-    /// Compiles the pipelines (one module, two entry points) and creates their layouts.
+    /// Compiles the pipelines (one module, four entry points) and creates their layouts.
     pub fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -39,17 +40,17 @@ impl FilterPass {
                 layout::texture_3d_load(1, c),
                 layout::storage_texture_3d(2, RADIANCE_FORMAT),
                 layout::texture_3d_load(3, c),
-                layout::storage(4, c, true),
+                // The volume's counters: the levels' bits and lists (changed.wgsl).
+                layout::storage(6, c, false),
             ],
         });
-        // `region` binds apart from the levels (filter.wgsl's bindings 5 to 8 of group 0).
-        let region_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("filter region"),
+        // `prepare` writes the dispatch sizes the levels are dispatched by, so they bind apart.
+        let prepare_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("filter prepare"),
             entries: &[
-                layout::uniform(5, c, false),
+                layout::uniform(0, c, true),
                 layout::storage(6, c, false),
                 layout::storage(7, c, false),
-                layout::storage(8, c, false),
             ],
         });
         let module = module_for(device, "voxels/dense/filter.wgsl", &super::KIND.shaders);
@@ -69,10 +70,12 @@ impl FilterPass {
             })
         };
         FilterPass {
-            pipeline: pipeline("main", &layout),
-            region: pipeline("region", &region_layout),
+            whole: pipeline("whole", &layout),
+            listed: pipeline("listed", &layout),
+            prepare: pipeline("prepare", &prepare_layout),
+            done: pipeline("done", &prepare_layout),
             layout,
-            region_layout,
+            prepare_layout,
         }
     }
 
@@ -105,7 +108,7 @@ impl FilterPass {
     }
 
     /// The bind groups of every level's step for a volume on `grid` with these textures (the
-    /// finest level's `radiance` and `normal`, the `chains` above) and its box of written
+    /// finest level's `radiance` and `normal`, the `chains` above) and its lists of changed
     /// voxels (in `counters`), with their parameters: made once per volume (they bind only its
     /// own resources).
     pub fn bind(
@@ -123,12 +126,6 @@ impl FilterPass {
                 .copy_from_slice(bytemuck::cast_slice(&s.params));
         }
         let n = steps.len().max(1) as u64;
-        let boxes = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("filter boxes"),
-            size: n * BOX_BYTES,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
         let args = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("filter dispatch sizes"),
             size: n * 12,
@@ -137,42 +134,33 @@ impl FilterPass {
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let blocks = super::chain_blocks(filtering.anisotropic);
-        let region = |all: bool| {
-            let params = [grid.resolution, steps.len() as u32, blocks, all as u32];
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("filter region"),
-                contents: bytemuck::cast_slice(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("filter region"),
-                layout: &self.region_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: uniform.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: counters.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 7,
-                        resource: boxes.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 8,
-                        resource: args.as_entire_binding(),
-                    },
-                ],
-            })
-        };
-        let region = [region(false), region(true)];
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("filter params"),
             contents: &bytes,
             usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let params_binding = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &params,
+            offset: 0,
+            size: wgpu::BufferSize::new(32),
+        });
+        let prepare = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("filter prepare"),
+            layout: &self.prepare_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params_binding.clone(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: counters.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: args.as_entire_binding(),
+                },
+            ],
         });
         let binds: Vec<wgpu::BindGroup> = steps
             .iter()
@@ -183,23 +171,24 @@ impl FilterPass {
                 };
                 let dst = mip_view(chains, s.dst);
                 let normals = mip_view(normal, 0);
+                let mut entries = layout::entries(vec![
+                    params_binding.clone(),
+                    wgpu::BindingResource::TextureView(&src),
+                    wgpu::BindingResource::TextureView(&dst),
+                    wgpu::BindingResource::TextureView(&normals),
+                ]);
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: counters.as_entire_binding(),
+                });
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("filter"),
                     layout: &self.layout,
-                    entries: &layout::entries(vec![
-                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &params,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(32),
-                        }),
-                        wgpu::BindingResource::TextureView(&src),
-                        wgpu::BindingResource::TextureView(&dst),
-                        wgpu::BindingResource::TextureView(&normals),
-                        boxes.as_entire_binding(),
-                    ]),
+                    entries: &entries,
                 })
             })
             .collect();
+        let blocks = super::chain_blocks(filtering.anisotropic);
         let whole = steps
             .iter()
             .map(|s| [s.params[1].div_ceil(4), (s.params[1] * blocks).div_ceil(4)])
@@ -208,17 +197,18 @@ impl FilterPass {
             _params: params,
             binds,
             whole,
-            region,
+            prepare,
             args,
+            counters: counters.clone(),
+            bits_end: counter_words_before_lists(grid) * 4,
         }
     }
 
-    /// Records the filtering of the levels above the finest, coarsest last: `region` finds
-    /// each level's voxels above the finest ones written since the last filter (every voxel
-    /// with `all`, after a build) and empties that box; then one dispatch per level, each
-    /// reading the level below it (the finest level's `radiance` for the first) and writing
-    /// its box in every block of `chains` (`binds`, from `bind`). Timed as "filter" (summed
-    /// over the steps).
+    /// Records the filtering of the levels above the finest, coarsest last, each level
+    /// reading the one below it (the finest level's `radiance` for the first) and writing
+    /// every block of `chains` (`binds`, from `bind`): with `all` (after a build) every voxel,
+    /// then the lists emptied; else per level only the voxels listed as having a changed
+    /// child, each listing its parent for the next. Timed as "filter" (summed over the steps).
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -231,38 +221,69 @@ impl FilterPass {
                 label: Some("filter"),
                 timestamp_writes: timer.compute("filter"),
             });
-            pass.set_pipeline(&self.region);
-            pass.set_bind_group(0, &binds.region[all as usize], &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-        }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("filter"),
-            timestamp_writes: timer.compute("filter"),
-        });
-        pass.set_pipeline(&self.pipeline);
-        for (i, b) in binds.binds.iter().enumerate() {
-            pass.set_bind_group(0, b, &[(i as u64 * STRIDE) as u32]);
-            if all {
-                // The whole level, sized here: an indirect dispatch makes a CPU driver wait
-                // for `region` before it starts, for nothing.
-                let [n, depth] = binds.whole[i];
-                pass.dispatch_workgroups(n, n, depth);
-            } else {
-                pass.dispatch_workgroups_indirect(&binds.args, i as u64 * 12);
+            for (i, b) in binds.binds.iter().enumerate() {
+                let offset = [(i as u64 * STRIDE) as u32];
+                if all {
+                    pass.set_pipeline(&self.whole);
+                    pass.set_bind_group(0, b, &offset);
+                    let [n, depth] = binds.whole[i];
+                    pass.dispatch_workgroups(n, n, depth);
+                } else {
+                    pass.set_pipeline(&self.prepare);
+                    pass.set_bind_group(0, &binds.prepare, &offset);
+                    pass.dispatch_workgroups(1, 1, 1);
+                    pass.set_pipeline(&self.listed);
+                    pass.set_bind_group(0, b, &offset);
+                    pass.dispatch_workgroups_indirect(&binds.args, i as u64 * 12);
+                }
             }
+            if !all {
+                pass.set_pipeline(&self.done);
+                pass.set_bind_group(0, &binds.prepare, &[0]);
+                pass.dispatch_workgroups(1, 1, 1);
+            }
+        }
+        if all {
+            // The build's writes listed voxels a whole filter has redone: from the redone
+            // count (word 6) through the counts and every level's bits.
+            encoder.clear_buffer(&binds.counters, 24, Some(binds.bits_end - 24));
         }
     }
 }
 
+/// Words of a volume's counters on `grid` before its lists: the counters, each level's
+/// count (voxels/dense/changed.wgsl's `COUNTS`, ten levels) and its bits (a bit per voxel of
+/// each level above the finest).
+fn counter_words_before_lists(grid: Grid) -> u64 {
+    let res = grid.resolution as u64;
+    let top = grid.levels() as u64 - 1;
+    let bits: u64 = (1..=top).map(|l| (res >> l).pow(3).div_ceil(32)).sum();
+    18 + bits
+}
+
+/// Bytes of a volume's counters on `grid` (the twin of voxels/dense/changed.wgsl's layout):
+/// the counters and bits (`counter_words_before_lists`), then each level's list of changed
+/// voxels (room for all of them).
+pub fn counter_bytes(grid: Grid) -> u64 {
+    let res = grid.resolution as u64;
+    let top = grid.levels() as u64 - 1;
+    let lists: u64 = (1..=top).map(|l| (res >> l).pow(3)).sum();
+    (counter_words_before_lists(grid) + lists) * 4
+}
+
 /// The dense filter's bind groups for one volume (`FilterPass::bind`).
 pub struct FilterBinds {
-    /// Every step's parameters at its dynamic offset; bound by `binds`.
+    /// Every step's parameters at its dynamic offset; bound by `binds` and `prepare`.
     _params: wgpu::Buffer,
     binds: Vec<wgpu::BindGroup>,
     /// Each level's workgroups when it is filtered whole: across, and along z (every block).
     whole: Vec<[u32; 2]>,
-    /// `region`'s bind group: `[0]` the written box, `[1]` the whole volume.
-    region: [wgpu::BindGroup; 2],
-    /// Each level's dispatch size, written by `region`.
+    /// `prepare`'s and `done`'s bind group.
+    prepare: wgpu::BindGroup,
+    /// Each listed level's dispatch size, written by `prepare`.
     pub(super) args: wgpu::Buffer,
+    /// The volume's counters (a handle), cleared after a whole filter.
+    counters: wgpu::Buffer,
+    /// Bytes of the counters before the lists.
+    bits_end: u64,
 }

@@ -151,8 +151,10 @@ pub struct DenseVolume {
     pub slot_capacity: u32,
     /// `[0]` occupied voxels (slots, counted past the capacity), `[1]` slots of the previous
     /// build, `[2]` slots of the static geometry, `[3]` and `[4]` slots the dynamic geometry
-    /// touched in this and the previous update (see dense_update.wgsl), `[8..16]` the box of
-    /// voxels the build and update wrote since the last filter.
+    /// touched in this and the previous update (see dense_update.wgsl), `[6]` the voxels above
+    /// the finest the last filter redid (one for all its directions; 0 when it filtered
+    /// everything, after a build), from `[8]` on each level's voxels with a changed child,
+    /// counted, as bits and as lists (voxels/dense/changed.wgsl).
     pub counters: wgpu::Buffer,
     /// Per finest voxel (x fastest): 0 empty, 2 + slot once allocated, or a lock value while
     /// allocating or past the capacity.
@@ -449,8 +451,8 @@ impl DenseVolume {
         let normal = texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT);
         let emission = texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT);
         let slot_voxel = storage_buffer(device, "voxel slots", slots * 4, no);
-        // Words 8 to 15: the box the build and update wrote (build_shared.wgsl).
-        let counters = storage_buffer(device, "voxel counters", 64, no);
+        // From word 8: the levels' voxels the build and update changed (changed.wgsl).
+        let counters = storage_buffer(device, "voxel counters", filter::counter_bytes(grid), no);
         let dyn_slots = if dynamic { slots } else { 1 };
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
@@ -532,12 +534,6 @@ impl DenseVolume {
             built: true.into(),
             pipelines: pipelines.clone(),
         }
-    }
-
-    /// The last filter's workgroups of 4³ voxels per level (x, y, z as u32, the level above
-    /// the finest first; z counts every block): how much of each level it redid.
-    pub fn filter_dispatch(&self) -> &wgpu::Buffer {
-        &self.filter_binds.args
     }
 
     /// Blocks (directions) of `chains`: six, or one in isotropic mode.
