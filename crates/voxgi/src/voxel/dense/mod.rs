@@ -555,6 +555,7 @@ impl DenseVolume {
                     + self.slot_irradiance.size(),
             ),
             ("voxel dynamic sums", self.dyn_accum.size()),
+            ("voxel filter lists", self.counters.size()),
             ("voxel albedo", texture_bytes(res, 4, 1)),
             ("voxel normal", texture_bytes(res, 4, 1)),
             ("voxel emission", texture_bytes(res, 8, 1)),
