@@ -71,6 +71,6 @@ pub use settings::{SceneSettings, Setting, parse_bounces};
 pub use voxel::{VoxelKind, voxel_passes};
 /// The scene model and loaders (re-exported from `voxgi-scene`).
 pub use voxgi_scene as scene;
-pub use voxgi_scene::prepare::{PointPreparation, prepare_points};
+pub use voxgi_scene::prepare::{PointPreparation, PointsAhead, prepare_points};
 /// The wgpu voxgi is built on: use it to create the device and textures you hand to voxgi.
 pub use wgpu;
