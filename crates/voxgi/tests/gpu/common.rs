@@ -164,3 +164,16 @@ pub fn filtering_tolerance() -> (f32, f32) {
         (3.0 / 256.0 * 6.91, 1.0 / 256.0)
     }
 }
+
+/// `../shared/scenes/<rel>`, or None (the test says it skips) when it is not there.
+pub fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/scenes")
+        .join(rel);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipped: ../shared/scenes/{rel} is not present");
+        None
+    }
+}

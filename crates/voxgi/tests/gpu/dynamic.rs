@@ -1282,6 +1282,67 @@ fn bounce_slices_end_like_a_full_bounce() {
     }
 }
 
+/// The bounce rule on a real scene: Sponza with its 1.5 m block (examples/sponza-moving.toml)
+/// slid 1.5 m along the ground floor under the sun, two bounces in three slices. The first
+/// update after the move gathers near the block at once and a third of the other leaves; its
+/// picture stays within the rule's stated bound of a full bounce's, and three updates later
+/// it is a full bounce's, to the bit (the octree's within its bricks' placement). Skips
+/// without ../shared/scenes.
+#[test]
+fn bounce_slices_on_sponza_stay_within_their_bound() {
+    if shared_scene("sponza_dabrovic_geometry_only/sponza.obj").is_none() {
+        return;
+    }
+    let file =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sponza-moving.toml");
+    let base = voxgi::scene::io::load(&file).expect("examples/sponza-moving.toml loads");
+    let block = base
+        .instances
+        .iter()
+        .position(|i| i.dynamic)
+        .expect("the block, the one dynamic instance");
+    let slices = 3;
+    for voxels in [voxgi::VoxelKind::DENSE, voxgi::VoxelKind::OCTREE] {
+        let options = RendererOptions {
+            voxels,
+            voxel_resolution: 64,
+            bounces: 2,
+            bounce_slices: slices,
+            ..options()
+        };
+        let what = format!("Sponza, {voxels:?}");
+        let mut scene = base.clone();
+        let mut r = renderer(&scene, &options);
+        let p = params(&r);
+        frame(&mut r, &p, SIZE, SIZE);
+        let moved =
+            Mat4::from_translation(Vec3::new(1.5, 0.0, 0.0)) * scene.instances[block].transform;
+        r.set_instance_transform(block, moved).expect("dynamic");
+        scene.instances[block].transform = moved;
+        let first = frame(&mut r, &p, SIZE, SIZE);
+        let mut fresh = renderer(&scene, &options);
+        let want = frame(&mut fresh, &p, SIZE, SIZE);
+        let held_back = largest_hdr_difference(&first, &want);
+        eprintln!("{what}: the first update is up to {held_back} from a full bounce");
+        // The rule's error here, stated in docs/QUALITY.md (measured on lavapipe; twice that
+        // allows for other drivers' rounding).
+        assert!(
+            held_back > 0.0 && held_back < SPONZA_SLICES_BOUND,
+            "{what}: the first update is {held_back} from a full bounce"
+        );
+        for _ in 2..slices {
+            frame(&mut r, &p, SIZE, SIZE);
+        }
+        assert_like_fresh_placed(&mut r, &scene, &options, &what);
+        assert!(r.voxels_settled(), "{what}: still updating after {slices}");
+    }
+}
+
+/// `bounce_slices_on_sponza_stay_within_their_bound`'s bound on the first update's largest HDR
+/// difference from a full bounce: measured 0.0027 on lavapipe, both structures (where the
+/// picture's mean is 0.34), and twice that.
+const SPONZA_SLICES_BOUND: f32 = 0.0055;
+
 /// With bounce slices the leaves near moved geometry gather at once (within the reach
 /// `lighting::bounce::near_change` states): a small cube nudged across the Cornell box's
 /// floor, the first update's radiance equals a full bounce's to the bit at every voxel inside

@@ -308,19 +308,6 @@ fn cornell_box_of_points_agrees_with_the_path_tracer() {
     }
 }
 
-/// `../shared/scenes/<rel>`, or None (the test says it skips) when it is not there.
-fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/scenes")
-        .join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: ../shared/scenes/{rel} is not present");
-        None
-    }
-}
-
 #[test]
 fn the_bunnys_vertices_bounce_light_as_its_mesh_does() {
     // The Stanford bunny on a floor under a spot light, once as its mesh and once as the
