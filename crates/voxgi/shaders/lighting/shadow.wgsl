@@ -95,6 +95,33 @@ fn fs_main(in: VsOut) -> @location(0) f32 {
     return occluder_distance(in.world);
 }
 
+// With dynamic geometry (`StaticMaps`): each view's static geometry alone, drawn first; the
+// dynamic geometry is then drawn over a copy of it, keeping a fragment only where it lies
+// nearer than the static occluder (the depth buffer orders the dynamic fragments among
+// themselves), as one pass over both would.
+@group(1) @binding(0) var static_maps: texture_2d_array<f32>;
+
+fn over_static(clip: vec4<f32>, d: f32) -> f32 {
+    let s = textureLoad(static_maps, vec2<i32>(clip.xy), i32(view.layer), 0).r;
+    if d >= s {
+        discard;
+    }
+    return d;
+}
+
+@fragment
+fn fs_main_over(in: VsOut) -> @location(0) f32 {
+    return over_static(in.clip, occluder_distance(in.world));
+}
+
+@fragment
+fn fs_points_over(in: PointOut) -> @location(0) f32 {
+    if dot(in.disc, in.disc) > 1.0 {
+        discard;
+    }
+    return over_static(in.clip, occluder_distance(in.world));
+}
+
 // Resetting a rectangle of a view before re-rendering only that part (the scissor limits the
 // triangle to it): "nothing seen", at the far plane, like the pass's clear.
 @vertex

@@ -86,6 +86,22 @@ pub struct ShadowAtlas {
     pub samples: bool,
     /// Index of the first sample view: they follow all the other views.
     first_sample: usize,
+    /// With dynamic geometry, the views' static geometry alone, kept so that a view
+    /// re-rendered where dynamic geometry was or is draws only the dynamic geometry
+    /// (`ShadowPass::record`). None without dynamic geometry.
+    pub(crate) statics: Option<StaticMaps>,
+}
+
+/// The shadow views' maps of the static geometry alone (every view but the sample views,
+/// which move every frame): what a view holds before the dynamic geometry is drawn over it.
+pub(crate) struct StaticMaps {
+    pub texture: wgpu::Texture,
+    /// One view per layer, for rendering into it.
+    pub layer_views: Vec<wgpu::TextureView>,
+    /// `texture` as a 2D-array view, read by the dynamic geometry's fragments.
+    pub array_view: wgpu::TextureView,
+    /// Per view: its layer holds its static geometry as the view is now.
+    pub fresh: Vec<bool>,
 }
 
 fn up_for(dir: Vec3) -> Vec3 {
@@ -495,6 +511,7 @@ impl ShadowAtlas {
         res: u32,
         moments: bool,
         samples: bool,
+        dynamic: bool,
     ) -> Self {
         let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
         // Sample views are the quarter-size ones, after all the others (`plan_views`).
@@ -532,24 +549,52 @@ impl ShadowAtlas {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: ATLAS_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        let layer_views = (0..layers)
-            .map(|l| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    label: Some("shadow layer"),
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: l,
-                    array_layer_count: Some(1),
-                    ..Default::default()
+        let layer_views = |texture: &wgpu::Texture| {
+            (0..layers)
+                .map(|l| {
+                    texture.create_view(&wgpu::TextureViewDescriptor {
+                        label: Some("shadow layer"),
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: l,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    })
                 })
+                .collect()
+        };
+        let array_of = |texture: &wgpu::Texture| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
             })
-            .collect();
-        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
+        };
+        let statics = dynamic.then(|| {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("shadow atlas, static geometry"),
+                size: texture.size(),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: ATLAS_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            StaticMaps {
+                layer_views: layer_views(&texture),
+                array_view: array_of(&texture),
+                fresh: vec![false; views.len()],
+                texture,
+            }
         });
+        let array_view = array_of(&texture);
+        let layer_views = layer_views(&texture);
         let depth = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow depth"),
             size: wgpu::Extent3d {
@@ -592,6 +637,7 @@ impl ShadowAtlas {
             depth_view: depth.create_view(&Default::default()),
             samples,
             first_sample,
+            statics,
         }
     }
 
@@ -646,7 +692,21 @@ impl ShadowAtlas {
         if !views.is_empty() {
             queue.write_buffer(&self.views_buffer, 0, bytemuck::cast_slice(&views));
         }
+        if let Some(s) = &mut self.statics {
+            for (i, (new, old)) in views.iter().zip(&self.views).enumerate() {
+                if bytemuck::bytes_of(new) != bytemuck::bytes_of(old) {
+                    s.fresh[i] = false;
+                }
+            }
+        }
         self.views = views;
+    }
+
+    /// Forgets the static geometry's maps (the next render of each view draws them anew).
+    pub fn forget_statics(&mut self) {
+        if let Some(s) = &mut self.statics {
+            s.fresh.fill(false);
+        }
     }
 
     /// Bindings 1 to 4 of every shader that includes `shared/lights.wgsl`: the lights, the
@@ -680,12 +740,13 @@ impl ShadowAtlas {
 
     /// GPU memory of the atlas in bytes, counted as 8 bytes per texel of every layer (the R32F
     /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound),
-    /// plus the moments.
+    /// plus the moments and the static geometry's maps.
     pub fn bytes(&self) -> u64 {
         let texels = |t: &wgpu::Texture| {
             t.width() as u64 * t.height() as u64 * t.depth_or_array_layers() as u64
         };
-        texels(&self.texture) * 8 + texels(&self.moments) * 16
+        let statics = self.statics.as_ref().map_or(0, |s| texels(&s.texture) * 4);
+        texels(&self.texture) * 8 + texels(&self.moments) * 16 + statics
     }
 }
 
@@ -708,7 +769,11 @@ pub fn plan_atlas(
     check_atlas(&views, casts, res, moments, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
-        ShadowAtlas::new(device, views, owners, res, moments, samples)
+        // Meshes or clouds that move. (Area lights' emitters move with their lights too, but
+        // alone they are few: a scene with nothing else that moves keeps no static maps.)
+        let dynamic =
+            scene.calls.iter().any(|c| c.dynamic) || scene.geometry_points > scene.static_points;
+        ShadowAtlas::new(device, views, owners, res, moments, samples, dynamic)
     })
 }
 

@@ -757,6 +757,7 @@ impl Renderer {
     /// the voxels, static geometry included.
     pub fn invalidate(&mut self) {
         self.pending = Pending::everything(self.atlas.views.len());
+        self.atlas.forget_statics();
     }
 
     /// The linear HDR radiance of the last frame (before exposure and tone mapping; with

@@ -381,7 +381,7 @@ impl Renderer {
             });
             p.shadow.record(
                 encoder,
-                &self.atlas,
+                &mut self.atlas,
                 &self.scene,
                 &views,
                 &b.shadow,
@@ -707,9 +707,9 @@ pub(super) struct FragmentBinds {
     splat_dynamic: Option<SplatBind>,
 }
 
-/// The shadow pass's bind group and the moments pass's (with VSM/ESM): made on the first
+/// The shadow pass's bind groups and the moments pass's (with VSM/ESM): made on the first
 /// shadow render after the atlas was made anew.
 pub(super) struct ShadowBinds {
-    shadow: wgpu::BindGroup,
+    shadow: crate::lighting::shadow::ShadowBind,
     moments: Option<crate::lighting::moments::MomentsBind>,
 }
