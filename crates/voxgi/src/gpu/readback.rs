@@ -53,7 +53,8 @@ pub fn read_texture(
     })
 }
 
-/// Reads one mip level of a 3D texture into tightly packed bytes (x fastest, then y, then z).
+/// Reads one mip level of a 3D texture, or of every layer of a 2D array texture, into tightly
+/// packed bytes (x fastest, then y, then z or the layer).
 pub fn read_texture_3d(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -64,16 +65,14 @@ pub fn read_texture_3d(
         context: "readback".into(),
         reason,
     };
-    if texture.dimension() != wgpu::TextureDimension::D3 || mip >= texture.mip_level_count() {
+    if texture.dimension() == wgpu::TextureDimension::D1 || mip >= texture.mip_level_count() {
         return Err(fail(format!(
             "mip {mip} of a {:?} texture with {} levels",
             texture.dimension(),
             texture.mip_level_count()
         )));
     }
-    let size = texture
-        .size()
-        .mip_level_size(mip, wgpu::TextureDimension::D3);
+    let size = texture.size().mip_level_size(mip, texture.dimension());
     let (w, h, d) = (size.width, size.height, size.depth_or_array_layers);
     let bpp = texture
         .format()

@@ -551,10 +551,11 @@ impl ShadowAtlas {
             format: ATLAS_FORMAT,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_DST,
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let layer_views = |texture: &wgpu::Texture| {
+        let layer_views = |texture: &wgpu::Texture, layers: u32| {
             (0..layers)
                 .map(|l| {
                     texture.create_view(&wgpu::TextureViewDescriptor {
@@ -573,10 +574,19 @@ impl ShadowAtlas {
                 ..Default::default()
             })
         };
+        // The sample views move every frame: their layers (after the others') keep nothing.
+        let static_layers = views[..first_sample]
+            .iter()
+            .map(|v| v.layer + 1)
+            .max()
+            .unwrap_or(1);
         let statics = dynamic.then(|| {
             let texture = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("shadow atlas, static geometry"),
-                size: texture.size(),
+                size: wgpu::Extent3d {
+                    depth_or_array_layers: static_layers,
+                    ..texture.size()
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -587,14 +597,14 @@ impl ShadowAtlas {
                 view_formats: &[],
             });
             StaticMaps {
-                layer_views: layer_views(&texture),
+                layer_views: layer_views(&texture, static_layers),
                 array_view: array_of(&texture),
                 fresh: vec![false; views.len()],
                 texture,
             }
         });
         let array_view = array_of(&texture);
-        let layer_views = layer_views(&texture);
+        let layer_views = layer_views(&texture, layers);
         let depth = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow depth"),
             size: wgpu::Extent3d {
@@ -769,12 +779,47 @@ pub fn plan_atlas(
     check_atlas(&views, casts, res, moments, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
-        // Meshes or clouds that move. (Area lights' emitters move with their lights too, but
-        // alone they are few: a scene with nothing else that moves keeps no static maps.)
-        let dynamic =
-            scene.calls.iter().any(|c| c.dynamic) || scene.geometry_points > scene.static_points;
-        ShadowAtlas::new(device, views, owners, res, moments, samples, dynamic)
+        ShadowAtlas::new(
+            device,
+            views,
+            owners,
+            res,
+            moments,
+            samples,
+            keep_static_maps(scene),
+        )
     })
+}
+
+/// How many times the dynamic occluders the static ones must number (triangles and surfels)
+/// for an atlas to keep the static geometry's maps: they cost half the atlas again, and pay
+/// for it only where redrawing the static geometry under a moving object costs more than
+/// drawing that object.
+pub const STATIC_MAPS_FROM: u64 = 4;
+
+/// Whether an atlas for `scene` keeps the static geometry's maps (`StaticMaps`): when
+/// something moves (meshes or clouds; area lights' emitters move with their lights, but alone
+/// are few) and the static occluders number `STATIC_MAPS_FROM` times the dynamic ones.
+pub fn keep_static_maps(scene: &GpuScene) -> bool {
+    let (mut fixed, mut moving) = (0u64, 0u64);
+    for c in &scene.calls {
+        let triangles = c.indices.len() as u64 / 3;
+        if c.dynamic || c.light.is_some() {
+            moving += triangles;
+        } else {
+            fixed += triangles;
+        }
+    }
+    fixed += scene.static_points as u64;
+    moving += (scene.geometry_points - scene.static_points) as u64;
+    moving += scene
+        .emitter_points
+        .iter()
+        .map(|(r, _)| r.len() as u64)
+        .sum::<u64>();
+    let dynamic =
+        scene.calls.iter().any(|c| c.dynamic) || scene.geometry_points > scene.static_points;
+    dynamic && fixed >= STATIC_MAPS_FROM * moving
 }
 
 #[cfg(test)]

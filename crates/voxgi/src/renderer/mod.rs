@@ -753,6 +753,12 @@ impl Renderer {
         self.timer.read(&self.device)
     }
 
+    /// The shadow maps: one R32Float layer per shadow view, the occluder's distance
+    /// from the light (for inspection; `gpu::readback::read_texture_3d` reads every layer).
+    pub fn shadow_maps(&self) -> &wgpu::Texture {
+        &self.atlas.texture
+    }
+
     /// Marks everything as changed: the next frame re-renders every shadow view and rebuilds
     /// the voxels, static geometry included.
     pub fn invalidate(&mut self) {
