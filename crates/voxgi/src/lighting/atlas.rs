@@ -538,23 +538,30 @@ impl ShadowAtlas {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow atlas"),
-            size: wgpu::Extent3d {
-                width: res,
-                height: res,
-                depth_or_array_layers: layers,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: ATLAS_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_DST
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        // Distance maps, one square layer a view.
+        let maps = |label: &str, layers: u32, usage: wgpu::TextureUsages| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: res,
+                    height: res,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: ATLAS_FORMAT,
+                usage: usage
+                    | wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let texture = maps(
+            "shadow atlas",
+            layers,
+            wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
+        );
         let layer_views = |texture: &wgpu::Texture, layers: u32| {
             (0..layers)
                 .map(|l| {
@@ -581,21 +588,11 @@ impl ShadowAtlas {
             .max()
             .unwrap_or(1);
         let statics = dynamic.then(|| {
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("shadow atlas, static geometry"),
-                size: wgpu::Extent3d {
-                    depth_or_array_layers: static_layers,
-                    ..texture.size()
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: ATLAS_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            });
+            let texture = maps(
+                "shadow atlas, static geometry",
+                static_layers,
+                wgpu::TextureUsages::COPY_SRC,
+            );
             StaticMaps {
                 layer_views: layer_views(&texture, static_layers),
                 array_view: array_of(&texture),
