@@ -106,15 +106,16 @@ pub fn prepare_cloud_with(pc: &mut PointCloud, camera: Vec3, nb: &Neighbours) ->
 /// A cloud's attributes estimated ahead of the frame that shows it, on any thread (the
 /// renderer's point sequences do it on the thread that reads the file): everything but the
 /// normals' orientation, which depends on where the cloud will be (`PointsAhead::finish`).
+/// Its parts are read, not written: the neighbours belong to these points.
 #[derive(Clone, Debug, Default)]
 pub struct PointsAhead {
     /// The points, their missing attributes filled; estimated normals with either sign.
-    pub points: PointCloud,
+    points: PointCloud,
     /// Their `pointcloud::SPREAD_NEIGHBOURS` nearest neighbours (the surface spread reads
     /// them).
-    pub neighbours: Neighbours,
+    neighbours: Neighbours,
     /// What the estimation took.
-    pub timing: PointPreparation,
+    timing: PointPreparation,
     /// The normals were estimated and still face either way.
     unoriented: bool,
 }
@@ -146,6 +147,16 @@ impl PointsAhead {
             timing,
             unoriented,
         }
+    }
+
+    /// The points, their missing attributes filled (estimated normals with either sign).
+    pub fn points(&self) -> &PointCloud {
+        &self.points
+    }
+
+    /// What the estimation took.
+    pub fn timing(&self) -> PointPreparation {
+        self.timing
     }
 
     /// Turns the estimated normals as `prepare_cloud` would for the cloud placed by

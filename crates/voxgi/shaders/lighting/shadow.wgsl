@@ -95,7 +95,8 @@ fn fs_main(in: VsOut) -> @location(0) f32 {
     return occluder_distance(in.world);
 }
 
-// With dynamic geometry (`StaticMaps`): each view's static geometry alone, drawn first; the
+// With static maps (`StaticMaps`, a scene with dynamic geometry and four times as many static
+// occluders): each view's static geometry alone, drawn first; the
 // dynamic geometry is then drawn over a copy of it, keeping a fragment only where it lies
 // nearer than the static occluder (the depth buffer orders the dynamic fragments among
 // themselves), as one pass over both would.

@@ -86,9 +86,9 @@ pub struct ShadowAtlas {
     pub samples: bool,
     /// Index of the first sample view: they follow all the other views.
     first_sample: usize,
-    /// With dynamic geometry, the views' static geometry alone, kept so that a view
-    /// re-rendered where dynamic geometry was or is draws only the dynamic geometry
-    /// (`ShadowPass::record`). None without dynamic geometry.
+    /// The views' static geometry alone, kept so that a view re-rendered where dynamic
+    /// geometry was or is draws only the dynamic geometry (`ShadowPass::record`), when
+    /// `keep_static_maps` holds; None otherwise.
     pub(crate) statics: Option<StaticMaps>,
 }
 

@@ -159,7 +159,7 @@ impl ShadowPass {
     /// it (scissored: the rest keeps its texels, which are what a full render would give since
     /// nothing there changed). A view that fills only part of its layer (a sample view's
     /// quarter) is rendered through a viewport onto that part. With the static geometry's maps
-    /// (a scene with dynamic geometry) a view other than a sample view is the static
+    /// (`keep_static_maps`) a view other than a sample view is the static
     /// geometry's map (drawn when the view changed), copied, and the dynamic geometry and the
     /// emitters drawn over it: a rectangle costs the dynamic geometry only. Timed as "shadow"
     /// (summed over the views), and the area lights' sample views as "shadow_samples".

@@ -753,7 +753,8 @@ impl Renderer {
         self.timer.read(&self.device)
     }
 
-    /// The shadow maps: one R32Float layer per shadow view, the occluder's distance
+    /// The shadow maps: one R32Float layer per shadow view (the area lights' sample views share
+    /// layers, a quarter each), the occluder's distance
     /// from the light (for inspection; `gpu::readback::read_texture_3d` reads every layer).
     pub fn shadow_maps(&self) -> &wgpu::Texture {
         &self.atlas.texture

@@ -177,8 +177,8 @@ impl Renderer {
         cloud: usize,
         points: &voxgi_scene::PointCloud,
     ) -> Result<voxgi_scene::prepare::PointPreparation> {
-        self.check_points(cloud, points)?;
-        self.set_points_ahead(cloud, PointsAhead::new(points.clone()))
+        let old = self.check_points(cloud, points)?;
+        self.apply_points(cloud, PointsAhead::new(points.clone()), &old)
     }
 
     /// `set_points` for points whose attributes were estimated ahead
@@ -189,7 +189,18 @@ impl Renderer {
         cloud: usize,
         ahead: PointsAhead,
     ) -> Result<voxgi_scene::prepare::PointPreparation> {
-        let old = self.check_points(cloud, &ahead.points)?;
+        let old = self.check_points(cloud, ahead.points())?;
+        self.apply_points(cloud, ahead, &old)
+    }
+
+    /// `set_points_ahead` once the points passed `check_points` (`old`: the cloud's points
+    /// until now).
+    fn apply_points(
+        &mut self,
+        cloud: usize,
+        ahead: PointsAhead,
+        old: &voxgi_scene::PointCloud,
+    ) -> Result<voxgi_scene::prepare::PointPreparation> {
         let c = &self.state.clouds[cloud];
         let (mut pc, neighbours, prepared) =
             ahead.finish(c.transform, self.default_camera.position);
@@ -435,7 +446,7 @@ impl Renderer {
         let mut frames = Vec::with_capacity(changes.frames.len());
         for f in changes.frames {
             let start = web_time::Instant::now();
-            let points = f.points.points.positions.len();
+            let points = f.points.points().positions.len();
             let prepared = match self.set_points_ahead(f.cloud, f.points) {
                 Ok(p) => p,
                 Err(e) => {

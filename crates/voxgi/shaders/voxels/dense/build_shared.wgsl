@@ -31,7 +31,7 @@
 // the static ones), resolved now and restored by the next update. (Eight storage buffers per
 // stage is the minimum limit: the flag and the list share this one.)
 @group(0) @binding(11) var<storage, read_write> dyn_accum: array<atomic<u32>>;
-// The box of voxels written since the last filter, for the filter (counters[8..16]).
+// The voxels written since the last filter, listed for the filter (changed.wgsl).
 //!include voxels/changed.wgsl
 
 // Indirect dispatch arguments: [0..3] over slots, [3..6] over fragments, [6..9] over

@@ -100,27 +100,27 @@ fn whole(@builtin(global_invocation_id) tid: vec3<u32>) {
     filter_voxel(vec3<u32>(tid.xy, tid.z % n), block);
 }
 
-// The voxels the level's list holds: x over the list, y over the direction blocks. Each
-// lists its parent for the next level and clears its own bit (nothing lists this level while
-// it runs).
+// The voxels the level's list holds: x and y over the list (x up to 65,535 workgroups, as
+// many rows as that takes), z over the direction blocks. Each lists its parent for the next
+// level and clears its own bit (nothing lists this level while it runs).
 @compute @workgroup_size(64)
-fn listed(@builtin(global_invocation_id) tid: vec3<u32>) {
+fn listed(@builtin(global_invocation_id) tid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let n = params.dst_res;
     let level = params.step + 1u;
     let res = n << level;
-    if tid.x >= atomicLoad(&counters[COUNTS + level - 1u]) {
+    let k = tid.x + tid.y * nwg.x * 64u;
+    if k >= atomicLoad(&counters[COUNTS + level - 1u]) {
         return;
     }
-    let i = atomicLoad(&counters[list_of(res, level) + tid.x]);
+    let i = atomicLoad(&counters[list_of(res, level) + k]);
     let gid = vec3<u32>(i % n, (i / n) % n, i / (n * n));
-    if tid.y == 0u {
+    if tid.z == 0u {
         if level < levels_above(res) {
             mark_level(res, level + 1u, gid >> vec3<u32>(1u));
         }
         atomicAnd(&counters[bits_of(res, level) + i / 32u], ~(1u << (i % 32u)));
-        atomicAdd(&counters[REDONE], 1u);
     }
-    filter_voxel(gid, tid.y);
+    filter_voxel(gid, tid.z);
 }
 
 // --- prepare: one thread before each listed level sizes its dispatch from its list; `done`
@@ -133,13 +133,16 @@ fn listed(@builtin(global_invocation_id) tid: vec3<u32>) {
 @compute @workgroup_size(1)
 fn prepare() {
     let level = params.step + 1u;
-    if level == 1u {
-        atomicStore(&counters[REDONE], 0u);
-    }
     let count = atomicLoad(&counters[COUNTS + level - 1u]);
-    level_args[3u * params.step] = (count + 63u) / 64u;
-    level_args[3u * params.step + 1u] = blocks();
-    level_args[3u * params.step + 2u] = 1u;
+    if level == 1u {
+        atomicStore(&counters[REDONE], count);
+    } else {
+        atomicAdd(&counters[REDONE], count);
+    }
+    let groups = (count + 63u) / 64u;
+    level_args[3u * params.step] = min(groups, 65535u);
+    level_args[3u * params.step + 1u] = (groups + 65534u) / 65535u;
+    level_args[3u * params.step + 2u] = blocks();
 }
 
 @compute @workgroup_size(1)

@@ -8,8 +8,8 @@
 
 @group(3) @binding(0) var leaf_radiance_out: texture_storage_3d<rgba16float, write>;
 
-// `v`: premultiplied radiance (rgb) and opacity. The voxel joins the box the next filter
-// redoes.
+// `v`: premultiplied radiance (rgb) and opacity. The voxel's parent is listed for the next
+// filter.
 fn store_leaf_radiance(i: u32, v: vec4<f32>) {
     let c = leaf_coord(i);
     textureStore(leaf_radiance_out, c, to_half(to_depth(v)));

@@ -24,7 +24,7 @@
 // Per slot: the voxel's linear index.
 @group(2) @binding(4) var<storage, read> slot_voxel: array<u32>;
 // [0]: slots of the last build (counted past the capacity).
-// Read-write: the leaf stores grow the box of written voxels in it (changed.wgsl).
+// Read-write: the leaf stores list the voxels they write in it for the filter (changed.wgsl).
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>>;
 // Per leaf: direct radiance (rgb) and opacity, kept for the bounces.
 @group(2) @binding(6) var<storage, read_write> leaf_direct: array<vec4<f32>>;

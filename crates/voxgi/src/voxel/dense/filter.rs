@@ -257,6 +257,8 @@ impl FilterPass {
 fn counter_words_before_lists(grid: Grid) -> u64 {
     let res = grid.resolution as u64;
     let top = grid.levels() as u64 - 1;
+    // changed.wgsl counts ten levels above the finest (a 1024³ volume's).
+    debug_assert!(top <= 10, "{top} levels above the finest");
     let bits: u64 = (1..=top).map(|l| (res >> l).pow(3).div_ceil(32)).sum();
     18 + bits
 }
