@@ -126,10 +126,7 @@ impl PointsAhead {
     pub fn new(mut points: PointCloud) -> Self {
         // `Renderer::set_points` names a point that is not finite; nothing to estimate.
         if !points.positions.iter().all(|p| p.is_finite()) {
-            return PointsAhead {
-                points,
-                ..Default::default()
-            };
+            return Self::unestimated(points);
         }
         let t = Instant::now();
         let neighbours = Neighbours::find(&points.positions, pointcloud::SPREAD_NEIGHBOURS);
@@ -146,6 +143,15 @@ impl PointsAhead {
             neighbours,
             timing,
             unoriented,
+        }
+    }
+
+    /// `points` as they are, estimation skipped (a frame nobody will show, or points that are
+    /// not all finite).
+    pub(crate) fn unestimated(points: PointCloud) -> Self {
+        PointsAhead {
+            points,
+            ..Default::default()
         }
     }
 

@@ -263,6 +263,10 @@ struct Ahead {
     frame: usize,
     #[cfg(not(target_arch = "wasm32"))]
     job: std::thread::JoinHandle<Result<PointsAhead>>,
+    /// False once the player moved elsewhere (a jump in time): the thread then skips the
+    /// estimation, which would only compete with the caller's.
+    #[cfg(not(target_arch = "wasm32"))]
+    wanted: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 /// A frame a sequence moved to: its cloud, the frame, its points (their attributes estimated
@@ -323,7 +327,15 @@ impl SequencePlayer {
                         "a point sequence's loader panicked".into(),
                     ))
                 })?,
-                _ => PointsAhead::new(s.load(frame)?),
+                other => {
+                    #[cfg(not(target_arch = "wasm32"))]
+                    if let Some(a) = other {
+                        a.wanted.store(false, std::sync::atomic::Ordering::Relaxed);
+                    }
+                    #[cfg(target_arch = "wasm32")]
+                    let _ = other;
+                    PointsAhead::new(s.load(frame)?)
+                }
             };
             let waited = start.elapsed();
             s.shown = frame;
@@ -332,11 +344,19 @@ impl SequencePlayer {
                 let next = s.next(frame);
                 if next != frame {
                     let (files, colour) = (s.files.clone(), s.base_color);
+                    let wanted = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+                    let still = wanted.clone();
                     *ahead = Some(Ahead {
                         frame: next,
                         job: std::thread::spawn(move || {
-                            load_frame(&files, next, colour).map(PointsAhead::new)
+                            let points = load_frame(&files, next, colour)?;
+                            Ok(if still.load(std::sync::atomic::Ordering::Relaxed) {
+                                PointsAhead::new(points)
+                            } else {
+                                PointsAhead::unestimated(points)
+                            })
                         }),
+                        wanted,
                     });
                 }
             }
