@@ -798,25 +798,26 @@ pub const STATIC_MAPS_FROM: u64 = 4;
 /// something moves (meshes or clouds; area lights' emitters move with their lights, but alone
 /// are few) and the static occluders number `STATIC_MAPS_FROM` times the dynamic ones.
 pub fn keep_static_maps(scene: &GpuScene) -> bool {
-    let (mut fixed, mut moving) = (0u64, 0u64);
+    // Triangles and surfels: the static geometry's, the dynamic geometry's, the emitters'.
+    let (mut fixed, mut dynamic, mut emitters) = (0u64, 0u64, 0u64);
     for c in &scene.calls {
         let triangles = c.indices.len() as u64 / 3;
-        if c.dynamic || c.light.is_some() {
-            moving += triangles;
+        if c.dynamic {
+            dynamic += triangles;
+        } else if c.light.is_some() {
+            emitters += triangles;
         } else {
             fixed += triangles;
         }
     }
     fixed += scene.static_points as u64;
-    moving += (scene.geometry_points - scene.static_points) as u64;
-    moving += scene
+    dynamic += (scene.geometry_points - scene.static_points) as u64;
+    emitters += scene
         .emitter_points
         .iter()
         .map(|(r, _)| r.len() as u64)
         .sum::<u64>();
-    let dynamic =
-        scene.calls.iter().any(|c| c.dynamic) || scene.geometry_points > scene.static_points;
-    dynamic && fixed >= STATIC_MAPS_FROM * moving
+    dynamic > 0 && fixed >= STATIC_MAPS_FROM * (dynamic + emitters)
 }
 
 #[cfg(test)]

@@ -1254,11 +1254,8 @@ fn bounce_slices_end_like_a_full_bounce() {
             };
             let what = format!("{voxels:?}, {bounces} bounces");
             let (scene, mut r, p) = light_moved(&options);
-            let first = frame(&mut r, &p, SIZE, SIZE);
-            let mut fresh = renderer(&scene, &options);
-            let want = frame(&mut fresh, &p, SIZE, SIZE);
             // The octree's radiance lies in atlases placed by its pools: the picture tells.
-            let held_back = largest_hdr_difference(&first, &want);
+            let held_back = first_update_gap(&mut r, &scene, &options, &p);
             eprintln!("{what}: the first update is up to {held_back} from a full bounce");
             assert!(
                 held_back > 10.0 * placement_tolerance(&options).max(1e-4),
@@ -1319,10 +1316,7 @@ fn bounce_slices_on_sponza_stay_within_their_bound() {
             Mat4::from_translation(Vec3::new(1.5, 0.0, 0.0)) * scene.instances[block].transform;
         r.set_instance_transform(block, moved).expect("dynamic");
         scene.instances[block].transform = moved;
-        let first = frame(&mut r, &p, SIZE, SIZE);
-        let mut fresh = renderer(&scene, &options);
-        let want = frame(&mut fresh, &p, SIZE, SIZE);
-        let held_back = largest_hdr_difference(&first, &want);
+        let held_back = first_update_gap(&mut r, &scene, &options, &p);
         eprintln!("{what}: the first update is up to {held_back} from a full bounce");
         // The rule's error here, stated in docs/QUALITY.md (measured on lavapipe; twice that
         // allows for other drivers' rounding).
@@ -1336,6 +1330,19 @@ fn bounce_slices_on_sponza_stay_within_their_bound() {
         assert_like_fresh_placed(&mut r, &scene, &options, &what);
         assert!(r.voxels_settled(), "{what}: still updating after {slices}");
     }
+}
+
+/// The largest HDR difference between `r`'s next frame and a fresh renderer's on `scene`.
+fn first_update_gap(
+    r: &mut Renderer,
+    scene: &Scene,
+    options: &RendererOptions,
+    p: &FrameParams,
+) -> f32 {
+    let first = frame(r, p, SIZE, SIZE);
+    let mut fresh = renderer(scene, options);
+    let want = frame(&mut fresh, p, SIZE, SIZE);
+    largest_hdr_difference(&first, &want)
 }
 
 /// `bounce_slices_on_sponza_stay_within_their_bound`'s bound on the first update's largest HDR
