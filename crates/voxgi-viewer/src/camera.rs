@@ -3,8 +3,8 @@
 //! between them, or to a scene's own camera, keeps the view.
 
 use glam::Vec3;
-use std::time::Instant;
 use voxgi::scene::{Camera, Projection};
+use web_time::Instant;
 
 /// Radians of turn per pixel of mouse motion.
 const TURN_PER_PIXEL: f32 = 0.005;

@@ -59,7 +59,7 @@ fn list_start() -> u32 {
 // A leaf's slice: a hash of its voxel (not its slot, which atomics hand out in any order, so
 // that renders are the same from run to run), spreading a turn's leaves through the scene.
 fn slice_of(c: vec3<u32>) -> u32 {
-    var h = c.x * 73856093u ^ c.y * 19349663u ^ c.z * 83492791u;
+    var h = (c.x * 73856093u) ^ (c.y * 19349663u) ^ (c.z * 83492791u);
     h = (h ^ (h >> 16u)) * 0x45d9f3bu;
     h = (h ^ (h >> 16u)) * 0x45d9f3bu;
     h = h ^ (h >> 16u);

@@ -1,0 +1,319 @@
+//! voxgi-web: voxgi in a browser page through WebGPU. The page (web/index.html, built by
+//! web/build.sh) holds a canvas, a status line and a panel; this crate opens the WebGPU
+//! device, renders a built-in scene into the canvas every animation frame, turns the viewer's
+//! orbit camera by mouse drags, and builds the settings panel from voxgi's one settings table.
+//!
+//! The query string chooses the scene (`?builtin=two-rooms`) and any setting by its key, as a
+//! scene file's `[settings]` would (`?voxel_resolution=64&bounces=1`).
+//!
+//! Only `wasm32` builds have code; elsewhere the crate is empty but for its browser test.
+#![cfg(target_arch = "wasm32")]
+
+// The viewer's camera controllers, shared as they are (the viewer is a binary crate).
+#[path = "../../voxgi-viewer/src/camera.rs"]
+#[allow(dead_code)]
+mod camera;
+mod page;
+mod panel;
+
+use anyhow::{Context, Result, anyhow};
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::{Arc, Mutex};
+use voxgi::wgpu;
+use voxgi::{FrameParams, Renderer, RendererOptions, SceneSettings};
+use wasm_bindgen::prelude::*;
+
+/// The page's entry point: runs when the module is instantiated.
+#[wasm_bindgen(start)]
+pub fn start() {
+    console_error_panic_hook::set_once();
+    page::init_logging();
+    wasm_bindgen_futures::spawn_local(async {
+        if let Err(e) = run().await {
+            page::show_error(&format!("{e:#}"));
+        }
+    });
+}
+
+/// Everything a frame needs, shared by the animation-frame loop and the event handlers.
+pub(crate) struct App {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    canvas: web_sys::HtmlCanvasElement,
+    pub(crate) renderer: Renderer,
+    pub(crate) options: RendererOptions,
+    pub(crate) params: FrameParams,
+    pub(crate) orbit: camera::Orbit,
+    scene_radius: f32,
+    /// The last pointer position of a drag, and whether it pans (right button or shift).
+    drag: Option<(f32, f32, bool)>,
+    /// The scene's animation: its length (0: none), the time shown, playing or not.
+    duration: f32,
+    time: f32,
+    playing: bool,
+    last_frame: Option<f64>,
+    /// Frames the GPU finished, and the time the last one finished (ms since the page began).
+    done: Arc<Mutex<Done>>,
+    /// Frames submitted.
+    submitted: u32,
+    /// An error stopped the loop (it is on the page).
+    stopped: bool,
+}
+
+/// What the GPU finished: counted by `Queue::on_submitted_work_done`.
+#[derive(Default)]
+struct Done {
+    frames: u32,
+    first_ms: Option<f64>,
+    /// Milliseconds between the last finished frames, smoothed.
+    frame_ms: Option<f64>,
+    last_ms: Option<f64>,
+}
+
+async fn run() -> Result<()> {
+    let query = page::query();
+    let builtin = query
+        .iter()
+        .find(|(k, _)| k == "builtin")
+        .map_or("cornell-box".to_string(), |(_, v)| v.clone());
+    let scene = voxgi::scene::builtin::by_name(&builtin)?;
+    // Every other key of the query is a setting, checked as a scene file's would be.
+    let pairs: Vec<(&str, &str)> = query
+        .iter()
+        .filter(|(k, _)| k != "builtin")
+        .map(|(k, v)| (k.as_str(), v.as_str()))
+        .collect();
+    let settings =
+        SceneSettings::from_pairs(pairs.iter().copied()).context("the page's query string")?;
+
+    page::status("asking the browser for a WebGPU adapter…");
+    let canvas: web_sys::HtmlCanvasElement = page::element("voxgi")?;
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+    descriptor.backends = wgpu::Backends::BROWSER_WEBGPU;
+    let instance = wgpu::Instance::new(descriptor);
+    let surface = instance
+        .create_surface(wgpu::SurfaceTarget::Canvas(canvas.clone()))
+        .map_err(|e| anyhow!("the canvas cannot show WebGPU: {e}"))?;
+    let adapter = instance
+        .request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: Some(&surface),
+            apply_limit_buckets: false,
+        })
+        .await
+        .map_err(|e| anyhow!("this browser offers no WebGPU adapter ({e}); voxgi needs WebGPU"))?;
+    let (device, queue) = adapter
+        .request_device(&wgpu::DeviceDescriptor {
+            label: Some("voxgi-web"),
+            required_features: voxgi::required_features(&adapter),
+            required_limits: voxgi::required_limits(&adapter),
+            ..Default::default()
+        })
+        .await
+        .context("cannot open the WebGPU device")?;
+    device.on_uncaptured_error(Arc::new(|e: wgpu::Error| {
+        page::show_error(&format!("WebGPU: {e}"));
+    }));
+
+    let mut options = RendererOptions::default();
+    // The camera follows the orbit from the first frame on.
+    let mut params = FrameParams::new(voxgi::scene::Camera::look_at(
+        glam::Vec3::Z,
+        glam::Vec3::ZERO,
+        45.0,
+    ));
+    settings.apply(&mut options, &mut params)?;
+    page::status("uploading the scene and building the pipelines…");
+    let renderer = Renderer::new(&device, &queue, &scene, &options)?;
+    let bounds = scene.bounds();
+    let scene_radius = (bounds.size().length() * 0.5).max(1e-3);
+    let orbit = camera::Orbit::from_camera(renderer.default_camera(), scene_radius * 2.0);
+    params.camera = orbit.camera();
+
+    let caps = surface.get_capabilities(&adapter);
+    // 8-bit without an sRGB view: voxgi applies the sRGB curve itself.
+    let format = caps
+        .formats
+        .iter()
+        .copied()
+        .find(|f| {
+            matches!(
+                f,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
+            )
+        })
+        .or_else(|| caps.formats.first().copied())
+        .ok_or_else(|| anyhow!("the canvas offers no format"))?;
+    let (width, height) = page::canvas_size(&canvas, device.limits().max_texture_dimension_2d);
+    let mut config = surface
+        .get_default_config(&adapter, width, height)
+        .ok_or_else(|| anyhow!("the adapter cannot draw into the canvas"))?;
+    config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    config.format = format;
+    config.present_mode = wgpu::PresentMode::Fifo;
+    surface.configure(&device, &config);
+
+    let info = adapter.get_info();
+    let limits = device.limits();
+    page::set_adapter(&format!(
+        "{} · {} · storage buffers up to {} MiB · 3D textures up to {}³ · {}",
+        if info.name.is_empty() {
+            "WebGPU adapter"
+        } else {
+            &info.name
+        },
+        builtin,
+        limits.max_storage_buffer_binding_size >> 20,
+        limits.max_texture_dimension_3d,
+        if device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+            "GPU timestamps"
+        } else {
+            "no GPU timestamps"
+        },
+    ));
+
+    let duration = scene.duration();
+    let app = Rc::new(RefCell::new(App {
+        device,
+        queue,
+        surface,
+        config,
+        canvas,
+        renderer,
+        options,
+        params,
+        orbit,
+        scene_radius,
+        drag: None,
+        duration,
+        time: 0.0,
+        playing: duration > 0.0,
+        last_frame: None,
+        done: Arc::new(Mutex::new(Done::default())),
+        submitted: 0,
+        stopped: false,
+    }));
+    panel::build(&app)?;
+    page::listen_input(&app)?;
+    page::animation_loop(app);
+    Ok(())
+}
+
+impl App {
+    /// Renders one frame into the canvas (called once per animation frame).
+    pub(crate) fn frame(&mut self, now_ms: f64) {
+        if self.stopped {
+            return;
+        }
+        // The browser asks for frames at the display's rate whatever the GPU's pace: with two
+        // frames still on the GPU, this one is skipped, so input is answered by the next frame
+        // rather than after a queue of stale ones.
+        let finished = self.done.lock().map_or(0, |d| d.frames);
+        if self.submitted > finished + 1 {
+            return;
+        }
+        if let Err(e) = self.try_frame(now_ms) {
+            self.stopped = true;
+            page::show_error(&format!("{e:#}"));
+        }
+    }
+
+    fn try_frame(&mut self, now_ms: f64) -> Result<()> {
+        let (w, h) = page::canvas_size(&self.canvas, self.device.limits().max_texture_dimension_2d);
+        if (w, h) != (self.config.width, self.config.height) {
+            self.config.width = w;
+            self.config.height = h;
+            self.surface.configure(&self.device, &self.config);
+        }
+        // Slow frames do not make the animation jump.
+        let dt = self
+            .last_frame
+            .map_or(0.0, |t| ((now_ms - t) / 1000.0).min(0.25) as f32);
+        self.last_frame = Some(now_ms);
+        if self.playing && self.duration > 0.0 {
+            self.time = (self.time + dt) % self.duration.max(1e-3);
+        }
+        self.renderer.set_time(self.time)?;
+        self.renderer.receive_feedback()?;
+        self.params.camera = self.orbit.camera();
+
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(());
+            }
+            other => return Err(anyhow!("the canvas's surface: {other:?}")),
+        };
+        let view = frame.texture.create_view(&Default::default());
+        let target = voxgi::Target::new(&view, self.config.format, w, h);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.renderer.render(&mut encoder, &target, &self.params)?;
+        self.queue.submit([encoder.finish()]);
+        self.submitted += 1;
+        let done = self.done.clone();
+        self.queue.on_submitted_work_done(move || {
+            let now = page::now_ms();
+            // A poisoned lock only means an earlier callback panicked: its counts still hold.
+            let mut d = done.lock().unwrap_or_else(|p| p.into_inner());
+            d.frames += 1;
+            d.first_ms.get_or_insert(now);
+            if let Some(last) = d.last_ms {
+                let ms = now - last;
+                d.frame_ms = Some(d.frame_ms.map_or(ms, |m| 0.8 * m + 0.2 * ms));
+            }
+            d.last_ms = Some(now);
+            page::frames_done(d.frames, d.first_ms, d.frame_ms);
+        });
+        self.queue.present(frame);
+        Ok(())
+    }
+
+    /// Applies a change of the options (from the panel): only what depends on it is redone.
+    pub(crate) fn set_options(&mut self, options: RendererOptions) -> voxgi::Result<()> {
+        self.renderer.set_options(&options)?;
+        self.options = options;
+        Ok(())
+    }
+
+    /// Back to the scene's own camera.
+    pub(crate) fn frame_scene(&mut self) {
+        self.orbit =
+            camera::Orbit::from_camera(self.renderer.default_camera(), self.scene_radius * 2.0);
+    }
+
+    /// A drag or a wheel step on the canvas.
+    pub(crate) fn pointer(&mut self, event: page::Pointer) {
+        match event {
+            page::Pointer::Down { x, y, pan } => self.drag = Some((x, y, pan)),
+            page::Pointer::Move { x, y } => {
+                if let Some((x0, y0, pan)) = self.drag {
+                    if pan {
+                        self.orbit.pan(x - x0, y - y0, self.config.height as f32);
+                    } else {
+                        self.orbit.rotate(x - x0, y - y0);
+                    }
+                    self.drag = Some((x, y, pan));
+                }
+            }
+            page::Pointer::Up => self.drag = None,
+            page::Pointer::Wheel { steps } => self.orbit.zoom(steps),
+        }
+    }
+
+    /// Plays or pauses the scene's animation; false when it has none.
+    pub(crate) fn toggle_play(&mut self) -> bool {
+        if self.duration > 0.0 {
+            self.playing = !self.playing;
+        }
+        self.playing
+    }
+}

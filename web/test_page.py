@@ -1,0 +1,229 @@
+#!/usr/bin/env python3
+"""Drives voxgi's web page in headless Chromium (WebGPU on SwiftShader) and checks it.
+
+    python3 web/test_page.py DIR [--out SHOTS] [--chromium PATH]
+
+DIR is what web/build.sh wrote. The page is served from DIR on a local port and opened with
+the built-in Cornell box at 64^3 voxels. The test waits for frames the GPU finished, then
+checks:
+  - the page shows no error and the console logged none;
+  - the picture: the left wall is red, the right wall green, and the ceiling, which only
+    bounced light reaches (the lamp faces down), is lit;
+  - an orbit drag on the canvas changes the picture;
+  - the panel: setting `bounces` to 0 (direct light only) darkens the ceiling.
+Screenshots go to SHOTS (default: a temporary folder), for looking at. It prints the time to
+the first frame and the frame time. Exit status 0 when every check passes.
+
+Needs Playwright (pip install playwright; it drives the system's Chromium, no download) and
+Debian's chromium. The flags are those that give headless Chromium a WebGPU adapter that can
+present to a canvas on a machine without a GPU.
+"""
+
+import argparse
+import functools
+import http.server
+import io
+import sys
+import tempfile
+import threading
+import time
+
+CHROMIUM_FLAGS = [
+    "--enable-unsafe-webgpu",
+    "--enable-unsafe-swiftshader",
+    "--enable-features=Vulkan",
+    "--use-vulkan=swiftshader",
+    "--use-angle=swiftshader",
+    "--no-sandbox",
+]
+
+# SwiftShader renders a frame of the page in seconds; the first frame also compiles every
+# pipeline and builds the voxels.
+FIRST_FRAMES_S = 300
+FRAMES_S = 120
+
+
+class Quiet(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+    def end_headers(self):
+        # Each run serves a fresh build.
+        self.send_header("Cache-Control", "no-store")
+        super().end_headers()
+
+
+def serve(directory):
+    handler = functools.partial(Quiet, directory=directory)
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server
+
+
+def frames(page):
+    return int(page.evaluate("document.body.dataset.frames || '0'"))
+
+
+def page_error(page):
+    return page.evaluate("document.getElementById('error').textContent").strip()
+
+
+def wait_frames(page, count, seconds):
+    """Waits until the GPU finished `count` frames; fails on a page error or a timeout."""
+    end = time.time() + seconds
+    while time.time() < end:
+        error = page_error(page)
+        if error:
+            raise AssertionError(f"the page shows an error: {error}")
+        if frames(page) >= count:
+            return
+        time.sleep(0.5)
+    raise AssertionError(
+        f"only {frames(page)} of {count} frames after {seconds} s; status: "
+        + page.evaluate("document.getElementById('status').textContent")
+    )
+
+
+def shot(page, path):
+    """The canvas as an RGB image (and saved to `path`)."""
+    from PIL import Image
+
+    data = page.locator("#voxgi").screenshot(path=path, timeout=FRAMES_S * 1000)
+    return Image.open(io.BytesIO(data)).convert("RGB")
+
+
+def box_bounds(img):
+    """The Cornell box's extent in the picture: the bounding box of pixels brighter than the
+    black background."""
+    w, h = img.size
+    px = img.load()
+    xs, ys = [], []
+    for y in range(0, h, 2):
+        for x in range(0, w, 2):
+            if sum(px[x, y]) > 45:
+                xs.append(x)
+                ys.append(y)
+    if not xs:
+        raise AssertionError("the canvas is black")
+    return min(xs), min(ys), max(xs), max(ys)
+
+
+def mean(img, box, fx0, fy0, fx1, fy1):
+    """Mean RGB over the part (fx0..fx1, fy0..fy1) of `box`, as fractions of its size."""
+    x0, y0, x1, y1 = box
+    bw, bh = x1 - x0, y1 - y0
+    px = img.load()
+    total, n = [0, 0, 0], 0
+    for y in range(int(y0 + fy0 * bh), int(y0 + fy1 * bh)):
+        for x in range(int(x0 + fx0 * bw), int(x0 + fx1 * bw)):
+            for c in range(3):
+                total[c] += px[x, y][c]
+            n += 1
+    return [t / max(n, 1) for t in total]
+
+
+def difference(a, b):
+    """Mean absolute difference per channel, 0..255."""
+    pa, pb = a.load(), b.load()
+    w, h = a.size
+    total = 0
+    for y in range(0, h, 2):
+        for x in range(0, w, 2):
+            total += sum(abs(pa[x, y][c] - pb[x, y][c]) for c in range(3))
+    return total / (3 * ((w + 1) // 2) * ((h + 1) // 2))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("dir")
+    parser.add_argument("--out", default=None)
+    parser.add_argument("--chromium", default="/usr/bin/chromium")
+    args = parser.parse_args()
+    out = args.out or tempfile.mkdtemp(prefix="voxgi-web-")
+
+    from playwright.sync_api import sync_playwright
+
+    server = serve(args.dir)
+    url = f"http://127.0.0.1:{server.server_address[1]}/index.html?voxel_resolution=64"
+    console_errors = []
+    with sync_playwright() as p:
+        browser = p.chromium.launch(
+            executable_path=args.chromium, headless=True, args=CHROMIUM_FLAGS
+        )
+        page = browser.new_page(viewport={"width": 760, "height": 400})
+        page.on(
+            "console",
+            lambda m: console_errors.append(m.text) if m.type == "error" else None,
+        )
+        page.on("pageerror", lambda e: console_errors.append(str(e)))
+        page.goto(url)
+
+        wait_frames(page, 4, FIRST_FRAMES_S)
+        first_ms = float(page.evaluate("document.body.dataset.firstFrameMs"))
+        before = shot(page, f"{out}/cornell.png")
+        box = box_bounds(before)
+        left = mean(before, box, 0.02, 0.3, 0.12, 0.7)
+        right = mean(before, box, 0.88, 0.3, 0.98, 0.7)
+        # Between the lamp (the middle of the ceiling) and the walls.
+        ceiling = mean(before, box, 0.2, 0.02, 0.32, 0.1)
+        print(f"left wall {left}, right wall {right}, ceiling {ceiling}")
+        # The walls' colours dominate their pixels (the reference's albedos are 0.63/0.065
+        # red and 0.14/0.45 green): a margin of 1.5x holds under any exposure.
+        assert left[0] > 1.5 * left[1] and left[0] > 1.5 * left[2] and left[0] > 40, (
+            f"the left wall is not red: {left}"
+        )
+        assert right[1] > 1.5 * right[0] and right[1] > 1.5 * right[2] and right[1] > 30, (
+            f"the right wall is not green: {right}"
+        )
+        # Bounced light alone lights the ceiling there: 20 of 255 is well above black and
+        # well below what the native renders show (about 90).
+        assert sum(ceiling) / 3 > 20, f"the ceiling is dark: {ceiling}"
+
+        # An orbit drag turns the view.
+        n = frames(page)
+        canvas = page.locator("#voxgi").bounding_box()
+        cx, cy = canvas["x"] + canvas["width"] / 2, canvas["y"] + canvas["height"] / 2
+        page.mouse.move(cx, cy)
+        page.mouse.down()
+        page.mouse.move(cx + 60, cy, steps=4)
+        page.mouse.move(cx + 120, cy + 10, steps=4)
+        page.mouse.up()
+        wait_frames(page, n + 3, FRAMES_S)
+        turned = shot(page, f"{out}/turned.png")
+        d = difference(before, turned)
+        print(f"the drag changed the picture by {d:.1f} of 255 on average")
+        assert d > 4, f"an orbit drag did not change the picture ({d:.1f})"
+
+        # Direct light only: the ceiling has none.
+        page.dblclick("#voxgi")  # back to the scene's camera
+        page.fill("#setting-bounces", "0")
+        page.press("#setting-bounces", "Enter")
+        n = frames(page)
+        wait_frames(page, n + 4, FRAMES_S)
+        direct = shot(page, f"{out}/direct.png")
+        dark = mean(direct, box, 0.2, 0.02, 0.32, 0.1)
+        print(f"ceiling with bounces = 0: {dark}")
+        assert sum(dark) < 0.5 * sum(ceiling), (
+            f"bounces = 0 did not darken the ceiling: {dark} against {ceiling}"
+        )
+
+        frame_ms = page.evaluate("document.body.dataset.frameMs")
+        print(
+            f"first frame after {first_ms / 1000:.1f} s, {frame_ms} ms a frame "
+            f"(SwiftShader); adapter: "
+            + page.evaluate("document.getElementById('adapter').textContent")
+        )
+        if page_error(page):
+            raise AssertionError(f"the page shows an error: {page_error(page)}")
+        browser.close()
+    server.shutdown()
+    assert not console_errors, f"the console logged errors: {console_errors}"
+    print(f"web page checks passed; screenshots in {out}")
+
+
+if __name__ == "__main__":
+    try:
+        main()
+    except AssertionError as e:
+        print(f"test_page: FAILED: {e}", file=sys.stderr)
+        sys.exit(1)
