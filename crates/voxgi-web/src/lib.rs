@@ -13,6 +13,7 @@
 #[path = "../../voxgi-viewer/src/camera.rs"]
 #[allow(dead_code)]
 mod camera;
+mod open;
 mod page;
 mod panel;
 
@@ -57,6 +58,8 @@ pub(crate) struct App {
     last_frame: Option<f64>,
     /// Frames the GPU finished, and the time the last one finished (ms since the page began).
     done: Arc<Mutex<Done>>,
+    /// When the renderer's choices were last shown (ms since the page began).
+    choices_at: Option<f64>,
     /// Frames submitted.
     submitted: u32,
     /// An error stopped the loop (it is on the page).
@@ -80,6 +83,7 @@ async fn run() -> Result<()> {
         .find(|(k, _)| k == "builtin")
         .map_or("cornell-box".to_string(), |(_, v)| v.clone());
     let scene = voxgi::scene::builtin::by_name(&builtin)?;
+
     // Every other key of the query is a setting, checked as a scene file's would be.
     let pairs: Vec<(&str, &str)> = query
         .iter()
@@ -119,13 +123,16 @@ async fn run() -> Result<()> {
         page::show_error(&format!("WebGPU: {e}"));
     }));
 
-    let mut options = RendererOptions::default();
-    // The camera follows the orbit from the first frame on.
-    let mut params = FrameParams::new(voxgi::scene::Camera::look_at(
-        glam::Vec3::Z,
-        glam::Vec3::ZERO,
-        45.0,
-    ));
+    // As the viewer: a CPU adapter (SwiftShader) stays usable at 64³ and half resolution.
+    let cpu = adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    let mut options = RendererOptions {
+        half_resolution: cpu,
+        voxel_resolution: if cpu { 64 } else { 128 },
+        ..RendererOptions::default()
+    };
+    let mut scene = scene;
+    scene.set_time(0.0);
+    let mut params = FrameParams::new(scene.default_camera());
     settings.apply(&mut options, &mut params)?;
     page::status("uploading the scene and building the pipelines…");
     let renderer = Renderer::new(&device, &queue, &scene, &options)?;
@@ -159,14 +166,10 @@ async fn run() -> Result<()> {
 
     let info = adapter.get_info();
     let limits = device.limits();
+    page::set_scene(&builtin);
     page::set_adapter(&format!(
-        "{} · {} · storage buffers up to {} MiB · 3D textures up to {}³ · {}",
-        if info.name.is_empty() {
-            "WebGPU adapter"
-        } else {
-            &info.name
-        },
-        builtin,
+        "{} · storage buffers up to {} MiB · 3D textures up to {}³ · {}",
+        adapter_name(&info),
         limits.max_storage_buffer_binding_size >> 20,
         limits.max_texture_dimension_3d,
         if device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
@@ -195,12 +198,34 @@ async fn run() -> Result<()> {
         last_frame: None,
         done: Arc::new(Mutex::new(Done::default())),
         submitted: 0,
+        choices_at: None,
         stopped: false,
     }));
+    open::build(&app, &builtin)?;
     panel::build(&app)?;
     page::listen_input(&app)?;
+    page::dismissable_errors()?;
     page::animation_loop(app);
     Ok(())
+}
+
+/// The adapter as the browser describes it (WebGPU gives a vendor and an architecture, and
+/// sometimes no name).
+fn adapter_name(info: &wgpu::AdapterInfo) -> String {
+    let parts: Vec<&str> = [
+        info.name.as_str(),
+        info.driver.as_str(),
+        info.driver_info.as_str(),
+    ]
+    .into_iter()
+    .filter(|s| !s.is_empty())
+    .collect();
+    let kind = format!("{:?}", info.device_type).to_lowercase();
+    if parts.is_empty() {
+        format!("WebGPU adapter ({kind}, vendor {:#x})", info.vendor)
+    } else {
+        format!("{} ({kind})", parts.join(", "))
+    }
 }
 
 impl App {
@@ -257,6 +282,10 @@ impl App {
         let target = voxgi::Target::new(&view, self.config.format, w, h);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.renderer.render(&mut encoder, &target, &self.params)?;
+        if self.choices_at.is_none_or(|t| now_ms - t > 1000.0) {
+            self.choices_at = Some(now_ms);
+            page::set_choices(&self.choices());
+        }
         self.queue.submit([encoder.finish()]);
         self.submitted += 1;
         let done = self.done.clone();
@@ -277,10 +306,57 @@ impl App {
         Ok(())
     }
 
+    /// What the renderer chose and holds: the structure, its resolution, GPU memory.
+    fn choices(&self) -> String {
+        let o = self.renderer.options();
+        let bytes: u64 = self.renderer.memory().iter().map(|(_, b)| b).sum();
+        format!(
+            "{} volume of {}³ voxels · {} at {}×{} · {:.0} MiB of GPU memory",
+            o.voxels.name(),
+            o.voxel_resolution,
+            if o.half_resolution {
+                "half-resolution gather"
+            } else {
+                "full-resolution gather"
+            },
+            self.config.width,
+            self.config.height,
+            bytes as f64 / (1u64 << 20) as f64
+        )
+    }
+
     /// Applies a change of the options (from the panel): only what depends on it is redone.
     pub(crate) fn set_options(&mut self, options: RendererOptions) -> voxgi::Result<()> {
         self.renderer.set_options(&options)?;
         self.options = options;
+        Ok(())
+    }
+
+    /// Shows `scene` (opened as `name`) instead, with its file's `[settings]` applied over
+    /// the options in use. On an error the scene shown stays.
+    pub(crate) fn replace_scene(
+        &mut self,
+        scene: &voxgi::scene::Scene,
+        settings: Option<&SceneSettings>,
+        name: &str,
+    ) -> Result<()> {
+        let mut options = self.options.clone();
+        let mut params = self.params.clone();
+        if let Some(s) = settings {
+            s.apply(&mut options, &mut params)?;
+        }
+        let renderer = Renderer::new(&self.device, &self.queue, scene, &options)
+            .with_context(|| format!("cannot show {name}"))?;
+        self.renderer = renderer;
+        self.options = options;
+        self.params = params;
+        self.scene_radius = (scene.bounds().size().length() * 0.5).max(1e-3);
+        self.duration = scene.duration();
+        self.time = 0.0;
+        self.playing = self.duration > 0.0;
+        self.frame_scene();
+        panel::refresh(self);
+        page::set_scene(name);
         Ok(())
     }
 

@@ -68,6 +68,20 @@ pub(crate) fn set_adapter(text: &str) {
     set_text("adapter", text);
 }
 
+/// The scene shown, in the page's title and its `data-scene` (for scripts).
+pub(crate) fn set_scene(name: &str) {
+    let doc = document();
+    doc.set_title(&format!("voxgi — {name}"));
+    if let Some(body) = doc.body() {
+        let _ = body.set_attribute("data-scene", name);
+    }
+}
+
+/// What the renderer chose for this device (structure, resolution, memory).
+pub(crate) fn set_choices(text: &str) {
+    set_text("choices", text);
+}
+
 /// Shows an error on the page (and in the console): the page stays, the loop may stop.
 pub(crate) fn show_error(text: &str) {
     web_sys::console::error_1(&JsValue::from_str(text));
@@ -84,6 +98,16 @@ pub(crate) fn show_error(text: &str) {
         }
         let _ = e.class_list().remove_1("hidden");
     }
+}
+
+/// A click on the error box dismisses it.
+pub(crate) fn dismissable_errors() -> Result<()> {
+    let e: web_sys::HtmlElement = element("error")?;
+    let target = e.clone();
+    on(e.as_ref(), "click", move |_: web_sys::MouseEvent| {
+        target.set_text_content(None);
+        let _ = target.class_list().add_1("hidden");
+    })
 }
 
 /// Records the frames the GPU finished on the page (`data-frames` on the body, for tests and
@@ -153,7 +177,7 @@ pub(crate) enum Pointer {
 }
 
 /// Adds `handler` for `event` on `target` for the page's lifetime.
-fn on<E: JsCast + 'static>(
+pub(crate) fn on<E: JsCast + 'static>(
     target: &web_sys::EventTarget,
     event: &str,
     mut handler: impl FnMut(E) + 'static,
@@ -231,4 +255,16 @@ pub(crate) fn animation_loop(app: Rc<RefCell<App>>) {
     if let Some(t) = tick.borrow().as_ref() {
         let _ = window().request_animation_frame(t.as_ref().unchecked_ref());
     }
+}
+
+/// Resolves after the browser painted once more: work that blocks the page (opening a
+/// scene) lets the status line say so first.
+pub(crate) async fn next_paint() {
+    let promise = js_sys::Promise::new(&mut |resolve, _| {
+        let after_paint = Closure::once_into_js(move || {
+            let _ = window().set_timeout_with_callback(resolve.unchecked_ref());
+        });
+        let _ = window().request_animation_frame(after_paint.unchecked_ref());
+    });
+    let _ = wasm_bindgen_futures::JsFuture::from(promise).await;
 }

@@ -22,17 +22,19 @@ pub(crate) fn build(app: &Rc<RefCell<App>>) -> Result<()> {
         doc.create_element(tag)
             .map_err(|_| anyhow!("cannot make a <{tag}>"))
     };
-    if app.borrow().duration > 0.0 {
-        let play = make("button")?;
-        play.set_id("play");
-        play.set_text_content(Some("pause"));
-        let a = app.clone();
-        let label = play.clone();
-        listen(&play, "click", move || {
-            let playing = a.borrow_mut().toggle_play();
-            label.set_text_content(Some(if playing { "pause" } else { "play" }));
-        })?;
-        append(&panel, &play)?;
+    // Plays or pauses the scene's animation (disabled for a still scene).
+    let play = make("button")?;
+    play.set_id("play");
+    let a = app.clone();
+    listen(&play, "click", move || {
+        let mut a = a.borrow_mut();
+        a.toggle_play();
+        show_playing(a.duration, a.playing);
+    })?;
+    append(&panel, &play)?;
+    {
+        let a = app.borrow();
+        show_playing(a.duration, a.playing);
     }
     for setting in SETTINGS.iter() {
         let row = make("label")?;
@@ -78,6 +80,45 @@ pub(crate) fn build(app: &Rc<RefCell<App>>) -> Result<()> {
         append(&panel, &row)?;
     }
     Ok(())
+}
+
+/// Shows the options and parameters in use in the widgets (after a scene file's settings).
+pub(crate) fn refresh(app: &App) {
+    for setting in SETTINGS.iter() {
+        let Some(field) = document().get_element_by_id(&format!("setting-{}", setting.key)) else {
+            continue;
+        };
+        let value = setting.value(&app.options, &app.params);
+        if let Some(input) = field.dyn_ref::<web_sys::HtmlInputElement>() {
+            if input.type_() == "checkbox" {
+                input.set_checked(value == Value::Bool(true));
+            } else {
+                input.set_value(&value.to_string());
+            }
+        } else if let Some(select) = field.dyn_ref::<web_sys::HtmlSelectElement>() {
+            select.set_value(&value.to_string());
+        }
+        let _ = field.class_list().remove_1("refused");
+    }
+    show_playing(app.duration, app.playing);
+}
+
+/// The play button's state: what pressing it does, or disabled for a still scene.
+pub(crate) fn show_playing(duration: f32, playing: bool) {
+    let Some(button) = document().get_element_by_id("play") else {
+        return;
+    };
+    let text = match (duration > 0.0, playing) {
+        (false, _) => "still scene",
+        (true, true) => "pause the animation",
+        (true, false) => "play the animation",
+    };
+    button.set_text_content(Some(text));
+    if duration > 0.0 {
+        button.remove_attribute("disabled").ok();
+    } else {
+        button.set_attribute("disabled", "").ok();
+    }
 }
 
 /// The widget for `setting`, showing `value`.

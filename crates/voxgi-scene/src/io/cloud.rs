@@ -19,7 +19,7 @@ use std::path::Path;
 pub const RECORD_SIZE: usize = 27;
 
 pub fn load(path: &Path) -> Result<Scene> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, e))?;
+    let bytes = super::source::read(path).map_err(|e| SceneError::load(path, e))?;
     let pc = parse(&bytes).map_err(|reason| SceneError::load(path, reason))?;
     let mut pc = pc;
     pc.name = stem(path);

@@ -10,10 +10,13 @@ pub mod obj;
 pub mod pcd;
 pub mod ply;
 pub mod scene_file;
+pub mod source;
 pub mod texture;
 
 use crate::{Result, Scene, SceneError};
 use std::path::Path;
+
+pub use source::{load_from_memory, with_files};
 
 /// File extensions `load` understands, for help texts and error messages.
 pub const EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "ply", "pcd", "cloud", "toml"];
@@ -25,10 +28,10 @@ pub fn load(path: &Path) -> Result<Scene> {
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
-    if !path.exists() {
+    if !source::exists(path) {
         return Err(SceneError::load(path, "no such file"));
     }
-    if path.is_dir() {
+    if source::is_dir(path) {
         return Err(SceneError::load(
             path,
             format!(

@@ -17,7 +17,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 pub fn load(path: &Path) -> Result<Scene> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, e))?;
+    let bytes = super::source::read(path).map_err(|e| SceneError::load(path, e))?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mtl_dirs: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
     let opts = tobj::LoadOptions {
@@ -29,7 +29,9 @@ pub fn load(path: &Path) -> Result<Scene> {
     };
     let (models, materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &opts, |mtl| {
         let p = dir.join(mtl);
-        let r = tobj::load_mtl(&p);
+        let r = super::source::read(&p)
+            .map_err(|_| tobj::LoadError::OpenFileFailed)
+            .and_then(|b| tobj::load_mtl_buf(&mut b.as_slice()));
         match &r {
             Ok(_) => mtl_dirs
                 .borrow_mut()
@@ -179,7 +181,7 @@ fn convert_material(
         // Options such as `-bm 1` may precede the file name; the name is the last word.
         let file = name.split_whitespace().last()?.replace('\\', "/");
         let mut p = tex_dir.join(&file);
-        if !p.is_file() && obj_dir.join(&file).is_file() {
+        if !super::source::is_file(&p) && super::source::is_file(&obj_dir.join(&file)) {
             p = obj_dir.join(&file);
         }
         *cache
@@ -210,7 +212,7 @@ fn convert_material(
 
 /// Decodes an image file to RGBA8 (sRGB values kept as they are).
 pub fn load_texture(p: &Path) -> std::result::Result<Texture, String> {
-    let bytes = std::fs::read(p).map_err(|e| e.to_string())?;
+    let bytes = super::source::read(p).map_err(|e| e.to_string())?;
     let name = p
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())

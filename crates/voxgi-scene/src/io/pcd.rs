@@ -228,7 +228,7 @@ fn parse_header(bytes: &[u8]) -> std::result::Result<Header, String> {
 }
 
 pub fn load(path: &Path) -> Result<Scene> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, e))?;
+    let bytes = super::source::read(path).map_err(|e| SceneError::load(path, e))?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -364,7 +364,7 @@ struct VertexLayout {
 }
 
 pub fn load(path: &Path) -> Result<Scene> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, e))?;
+    let bytes = super::source::read(path).map_err(|e| SceneError::load(path, e))?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -285,9 +285,7 @@ pub fn load(path: &Path) -> Result<Scene> {
 /// Loads a scene file and returns its `[settings]` table, if any, untouched.
 pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     let err = |reason: String| SceneError::load(path, reason);
-    let canon = path
-        .canonicalize()
-        .map_err(|e| err(format!("cannot open: {e}")))?;
+    let canon = super::source::canonicalize(path).map_err(|e| err(format!("cannot open: {e}")))?;
     let cycle = STACK.with(|s| {
         let s = s.borrow();
         if s.contains(&canon) {
@@ -309,7 +307,7 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     STACK.with(|s| s.borrow_mut().push(canon));
     let _guard = StackGuard;
 
-    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    let text = super::source::read_to_string(path).map_err(|e| err(e.to_string()))?;
     let file: SceneFile = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut scene = Scene {

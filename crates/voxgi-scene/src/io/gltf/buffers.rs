@@ -60,7 +60,7 @@ fn read_uri(uri: &str, base: &Path) -> R<Vec<u8>> {
     }
     let rel = percent_decode(uri)?;
     let full = base.join(rel);
-    std::fs::read(&full).map_err(|e| io_reason(&e))
+    crate::io::source::read(&full).map_err(|e| io_reason(&e))
 }
 
 fn percent_decode(s: &str) -> R<String> {

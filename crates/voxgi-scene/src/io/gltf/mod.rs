@@ -21,7 +21,7 @@ type R<T> = std::result::Result<T, String>;
 
 /// Loads a `.gltf` or `.glb` file into a validated [`Scene`].
 pub fn load(path: &Path) -> Result<Scene> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::load(path, io_reason(&e)))?;
+    let bytes = crate::io::source::read(path).map_err(|e| SceneError::load(path, io_reason(&e)))?;
     // The loader checks everything it hands to the `gltf` crate, but a panic in a dependency on
     // a hostile file must still come back as an error, not abort the caller.
     let outcome =
