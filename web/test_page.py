@@ -10,7 +10,7 @@ checks:
   - the page shows no error and the console logged none;
   - the picture: the left wall is red, the right wall green, and the ceiling, which only
     bounced light reaches (the lamp faces down), is lit;
-  - an orbit drag on the canvas changes the picture;
+  - an orbit drag on the canvas changes the picture, and so does flying forward (F, W);
   - the panel: the octree instead of the dense volume shows the same picture; setting
     `bounces` to 0 (direct light only) darkens the ceiling;
   - opening files with the file button: a broken .glb shows an error naming it while the
@@ -155,7 +155,7 @@ def main():
         browser = p.chromium.launch(
             executable_path=args.chromium, headless=True, args=CHROMIUM_FLAGS
         )
-        page = browser.new_page(viewport={"width": 760, "height": 400})
+        page = browser.new_page(viewport={"width": 820, "height": 440})
         page.on(
             "console",
             lambda m: console_errors.append(m.text) if m.type == "error" else None,
@@ -166,6 +166,8 @@ def main():
         wait_frames(page, 4, FIRST_FRAMES_S)
         first_ms = float(page.evaluate("document.body.dataset.firstFrameMs"))
         before = shot(page, f"{out}/cornell.png")
+        # The whole page too, panel and status lines with it (the README's picture).
+        page.screenshot(path=f"{out}/page.png", timeout=FRAMES_S * 1000)
         box = box_bounds(before)
         left = mean(before, box, 0.02, 0.3, 0.12, 0.7)
         right = mean(before, box, 0.88, 0.3, 0.98, 0.7)
@@ -198,6 +200,25 @@ def main():
         d = difference(before, turned)
         print(f"the drag changed the picture by {d:.1f} of 255 on average")
         assert d > 4, f"an orbit drag did not change the picture ({d:.1f})"
+
+        # Flying: F, then W held for a second moves the camera forward.
+        page.dblclick("#voxgi")  # back to the scene's camera
+        page.keyboard.press("f")
+        assert page.evaluate("document.body.dataset.camera") == "fly", "F did not fly"
+        n = frames(page)
+        wait_frames(page, n + 2, FRAMES_S)
+        still = shot(page, f"{out}/fly_before.png")
+        page.keyboard.down("w")
+        time.sleep(1.0)
+        page.keyboard.up("w")
+        n = frames(page)
+        wait_frames(page, n + 3, FRAMES_S)
+        flown = shot(page, f"{out}/flown.png")
+        d = difference(still, flown)
+        print(f"flying forward changed the picture by {d:.1f} of 255 on average")
+        assert d > 4, f"holding W while flying did not move the camera ({d:.1f})"
+        page.keyboard.press("f")
+        assert page.evaluate("document.body.dataset.camera") == "orbit", "F did not orbit"
 
         # The other structure: the octree, from the panel, shows the same box.
         page.dblclick("#voxgi")  # back to the scene's camera

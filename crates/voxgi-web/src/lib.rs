@@ -47,7 +47,10 @@ pub(crate) struct App {
     pub(crate) renderer: Renderer,
     pub(crate) options: RendererOptions,
     pub(crate) params: FrameParams,
-    pub(crate) orbit: camera::Orbit,
+    /// Orbit or fly (F toggles), as the viewer's.
+    controller: Controller,
+    /// How long the fly keys were held since the last frame.
+    held: camera::HeldKeys,
     scene_radius: f32,
     /// The last pointer position of a drag, and whether it pans (right button or shift).
     drag: Option<(f32, f32, bool)>,
@@ -64,6 +67,21 @@ pub(crate) struct App {
     submitted: u32,
     /// An error stopped the loop (it is on the page).
     stopped: bool,
+}
+
+/// How the camera moves.
+enum Controller {
+    Orbit(camera::Orbit),
+    Fly(camera::Fly),
+}
+
+impl Controller {
+    fn camera(&self) -> voxgi::scene::Camera {
+        match self {
+            Controller::Orbit(o) => o.camera(),
+            Controller::Fly(f) => f.camera(),
+        }
+    }
 }
 
 /// What the GPU finished: counted by `Queue::on_submitted_work_done`.
@@ -140,6 +158,7 @@ async fn run() -> Result<()> {
     let scene_radius = (bounds.size().length() * 0.5).max(1e-3);
     let orbit = camera::Orbit::from_camera(renderer.default_camera(), scene_radius * 2.0);
     params.camera = orbit.camera();
+    let controller = Controller::Orbit(orbit);
 
     let caps = surface.get_capabilities(&adapter);
     // 8-bit without an sRGB view: voxgi applies the sRGB curve itself.
@@ -189,7 +208,8 @@ async fn run() -> Result<()> {
         renderer,
         options,
         params,
-        orbit,
+        controller,
+        held: camera::HeldKeys::default(),
         scene_radius,
         drag: None,
         duration,
@@ -264,7 +284,11 @@ impl App {
         }
         self.renderer.set_time(self.time)?;
         self.renderer.receive_feedback()?;
-        self.params.camera = self.orbit.camera();
+        if let Controller::Fly(f) = &mut self.controller {
+            let (m, secs) = self.held.take(web_time::Instant::now());
+            f.step(m, secs);
+        }
+        self.params.camera = self.controller.camera();
 
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
@@ -360,28 +384,62 @@ impl App {
         Ok(())
     }
 
-    /// Back to the scene's own camera.
+    /// Back to the scene's own camera (orbiting).
     pub(crate) fn frame_scene(&mut self) {
-        self.orbit =
-            camera::Orbit::from_camera(self.renderer.default_camera(), self.scene_radius * 2.0);
+        self.controller = Controller::Orbit(camera::Orbit::from_camera(
+            self.renderer.default_camera(),
+            self.scene_radius * 2.0,
+        ));
+        // A cut to another view: nothing of the last view's history belongs in it.
+        self.renderer.reset_history();
     }
 
-    /// A drag or a wheel step on the canvas.
+    /// Orbit to fly or back, keeping the view.
+    pub(crate) fn toggle_fly(&mut self) {
+        let camera = self.controller.camera();
+        self.controller = match self.controller {
+            Controller::Orbit(_) => {
+                Controller::Fly(camera::Fly::from_camera(&camera, self.scene_radius * 0.5))
+            }
+            Controller::Fly(_) => {
+                Controller::Orbit(camera::Orbit::from_camera(&camera, self.scene_radius))
+            }
+        };
+        self.held = camera::HeldKeys::default();
+        page::set_controller(matches!(self.controller, Controller::Fly(_)));
+    }
+
+    /// A fly key (axis 0 right, 1 up, 2 forward; which way) went down or up.
+    pub(crate) fn fly_key(&mut self, axis: usize, positive: bool, down: bool) {
+        let now = web_time::Instant::now();
+        if down {
+            self.held.press(axis, positive, now);
+        } else {
+            self.held.release(axis, positive, now);
+        }
+    }
+
+    /// A drag or a wheel step on the canvas: orbiting, they turn, pan and zoom; flying, a drag
+    /// looks around and the wheel sets the speed.
     pub(crate) fn pointer(&mut self, event: page::Pointer) {
         match event {
             page::Pointer::Down { x, y, pan } => self.drag = Some((x, y, pan)),
             page::Pointer::Move { x, y } => {
                 if let Some((x0, y0, pan)) = self.drag {
-                    if pan {
-                        self.orbit.pan(x - x0, y - y0, self.config.height as f32);
-                    } else {
-                        self.orbit.rotate(x - x0, y - y0);
+                    let (dx, dy) = (x - x0, y - y0);
+                    match &mut self.controller {
+                        Controller::Orbit(o) if pan => o.pan(dx, dy, self.config.height as f32),
+                        Controller::Orbit(o) => o.rotate(dx, dy),
+                        Controller::Fly(f) => f.look(dx, dy),
                     }
                     self.drag = Some((x, y, pan));
                 }
             }
             page::Pointer::Up => self.drag = None,
-            page::Pointer::Wheel { steps } => self.orbit.zoom(steps),
+            page::Pointer::Wheel { steps } => match &mut self.controller {
+                Controller::Orbit(o) => o.zoom(steps),
+                Controller::Fly(f) => f.speed = (f.speed * 1.2f32.powf(steps)).max(1e-3),
+            },
         }
     }
 

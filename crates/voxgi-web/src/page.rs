@@ -195,8 +195,9 @@ pub(crate) fn on<E: JsCast + 'static>(
     Ok(())
 }
 
-/// Drags turn the orbit (the right button or shift pans), the wheel zooms, a double click
-/// goes back to the scene's camera, space plays or pauses an animation.
+/// Drags turn the orbit (the right button or shift pans), the wheel zooms, a double click or H
+/// goes back to the scene's camera, F flies (WASD/arrows, Q/E), space plays or pauses an
+/// animation.
 pub(crate) fn listen_input(app: &Rc<RefCell<App>>) -> Result<()> {
     let canvas: web_sys::HtmlCanvasElement = element("voxgi")?;
     let target: &web_sys::EventTarget = canvas.as_ref();
@@ -238,7 +239,74 @@ pub(crate) fn listen_input(app: &Rc<RefCell<App>>) -> Result<()> {
     on(target, "dblclick", move |_: web_sys::MouseEvent| {
         a.borrow_mut().frame_scene()
     })?;
+    // Keys reach the view unless a panel field has the focus (typing a value).
+    let typing = |e: &web_sys::KeyboardEvent| {
+        e.target()
+            .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+            .is_some_and(|el| matches!(el.tag_name().as_str(), "INPUT" | "SELECT" | "TEXTAREA"))
+    };
+    let page: web_sys::EventTarget = window().into();
+    let a = app.clone();
+    on(&page, "keydown", move |e: web_sys::KeyboardEvent| {
+        if typing(&e) || e.ctrl_key() || e.meta_key() || e.alt_key() {
+            return;
+        }
+        let code = e.code();
+        if let Some((axis, positive)) = fly_key(&code) {
+            e.prevent_default();
+            if !e.repeat() {
+                a.borrow_mut().fly_key(axis, positive, true);
+            }
+            return;
+        }
+        match code.as_str() {
+            "KeyF" => a.borrow_mut().toggle_fly(),
+            "KeyH" => a.borrow_mut().frame_scene(),
+            "Space" => {
+                e.prevent_default();
+                let mut a = a.borrow_mut();
+                a.toggle_play();
+                crate::panel::show_playing(a.duration, a.playing);
+            }
+            _ => {}
+        }
+    })?;
+    let a = app.clone();
+    on(&page, "keyup", move |e: web_sys::KeyboardEvent| {
+        if let Some((axis, positive)) = fly_key(&e.code()) {
+            a.borrow_mut().fly_key(axis, positive, false);
+        }
+    })?;
     Ok(())
+}
+
+/// The fly keys, as the viewer's: the axis each pushes along (0 right, 1 up, 2 forward) and
+/// which way.
+fn fly_key(code: &str) -> Option<(usize, bool)> {
+    Some(match code {
+        "KeyD" | "ArrowRight" => (0, true),
+        "KeyA" | "ArrowLeft" => (0, false),
+        "KeyE" => (1, true),
+        "KeyQ" => (1, false),
+        "KeyW" | "ArrowUp" => (2, true),
+        "KeyS" | "ArrowDown" => (2, false),
+        _ => return None,
+    })
+}
+
+/// Says on the page whether the camera flies (and how) or orbits.
+pub(crate) fn set_controller(flying: bool) {
+    set_text(
+        "controller",
+        if flying {
+            "flying: WASD or the arrows move, Q/E down and up, drag to look, wheel for speed; F orbits"
+        } else {
+            "orbiting: F flies"
+        },
+    );
+    if let Some(body) = document().body() {
+        let _ = body.set_attribute("data-camera", if flying { "fly" } else { "orbit" });
+    }
 }
 
 /// Renders a frame on every animation frame the browser gives, for the page's lifetime.
