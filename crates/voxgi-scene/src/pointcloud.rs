@@ -313,14 +313,21 @@ impl CellGrid {
     }
 }
 
-/// Splits `0..n` into one chunk per core and concatenates what `f` writes for each chunk, in
-/// order.
+/// Splits `0..n` into one chunk per core (`available_parallelism`, 1 where it is unknown) and
+/// concatenates what `f` writes for each chunk, in order.
 fn par_chunks<T: Send>(n: usize, f: impl Fn(std::ops::Range<usize>, &mut Vec<T>) + Sync) -> Vec<T> {
     let threads = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
         .min(16);
     let chunk = n.div_ceil(threads).max(1);
+    // One chunk (one core, or a platform without threads: the browser's main thread) runs
+    // here rather than on a thread of its own.
+    if chunk >= n {
+        let mut out = Vec::new();
+        f(0..n, &mut out);
+        return out;
+    }
     std::thread::scope(|s| {
         let handles: Vec<_> = (0..n)
             .step_by(chunk)

@@ -28,7 +28,12 @@ use wasm_bindgen::prelude::*;
 /// The page's entry point: runs when the module is instantiated.
 #[wasm_bindgen(start)]
 pub fn start() {
-    console_error_panic_hook::set_once();
+    // A panic is a bug: its message goes to the console (with the stack) and onto the page,
+    // which cannot go on (the module's state is then undefined).
+    std::panic::set_hook(Box::new(|info| {
+        console_error_panic_hook::hook(info);
+        page::show_error(&format!("voxgi stopped (a bug; please report it): {info}"));
+    }));
     page::init_logging();
     wasm_bindgen_futures::spawn_local(async {
         if let Err(e) = run().await {
