@@ -16,6 +16,7 @@ mod camera;
 mod open;
 mod page;
 mod panel;
+mod traced;
 
 use anyhow::{Context, Result, anyhow};
 use std::cell::RefCell;
@@ -52,6 +53,15 @@ pub(crate) struct App {
     pub(crate) renderer: Renderer,
     pub(crate) options: RendererOptions,
     pub(crate) params: FrameParams,
+    /// The scene shown, kept for the path tracer (made when first shown).
+    scene: voxgi::scene::Scene,
+    /// Cone tracing, the path tracer, or both split.
+    pub(crate) display: traced::Display,
+    traced: Option<traced::Traced>,
+    /// The path tracer's samples a pixel, when it is shown.
+    traced_samples: Option<u32>,
+    /// The adapter is a CPU (SwiftShader): smaller defaults.
+    cpu: bool,
     /// Orbit or fly (F toggles), as the viewer's.
     controller: Controller,
     /// How long the fly keys were held since the last frame.
@@ -68,10 +78,52 @@ pub(crate) struct App {
     done: Arc<Mutex<Done>>,
     /// When the renderer's choices were last shown (ms since the page began).
     choices_at: Option<f64>,
+    /// What the page changed to fit the device (the voxel resolution), said under the view.
+    notice: Option<String>,
     /// Frames submitted.
     submitted: u32,
     /// An error stopped the loop (it is on the page).
     stopped: bool,
+}
+
+/// The least voxel resolution the page lowers to when the device's limits refuse a larger.
+const MIN_FITTED_RESOLUTION: u32 = 16;
+
+/// The options a renderer was made with, and what was lowered to make it fit.
+struct Fitted {
+    options: RendererOptions,
+    notice: Option<String>,
+}
+
+fn lowered(from: u32, to: u32, reason: &str) -> String {
+    format!("lowered from {from}³ to {to}³ to fit this device ({reason})")
+}
+
+/// A renderer for `scene` with `options`, the voxel resolution halved while the device's
+/// limits refuse it (`Error::TooLarge`), down to `MIN_FITTED_RESOLUTION`.
+fn fitting_renderer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &voxgi::scene::Scene,
+    options: &RendererOptions,
+) -> Result<(Renderer, Fitted)> {
+    let mut o = options.clone();
+    let mut first_refusal = None;
+    loop {
+        match Renderer::new(device, queue, scene, &o) {
+            Ok(r) => {
+                let notice = first_refusal.map(|reason: String| {
+                    lowered(options.voxel_resolution, o.voxel_resolution, &reason)
+                });
+                return Ok((r, Fitted { options: o, notice }));
+            }
+            Err(voxgi::Error::TooLarge(reason)) if o.voxel_resolution > MIN_FITTED_RESOLUTION => {
+                first_refusal.get_or_insert(reason);
+                o.voxel_resolution /= 2;
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
 }
 
 /// How the camera moves.
@@ -108,9 +160,14 @@ async fn run() -> Result<()> {
     let scene = voxgi::scene::builtin::by_name(&builtin)?;
 
     // Every other key of the query is a setting, checked as a scene file's would be.
+    // `webgpu_limits=default` asks only for WebGPU's default limits (128 MiB storage
+    // buffers), as a browser that offers no more would give: the page then shows how it fits.
+    let default_limits = query
+        .iter()
+        .any(|(k, v)| k == "webgpu_limits" && v == "default");
     let pairs: Vec<(&str, &str)> = query
         .iter()
-        .filter(|(k, _)| k != "builtin")
+        .filter(|(k, _)| k != "builtin" && k != "webgpu_limits")
         .map(|(k, v)| (k.as_str(), v.as_str()))
         .collect();
     let settings =
@@ -137,7 +194,11 @@ async fn run() -> Result<()> {
         .request_device(&wgpu::DeviceDescriptor {
             label: Some("voxgi-web"),
             required_features: voxgi::required_features(&adapter),
-            required_limits: voxgi::required_limits(&adapter),
+            required_limits: if default_limits {
+                voxgi::minimum_limits()
+            } else {
+                voxgi::required_limits(&adapter)
+            },
             ..Default::default()
         })
         .await
@@ -158,7 +219,8 @@ async fn run() -> Result<()> {
     let mut params = FrameParams::new(scene.default_camera());
     settings.apply(&mut options, &mut params)?;
     page::status("uploading the scene and building the pipelines…");
-    let renderer = Renderer::new(&device, &queue, &scene, &options)?;
+    let (renderer, fitted) = fitting_renderer(&device, &queue, &scene, &options)?;
+    let options = fitted.options;
     let bounds = scene.bounds();
     let scene_radius = (bounds.size().length() * 0.5).max(1e-3);
     let orbit = camera::Orbit::from_camera(renderer.default_camera(), scene_radius * 2.0);
@@ -215,6 +277,11 @@ async fn run() -> Result<()> {
         params,
         controller,
         held: camera::HeldKeys::default(),
+        scene,
+        display: traced::Display::Cones,
+        traced: None,
+        traced_samples: None,
+        cpu,
         scene_radius,
         drag: None,
         duration,
@@ -224,6 +291,7 @@ async fn run() -> Result<()> {
         done: Arc::new(Mutex::new(Done::default())),
         submitted: 0,
         choices_at: None,
+        notice: fitted.notice,
         stopped: false,
     }));
     open::build(&app, &builtin)?;
@@ -267,6 +335,14 @@ impl App {
             return;
         }
         if let Err(e) = self.try_frame(now_ms) {
+            // Pools grow from a frame's counts: one past the device's limits arrives here.
+            let too_large = matches!(
+                e.downcast_ref::<voxgi::Error>(),
+                Some(voxgi::Error::TooLarge(_))
+            );
+            if too_large && self.lower_resolution(&e.to_string()) {
+                return;
+            }
             self.stopped = true;
             page::show_error(&format!("{e:#}"));
         }
@@ -310,7 +386,32 @@ impl App {
         let view = frame.texture.create_view(&Default::default());
         let target = voxgi::Target::new(&view, self.config.format, w, h);
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.renderer.render(&mut encoder, &target, &self.params)?;
+        // The path tracer alone needs no cone-traced image under it.
+        if self.display != traced::Display::Traced {
+            self.renderer.render(&mut encoder, &target, &self.params)?;
+        }
+        self.traced_samples = match self.display.traced_columns(w) {
+            Some(columns) => {
+                if self.traced.is_none() {
+                    self.traced = Some(traced::Traced::new(
+                        &self.device,
+                        &self.queue,
+                        &self.scene,
+                        &self.options,
+                        self.cpu,
+                    )?);
+                }
+                let t = self.traced.as_mut().expect("made above");
+                Some(t.record(
+                    &mut encoder,
+                    &target,
+                    &self.params,
+                    self.options.bounces,
+                    columns,
+                )?)
+            }
+            None => None,
+        };
         if self.choices_at.is_none_or(|t| now_ms - t > 1000.0) {
             self.choices_at = Some(now_ms);
             page::set_choices(&self.choices());
@@ -335,8 +436,24 @@ impl App {
         Ok(())
     }
 
-    /// What the renderer chose and holds: the structure, its resolution, GPU memory.
+    /// What the renderer chose and holds: the structure, its resolution, GPU memory, and what
+    /// the page lowered to fit the device.
     fn choices(&self) -> String {
+        let mut text = self.holds();
+        if let Some(n) = self.traced_samples {
+            text.push_str(&format!(
+                " · {}: the path tracer at {n} samples a pixel",
+                self.display.name()
+            ));
+        }
+        if let Some(n) = &self.notice {
+            text.push_str(" · ");
+            text.push_str(n);
+        }
+        text
+    }
+
+    fn holds(&self) -> String {
         let o = self.renderer.options();
         let bytes: u64 = self.renderer.memory().iter().map(|(_, b)| b).sum();
         format!(
@@ -352,6 +469,26 @@ impl App {
             self.config.height,
             bytes as f64 / (1u64 << 20) as f64
         )
+    }
+
+    /// Halves the voxel resolution after `reason` (the device's limits), saying so; false
+    /// at the least resolution or when the renderer refuses.
+    fn lower_resolution(&mut self, reason: &str) -> bool {
+        let from = self.options.voxel_resolution;
+        if from <= MIN_FITTED_RESOLUTION {
+            return false;
+        }
+        let options = RendererOptions {
+            voxel_resolution: from / 2,
+            ..self.options.clone()
+        };
+        if self.set_options(options).is_err() {
+            return false;
+        }
+        self.notice = Some(lowered(from, from / 2, reason));
+        log::warn!("{}", self.notice.as_deref().unwrap_or_default());
+        panel::refresh(self);
+        true
     }
 
     /// Applies a change of the options (from the panel): only what depends on it is redone.
@@ -374,10 +511,13 @@ impl App {
         if let Some(s) = settings {
             s.apply(&mut options, &mut params)?;
         }
-        let renderer = Renderer::new(&self.device, &self.queue, scene, &options)
+        let (renderer, fitted) = fitting_renderer(&self.device, &self.queue, scene, &options)
             .with_context(|| format!("cannot show {name}"))?;
         self.renderer = renderer;
-        self.options = options;
+        self.options = fitted.options;
+        self.notice = fitted.notice;
+        self.scene = scene.clone();
+        self.traced = None;
         self.params = params;
         self.scene_radius = (scene.bounds().size().length() * 0.5).max(1e-3);
         self.duration = scene.duration();

@@ -36,6 +36,28 @@ pub(crate) fn build(app: &Rc<RefCell<App>>) -> Result<()> {
         let a = app.borrow();
         show_playing(a.duration, a.playing);
     }
+    // What the view shows: cone tracing, the path tracer, or both split.
+    let display: web_sys::HtmlSelectElement = make("select")?.unchecked_into();
+    display.set_id("display");
+    display.set_title("cone tracing, voxgi's path tracer (the ground truth), or both split");
+    for (_, name) in crate::traced::Display::ALL {
+        let option = make("option")?;
+        option.set_text_content(Some(name));
+        option.set_attribute("value", name).ok();
+        append(&display, &option)?;
+    }
+    let a = app.clone();
+    let list = display.clone();
+    listen(&display, "change", move || {
+        let chosen = list.value();
+        if let Some((d, _)) = crate::traced::Display::ALL
+            .iter()
+            .find(|(_, n)| *n == chosen)
+        {
+            a.borrow_mut().display = *d;
+        }
+    })?;
+    append(&panel, &display)?;
     for setting in SETTINGS.iter() {
         let row = make("label")?;
         row.set_class_name("setting");

@@ -53,8 +53,13 @@ pub enum Error {
     /// The scene failed to load or failed `Scene::validate` (voxgi-scene's error, unchanged).
     #[error(transparent)]
     Scene(#[from] voxgi_scene::SceneError),
+    /// The scene at this voxel resolution needs more than the device's limits hold: the
+    /// message names the limit and what it would take. A lower voxel resolution fits
+    /// (applications may lower it and try again, as the web page does).
+    #[error("{0}")]
+    TooLarge(String),
     /// An option, setting, argument or input is out of range or malformed (a settings file, a
-    /// renderer option, a scene too large for the device, images of different sizes to compare).
+    /// renderer option, images of different sizes to compare).
     #[error("invalid setting: {0}")]
     Setting(String),
     /// The scene has nothing to render: a renderer got no triangles and no points, the

@@ -301,7 +301,7 @@ pub fn triangle_table(
     let bytes = size_of_val(t.as_slice()) as u64;
     let limit = device.limits().max_storage_buffer_binding_size;
     if bytes > limit {
-        return Err(Error::Setting(format!(
+        return Err(Error::TooLarge(format!(
             "the scene's drawn triangles need a {} MiB voxelization table ({n} workgroups), \
              more than this GPU's storage-buffer limit of {} MiB",
             bytes >> 20,

@@ -29,7 +29,7 @@ pub fn pool_capacity(
     let limit = max_entries(device, entry_bytes);
     let cap = wanted.max(1024);
     if cap > limit.min(u32::MAX as u64) {
-        return Err(Error::Setting(format!(
+        return Err(Error::TooLarge(format!(
             "the scene needs about {cap} {what} at this resolution, more than this GPU's \
              storage-buffer limit allows ({limit}); lower the voxel resolution"
         )));

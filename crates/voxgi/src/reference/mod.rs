@@ -291,11 +291,7 @@ pub fn flatten(scene: &Scene) -> FlatScene {
             }
         })
         .collect();
-    let bvh = obvhs::bvh2::builder::build_bvh2(
-        &bounds,
-        obvhs::BvhBuildParams::medium_build(),
-        &mut std::time::Duration::default(),
-    );
+    let bvh = build_bvh2(&bounds, obvhs::BvhBuildParams::medium_build());
     let nodes: Vec<GpuNode> = bvh
         .nodes
         .iter()
@@ -569,4 +565,30 @@ impl PathTracer {
             ldr,
         })
     }
+}
+
+/// obvhs's `build_bvh2`, step for step, without its build timer: `std::time::Instant` panics
+/// on wasm32 (the web page's path tracer).
+fn build_bvh2(bounds: &[obvhs::aabb::Aabb], config: obvhs::BvhBuildParams) -> obvhs::bvh2::Bvh2 {
+    use obvhs::bvh2::{leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(bounds.len()).build(
+        config.ploc_search_distance,
+        bounds,
+        (0..bounds.len() as u32).collect::<Vec<_>>(),
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, config.reinsertion_batch_ratio, None);
+    collapse(
+        &mut bvh,
+        config.max_prims_per_leaf.clamp(1, 255),
+        config.collapse_traversal_cost,
+    );
+    reinsertion.run(
+        &mut bvh,
+        config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    bvh
 }

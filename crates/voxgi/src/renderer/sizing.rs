@@ -68,7 +68,7 @@ impl Sizing<'_> {
         if count > fragments.capacity as u64 {
             let limit = crate::gpu::max_entries(self.device, FRAGMENT_BYTES);
             if count > limit {
-                return Err(Error::Setting(format!(
+                return Err(Error::TooLarge(format!(
                     "at {r}³ voxels the scene makes {count} voxel fragments, more than this \
                      GPU's storage-buffer limit of {} MiB holds ({limit}); lower the voxel \
                      resolution (each halving divides the fragments by about 4)",

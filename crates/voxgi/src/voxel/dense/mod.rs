@@ -114,7 +114,7 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
     let l = device.limits();
     let occupancy = (grid.resolution as u64).pow(3) * 4;
     if occupancy > l.max_storage_buffer_binding_size {
-        return Err(Error::Setting(format!(
+        return Err(Error::TooLarge(format!(
             "a {r}³ volume needs a {} MiB occupancy buffer, more than this GPU's {} MiB \
              storage-buffer limit; use a voxel resolution of at most {}",
             occupancy >> 20,

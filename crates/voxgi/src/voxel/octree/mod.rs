@@ -203,7 +203,7 @@ impl OctreeVolume {
                     .min(limits.max_buffer_size)
                 || tiles > u32::MAX as u64 / 8
             {
-                return Err(crate::Error::Setting(format!(
+                return Err(crate::Error::TooLarge(format!(
                     "the octree needs {} MiB of {what}, more than this GPU's storage-buffer \
                      limit ({} MiB); lower the voxel resolution",
                     bytes >> 20,
@@ -215,7 +215,7 @@ impl OctreeVolume {
         too_big("nodes", node_words * 4)?;
         let flag_rows = (8 * base_v).div_ceil(1 << FLAG_SHIFT);
         if flag_rows > limits.max_texture_dimension_2d as u64 {
-            return Err(crate::Error::Setting(format!(
+            return Err(crate::Error::TooLarge(format!(
                 "the octree needs {} nodes above its leaves, more than the filter's flags hold \
                  in a {}-texel-high texture; lower the voxel resolution",
                 8 * base_v,
@@ -226,7 +226,7 @@ impl OctreeVolume {
         too_big("leaf slots", pools.slots as u64 * ACCUM_WORDS * 4)?;
         let max_dim = limits.max_texture_dimension_3d;
         let too_many = |bricks: u64| {
-            crate::Error::Setting(format!(
+            crate::Error::TooLarge(format!(
                 "the octree needs {bricks} bricks, more than a {max_dim}³ atlas holds; lower \
                  the voxel resolution"
             ))
