@@ -45,7 +45,8 @@ bindgen="$(command -v wasm-bindgen || true)"
 if [ -z "$bindgen" ] || [ "$("$bindgen" --version | awk '{ print $2 }')" != "$version" ]; then
     echo "web/build.sh: installing wasm-bindgen-cli $version (it must match Cargo.lock's wasm-bindgen)"
     # Not --locked: the CLI's own lock file names a crate version the registry no longer has.
-    cargo install --quiet wasm-bindgen-cli --version "$version"
+    # --force: a missing binary with its install record left behind is installed again too.
+    cargo install --quiet --force wasm-bindgen-cli --version "$version"
     bindgen="$(command -v wasm-bindgen || echo "$HOME/.cargo/bin/wasm-bindgen")"
 fi
 

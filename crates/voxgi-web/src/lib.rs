@@ -1,7 +1,9 @@
 //! voxgi-web: voxgi in a browser page through WebGPU. The page (web/index.html, built by
-//! web/build.sh) holds a canvas, a status line and a panel; this crate opens the WebGPU
-//! device, renders a built-in scene into the canvas every animation frame, turns the viewer's
-//! orbit camera by mouse drags, and builds the settings panel from voxgi's one settings table.
+//! web/build.sh) holds a canvas, status lines and a panel; this crate opens the WebGPU device,
+//! renders a scene into the canvas every animation frame (cone tracing, the path tracer, or
+//! both split), moves the viewer's orbit and fly cameras, opens built-in scenes and files
+//! picked or dropped (open.rs), builds the settings panel from voxgi's one settings table
+//! (panel.rs), and lowers the voxel resolution where the device's limits refuse it.
 //!
 //! The query string chooses the scene (`?builtin=two-rooms`) and any setting by its key, as a
 //! scene file's `[settings]` would (`?voxel_resolution=64&bounces=1`).
@@ -80,6 +82,11 @@ pub(crate) struct App {
     choices_at: Option<f64>,
     /// What the page changed to fit the device (the voxel resolution), said under the view.
     notice: Option<String>,
+    /// The voxel resolution asked for (the query, a scene file, the panel), which `options`
+    /// may hold lowered to fit the device.
+    requested_resolution: u32,
+    /// Whether the device was lost (the page cannot go on then).
+    watch: voxgi::gpu::lost::DeviceWatch,
     /// Frames submitted.
     submitted: u32,
     /// An error stopped the loop (it is on the page).
@@ -206,6 +213,7 @@ async fn run() -> Result<()> {
     device.on_uncaptured_error(Arc::new(|e: wgpu::Error| {
         page::show_error(&format!("WebGPU: {e}"));
     }));
+    let watch = voxgi::gpu::lost::DeviceWatch::new(&device);
 
     // As the viewer: a CPU adapter (SwiftShader) stays usable at 64³ and half resolution.
     let cpu = adapter.get_info().device_type == wgpu::DeviceType::Cpu;
@@ -219,6 +227,7 @@ async fn run() -> Result<()> {
     let mut params = FrameParams::new(scene.default_camera());
     settings.apply(&mut options, &mut params)?;
     page::status("uploading the scene and building the pipelines…");
+    let requested_resolution = options.voxel_resolution;
     let (renderer, fitted) = fitting_renderer(&device, &queue, &scene, &options)?;
     let options = fitted.options;
     let bounds = scene.bounds();
@@ -290,8 +299,10 @@ async fn run() -> Result<()> {
         last_frame: None,
         done: Arc::new(Mutex::new(Done::default())),
         submitted: 0,
+        watch,
         choices_at: None,
         notice: fitted.notice,
+        requested_resolution,
         stopped: false,
     }));
     open::build(&app, &builtin)?;
@@ -349,6 +360,9 @@ impl App {
     }
 
     fn try_frame(&mut self, now_ms: f64) -> Result<()> {
+        if let Some(why) = self.watch.lost() {
+            anyhow::bail!("the GPU device was lost ({why}); reload the page");
+        }
         let (w, h) = page::canvas_size(&self.canvas, self.device.limits().max_texture_dimension_2d);
         if (w, h) != (self.config.width, self.config.height) {
             self.config.width = w;
@@ -391,25 +405,17 @@ impl App {
             self.renderer.render(&mut encoder, &target, &self.params)?;
         }
         self.traced_samples = match self.display.traced_columns(w) {
-            Some(columns) => {
-                if self.traced.is_none() {
-                    self.traced = Some(traced::Traced::new(
-                        &self.device,
-                        &self.queue,
-                        &self.scene,
-                        &self.options,
-                        self.cpu,
-                    )?);
+            Some(columns) => match self.record_traced(&mut encoder, &target, columns) {
+                Ok(samples) => Some(samples),
+                Err(e) => {
+                    // The cone tracer goes on; the path tracer's failure is shown.
+                    self.display = traced::Display::Cones;
+                    self.traced = None;
+                    panel::show_display(self.display);
+                    page::show_error(&format!("the path tracer: {e:#}"));
+                    None
                 }
-                let t = self.traced.as_mut().expect("made above");
-                Some(t.record(
-                    &mut encoder,
-                    &target,
-                    &self.params,
-                    self.options.bounces,
-                    columns,
-                )?)
-            }
+            },
             None => None,
         };
         if self.choices_at.is_none_or(|t| now_ms - t > 1000.0) {
@@ -471,6 +477,40 @@ impl App {
         )
     }
 
+    /// One band of the path tracer over `columns`, made (its BVH built) at the scene's time
+    /// shown when first needed and again when that time changed: its image is of one instant.
+    fn record_traced(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &voxgi::Target,
+        columns: std::ops::Range<u32>,
+    ) -> Result<u32> {
+        if self.traced.as_ref().is_none_or(|t| t.time != self.time) {
+            let mut scene = self.scene.clone();
+            scene.set_time(self.time);
+            self.traced = Some(traced::Traced::new(
+                &self.device,
+                &self.queue,
+                &scene,
+                &self.options,
+                self.cpu,
+                self.time,
+            )?);
+        }
+        let t = self.traced.as_mut().expect("made above");
+        t.record(encoder, target, &self.params, self.options.bounces, columns)
+    }
+
+    /// Shows cone tracing, the path tracer or both. Showing the path tracer pauses the
+    /// animation: its image accumulates over one instant.
+    pub(crate) fn set_display(&mut self, display: traced::Display) {
+        self.display = display;
+        if display != traced::Display::Cones && self.playing {
+            self.playing = false;
+            panel::show_playing(self.duration, self.playing);
+        }
+    }
+
     /// Halves the voxel resolution after `reason` (the device's limits), saying so; false
     /// at the least resolution or when the renderer refuses.
     fn lower_resolution(&mut self, reason: &str) -> bool {
@@ -482,10 +522,11 @@ impl App {
             voxel_resolution: from / 2,
             ..self.options.clone()
         };
-        if self.set_options(options).is_err() {
+        if self.renderer.set_options(&options).is_err() {
             return false;
         }
-        self.notice = Some(lowered(from, from / 2, reason));
+        self.options = options;
+        self.notice = Some(lowered(self.requested_resolution, from / 2, reason));
         log::warn!("{}", self.notice.as_deref().unwrap_or_default());
         panel::refresh(self);
         true
@@ -494,6 +535,11 @@ impl App {
     /// Applies a change of the options (from the panel): only what depends on it is redone.
     pub(crate) fn set_options(&mut self, options: RendererOptions) -> voxgi::Result<()> {
         self.renderer.set_options(&options)?;
+        if options.voxel_resolution != self.options.voxel_resolution {
+            // Asked for: what was lowered before no longer holds.
+            self.requested_resolution = options.voxel_resolution;
+            self.notice = None;
+        }
         self.options = options;
         Ok(())
     }
@@ -506,11 +552,19 @@ impl App {
         settings: Option<&SceneSettings>,
         name: &str,
     ) -> Result<()> {
-        let mut options = self.options.clone();
+        // The resolution asked for, not one lowered to fit the last scene.
+        let mut options = RendererOptions {
+            voxel_resolution: self.requested_resolution,
+            ..self.options.clone()
+        };
         let mut params = self.params.clone();
         if let Some(s) = settings {
             s.apply(&mut options, &mut params)?;
         }
+        let requested = options.voxel_resolution;
+        let mut scene = scene.clone();
+        scene.set_time(0.0);
+        let scene = &scene;
         let (renderer, fitted) = fitting_renderer(&self.device, &self.queue, scene, &options)
             .with_context(|| format!("cannot show {name}"))?;
         self.renderer = renderer;
@@ -518,6 +572,9 @@ impl App {
         self.notice = fitted.notice;
         self.scene = scene.clone();
         self.traced = None;
+        self.requested_resolution = requested;
+        // A new scene starts afresh, after an error too.
+        self.stopped = false;
         self.params = params;
         self.scene_radius = (scene.bounds().size().length() * 0.5).max(1e-3);
         self.duration = scene.duration();
@@ -535,8 +592,15 @@ impl App {
             self.renderer.default_camera(),
             self.scene_radius * 2.0,
         ));
+        self.held = camera::HeldKeys::default();
+        page::set_controller(false);
         // A cut to another view: nothing of the last view's history belongs in it.
         self.renderer.reset_history();
+    }
+
+    /// The page lost the keyboard's focus: no key is held any more.
+    pub(crate) fn release_keys(&mut self) {
+        self.held = camera::HeldKeys::default();
     }
 
     /// Orbit to fly or back, keeping the view.

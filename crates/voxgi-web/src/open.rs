@@ -45,7 +45,7 @@ pub(crate) fn build(app: &Rc<RefCell<App>>, shown: &str) -> Result<()> {
         let name = list.value();
         let a = a.clone();
         wasm_bindgen_futures::spawn_local(async move {
-            page::status(&format!("opening {name}…"));
+            page::message(&format!("opening {name}…"));
             page::next_paint().await;
             let opened = builtin::by_name(&name)
                 .map_err(anyhow::Error::from)
@@ -98,7 +98,7 @@ fn open_files(app: Rc<RefCell<App>>, files: web_sys::FileList) {
             .map(|f| f.name())
             .collect::<Vec<_>>()
             .join(", ");
-        page::status(&format!("reading {label}…"));
+        page::message(&format!("reading {label}…"));
         let opened = async {
             let mut read = Vec::with_capacity(files.len());
             for f in &files {
@@ -108,7 +108,7 @@ fn open_files(app: Rc<RefCell<App>>, files: web_sys::FileList) {
                 read.push((f.name(), js_sys::Uint8Array::new(&buffer).to_vec()));
             }
             let main = main_file(&read)?;
-            page::status(&format!("opening {main}…"));
+            page::message(&format!("opening {main}…"));
             page::next_paint().await;
             let (scene, settings) = load(read, &main)?;
             app.borrow_mut()
@@ -125,9 +125,9 @@ fn open_files(app: Rc<RefCell<App>>, files: web_sys::FileList) {
 
 fn report(opened: Result<()>, name: &str) {
     match opened {
-        Ok(()) => page::status(&format!("opened {name}")),
+        Ok(()) => page::message(&format!("opened {name}")),
         Err(e) => {
-            page::status(&format!("{name} did not open; the scene shown stays"));
+            page::message(&format!("{name} did not open; the scene shown stays"));
             page::show_error(&format!("{e:#}"));
         }
     }

@@ -63,6 +63,12 @@ pub(crate) fn status(text: &str) {
     set_text("status", text);
 }
 
+/// What the last thing asked for did (a scene opened or not): its own line, which the frame
+/// count does not overwrite.
+pub(crate) fn message(text: &str) {
+    set_text("message", text);
+}
+
 /// What the adapter and its limits are.
 pub(crate) fn set_adapter(text: &str) {
     set_text("adapter", text);
@@ -276,6 +282,11 @@ pub(crate) fn listen_input(app: &Rc<RefCell<App>>) -> Result<()> {
         if let Some((axis, positive)) = fly_key(&e.code()) {
             a.borrow_mut().fly_key(axis, positive, false);
         }
+    })?;
+    // A key released while the page had no focus never comes up here.
+    let a = app.clone();
+    on(&page, "blur", move |_: web_sys::Event| {
+        a.borrow_mut().release_keys()
     })?;
     Ok(())
 }

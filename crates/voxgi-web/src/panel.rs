@@ -54,7 +54,7 @@ pub(crate) fn build(app: &Rc<RefCell<App>>) -> Result<()> {
             .iter()
             .find(|(_, n)| *n == chosen)
         {
-            a.borrow_mut().display = *d;
+            a.borrow_mut().set_display(*d);
         }
     })?;
     append(&panel, &display)?;
@@ -123,6 +123,16 @@ pub(crate) fn refresh(app: &App) {
         let _ = field.class_list().remove_1("refused");
     }
     show_playing(app.duration, app.playing);
+}
+
+/// The display list's choice (after the page changed it).
+pub(crate) fn show_display(display: crate::traced::Display) {
+    if let Some(list) = document()
+        .get_element_by_id("display")
+        .and_then(|e| e.dyn_into::<web_sys::HtmlSelectElement>().ok())
+    {
+        list.set_value(display.name());
+    }
 }
 
 /// The play button's state: what pressing it does, or disabled for a still scene.

@@ -1,8 +1,9 @@
 //! voxgi's path tracer on the page: the ground truth instead of cone tracing, or right of the
 //! middle of the view beside it (the viewer's split view). As in the viewer it adds a band of
 //! rows a frame, sized to a budget of paths, and stops at a sample count; the accumulation
-//! starts over when the view or the bounce count changes. Unlike the viewer it builds the
-//! scene's BVH on the page's thread when first shown (a browser page has no threads).
+//! starts over when the view, the bounce count or the columns change. Unlike the viewer it
+//! builds the scene's BVH on the page's thread (a browser page has no threads), when first
+//! shown and when the scene's time changed; showing it pauses the animation.
 
 use anyhow::Result;
 use std::ops::Range;
@@ -47,7 +48,11 @@ impl Display {
 /// The path tracer and its running image.
 pub(crate) struct Traced {
     tracer: PathTracer,
+    /// The scene's time it traces.
+    pub(crate) time: f32,
     acc: Option<Accumulation>,
+    /// The columns the image holds samples of (another set starts it over).
+    columns: Range<u32>,
     /// The next band's first row.
     next_row: u32,
     /// Paths a frame: on a CPU adapter a band that takes a few hundred milliseconds, on a GPU
@@ -64,10 +69,13 @@ impl Traced {
         scene: &voxgi::scene::Scene,
         options: &voxgi::RendererOptions,
         cpu: bool,
+        time: f32,
     ) -> Result<Self> {
         Ok(Traced {
             tracer: PathTracer::new(device, queue, scene, options)?,
+            time,
             acc: None,
+            columns: 0..0,
             next_row: 0,
             paths_per_frame: if cpu { 1 << 15 } else { 1 << 22 },
             max_samples: if cpu { 64 } else { 4096 },
@@ -86,7 +94,12 @@ impl Traced {
         columns: Range<u32>,
     ) -> Result<u32> {
         let size = (target.width, target.height);
-        if self.acc.as_ref().map(|a| (a.width(), a.height())) != Some(size) {
+        // A new size, or other columns (the split view turned into the path tracer alone:
+        // its sample count is the least over what it traced).
+        if self.acc.as_ref().map(|a| (a.width(), a.height())) != Some(size)
+            || self.columns != columns
+        {
+            self.columns = columns.clone();
             self.acc = Some(self.tracer.accumulation(size.0, size.1)?);
             self.next_row = 0;
         }

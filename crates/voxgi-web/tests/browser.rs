@@ -1,7 +1,8 @@
 //! The web page in a real browser: web/build.sh builds it (wasm32, Debian's rustc-web), and
 //! web/test_page.py opens it in headless Chromium (WebGPU on SwiftShader) and checks the
-//! picture, the console, an orbit drag and a setting from the panel (its docstring says what
-//! and why). Skipped, with the reason, when a tool is missing; under `CI` (which installs
+//! picture, the camera, the panel, both structures, the split view with the path tracer,
+//! files opened from the page, the console, and the resolution lowered under WebGPU's default
+//! limits (its docstring says what and why). Skipped, with the reason, when a tool is missing; under `CI` (which installs
 //! them all) a missing tool fails the test.
 
 use std::path::{Path, PathBuf};

@@ -59,7 +59,8 @@ pub enum Error {
     #[error("{0}")]
     TooLarge(String),
     /// An option, setting, argument or input is out of range or malformed (a settings file, a
-    /// renderer option, images of different sizes to compare).
+    /// renderer option, a scene too large for the device whatever the voxel resolution, images
+    /// of different sizes to compare).
     #[error("invalid setting: {0}")]
     Setting(String),
     /// The scene has nothing to render: a renderer got no triangles and no points, the

@@ -2,7 +2,8 @@
 //! files held in memory (a browser page's dropped or picked files, which have no paths). Every
 //! loader reads through here, so a scene's side files (an OBJ's material library and
 //! textures, a glTF's buffers and images, a scene file's includes) are found among the files
-//! given with it.
+//! given with it. A point sequence's frames are not: the player reads them from the disk while
+//! the scene plays, after the load.
 
 use crate::{Result, Scene, SceneError};
 use std::cell::RefCell;
@@ -54,8 +55,11 @@ fn normal(path: &Path) -> PathBuf {
     for c in path.components() {
         match c {
             Component::CurDir => {}
+            // `..` takes back a name, never another `..` (nor the root).
             Component::ParentDir => {
-                if !out.pop() {
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) {
+                    out.pop();
+                } else {
                     out.push("..");
                 }
             }
@@ -179,5 +183,7 @@ mod tests {
             Some(PathBuf::from("tex.png"))
         );
         assert_eq!(find(&files, Path::new("c.bin")), None);
+        assert_eq!(normal(Path::new("../../x")), PathBuf::from("../../x"));
+        assert_eq!(normal(Path::new("a/../../x")), PathBuf::from("../x"));
     }
 }

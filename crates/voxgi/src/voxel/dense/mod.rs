@@ -128,7 +128,7 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
         )));
     }
     if grid.resolution > l.max_texture_dimension_3d {
-        return Err(Error::Setting(format!(
+        return Err(Error::TooLarge(format!(
             "a {}³ volume exceeds this GPU's 3D texture limit of {}",
             grid.resolution, l.max_texture_dimension_3d
         )));
