@@ -43,6 +43,8 @@ pub(crate) fn build(app: &Rc<RefCell<App>>, shown: &str) -> Result<()> {
     let list = select.clone();
     page::on(select.as_ref(), "change", move |_: web_sys::Event| {
         let name = list.value();
+        // Keys go back to the view (a list with the focus takes the arrows).
+        let _ = list.blur();
         let a = a.clone();
         wasm_bindgen_futures::spawn_local(async move {
             page::message(&format!("opening {name}…"));
@@ -71,6 +73,8 @@ pub(crate) fn build(app: &Rc<RefCell<App>>, shown: &str) -> Result<()> {
         }
         // The same file picked again is a change too.
         picker.set_value("");
+        // Keys go back to the view (Space on the button would open the dialog again).
+        let _ = picker.blur();
     })?;
     row.append_child(&input).ok();
     panel.append_child(&row).ok();

@@ -50,6 +50,7 @@ pub(crate) fn build(app: &Rc<RefCell<App>>) -> Result<()> {
     let list = display.clone();
     listen(&display, "change", move || {
         let chosen = list.value();
+        let _ = list.blur();
         if let Some((d, _)) = crate::traced::Display::ALL
             .iter()
             .find(|(_, n)| *n == chosen)
@@ -84,6 +85,11 @@ pub(crate) fn build(app: &Rc<RefCell<App>>) -> Result<()> {
         // A text field applies when it is left or Enter is pressed.
         listen(&input, "change", move || {
             let text = read(&field);
+            // Keys go back to the view once a value is in (a widget with the focus takes the
+            // arrows and Space).
+            if let Some(f) = field.dyn_ref::<web_sys::HtmlElement>() {
+                let _ = f.blur();
+            }
             let outcome = apply(&a, setting, &text);
             let classes = field.class_list();
             match outcome {
