@@ -215,13 +215,9 @@ async fn run() -> Result<()> {
     }));
     let watch = voxgi::gpu::lost::DeviceWatch::new(&device);
 
-    // As the viewer: a CPU adapter (SwiftShader) stays usable at 64³ and half resolution.
+    // As the viewer's: a CPU adapter (SwiftShader) stays usable at 64³ and half resolution.
     let cpu = adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-    let mut options = RendererOptions {
-        half_resolution: cpu,
-        voxel_resolution: if cpu { 64 } else { 128 },
-        ..RendererOptions::default()
-    };
+    let mut options = RendererOptions::interactive(cpu);
     let mut scene = scene;
     scene.set_time(0.0);
     let mut params = FrameParams::new(scene.default_camera());
@@ -237,18 +233,7 @@ async fn run() -> Result<()> {
     let controller = Controller::Orbit(orbit);
 
     let caps = surface.get_capabilities(&adapter);
-    // 8-bit without an sRGB view: voxgi applies the sRGB curve itself.
-    let format = caps
-        .formats
-        .iter()
-        .copied()
-        .find(|f| {
-            matches!(
-                f,
-                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
-            )
-        })
-        .or_else(|| caps.formats.first().copied())
+    let format = voxgi::surface_format(&caps.formats)
         .ok_or_else(|| anyhow!("the canvas offers no format"))?;
     let (width, height) = page::canvas_size(&canvas, device.limits().max_texture_dimension_2d);
     let mut config = surface

@@ -57,7 +57,7 @@ pub mod voxel;
 mod wgsl_twins;
 
 pub use error::{Error, Result};
-pub use frame::targets::{FrameTargets, Target};
+pub use frame::targets::{FrameTargets, Target, surface_format};
 pub use gpu::requirements::{check_device, minimum_limits, required_features, required_limits};
 pub use options::{
     ConeSet, DIRECTIONS, FrameParams, IndirectShading, MAX_BOUNCES, MAX_IMAGE_SIZE,

@@ -354,6 +354,19 @@ pub struct RendererOptions {
     pub temporal: bool,
 }
 
+impl RendererOptions {
+    /// The defaults for an interactive view (a window, a web page): on a CPU adapter
+    /// (lavapipe, SwiftShader) a 64³ volume and the half-resolution gather keep frames to a
+    /// fraction of a second; on a GPU, 128³ at full resolution.
+    pub fn interactive(cpu: bool) -> Self {
+        RendererOptions {
+            half_resolution: cpu,
+            voxel_resolution: if cpu { 64 } else { 128 },
+            ..RendererOptions::default()
+        }
+    }
+}
+
 impl Default for RendererOptions {
     fn default() -> Self {
         RendererOptions {

@@ -356,12 +356,7 @@ impl Viewer {
         let gpu = surface::open_window(event_loop, args, &scene_label(&scene))?;
         let opened = std::time::Instant::now();
         let cpu = gpu.cpu;
-        let mut options = RendererOptions {
-            // A CPU driver stays usable at half resolution.
-            half_resolution: cpu,
-            voxel_resolution: if cpu { 64 } else { 128 },
-            ..RendererOptions::default()
-        };
+        let mut options = RendererOptions::interactive(cpu);
         let mut scene = scene;
         scene.set_time(0.0);
         let mut params = FrameParams::new(scene.default_camera());

@@ -78,19 +78,7 @@ pub(super) fn open_window(
     let _ = window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
     let size = window.inner_size();
     let caps = surface.get_capabilities(&adapter);
-    // 8-bit without an sRGB view: voxgi applies the sRGB curve itself, and egui, which
-    // blends in gamma space, wants exactly that.
-    let format = caps
-        .formats
-        .iter()
-        .copied()
-        .find(|f| {
-            matches!(
-                f,
-                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
-            )
-        })
-        .or_else(|| caps.formats.first().copied())
+    let format = voxgi::surface_format(&caps.formats)
         .ok_or_else(|| anyhow!("the window offers no surface format"))?;
     let mut config = surface
         .get_default_config(&adapter, size.width.max(1), size.height.max(1))

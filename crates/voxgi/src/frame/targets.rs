@@ -181,3 +181,20 @@ impl<'a> Target<'a> {
         }
     }
 }
+
+/// The format to configure a window's or a canvas's surface with, of those it offers: an 8-bit
+/// format without an sRGB view (voxgi applies the sRGB curve itself, the same bits `voxgi
+/// render` writes, and a UI drawn over it that blends in gamma space, as egui does, wants
+/// exactly that), else the first offered.
+pub fn surface_format(offered: &[wgpu::TextureFormat]) -> Option<wgpu::TextureFormat> {
+    offered
+        .iter()
+        .copied()
+        .find(|f| {
+            matches!(
+                f,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
+            )
+        })
+        .or_else(|| offered.first().copied())
+}
