@@ -104,6 +104,20 @@ def wait_frames(page, count, seconds):
     )
 
 
+def more_frames(page, count):
+    """Waits until the GPU finished `count` more frames than it had."""
+    wait_frames(page, frames(page) + count, FRAMES_S)
+
+
+def wait_scene(page, name):
+    """Waits until the page shows the scene `name` (`data-scene`); fails on a page error."""
+    end = time.time() + FRAMES_S
+    while page.evaluate("document.body.dataset.scene") != name:
+        if page_error(page) or time.time() > end:
+            raise AssertionError(f"{name} did not open: {page_error(page)}")
+        time.sleep(0.5)
+
+
 def shot(page, path):
     """The canvas as an RGB image (and saved to `path`)."""
     from PIL import Image
@@ -226,14 +240,12 @@ def main():
         page.dblclick("#voxgi")  # back to the scene's camera
         page.keyboard.press("f")
         assert page.evaluate("document.body.dataset.camera") == "fly", "F did not fly"
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
         still = shot(page, f"{out}/fly_before.png")
         page.keyboard.down("w")
         time.sleep(1.0)
         page.keyboard.up("w")
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
         flown = shot(page, f"{out}/flown.png")
         d = difference(still, flown)
         say(f"flying forward changed the picture by {d:.1f} of 255 on average")
@@ -246,8 +258,7 @@ def main():
         # The other structure: the octree, from the panel, shows the same box.
         page.dblclick("#voxgi")  # back to the scene's camera
         page.select_option("#setting-voxels", "octree")
-        n = frames(page)
-        wait_frames(page, n + 3, FRAMES_S)
+        more_frames(page, 3)
         octree = shot(page, f"{out}/octree.png")
         d = difference(before, octree)
         say(f"octree against dense: {d:.1f} of 255 on average")
@@ -258,8 +269,7 @@ def main():
 
         # The split view: voxgi's path tracer right of the middle, accumulating.
         page.select_option("#display", "split: cones | path tracer")
-        n = frames(page)
-        wait_frames(page, n + 5, FRAMES_S)
+        more_frames(page, 5)
         split = shot(page, f"{out}/split.png")
         choices = page.evaluate("document.getElementById('choices').textContent")
         say(f"split view: {choices}")
@@ -280,8 +290,7 @@ def main():
         # Direct light only: the ceiling has none.
         page.fill("#setting-bounces", "0")
         page.press("#setting-bounces", "Enter")
-        n = frames(page)
-        wait_frames(page, n + 3, FRAMES_S)
+        more_frames(page, 3)
         direct = shot(page, f"{out}/direct.png")
         dark = mean(direct, box, 0.2, 0.02, 0.32, 0.1)
         say(f"ceiling with bounces = 0: {dark}")
@@ -292,33 +301,25 @@ def main():
         # A scene file with an animation and [settings], from the repository's examples.
         moving = Path(__file__).resolve().parent.parent / "examples" / "cornell-moving.toml"
         page.set_input_files("#file", files=[str(moving)])
-        end = time.time() + FRAMES_S
-        while page.evaluate("document.body.dataset.scene") != "cornell-moving.toml":
-            if page_error(page) or time.time() > end:
-                raise AssertionError(f"cornell-moving.toml did not open: {page_error(page)}")
-            time.sleep(0.5)
+        wait_scene(page, "cornell-moving.toml")
         play = page.evaluate("document.getElementById('play').textContent")
         assert play == "pause the animation", f"the animation is not playing: {play!r}"
         bounces = page.input_value("#setting-bounces")
         assert bounces == "2", f"the file's [settings] bounces = 2 is not shown: {bounces}"
         # A moving frame re-voxelizes the block and bounces twice: seconds on SwiftShader,
         # and the animation advances at most a quarter of a second a frame.
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
         t0 = shot(page, f"{out}/moving_0.png")
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
         t1 = shot(page, f"{out}/moving_1.png")
         moving = difference(t0, t1)
         # Paused (Space), the same frames' difference is the accumulation's noise alone.
         page.keyboard.press("Space")
         play = page.evaluate("document.getElementById('play').textContent")
         assert play == "play the animation", f"Space did not pause: {play!r}"
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
         p0 = shot(page, f"{out}/paused_0.png")
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
         p1 = shot(page, f"{out}/paused_1.png")
         still = difference(p0, p1)
         say(
@@ -350,8 +351,7 @@ def main():
         console_errors[:] = [e for e in console_errors if "broken.glb" not in e]
         page.click("#error")  # dismissed
         assert not page_error(page), "a click did not dismiss the error"
-        n = frames(page)
-        wait_frames(page, n + 2, FRAMES_S)
+        more_frames(page, 2)
 
         # An OBJ with its material library: a white floor and a red wall.
         obj = (
@@ -369,13 +369,8 @@ def main():
                 {"name": "room.mtl", "mimeType": "text/plain", "buffer": mtl.encode()},
             ],
         )
-        end = time.time() + FRAMES_S
-        while page.evaluate("document.body.dataset.scene") != "room.obj":
-            if page_error(page) or time.time() > end:
-                raise AssertionError(f"room.obj did not open: {page_error(page)}")
-            time.sleep(0.5)
-        n = frames(page)
-        wait_frames(page, n + 3, FRAMES_S)
+        wait_scene(page, "room.obj")
+        more_frames(page, 3)
         room = shot(page, f"{out}/room.png")
         px = room.load()
         w, h = room.size
@@ -433,5 +428,5 @@ if __name__ == "__main__":
     try:
         main()
     except AssertionError as e:
-        say(f"test_page: FAILED: {e}", file=sys.stderr)
+        print(f"test_page: FAILED: {e}", file=sys.stderr)
         sys.exit(1)
