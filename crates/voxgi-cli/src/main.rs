@@ -4,6 +4,7 @@ mod args;
 mod bench;
 mod compare;
 mod info;
+mod probe;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -43,6 +44,9 @@ enum Command {
     /// Compare a test image with a reference: mean FLIP (LDR-FLIP for PNG, HDR-FLIP for EXR),
     /// RMSE and relative MSE on linear values, printed as one JSON line.
     Compare(compare::CompareArgs),
+    /// Trace the diffuse cones at chosen pixels and compare each with the path tracer's light
+    /// over the same cone: gathered radiance, transmittance, weights.
+    Probe(probe::ProbeArgs),
 }
 
 fn main() {
@@ -59,6 +63,7 @@ fn main() {
         Command::Info(a) => info::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Probe(a) => probe::run(a),
     };
     if let Err(e) = result {
         eprintln!("voxgi: error: {e:#}");

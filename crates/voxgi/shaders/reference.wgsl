@@ -26,7 +26,8 @@ struct Params {
     seed: u32,
     // Number of indirect bounces: 0 direct only, 1, or a large cap for unlimited.
     bounces: u32,
-    // 0 radiance, 1 ambient occlusion.
+    // 0 radiance, 1 ambient occlusion, 2 the cone probe (`probe`: one invocation per cone of
+    // `queries`, width of them in row 0).
     mode: u32,
     ao_radius: f32,
     // Russian roulette from this path depth on (a huge value disables it).
@@ -78,6 +79,18 @@ struct TriShading {
 @group(0) @binding(6) var textures: texture_2d_array<f32>;
 @group(0) @binding(7) var texture_sampler: sampler;
 @group(0) @binding(8) var<storage, read_write> accum: array<vec4<f32>>;
+
+// A cone of the cone tracer, for the probe mode (reference/probe.rs, `ConeQuery`).
+struct ConeQuery {
+    origin: vec3<f32>,
+    tan_half: f32,
+    dir: vec3<f32>,
+    max_distance: f32,
+    normal: vec3<f32>,
+    _pad: f32,
+}
+
+@group(0) @binding(9) var<storage, read> queries: array<ConeQuery>;
 
 // ---------------------------------------------------------------------------------------------
 // Random numbers: PCG (O'Neill), seeded by hashing pixel, sample index and seed.
@@ -542,15 +555,20 @@ fn camera_ray(px: vec2<u32>) -> array<vec3<f32>, 2> {
 // (NEE plus MIS-weighted hits on area-light emitters) is gathered at the first N + 1 surfaces of
 // the path, and other emissive surfaces and the background count up to path vertex N + 1 (the
 // camera sees them at vertex 1). So N = 0 is exactly what the rasterizer computes.
-fn radiance(px: vec2<u32>) -> vec3<f32> {
-    let ray = camera_ray(px);
-    var o = ray[0];
-    var d = ray[1];
+//
+// The light arriving along (o, d) at path vertex `first` - 1: 1 for a camera ray; 2 for a ray
+// leaving a surface the camera sees (the probe), where an area light's emitter counts nothing,
+// its light at that surface being the direct term. w: the distance to the first hit, -1 for
+// none.
+fn path(o_in: vec3<f32>, d_in: vec3<f32>, first: u32) -> vec4<f32> {
+    var o = o_in;
+    var d = d_in;
     var beta = vec3<f32>(1.0);
     var sum = vec3<f32>(0.0);
     var prev_pdf = 0.0;
+    var first_t = -1.0;
     let last = params.bounces + 1u;
-    for (var depth = 1u; depth <= last + 1u; depth++) {
+    for (var depth = first; depth <= last + 1u; depth++) {
         let h = trace(o, d, FAR_AWAY, false);
         if h.tri == NO_HIT {
             if depth <= last {
@@ -558,14 +576,19 @@ fn radiance(px: vec2<u32>) -> vec3<f32> {
             }
             break;
         }
+        if depth == first {
+            first_t = h.t;
+        }
         let x = surface_at(h, o, d);
         if x.light != NO_INDEX {
             // The emitter of an area light: direct light of the previous vertex, weighted
             // against that vertex's light sample; seen by the camera, counted in full.
             var w = 1.0;
-            if depth > 1u {
+            if depth > first {
                 let light = lights[x.light];
                 w = power_heuristic(prev_pdf, area_light_pdf(light, d, h.t));
+            } else if first > 1u {
+                w = 0.0;
             }
             sum += beta * x.emission * w;
         } else if depth <= last {
@@ -592,7 +615,50 @@ fn radiance(px: vec2<u32>) -> vec3<f32> {
         o = offset_origin(x.p, x.ng, bs.l);
         d = bs.l;
     }
-    return sum;
+    return vec4<f32>(sum, first_t);
+}
+
+fn radiance(px: vec2<u32>) -> vec3<f32> {
+    let ray = camera_ray(px);
+    return path(ray[0], ray[1], 1u).rgb;
+}
+
+// The probe mode: the light inside cone `i` of `queries`, from directions drawn uniformly over
+// its solid angle, each followed as a path leaving a surface the camera sees. Three sums per
+// cone, the last entry of each its weight: accum[3i] (radiance, 1), accum[3i + 1] (radiance
+// times the cosine to the normal, that cosine), accum[3i + 2] (escaped, hit distance if hit,
+// hit, 1). A direction below the surface is blocked at distance 0 and carries no light.
+fn probe(i: u32) {
+    let q = queries[i];
+    let base = u32(accum[3u * i].w);
+    let cos_max = 1.0 / sqrt(1.0 + q.tan_half * q.tan_half);
+    let frame = tangent_frame(q.dir);
+    var light = vec4<f32>(0.0);
+    var cosine = vec4<f32>(0.0);
+    var reach = vec4<f32>(0.0);
+    for (var k = 0u; k < params.sample_count; k++) {
+        rng = pcg_hash(pcg_hash(pcg_hash(i ^ pcg_hash(params.seed)) + base + k) ^ 0x9e3779b9u);
+        let u = rand2();
+        let c = 1.0 - u.x * (1.0 - cos_max);
+        let s = sqrt(max(1.0 - c * c, 0.0));
+        let phi = 2.0 * PI * u.y;
+        let d = normalize(frame * vec3<f32>(s * cos(phi), s * sin(phi), c));
+        let cos_n = dot(d, q.normal);
+        var l = vec4<f32>(0.0);
+        if cos_n > 0.0 {
+            l = path(offset_origin(q.origin, q.normal, d), d, 2u);
+            if !(all(l.rgb == l.rgb) && all(l.rgb < vec3<f32>(FAR_AWAY))) {
+                l = vec4<f32>(0.0, 0.0, 0.0, l.w);
+            }
+        }
+        let hit = l.w >= 0.0 && l.w <= q.max_distance;
+        light += vec4<f32>(l.rgb, 1.0);
+        cosine += vec4<f32>(l.rgb * max(cos_n, 0.0), max(cos_n, 0.0));
+        reach += vec4<f32>(select(1.0, 0.0, hit), select(0.0, l.w, hit), select(0.0, 1.0, hit), 1.0);
+    }
+    accum[3u * i] += light;
+    accum[3u * i + 1u] += cosine;
+    accum[3u * i + 2u] += reach;
 }
 
 // Ambient occlusion: 1 when a cosine-distributed ray from the first hit escapes within
@@ -615,6 +681,10 @@ fn ambient_occlusion(px: vec2<u32>) -> f32 {
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = id.xy + vec2<u32>(params.x0, params.y0);
     if px.x >= params.x1 || px.y >= params.y1 {
+        return;
+    }
+    if params.mode == 2u {
+        probe(px.x);
         return;
     }
     let pixel = px.y * params.width + px.x;

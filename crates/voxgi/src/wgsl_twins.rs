@@ -13,6 +13,7 @@ use crate::lighting::bounce::GpuSlices;
 use crate::lighting::cones::GpuCones;
 use crate::lighting::inject::GpuInjectParams;
 use crate::lighting::moments::GpuMomentRect;
+use crate::reference::probe::ConeQuery;
 use crate::reference::progressive::GpuDisplay;
 use crate::reference::{GpuNode, GpuParams, GpuTri, GpuTriShading};
 use crate::voxel::octree::{GpuAtlasShape, GpuOctree};
@@ -312,6 +313,12 @@ fn every_twin_has_the_wgsl_layout() {
     twin!(m, GpuNode, "Node", [lo, first, hi, count]);
     twin!(m, GpuTri, "Tri", [p0, material, p1, light, p2, kind]);
     twin!(m, GpuTriShading, "TriShading", [n0, n1, n2, uv]);
+    twin!(
+        m,
+        ConeQuery,
+        "ConeQuery",
+        [origin, tan_half, dir, max_distance, normal]
+    );
     twin!(m, GpuDisplay, "Display", [exposure, tonemap, width]);
 }
 

@@ -116,23 +116,26 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var ao = 1.0;
     // Records turn their bundles by the layout the pixels' window filter averages
     // (shared/irradiance_record.wgsl).
-    let records_angle = leaf_rotation(c) * 2.0 * PI / f32(max(cones.count, 2u) - 1u);
+    let records_turn = leaf_turn(c);
+    // Otherwise a fixed turn per voxel, varied between voxels to break up patterns. It
+    // follows the voxel's coordinates, not its slot: slots are handed out by atomics in
+    // whatever order the GPU runs, and renders must not change from run to run. (Roberts' R3
+    // sequence in two of its dimensions: neighbouring voxels get well spread turns.)
+    let r3 = fract(vec2<f32>(
+        dot(vec3<f32>(c), vec3<f32>(0.8191725134, 0.6710436067, 0.5497004779)),
+        dot(vec3<f32>(c), vec3<f32>(0.6710436067, 0.5497004779, 0.8191725134)),
+    ));
+    let turn = select(r3, records_turn, IRRADIANCE);
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
-        // A fixed bundle orientation per voxel, varied between voxels to break up patterns. It
-        // follows the voxel's coordinates, not its slot: slots are handed out by atomics in
-        // whatever order the GPU runs, and renders must not change from run to run. (The
-        // constants are Roberts' R3 sequence: neighbouring voxels get well spread angles.)
-        let r3 = fract(dot(vec3<f32>(c), vec3<f32>(0.8191725134, 0.6710436067, 0.5497004779))) * 2.0 * PI;
-        let g = gather_diffuse(center, n, select(r3, records_angle, IRRADIANCE), IRRADIANCE, ALL_CONES);
+        let g = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES);
         e = g.irradiance;
         ao = g.ao;
     } else {
         // Two-sided voxel: half the light from each side.
         let n = vec3<f32>(0.0, 1.0, 0.0);
-        let angle = select(0.0, records_angle, IRRADIANCE);
-        let up = gather_diffuse(center, n, angle, IRRADIANCE, ALL_CONES);
-        let down = gather_diffuse(center, -n, angle, IRRADIANCE, ALL_CONES);
+        let up = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES);
+        let down = gather_diffuse(center, -n, turn, IRRADIANCE, ALL_CONES);
         e = 0.5 * (up.irradiance + down.irradiance);
         ao = 0.5 * (up.ao + down.ao);
     }

@@ -98,18 +98,23 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = normalize(nr.xyz);
     let v = normalize(frame.camera_pos - p);
     textureStore(guide_out, gid.xy, vec4<f32>(nr.xyz, length(frame.camera_pos - p)));
-    // The ring of tilted cones repeats every 2 pi / (count - 1).
-    let period = 2.0 * PI / f32(max(cones.count, 2u) - 1u);
-    // With temporal accumulation each frame turns the whole pattern a little further
-    // (frame.cone_turn, 0 in frame 0), so the frames between them trace many more rotations.
-    let angle = (f32(bayer4(gid.xy)) + 0.5 + frame.cone_turn) / 16.0 * period;
+    // The sixteen pixels of a 4x4 block draw the cones' axes from their cells at the sixteen
+    // points of a Hammersley set (the Bayer rank and its bit reversal), which the upsample's
+    // 4x4 average takes the mean of. With temporal accumulation each frame shifts the set a
+    // little further within its strata (frame.cone_turn, 0 in frame 0), so
+    // the frames between them trace many more.
+    let rank = bayer4(gid.xy);
+    let turn = vec2<f32>(
+        (f32(rank) + 0.5 + frame.cone_turn.x) / 16.0,
+        (f32(reverseBits(rank) >> 28u) + 0.5 + frame.cone_turn.y) / 16.0,
+    );
     // Even and odd Bayer ranks trace the two halves of the ring: each half then meets eight
     // rotations spread over the whole period.
     var g: Gathered;
     if LEAVES {
         g = leaf_gather(p, n);
     } else {
-        g = gather_diffuse(p, n, angle, frame.view_mode == VIEW_AO, cone_half(gid.xy));
+        g = gather_diffuse(p, n, turn, frame.view_mode == VIEW_AO, cone_half(gid.xy));
     }
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);

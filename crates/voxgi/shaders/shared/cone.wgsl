@@ -101,12 +101,6 @@ fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f
     return occ;
 }
 
-fn rotate_z(v: vec3<f32>, angle: f32) -> vec3<f32> {
-    let c = cos(angle);
-    let s = sin(angle);
-    return vec3<f32>(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
-}
-
 struct Gathered {
     // Irradiance from the cones, W/m^2.
     irradiance: vec3<f32>,
@@ -114,14 +108,52 @@ struct Gathered {
     ao: f32,
 }
 
+// The diffuse bundle partitions the hemisphere into cells: the normal's cone a cap, each cone
+// of the ring a sector of the band below it, each weighted by its cell's share of the
+// cosine-weighted hemisphere (`cones.dirs[i].w`; the cap's share is sin² of its rim's zenith
+// angle, so the cap ends where sin² reaches the normal cone's weight).
+//
+// Near their surface the cones are far narrower than their aperture (cone_sample_size keeps a
+// sample's filter off the cone's own surface), so a cone measures the light about its axis,
+// not the mean over its cell: traced along fixed axes (the ring at 60 degrees) with the
+// cells' weights, the sum was 20-25 % off the path tracer's irradiance wherever the light
+// differs across a cell (beside the Cornell box's open front: `voxgi probe`). So each cone's
+// axis is drawn from its cell, cosine-weighted, by `turn` in [0, 1)^2: x turns the sectors
+// about the normal (a fraction of the ring's period; the cap's azimuth goes once round), y
+// places the zenith within the cell (uniform in sin², the cosine-weighted measure). Pixels of
+// a 4x4 block and frames draw different turns, so their mean is each cell's cosine-weighted
+// mean, as the weights assume.
+//
+// Directions within 12 degrees of the horizon are traced at 78 degrees: a cone that grazes
+// its own plane steps a voxel at a time (3 % of the cosine-weighted hemisphere lies there).
+const GRAZING_SIN2: f32 = 0.9568;
+
+// Cone i of the diffuse bundle at `turn` (`frame`: tangent space to world): its direction
+// (xyz) and its weight (w).
+fn diffuse_cone(frame: mat3x3<f32>, turn: vec2<f32>, i: u32) -> vec4<f32> {
+    let cap = cones.dirs[0].w;
+    let ring = max(cones.count, 2u) - 1u;
+    var u = turn.y * cap;
+    var phi = turn.x * 2.0 * PI;
+    if i > 0u {
+        u = cap + turn.y * (1.0 - cap);
+        phi = atan2(cones.dirs[i].y, cones.dirs[i].x) + turn.x * 2.0 * PI / f32(ring);
+    }
+    u = min(u, GRAZING_SIN2);
+    let s = sqrt(u);
+    let d = frame * vec3<f32>(s * cos(phi), s * sin(phi), sqrt(1.0 - u));
+    return vec4<f32>(normalize(d), cones.dirs[i].w);
+}
+
 const ALL_CONES: u32 = 2u;
 
-// Irradiance at a surface point from the diffuse cones, the bundle rotated by `angle` about n.
+// Irradiance at a surface point from the diffuse cones, the bundle drawn at `turn`
+// (diffuse_cone).
 // `half` = ALL_CONES traces every cone. `half` = 0 or 1 traces the normal's cone and every
 // other cone of the ring at twice its weight: pixels of even and odd Bayer rank trace the two
 // halves, and the reconstruction's 4x4 average sees every cone in eight rotations spread over
 // the period, so the estimate is unbiased at about 60 % of the cost.
-fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool, half: u32) -> Gathered {
+fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32) -> Gathered {
     let frame = tangent_frame(n);
     let origin = p + n * voxels_voxel_size() * cones.origin_offset;
     var e = vec3<f32>(0.0);
@@ -133,15 +165,6 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool, half: u
     if half != ALL_CONES {
         n_cones = 1u + (ring + 1u) / 2u;
     }
-    // The normal's cone is tilted by two thirds of its aperture (about the cosine-weighted mean
-    // angle of its cell) towards an azimuth that goes once round as the ring's angle covers
-    // its period: the sixteen pixels of a 4x4 block spread it over its cell. Untilted, every
-    // pixel of a plane traced the same direction, and a sample narrowed near its own surface
-    // imaged what lies straight ahead like a pinhole (a sharp bright patch on the Cornell
-    // box's ceiling above the tall block).
-    let az = angle * f32(max(ring, 1u));
-    let tilt = (2.0 / 3.0) * atan(cones.diffuse_tan);
-    let tilted = vec3<f32>(sin(tilt) * cos(az), sin(tilt) * sin(az), cos(tilt));
     for (var k = 0u; k < n_cones; k++) {
         var i = k;
         var w_scale = 1.0;
@@ -152,8 +175,9 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, angle: f32, with_ao: bool, half: u
         if i >= cones.count {
             continue;
         }
-        let w = cones.dirs[i].w * w_scale;
-        let d = normalize(frame * select(rotate_z(cones.dirs[i].xyz, angle), tilted, i == 0u));
+        let c = diffuse_cone(frame, turn, i);
+        let w = c.w * w_scale;
+        let d = c.xyz;
         if cones.indirect != 0u {
             let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance);
             // Weights are fractions of the cosine-weighted hemisphere, whose integral is pi.

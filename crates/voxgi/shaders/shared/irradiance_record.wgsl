@@ -19,10 +19,11 @@ fn record_normal(r: vec4<u32>) -> vec4<f32> {
     return unpack4x8snorm(r.z);
 }
 
-// The rotation of leaf c's cone bundle, as a fraction of the bundle's period: one of sixteen,
-// each once in every 4x4 window of any axis-aligned plane ((x + y, y + z) mod 4 is one-to-one
-// on each), the layout shared/leaf_irradiance.wgsl's window averages.
-fn leaf_rotation(c: vec3<u32>) -> f32 {
+// The turn of leaf c's cone bundle (shared/cone.wgsl, diffuse_cone): one of the sixteen
+// points of a Hammersley set, each once in every 4x4 window of any axis-aligned plane
+// ((x + y, y + z) mod 4 is one-to-one on each), the layout shared/leaf_irradiance.wgsl's
+// window averages.
+fn leaf_turn(c: vec3<u32>) -> vec2<f32> {
     let rank = 4u * ((c.x + c.y) & 3u) + ((c.y + c.z) & 3u);
-    return (f32(rank) + 0.5) / 16.0;
+    return (vec2<f32>(f32(rank), f32(reverseBits(rank) >> 28u)) + 0.5) / 16.0;
 }

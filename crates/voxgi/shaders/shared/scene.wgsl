@@ -52,12 +52,12 @@ struct Frame {
     prev_camera_pos: vec3<f32>,
     // HISTORY_*: what the temporal pass may do with the history.
     history: u32,
-    // How far this frame turns the diffuse cone bundle, in interleaving steps.
-    cone_turn: f32,
+    // How far this frame shifts the diffuse cones' turns about the normal and in zenith, in
+    // interleaving steps.
+    cone_turn: vec2<f32>,
     // Which frame of the area lights' sample points the sample views show.
     light_sample: u32,
     _pad2: u32,
-    _pad3: u32,
 }
 
 const HISTORY_NONE: u32 = 0u;

@@ -31,12 +31,15 @@ pub fn jitter(k: u32) -> [f32; 2] {
     [wrap(radical_inverse(k, 2)), wrap(radical_inverse(k, 3))]
 }
 
-/// How far frame `k` turns the diffuse cone bundle, as a fraction of one interleaving step
-/// (a sixteenth of the ring's period, `shaders/shared/interleave.wgsl`): the base-5 radical
-/// inverse, a base prime to the jitter's so that the turn and the sample position do not
-/// repeat together.
-pub fn cone_turn(k: u32) -> f32 {
-    radical_inverse(k % PERIOD, 5)
+/// How far frame `k` shifts the diffuse cones' turns (`shaders/shared/cone.wgsl`,
+/// `diffuse_cone`) within their sixteenths: about the normal and in zenith, each as a fraction
+/// of one interleaving step. The base-5 and base-7 radical inverses, bases prime to the
+/// jitter's so that the turn and the sample position do not repeat together.
+pub fn cone_turn(k: u32) -> [f32; 2] {
+    [
+        radical_inverse(k % PERIOD, 5),
+        radical_inverse(k % PERIOD, 7),
+    ]
 }
 
 /// Frame `k`'s points on an area light, in the unit square (`lighting::atlas::light_point`):
@@ -61,7 +64,7 @@ mod tests {
     #[test]
     fn frame_zero_is_the_still() {
         assert_eq!(jitter(0), [0.0, 0.0]);
-        assert_eq!(cone_turn(0), 0.0);
+        assert_eq!(cone_turn(0), [0.0, 0.0]);
     }
 
     #[test]
@@ -93,11 +96,14 @@ mod tests {
 
     #[test]
     fn cone_turns_spread_over_the_step() {
-        let mut t: Vec<f32> = (0..25).map(cone_turn).collect();
-        t.sort_by(f32::total_cmp);
-        // 25 = 5²: the base-5 radical inverse of 0..25 is exactly the multiples of 1/25.
-        for (i, v) in t.iter().enumerate() {
-            assert!((v - i as f32 / 25.0).abs() < 1e-6, "{t:?}");
+        // 25 = 5² and 49 = 7²: the base-5 radical inverse of 0..25 is exactly the multiples
+        // of 1/25, the base-7 one of 0..49 those of 1/49.
+        for (axis, n) in [(0, 25), (1, 49)] {
+            let mut t: Vec<f32> = (0..n).map(|k| cone_turn(k)[axis]).collect();
+            t.sort_by(f32::total_cmp);
+            for (i, v) in t.iter().enumerate() {
+                assert!((v - i as f32 / n as f32).abs() < 1e-6, "{t:?}");
+            }
         }
     }
 

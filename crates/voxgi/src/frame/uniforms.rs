@@ -49,14 +49,15 @@ pub struct GpuFrame {
     /// What the temporal pass may do with the history: `HISTORY_*` in the WGSL (none, a
     /// moving view that is clamped to the frame, or a still that is averaged).
     pub history: u32,
-    /// How far this frame turns the diffuse cone bundle, as a fraction of one interleaving
-    /// step (`sequence::cone_turn`; zero without temporal accumulation).
-    pub cone_turn: f32,
+    /// How far this frame shifts the diffuse cones' turns about the normal and in zenith, as
+    /// fractions of one interleaving step (`sequence::cone_turn`; zero without temporal
+    /// accumulation).
+    pub cone_turn: [f32; 2],
     /// The frame's index in the sequence of area-light sample points: its sample views show
     /// points `4 light_sample` to `4 light_sample + 3` (`sequence::light_points`).
     pub light_sample: u32,
     /// Padding to a multiple of 16 bytes; zero.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
 
 /// `GpuFrame::history`: no history to use (the first frame, a cut, accumulation off).

@@ -62,6 +62,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "screen/tonemap.wgsl",
     "reference.wgsl",
     "reference_display.wgsl",
+    "cone_probe.wgsl",
 ];
 
 /// Shader development: with `VOXGI_SHADER_DIR` set, WGSL is read from that directory (laid out

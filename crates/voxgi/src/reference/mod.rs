@@ -22,6 +22,7 @@ use glam::{Mat3, Vec3};
 use voxgi_scene::{Light, Scene};
 use wgpu::util::DeviceExt;
 
+pub mod probe;
 pub(crate) mod progressive;
 pub use progressive::{Accumulation, Region};
 
@@ -56,6 +57,16 @@ impl Bounces {
 
 /// Path-length cap for [`Bounces::Unlimited`].
 pub const MAX_BOUNCES: u32 = 64;
+
+/// The shader's bounce count and Russian-roulette depth for `bounces`.
+fn bounce_limits(bounces: Bounces) -> (u32, u32) {
+    match bounces {
+        Bounces::DirectOnly => (0, u32::MAX),
+        Bounces::One => (1, u32::MAX),
+        Bounces::Unlimited => (MAX_BOUNCES - 1, 3),
+        Bounces::Exactly(n) => (n.min(MAX_BOUNCES - 1), u32::MAX),
+    }
+}
 
 /// What the reference computes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -189,6 +200,8 @@ pub struct PathTracer {
     shading: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    /// The probe mode's cone queries, bound where there are none (binding 9 of `layout`).
+    no_queries: wgpu::Buffer,
     display: progressive::DisplayPass,
     timer: GpuTimer,
 }
@@ -378,6 +391,10 @@ impl PathTracer {
                     storage("reference bvh", bytemuck::cast_slice(&flat.nodes)),
                     storage("reference triangles", bytemuck::cast_slice(&flat.tris)),
                     storage("reference shading", bytemuck::cast_slice(&flat.shading)),
+                    storage(
+                        "reference no cone queries",
+                        bytemuck::bytes_of(&probe::ConeQuery::zeroed()),
+                    ),
                 ),
             ))
         })??;
@@ -400,6 +417,7 @@ impl PathTracer {
                     ),
                     layout::sampler(7, S::COMPUTE),
                     layout::storage(8, S::COMPUTE, false),
+                    layout::storage(9, S::COMPUTE, true),
                 ],
             });
             let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -433,6 +451,33 @@ impl PathTracer {
             shading: buffers.2,
             layout,
             pipeline,
+            no_queries: buffers.3,
+        })
+    }
+
+    /// The tracing pass's bind group: `params`, the scene, the sums `accum` and the probe
+    /// mode's cone `queries` (`probe::ConeQuery`).
+    fn trace_group(
+        &self,
+        params: &wgpu::Buffer,
+        accum: &wgpu::Buffer,
+        queries: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("reference"),
+            layout: &self.layout,
+            entries: &layout::entries(vec![
+                params.as_entire_binding(),
+                self.nodes.as_entire_binding(),
+                self.tris.as_entire_binding(),
+                self.shading.as_entire_binding(),
+                self.scene.materials.as_entire_binding(),
+                self.scene.lights.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&self.scene.texture_view),
+                wgpu::BindingResource::Sampler(&self.scene.sampler),
+                accum.as_entire_binding(),
+                queries.as_entire_binding(),
+            ]),
         })
     }
 

@@ -3,7 +3,7 @@
 //! target, tone-mapped as the tonemap pass does. The accumulation starts over by itself when
 //! the view or the options change, so a caller only says how many samples to add and where.
 
-use super::{Bounces, GpuParams, MAX_BOUNCES, PathTracer, ReferenceMode, ReferenceOptions};
+use super::{Bounces, GpuParams, PathTracer, ReferenceMode, ReferenceOptions, bounce_limits};
 use crate::frame::targets::Target;
 use crate::gpu::{layout, shader};
 use crate::options::{FrameParams, Tonemap, validate_size};
@@ -212,21 +212,7 @@ impl PathTracer {
         };
         let params = uniform("reference params", size_of::<GpuParams>());
         let display_params = uniform("reference_display", size_of::<GpuDisplay>());
-        let trace_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("reference"),
-            layout: &self.layout,
-            entries: &layout::entries(vec![
-                params.as_entire_binding(),
-                self.nodes.as_entire_binding(),
-                self.tris.as_entire_binding(),
-                self.shading.as_entire_binding(),
-                self.scene.materials.as_entire_binding(),
-                self.scene.lights.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&self.scene.texture_view),
-                wgpu::BindingResource::Sampler(&self.scene.sampler),
-                buffer.as_entire_binding(),
-            ]),
-        });
+        let trace_group = self.trace_group(&params, &buffer, &self.no_queries);
         let display_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("reference_display"),
             layout: &self.display.layout,
@@ -283,12 +269,7 @@ impl PathTracer {
                 (1, radius)
             }
         };
-        let (bounces, rr_depth) = match opts.bounces {
-            Bounces::DirectOnly => (0, u32::MAX),
-            Bounces::One => (1, u32::MAX),
-            Bounces::Unlimited => (MAX_BOUNCES - 1, 3),
-            Bounces::Exactly(n) => (n.min(MAX_BOUNCES - 1), u32::MAX),
-        };
+        let (bounces, rr_depth) = bounce_limits(opts.bounces);
         let key = self.key(acc, frame, opts);
         let view_proj = glam::Mat4::from_cols_array(&key.view_proj);
         let columns = region.columns.clone();

@@ -354,7 +354,7 @@ impl Renderer {
             history: history.mode,
             cone_turn: history.cone_turn,
             light_sample: history.sample,
-            _pad: [0; 2],
+            _pad: 0,
         }
     }
 

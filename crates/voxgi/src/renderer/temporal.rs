@@ -58,8 +58,8 @@ pub(super) struct FrameHistory {
     pub mode: u32,
     /// The camera's sub-pixel offset, pixels.
     pub jitter: [f32; 2],
-    /// The cone bundle's turn, in interleaving steps.
-    pub cone_turn: f32,
+    /// The cone bundle's turn about the normal and in zenith, in interleaving steps.
+    pub cone_turn: [f32; 2],
     /// The frame's index in the sample sequence (area lights' points, `sequence`).
     pub sample: u32,
     /// The last frame's view-projection without jitter and camera position (this frame's own
@@ -111,7 +111,7 @@ impl TemporalState {
             return FrameHistory {
                 mode: HISTORY_NONE,
                 jitter: [0.0; 2],
-                cone_turn: 0.0,
+                cone_turn: [0.0; 2],
                 sample: 0,
                 prev_view_proj: view_proj,
                 prev_camera: camera,

@@ -17,6 +17,7 @@ mod options;
 mod point_gi;
 mod points;
 mod prepare;
+mod probe;
 mod reference;
 mod registry;
 mod resize;
