@@ -300,17 +300,6 @@ fn cosine_hemisphere(u: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
 }
 
-// GGX visible-normal sampling by spherical caps (Dupuy & Benyoub 2023), in the tangent frame.
-fn sample_vndf(v: vec3<f32>, a: f32, u: vec2<f32>) -> vec3<f32> {
-    let vh = normalize(vec3<f32>(a * v.x, a * v.y, v.z));
-    let phi = 2.0 * PI * u.x;
-    let z = (1.0 - u.y) * (1.0 + vh.z) - vh.z;
-    let sin_t = sqrt(clamp(1.0 - z * z, 0.0, 1.0));
-    let c = vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), z);
-    let h = c + vh;
-    return normalize(vec3<f32>(a * h.x, a * h.y, max(h.z, 1e-6)));
-}
-
 fn g1_ggx(n_dot_v: f32, a: f32) -> f32 {
     let a2 = a * a;
     return 2.0 * n_dot_v / (n_dot_v + sqrt(a2 + (1.0 - a2) * n_dot_v * n_dot_v));

@@ -120,13 +120,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f0 = f0_of(s);
     if GLOSSY && cones.indirect != 0u && max(f0.r, max(f0.g, f0.b)) > 0.0 {
         let a = ggx_alpha(s.roughness);
-        // Along the lobe's dominant direction, which leans from the mirror direction towards
-        // the normal as the lobe widens (Lagarde and de Rousiers's fit for GGX): at grazing
-        // views the mirror direction skims the surface, where a rough lobe reflects little.
-        let lean = (1.0 - a) * (sqrt(1.0 - a) + a);
-        let dir = normalize(mix(n, reflect(-v, n), lean));
-        // Cone half-angle from the GGX lobe width, no narrower than a voxel allows anyway.
-        let tan_half = clamp(a, 0.01, 1.0);
+        // A direction drawn from the lobe: a visible normal of the GGX distribution at the
+        // pixel's turn (the sixteen points of the block's Hammersley set, shifted each frame),
+        // the view reflected about it, so the block's and the frames' mean is the lobe's mean.
+        // One cone along the lobe's dominant direction was not (its footprint mean reached
+        // 0.65 of the path tracer's reflection at roughness 0.3). A direction reflected below
+        // the surface is folded back above it: the lobe's albedo already counts the light
+        // that geometry loses there.
+        let frame_n = tangent_frame(n);
+        let vt = transpose(frame_n) * v;
+        let h = frame_n * sample_vndf(vec3<f32>(vt.xy, max(vt.z, 1e-4)), a, turn);
+        let r = reflect(-v, h);
+        let dir = normalize(r - 2.0 * min(dot(r, n), 0.0) * n);
+        // Each of the block's sixteen directions stands for a sixteenth of the lobe, whose
+        // reflected directions spread about twice the distribution's width a: cones a quarter
+        // of that wide, no narrower than a voxel allows anyway.
+        let tan_half = clamp(0.5 * a, 0.01, 1.0);
         let origin = p + n * voxels_voxel_size() * cones.origin_offset;
         let spec = trace_cone(origin, n, dir, tan_half, cones.max_distance).rgb;
         // Weighted by the lobe's directional albedo, a table of the very BRDF the path tracer
