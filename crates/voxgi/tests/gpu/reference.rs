@@ -742,7 +742,7 @@ fn a_light_set_in_place_equals_a_fresh_path_tracer() {
 
 /// The Cornell box with its floor a metal of `roughness`: all the floor's indirect light comes
 /// from the glossy cone.
-fn metal_floor_cornell(roughness: f32) -> Scene {
+pub(crate) fn metal_floor_cornell(roughness: f32) -> Scene {
     let mut scene = builtin::cornell_box();
     let floor = scene
         .materials

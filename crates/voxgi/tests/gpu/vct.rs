@@ -385,14 +385,7 @@ fn a_metal_floor_mirrors_the_red_wall_by_its_glossy_cone() {
     // A metal floor has no diffuse reflection: all its indirect light comes from the glossy
     // cone, drawn from the lobe (compiled into the gather only for scenes with a specular
     // lobe somewhere; the Cornell box has none).
-    let mut scene = builtin::cornell_box();
-    let floor = scene
-        .materials
-        .iter_mut()
-        .find(|m| m.name == "floor")
-        .expect("floor material");
-    floor.metallic = 1.0;
-    floor.roughness = 0.3;
+    let scene = crate::reference::metal_floor_cornell(0.3);
     let cam = scene.cameras[0].clone();
     let indirect = |scene: &Scene| {
         let out = render(scene, vct(ViewMode::Indirect, 32, 1), &cam, 32, 32);
