@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::time::Instant;
 use voxgi::reference::probe::{ConeQuery, ConeTruth, TracedCone, trace_diffuse_cones};
-use voxgi::reference::{PRIM_TRIANGLE, flatten};
+use voxgi::reference::{PRIM_DISC, flatten};
 use voxgi::scene::glam::{Vec2, Vec3};
 use voxgi::scene::{Camera, Projection};
 use voxgi::{Bounces, PathTracer, headless};
@@ -27,7 +27,8 @@ pub struct ProbeArgs {
     #[command(flatten)]
     pub settings: SettingsArgs,
     /// Path-traced directions per cone.
-    #[arg(long, value_name = "N", default_value_t = 4096)]
+    #[arg(long, value_name = "N", default_value_t = 4096,
+          value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub spp: u32,
     /// Trace the path tracer's cones as narrow as the cone tracer's samples are near their
     /// surface (a third of their height above it wide: half-angle tangent cos θ / 6), rather
@@ -75,11 +76,28 @@ fn pixel_ray(camera: &Camera, (x, y): (u32, u32), (w, h): (u32, u32)) -> (Vec3, 
     }
 }
 
-/// The nearest triangle hit along the ray: the point and the triangle's normal facing the ray.
+/// The nearest triangle or point disc hit along the ray: the point and the surface's normal
+/// facing the ray.
 fn first_hit(tris: &[voxgi::reference::GpuTri], o: Vec3, d: Vec3) -> Option<(Vec3, Vec3)> {
     let mut best: Option<(f32, Vec3)> = None;
-    for t in tris.iter().filter(|t| t.kind == PRIM_TRIANGLE) {
+    let mut keep = |dist: f32, n: Vec3| {
+        if dist > 1e-6 && best.is_none_or(|(bd, _)| dist < bd) {
+            best = Some((dist, if n.dot(d) > 0.0 { -n } else { n }));
+        }
+    };
+    for t in tris {
         let [a, b, c] = [t.p0, t.p1, t.p2].map(Vec3::from_array);
+        if t.kind == PRIM_DISC {
+            // p0 the centre, p1 the unit normal, p2.x the radius.
+            let denom = b.dot(d);
+            if denom.abs() > 1e-12 {
+                let dist = (a - o).dot(b) / denom;
+                if (o + d * dist - a).length() <= c.x {
+                    keep(dist, b);
+                }
+            }
+            continue;
+        }
         let (e1, e2) = (b - a, c - a);
         let p = d.cross(e2);
         let det = e1.dot(p);
@@ -91,13 +109,10 @@ fn first_hit(tris: &[voxgi::reference::GpuTri], o: Vec3, d: Vec3) -> Option<(Vec
         let q = s.cross(e1);
         let v = d.dot(q) / det;
         let dist = e2.dot(q) / det;
-        if u < 0.0 || v < 0.0 || u + v > 1.0 || dist <= 1e-6 {
+        if u < 0.0 || v < 0.0 || u + v > 1.0 {
             continue;
         }
-        if best.is_none_or(|(bd, _)| dist < bd) {
-            let n = e1.cross(e2).normalize();
-            best = Some((dist, if n.dot(d) > 0.0 { -n } else { n }));
-        }
+        keep(dist, e1.cross(e2).normalize());
     }
     best.map(|(dist, n)| (o + d * dist, n))
 }
@@ -141,7 +156,7 @@ pub fn run(args: &ProbeArgs) -> Result<()> {
     for &px in &args.pixels {
         let (o, d) = pixel_ray(&camera, px, args.size);
         let (hit, n) = first_hit(&tris, o, d)
-            .with_context(|| format!("pixel {},{} sees no triangle", px.0, px.1))?;
+            .with_context(|| format!("pixel {},{} sees no surface", px.0, px.1))?;
         points.push((hit, n));
     }
     let ctx = p.stage("opening GPU", headless::GpuContext::from_env)?;

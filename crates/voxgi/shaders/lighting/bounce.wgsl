@@ -120,10 +120,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     // Otherwise a fixed turn per voxel, varied between voxels to break up patterns. It
     // follows the voxel's coordinates, not its slot: slots are handed out by atomics in
     // whatever order the GPU runs, and renders must not change from run to run. (Roberts' R3
-    // sequence in two of its dimensions: neighbouring voxels get well spread turns.)
+    // step for the first coordinate, so neighbouring voxels get well spread turns; the second
+    // takes the plastic number's powers and sqrt(2) - 1, which no plane of voxels makes a
+    // multiple of the first: R3's own powers would tie the two on every plane z = const.)
     let r3 = fract(vec2<f32>(
         dot(vec3<f32>(c), vec3<f32>(0.8191725134, 0.6710436067, 0.5497004779)),
-        dot(vec3<f32>(c), vec3<f32>(0.6710436067, 0.5497004779, 0.8191725134)),
+        dot(vec3<f32>(c), vec3<f32>(0.5698402910, 0.7548776662, 0.4142135624)),
     ));
     let turn = select(r3, records_turn, IRRADIANCE);
     if nw.w > 0.3 {

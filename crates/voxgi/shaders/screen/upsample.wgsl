@@ -1,6 +1,6 @@
 // upsample, stage one of two: at the gather's resolution, each sample averages the 4x4 window
-// of gather samples around it (one bundle rotation each), weighted by depth and normal
-// similarity, so it holds all sixteen rotations while light does not bleed across silhouettes
+// of gather samples around it (one turn of the cone bundle each), weighted by depth and normal
+// similarity, so it holds all sixteen turns while light does not bleed across silhouettes
 // and creases. The composite upsamples the result to full resolution (shared/upsample.wgsl).
 
 //!include shared/globals.wgsl
@@ -27,7 +27,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     // The window moves inside the image rather than clamping, so it always holds all sixteen
-    // rotations and both halves of the cone set.
+    // turns and both halves of the cone set.
     let base = clamp(vec2<i32>(gid.xy) - 1, vec2<i32>(0), max(vec2<i32>(low_size) - 4, vec2<i32>(0)));
     // Even and odd Bayer ranks traced different halves of the cones: average each half on its
     // own, then the two, so rejected neighbours at edges cannot tip the balance.

@@ -125,8 +125,10 @@ struct Gathered {
 // mean, as the weights assume.
 //
 // Directions within 12 degrees of the horizon are traced at 78 degrees: a cone that grazes
-// its own plane steps a voxel at a time (3 % of the cosine-weighted hemisphere lies there).
+// its own plane steps a voxel at a time (4.3 % of the cosine-weighted hemisphere lies there).
 const GRAZING_SIN2: f32 = 0.9568;
+// The cosine of that zenith angle, sqrt(1 - GRAZING_SIN2).
+const GRAZING_COS: f32 = 0.2079;
 
 // Cone i of the diffuse bundle at `turn` (`frame`: tangent space to world): its direction
 // (xyz) and its weight (w).
@@ -151,8 +153,9 @@ const ALL_CONES: u32 = 2u;
 // (diffuse_cone).
 // `half` = ALL_CONES traces every cone. `half` = 0 or 1 traces the normal's cone and every
 // other cone of the ring at twice its weight: pixels of even and odd Bayer rank trace the two
-// halves, and the reconstruction's 4x4 average sees every cone in eight rotations spread over
-// the period, so the estimate is unbiased at about 60 % of the cost.
+// halves, and the reconstruction's 4x4 average sees every cone at eight turns spread over its
+// cell (the gather gives each parity a Hammersley set of its own), so the estimate keeps its
+// mean at about 60 % of the cost.
 fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32) -> Gathered {
     let frame = tangent_frame(n);
     let origin = p + n * voxels_voxel_size() * cones.origin_offset;

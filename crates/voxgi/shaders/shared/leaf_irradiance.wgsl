@@ -4,14 +4,14 @@
 // pixel's (squared cosine; a two-sided leaf, whose record averages both sides, by 1/4). Empty
 // voxels weigh nothing.
 //
-// The filter is interleaved sampling's, in voxels: the last bounce turns each leaf's cone
-// bundle by one of sixteen angles (`leaf_rotation`), laid out so that every 4x4 window of any
-// axis-aligned plane of leaves holds each angle once, and a pixel averages a 4-leaf-wide
+// The filter is interleaved sampling's, in voxels: the last bounce draws each leaf's cone
+// bundle at one of sixteen turns (`leaf_turn`), laid out so that every 4x4 window of any
+// axis-aligned plane of leaves holds each turn once, and a pixel averages a 4-leaf-wide
 // window across the two axes its normal lies least along (the mean of four linear
 // interpolants, so the weights move continuously with the pixel: five leaves, the outer two
-// sharing one quarter) and interpolates linearly along the third. Each angle then weighs the
-// same, as each of the sixteen rotations does in the gather's 4x4 reconstruction. A trilinear
-// or tricubic fetch weighted the few leaves nearest the pixel most, and their rotations'
+// sharing one quarter) and interpolates linearly along the third. Each turn then weighs the
+// same, as each of the sixteen turns does in the gather's 4x4 reconstruction. A trilinear
+// or tricubic fetch weighted the few leaves nearest the pixel most, and their turns'
 // differences showed as a voxel-sized pattern.
 //
 // The normal weight keeps the far side of a thin wall and the other face of a corner out;

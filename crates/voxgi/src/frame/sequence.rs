@@ -32,8 +32,8 @@ pub fn jitter(k: u32) -> [f32; 2] {
 }
 
 /// How far frame `k` shifts the diffuse cones' turns (`shaders/shared/cone.wgsl`,
-/// `diffuse_cone`) within their sixteenths: about the normal and in zenith, each as a fraction
-/// of one interleaving step. The base-5 and base-7 radical inverses, bases prime to the
+/// `diffuse_cone`; the gather wraps them round): about the normal and in zenith, each as a
+/// fraction of one interleaving step. The base-5 and base-7 radical inverses, bases prime to the
 /// jitter's so that the turn and the sample position do not repeat together.
 pub fn cone_turn(k: u32) -> [f32; 2] {
     [

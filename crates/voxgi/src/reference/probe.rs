@@ -50,7 +50,7 @@ pub fn trace_diffuse_cones(
         return Ok(Vec::new());
     }
     for (p, n) in points {
-        if !(p.is_finite() && n.is_finite() && n.length() > 0.5) {
+        if !(p.is_finite() && n.is_finite() && (n.length() - 1.0).abs() < 1e-3) {
             return Err(Error::Setting(format!(
                 "probe point {p} with normal {n}: the position must be finite and the normal \
                  a unit vector"
@@ -211,7 +211,8 @@ pub struct ConeTruth {
     /// Fraction of its directions that meet nothing within `max_distance`: what a cone's
     /// transmittance estimates.
     pub escaped: f32,
-    /// Mean distance to the first hit of the directions that meet something, metres.
+    /// Mean distance to the first hit of the directions that meet something, metres (a
+    /// direction below the surface counts as a hit at 0).
     pub mean_hit: f32,
 }
 
@@ -227,26 +228,32 @@ impl PathTracer {
         spp: u32,
         seed: u32,
     ) -> Result<Vec<ConeTruth>> {
-        if spp == 0 {
-            return Err(Error::Setting("spp must be at least 1".into()));
+        // Each cone numbers its paths in an f32 sum, exact up to 2^24.
+        if spp == 0 || spp > 1 << 24 {
+            return Err(Error::Setting(format!(
+                "{spp} paths per cone: between 1 and {}",
+                1 << 24
+            )));
         }
         if queries.is_empty() {
             return Ok(Vec::new());
         }
+        let unit = |v: [f32; 3]| (Vec3::from_array(v).length() - 1.0).abs() < 1e-3;
         for q in queries {
-            let ok = q
-                .origin
-                .iter()
-                .chain(&q.dir)
-                .chain(&q.normal)
-                .all(|x| x.is_finite())
+            let ok = unit(q.dir)
+                && unit(q.normal)
+                && q.origin
+                    .iter()
+                    .chain(&q.dir)
+                    .chain(&q.normal)
+                    .all(|x| x.is_finite())
                 && q.tan_half > 0.0
                 && q.tan_half <= 1e4
                 && q.max_distance > 0.0;
             if !ok {
                 return Err(Error::Setting(format!(
-                    "cone query {q:?}: positions and directions must be finite, the half-angle's \
-                     tangent in (0, 1e4] and the distance positive"
+                    "cone query {q:?}: positions must be finite, directions unit vectors, the \
+                     half-angle's tangent in (0, 1e4] and the distance positive"
                 )));
             }
         }

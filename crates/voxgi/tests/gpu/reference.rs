@@ -447,15 +447,15 @@ fn agrees_with_the_path_tracer(
             "{name} ({kind:?}): path tracer {a:.4}, cone tracer {b:.4}, ratio {:.3}",
             b / a
         );
-        // Measured at the default 128³ (dense; the octree within 0.01): back wall 1.07, floor
-        // 1.08, red wall 1.06, green wall 1.03, the cones' own excess (`voxgi probe`,
+        // Measured at the default 128³ (dense; the octree within 0.01): back wall 1.06, floor
+        // 1.08, red wall 1.05, green wall 1.05, the cones' own excess (`voxgi probe`,
         // docs/QUALITY.md) now that their axes are drawn from their cells (fixed axes read
-        // 1.01, 1.04, 1.04, 1.02, their quadrature error offsetting it). 10 % covers the
-        // 128-spp reference's noise on these small regions and other drivers; a wrong cone
-        // weight or a lost bounce moves them by 15 % or more.
-        // The ceiling's front (lit only by bounced light, beside the open front) reads 1.26
+        // 1.01, 1.04, 1.04, 1.02, their quadrature error offsetting it). 12 % holds that
+        // excess with the 128-spp reference's noise on these small regions; a wrong cone
+        // weight or a lost bounce moves them by 20 % or more.
+        // The ceiling's front (lit only by bounced light, beside the open front) reads 1.20
         // (1.41 along fixed axes): a known error, bounded here so it cannot grow unnoticed.
-        let tolerance = if name == "ceiling" { 0.5 } else { 0.10 };
+        let tolerance = if name == "ceiling" { 0.5 } else { 0.12 };
         assert!(
             (b / a - 1.0).abs() < tolerance,
             "{kind:?}, {name}: {b} vs {a}"
@@ -789,7 +789,7 @@ fn metal_floor_indirect(roughness: f32) -> (f32, f32) {
 #[test]
 fn glossy_floor_reflects_the_lobes_mean() {
     // (roughness, the least and the most the cones may reach of the path tracer's reflection)
-    // Measured on lavapipe: 0.80, 0.71 and 0.99 at roughness 0.1, 0.3 and 0.5 (one cone along
+    // Measured on lavapipe: 0.81, 0.75 and 1.02 at roughness 0.1, 0.3 and 0.5 (one cone along
     // the lobe's dominant direction read 0.81, 0.58 and 0.64 on this strip). What remains
     // below 1 at the narrower lobes is the narrow cones' own error in the voxels, not the
     // lobe's sampling (docs/QUALITY.md, "Glossy reflections"). The bounds keep each within
