@@ -7,7 +7,9 @@ use crate::args::{
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::time::Instant;
-use voxgi::reference::probe::{ConeQuery, ConeTruth, TracedCone, trace_diffuse_cones};
+use voxgi::reference::probe::{
+    ConeQuery, ConeTruth, TracedCone, hammersley_turns, trace_diffuse_cones,
+};
 use voxgi::reference::{PRIM_DISC, flatten};
 use voxgi::scene::glam::{Vec2, Vec3};
 use voxgi::scene::{Camera, Projection};
@@ -169,15 +171,8 @@ pub fn run(args: &ProbeArgs) -> Result<()> {
     })?;
     let count = options.cones.axes().len();
     let turns: Vec<Vec<Vec<TracedCone>>> = p.stage("tracing the cones", || {
-        (0..args.turns)
-            .map(|k| {
-                let turn = Vec2::new(
-                    (k as f32 + 0.5) / args.turns as f32,
-                    (k.reverse_bits() as f32 / 2f32.powi(32) + 0.5 / args.turns as f32).fract(),
-                );
-                trace_diffuse_cones(&ctx.device, &ctx.queue, &renderer, &points, turn)
-            })
-            .collect::<voxgi::Result<_>>()
+        let turns = hammersley_turns(args.turns);
+        trace_diffuse_cones(&ctx.device, &ctx.queue, &renderer, &points, &turns)
     })?;
     // Per point: every turn's cones, then the hemisphere.
     let mut queries = Vec::new();

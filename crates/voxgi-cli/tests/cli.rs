@@ -784,7 +784,7 @@ fn probe_prints_each_cone_and_refuses_pixels_it_cannot_probe() {
         .find(|l| l.starts_with("irradiance / pi"))
         .unwrap_or_else(|| panic!("no sum line: {out}"));
     // "(the cones' ratio R)": the back wall's irradiance from the cones against the path
-    // tracer's, measured 1.34 at 32³ with 128 paths a cone (the cones' own estimate is high
+    // tracer's, measured 1.33 at 32³ with 128 paths a cone (the cones' own estimate is high
     // there, 1.21 at 128³: docs/QUALITY.md, "Beside openings"); a probe that traced no light
     // or counted a bounce twice is off by half or more.
     let ratio: f32 = sum

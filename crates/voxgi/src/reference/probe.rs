@@ -6,11 +6,12 @@
 //! nothing, its weight against the cosine-weighted light of its cell.
 
 use super::{GpuParams, PATHS_PER_SUBMIT, PathTracer, bounce_limits};
+use crate::frame::sequence::radical_inverse;
 use crate::gpu::{checked, layout, readback, shader};
 use crate::lighting::cones::cone_uniforms;
 use crate::{Bounces, Error, Renderer, Result};
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 /// Cone slots per point in the cone probe's results (`Cones::dirs` holds at most 16).
@@ -34,20 +35,35 @@ pub struct TracedCone {
     pub opacity: f32,
 }
 
+/// `n` turns of the cone bundle spread as the gather's pixels spread theirs: the points of a
+/// Hammersley set, each at the centre of its stratum.
+pub fn hammersley_turns(n: u32) -> Vec<Vec2> {
+    let n = n.max(1);
+    (0..n)
+        .map(|k| {
+            let centre = 0.5 / n as f32;
+            Vec2::new(
+                k as f32 / n as f32 + centre,
+                (radical_inverse(k, 2) + centre).fract(),
+            )
+        })
+        .collect()
+}
+
 /// The diffuse cones of `renderer`'s gather at each surface point (position, unit normal),
-/// their axes drawn from their cells at `turn` in [0, 1)² (about the normal, in zenith; the
-/// gather's pixels use the points of a Hammersley set: shaders/shared/cone.wgsl,
-/// `diffuse_cone`), traced on its current voxels. The renderer must have rendered a frame (its
+/// their axes drawn from their cells at each of `turns` in [0, 1)² (about the normal, in
+/// zenith: shaders/shared/cone.wgsl, `diffuse_cone`), traced on its current voxels in one
+/// dispatch: per turn, per point, its cones. The renderer must have rendered a frame (its
 /// voxels lit).
 pub fn trace_diffuse_cones(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     renderer: &Renderer,
     points: &[(Vec3, Vec3)],
-    turn: glam::Vec2,
-) -> Result<Vec<Vec<TracedCone>>> {
-    if points.is_empty() {
-        return Ok(Vec::new());
+    turns: &[Vec2],
+) -> Result<Vec<Vec<Vec<TracedCone>>>> {
+    if points.is_empty() || turns.is_empty() {
+        return Ok(vec![Vec::new(); turns.len()]);
     }
     for (p, n) in points {
         if !(p.is_finite() && n.is_finite() && (n.length() - 1.0).abs() < 1e-3) {
@@ -60,11 +76,15 @@ pub fn trace_diffuse_cones(
     let options = renderer.options();
     let volume = renderer.volume();
     let cones = cone_uniforms(options, &volume.grid());
-    let input: Vec<[f32; 8]> = points
+    let input: Vec<[f32; 8]> = turns
         .iter()
-        .map(|(p, n)| [p.x, p.y, p.z, turn.x, n.x, n.y, n.z, turn.y])
+        .flat_map(|t| {
+            points
+                .iter()
+                .map(|(p, n)| [p.x, p.y, p.z, t.x, n.x, n.y, n.z, t.y])
+        })
         .collect();
-    let slots = (points.len() * SLOTS) as u64;
+    let slots = (input.len() * SLOTS) as u64;
     let (pipeline, bind, output) = checked(device, "cone_probe", || {
         let buffer = |label: &str, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -134,19 +154,23 @@ pub fn trace_diffuse_cones(
     queue.submit([encoder.finish()]);
     let bytes = readback::read_buffer_copy(device, queue, &output)?;
     let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-    Ok((0..points.len())
-        .map(|p| {
-            (0..cones.count as usize)
-                .map(|i| {
-                    let [c, r] = [v[2 * (p * SLOTS + i)], v[2 * (p * SLOTS + i) + 1]];
-                    TracedCone {
-                        dir: Vec3::new(c[0], c[1], c[2]),
-                        weight: c[3],
-                        tan_half: cones.diffuse_tan,
-                        max_distance: cones.max_distance,
-                        radiance: Vec3::new(r[0], r[1], r[2]),
-                        opacity: r[3],
-                    }
+    let cone = |slot: usize| {
+        let [c, r] = [v[2 * slot], v[2 * slot + 1]];
+        TracedCone {
+            dir: Vec3::new(c[0], c[1], c[2]),
+            weight: c[3],
+            tan_half: cones.diffuse_tan,
+            max_distance: cones.max_distance,
+            radiance: Vec3::new(r[0], r[1], r[2]),
+            opacity: r[3],
+        }
+    };
+    Ok((0..turns.len())
+        .map(|t| {
+            (0..points.len())
+                .map(|p| {
+                    let first = (t * points.len() + p) * SLOTS;
+                    (first..first + cones.count as usize).map(cone).collect()
                 })
                 .collect()
         })

@@ -3,23 +3,13 @@
 //! the irradiance as their weights assume.
 
 use crate::common::*;
-use voxgi::reference::probe::{ConeQuery, ConeTruth, TracedCone, trace_diffuse_cones};
+use voxgi::reference::probe::{
+    ConeQuery, ConeTruth, TracedCone, hammersley_turns, trace_diffuse_cones,
+};
 use voxgi::scene::Scene;
 use voxgi::scene::builtin;
-use voxgi::scene::glam::{Vec2, Vec3};
+use voxgi::scene::glam::Vec3;
 use voxgi::{Bounces, FrameParams, PathTracer, RendererOptions, headless};
-
-/// The sixteen turns of a 4x4 block: a Hammersley set, as the gather draws them.
-fn turns() -> Vec<Vec2> {
-    (0..16u32)
-        .map(|k| {
-            Vec2::new(
-                (k as f32 + 0.5) / 16.0,
-                (k.reverse_bits() as f32 / 2f32.powi(32) + 0.5 / 16.0).fract(),
-            )
-        })
-        .collect()
-}
 
 /// The diffuse cones at `points` for every turn, on `scene`'s lit voxels, with the renderer.
 fn traced(
@@ -30,10 +20,14 @@ fn traced(
     let mut r = renderer(scene, options);
     let params = FrameParams::new(r.default_camera().clone());
     headless::render_still(ctx(), &mut r, &params, 32, 32, 1).expect("render");
-    let cones = turns()
-        .into_iter()
-        .map(|t| trace_diffuse_cones(&ctx().device, &ctx().queue, &r, points, t).expect("probe"))
-        .collect();
+    let cones = trace_diffuse_cones(
+        &ctx().device,
+        &ctx().queue,
+        &r,
+        points,
+        &hammersley_turns(16),
+    )
+    .expect("probe");
     (r, cones)
 }
 
