@@ -27,7 +27,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub revoxelize: bool,
     /// Play the scene's animations: each frame advances the scene's time by 1/--fps, and only
-    /// what moved is updated.
+    /// what moved is updated; an animated camera flies along.
     #[arg(long)]
     pub animate: bool,
     /// Frames per second of scene time with --animate.
@@ -69,7 +69,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .load_frames_at(args.time)
         .with_context(|| label.clone())?;
     let camera = scene.default_camera();
-    let (settings, frame) = args
+    let (settings, mut frame) = args
         .settings
         .resolve(table.as_ref(), camera)
         .with_context(|| label.clone())?;
@@ -135,6 +135,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut sequence_frames: Vec<voxgi::SequenceFrame> = Vec::new();
     let mut first_frame: Vec<(&'static str, f64)> = Vec::new();
     let voxel_passes = voxgi::voxel_passes();
+    let flies = scene.camera_is_animated(0);
     for i in 0..args.warmup + args.frames {
         if i == args.warmup && args.trace.is_some() {
             renderer.keep_pass_trace();
@@ -146,9 +147,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             renderer.invalidate();
         }
         if args.animate {
-            let frames = renderer.set_time(args.time + i as f32 / args.fps)?;
+            let t = args.time + i as f32 / args.fps;
+            let frames = renderer.set_time(t)?;
             if i >= args.warmup {
                 sequence_frames.extend(frames);
+            }
+            // A flight: the scene's camera where its animation puts it.
+            if let Some(c) = scene.camera_at(0, t).filter(|_| flies) {
+                frame.camera = c;
             }
         }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());

@@ -114,6 +114,10 @@ fn describe(s: &Scene, label: &str) -> String {
                 "light '{}'",
                 s.lights.get(*light).map_or("?", |l| l.name.as_str())
             ),
+            AnimationTarget::Camera { camera, .. } => format!(
+                "camera [{camera}] '{}'",
+                s.cameras.get(*camera).map_or("?", |c| c.name.as_str())
+            ),
         };
         let _ = writeln!(
             o,

@@ -51,7 +51,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
     pub time: f32,
     /// Render an image sequence of N frames, one renderer updated from frame to frame (only
-    /// what moved is re-voxelized).
+    /// what moved is re-voxelized); an animated camera flies along.
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
     /// Frames per second of scene time in a sequence.
@@ -158,8 +158,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     scene
         .load_frames_at(times[0])
         .with_context(|| label.clone())?;
-    let default = scene.default_camera();
-    let camera = pick_camera(&scene, &default, args)?;
+    let camera = pick_camera(&scene, args, times[0])?;
     let (options, frame) = args
         .settings
         .resolve(table.as_ref(), camera)
@@ -280,7 +279,11 @@ fn render_sequence(
         times[n - 1]
     );
     let start = Instant::now();
+    let mut frame = frame.clone();
     for (k, &t) in times.iter().enumerate() {
+        // A camera that flies takes its place at this frame's time.
+        frame.camera = pick_camera(scene, args, t)?;
+        let frame = &frame;
         let out = match &mut renderer {
             Some(r) => {
                 r.set_time(t)?;
@@ -314,15 +317,19 @@ fn render_sequence(
     Ok(())
 }
 
-fn pick_camera(scene: &Scene, default: &Camera, args: &RenderArgs) -> Result<Camera> {
+/// The camera of the frame at time `t`: the chosen camera of the scene (`--camera`, else its
+/// default) where its animation puts it then, with `--eye`, `--target` and `--fov` applied.
+fn pick_camera(scene: &Scene, args: &RenderArgs, t: f32) -> Result<Camera> {
     let mut cam = match args.camera {
-        Some(i) => scene.cameras.get(i).cloned().with_context(|| {
+        Some(i) => scene.camera_at(i, t).with_context(|| {
             format!(
                 "camera {i} does not exist (the scene has {})",
                 scene.cameras.len()
             )
         })?,
-        None => default.clone(),
+        None => scene
+            .camera_at(0, t)
+            .unwrap_or_else(|| scene.default_camera()),
     };
     if args.eye.is_some() || args.target.is_some() {
         let eye = args.eye.unwrap_or(cam.position);

@@ -471,6 +471,85 @@ fn render_time_samples_the_scene_file_animations() {
     assert!(error_line(&bad).contains("--time"), "{}", error_line(&bad));
 }
 
+/// A camera flight: each frame of a sequence is seen from where the camera's keyframes put it
+/// then, byte for byte the still of a scene whose fixed camera stands at that pose; the
+/// geometry does not move, so the frames differ only by the view.
+#[test]
+fn a_camera_flight_renders_each_frame_from_its_pose() {
+    let dir = tmp("flight");
+    std::fs::create_dir_all(&dir).unwrap();
+    let box_and =
+        |camera: &str| format!("[[include]]\nbuiltin = \"cornell-box\"\n[camera]\n{camera}");
+    let flight = dir.join("flight.toml");
+    std::fs::write(
+        &flight,
+        box_and("position = [0.2, 0.27, -0.8]\ntarget = [0.28, 0.27, 0.3]\nfov = 40.0\n")
+            + "[[animation]]\ntarget = \"camera\"\ntimes = [0.0, 2.0]\n\
+               position = [[0.2, 0.27, -0.8], [0.4, 0.27, -0.8]]\n\
+               look_at = [[0.28, 0.27, 0.3], [0.28, 0.27, 0.3]]\nfov = [40.0, 50.0]\n",
+    )
+    .unwrap();
+    let common = [
+        "--size",
+        "32x24",
+        "--voxel-resolution",
+        "32",
+        "--temporal=false",
+    ];
+    let pattern = dir.join("fly_%02d.png");
+    let mut args = vec![
+        "render",
+        flight.to_str().unwrap(),
+        "--frames",
+        "2",
+        "--fps",
+        "1",
+        "-o",
+        pattern.to_str().unwrap(),
+    ];
+    args.extend(common);
+    let o = voxgi(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // t = 0 and t = 1 (half way: x = 0.3, fov 45).
+    for (k, pose) in [
+        "position = [0.2, 0.27, -0.8]\ntarget = [0.28, 0.27, 0.3]\nfov = 40.0\n",
+        "position = [0.3, 0.27, -0.8]\ntarget = [0.28, 0.27, 0.3]\nfov = 45.0\n",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let fixed = dir.join(format!("fixed_{k}.toml"));
+        std::fs::write(&fixed, box_and(pose)).unwrap();
+        let still = dir.join(format!("fixed_{k}.png"));
+        let mut args = vec![
+            "render",
+            fixed.to_str().unwrap(),
+            "-o",
+            still.to_str().unwrap(),
+        ];
+        args.extend(common);
+        let o = voxgi(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let a = image::open(dir.join(format!("fly_{k:02}.png"))).unwrap();
+        let b = image::open(&still).unwrap();
+        assert!(
+            a.as_bytes() == b.as_bytes(),
+            "frame {k} is not the view from the camera's pose at t = {k}"
+        );
+    }
+    let first = image::open(dir.join("fly_00.png")).unwrap();
+    let second = image::open(dir.join("fly_01.png")).unwrap();
+    let mean = |i: &image::DynamicImage| {
+        i.as_bytes().iter().map(|&c| c as f64).sum::<f64>() / i.as_bytes().len() as f64
+    };
+    // The box fills the view (a black frame would pass the comparisons above).
+    assert!(mean(&first) > 20.0, "mean pixel value {}", mean(&first));
+    assert!(
+        first.as_bytes() != second.as_bytes(),
+        "the camera did not move"
+    );
+}
+
 /// Without temporal accumulation an image sequence (one renderer moved from frame to frame,
 /// only the moving block re-voxelized) equals `--time` renders of the same instants made from
 /// scratch, to the byte: incremental updates reproduce fresh builds exactly. With it, the

@@ -10,7 +10,7 @@
 //! then an instance's placement below that node. A light's animated parameters replace its rest
 //! values, positions and directions given in the animation's space.
 
-use crate::{Light, Scene};
+use crate::{Camera, Light, Projection, Scene};
 use glam::{Mat4, Quat, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -506,6 +506,123 @@ impl LightTracks {
     }
 }
 
+/// Keyframed camera parameters; a missing track keeps the camera's rest value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CameraTracks {
+    /// The eye, metres.
+    pub position: Option<Track<Vec3>>,
+    /// The point it looks at, metres (wins over `direction`).
+    pub look_at: Option<Track<Vec3>>,
+    /// Where it looks (normalised when sampled).
+    pub direction: Option<Track<Vec3>>,
+    /// Vertical field of view, degrees (perspective cameras).
+    pub fov: Option<Track<f32>>,
+}
+
+impl CameraTracks {
+    fn duration(&self) -> f32 {
+        [
+            self.position.as_ref().map(Track::duration),
+            self.look_at.as_ref().map(Track::duration),
+            self.direction.as_ref().map(Track::duration),
+            self.fov.as_ref().map(Track::duration),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(0.0, f32::max)
+    }
+}
+
+/// How an animated camera moves.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraMotion {
+    /// Keyframed eye, aim and field of view; `outer` places positions and directions in the
+    /// world. The camera stays upright (its up is the world's +Y, or its rest up when it
+    /// looks straight along +Y).
+    Tracks(CameraTracks),
+    /// A rigid motion of the camera's frame (a generator, or glTF's node hierarchy): the
+    /// camera looks along -Z of `outer * motion(t) * inner`, +Y up.
+    Rigid {
+        /// The motion.
+        motion: Motion,
+        /// The camera's frame in the motion's space when the motion is the identity.
+        inner: Mat4,
+    },
+}
+
+/// The frame of `camera`: +X right, +Y up, -Z forward, its eye at the origin.
+pub fn camera_frame(camera: &Camera) -> Mat4 {
+    let f = camera.forward.normalize_or(Vec3::NEG_Z);
+    let right = f.cross(camera.up).normalize_or(f.any_orthonormal_vector());
+    let up = right.cross(f);
+    Mat4::from_cols(
+        right.extend(0.0),
+        up.extend(0.0),
+        (-f).extend(0.0),
+        camera.position.extend(1.0),
+    )
+}
+
+/// `rest` moved to frame `m` (`camera_frame`'s convention; scale is dropped).
+fn camera_in_frame(rest: &Camera, m: Mat4) -> Camera {
+    let mut c = rest.clone();
+    c.position = m.transform_point3(Vec3::ZERO);
+    c.forward = m.transform_vector3(Vec3::NEG_Z).normalize_or(rest.forward);
+    let up = m.transform_vector3(Vec3::Y);
+    c.up = (up - c.forward * up.dot(c.forward))
+        .try_normalize()
+        .unwrap_or_else(|| c.forward.any_orthonormal_vector());
+    c
+}
+
+impl CameraMotion {
+    /// The camera at time `t` from its rest state (in the world); `outer` places the motion's
+    /// space in the world.
+    pub fn apply(&self, rest: &Camera, outer: Mat4, t: f32) -> Camera {
+        match self {
+            CameraMotion::Rigid { motion, inner } => {
+                camera_in_frame(rest, outer * motion.at(t) * *inner)
+            }
+            CameraMotion::Tracks(tracks) => {
+                let mut c = rest.clone();
+                if let Some(p) = &tracks.position {
+                    c.position = outer.transform_point3(p.sample(t));
+                }
+                let forward = if let Some(l) = &tracks.look_at {
+                    Some(outer.transform_point3(l.sample(t)) - c.position)
+                } else {
+                    tracks
+                        .direction
+                        .as_ref()
+                        .map(|d| outer.transform_vector3(d.sample(t)))
+                };
+                if let Some(f) = forward.and_then(Vec3::try_normalize) {
+                    c.forward = f;
+                    let right = f
+                        .cross(Vec3::Y)
+                        .try_normalize()
+                        .or_else(|| f.cross(rest.up).try_normalize())
+                        .unwrap_or_else(|| f.any_orthonormal_vector());
+                    c.up = right.cross(f);
+                }
+                if let (Some(fov), Projection::Perspective { yfov }) =
+                    (&tracks.fov, &mut c.projection)
+                {
+                    *yfov = fov.sample(t).clamp(0.5, 179.0).to_radians();
+                }
+                c
+            }
+        }
+    }
+
+    fn duration(&self) -> f32 {
+        match self {
+            CameraMotion::Tracks(t) => t.duration(),
+            CameraMotion::Rigid { motion, .. } => motion.duration(),
+        }
+    }
+}
+
 /// What an animation moves.
 #[derive(Clone, Debug, PartialEq)]
 pub enum AnimationTarget {
@@ -540,6 +657,18 @@ pub enum AnimationTarget {
         outer: Mat4,
         /// The animated parameters.
         tracks: LightTracks,
+    },
+    /// A camera (`Scene::cameras` index) and its rest state. It moves no geometry: a scene
+    /// whose only animation is a camera's needs no voxel work as it plays.
+    Camera {
+        /// Index into `Scene::cameras`.
+        camera: usize,
+        /// The camera at rest, in the world.
+        rest: Camera,
+        /// Places the motion's space in the world.
+        outer: Mat4,
+        /// How it moves.
+        motion: CameraMotion,
     },
 }
 
@@ -606,6 +735,7 @@ impl Animation {
         match &self.target {
             AnimationTarget::Instances { motion, .. } => motion.duration(),
             AnimationTarget::Light { tracks, .. } => tracks.duration(),
+            AnimationTarget::Camera { motion, .. } => motion.duration(),
         }
     }
 }
@@ -659,8 +789,44 @@ impl Scene {
                         tracks.apply(rest, *outer, t),
                     );
                 }
+                AnimationTarget::Camera {
+                    camera,
+                    rest,
+                    outer,
+                    motion,
+                } => {
+                    if let Some(c) = self.cameras.get_mut(*camera) {
+                        *c = motion.apply(rest, *outer, t);
+                    }
+                }
             }
         }
+    }
+
+    /// Camera `index` at time `t`: where the animations that move it put it (the camera as
+    /// it is now when none does). `None` when there is no such camera.
+    pub fn camera_at(&self, index: usize, t: f32) -> Option<Camera> {
+        let mut c = self.cameras.get(index)?.clone();
+        for a in &self.animations {
+            if let AnimationTarget::Camera {
+                camera,
+                rest,
+                outer,
+                motion,
+            } = &a.target
+                && *camera == index
+            {
+                c = motion.apply(rest, *outer, t);
+            }
+        }
+        Some(c)
+    }
+
+    /// Whether an animation moves camera `index`.
+    pub fn camera_is_animated(&self, index: usize) -> bool {
+        self.animations.iter().any(
+            |a| matches!(&a.target, AnimationTarget::Camera { camera, .. } if *camera == index),
+        )
     }
 
     /// A copy of the scene at time `t`.

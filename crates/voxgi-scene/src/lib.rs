@@ -191,6 +191,15 @@ impl Scene {
             self.lights.len(),
         );
         let linear = glam::Mat3::from_mat4(transform);
+        let camera0 = self.cameras.len();
+        let moved_camera = |mut c: Camera| {
+            c.position = transform.transform_point3(c.position);
+            c.forward = (linear * c.forward).normalize_or(c.forward);
+            let up = (linear * c.up).normalize_or(c.up);
+            let right = c.forward.cross(up).normalize_or(Vec3::X);
+            c.up = right.cross(c.forward).normalize_or(Vec3::Y);
+            c
+        };
         self.textures.extend(other.textures);
         self.materials
             .extend(other.materials.into_iter().map(|mut m| {
@@ -256,17 +265,21 @@ impl Scene {
                         }
                         *outer = transform * *outer;
                     }
+                    crate::animation::AnimationTarget::Camera {
+                        camera,
+                        rest,
+                        outer,
+                        ..
+                    } => {
+                        *camera += camera0;
+                        *rest = moved_camera(rest.clone());
+                        *outer = transform * *outer;
+                    }
                 }
                 a
             }));
-        self.cameras.extend(other.cameras.into_iter().map(|mut c| {
-            c.position = transform.transform_point3(c.position);
-            c.forward = (linear * c.forward).normalize_or(c.forward);
-            let up = (linear * c.up).normalize_or(c.up);
-            let right = c.forward.cross(up).normalize_or(Vec3::X);
-            c.up = right.cross(c.forward).normalize_or(Vec3::Y);
-            c
-        }));
+        self.cameras
+            .extend(other.cameras.into_iter().map(moved_camera));
     }
 
     /// Checks every index and count the renderer relies on. Loaders call this last.
@@ -738,6 +751,7 @@ impl Scene {
                 })
                 .collect(),
             animations: self.animations.clone(),
+            cameras: self.cameras.clone(),
             ..Default::default()
         }
     }
@@ -794,7 +808,8 @@ impl Scene {
                 animation::AnimationTarget::Instances { clouds, .. } => {
                     clouds.iter().map(|(c, _)| *c).collect()
                 }
-                animation::AnimationTarget::Light { .. } => Vec::new(),
+                animation::AnimationTarget::Light { .. }
+                | animation::AnimationTarget::Camera { .. } => Vec::new(),
             })
             .collect();
         v.sort_unstable();
@@ -809,7 +824,8 @@ impl Scene {
             .iter()
             .flat_map(|a| match &a.target {
                 animation::AnimationTarget::Instances { instances, .. } => instances.clone(),
-                animation::AnimationTarget::Light { .. } => Vec::new(),
+                animation::AnimationTarget::Light { .. }
+                | animation::AnimationTarget::Camera { .. } => Vec::new(),
             })
             .collect();
         v.sort_unstable();

@@ -1199,6 +1199,60 @@ fn a_child_moves_with_its_animated_parent() {
     );
 }
 
+/// A camera on a child of an animated node flies with it: its eye and its aim follow the
+/// node's transform, and the scene's camera list gains no copy.
+#[test]
+fn a_camera_below_an_animated_node_moves_with_it() {
+    let mut b = tri_bin();
+    let times = b.f32s(&[0.0, 1.0]);
+    let slide = b.vec3(&[[0.0, 0.0, 0.0], [4.0, 0.0, 0.0]]);
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    // A quarter turn about +Y: -Z (where a glTF camera looks) turns to -X.
+    let turn = b.vec4(&[[0.0, 0.0, 0.0, 1.0], [0.0, s, 0.0, s]]);
+    let nodes = json!([
+        {"name": "rig", "children": [1]},
+        {"name": "eye", "camera": 0, "translation": [0.0, 1.0, 2.0]},
+        {"name": "static", "mesh": 0}
+    ]);
+    let animations = json!([
+        {"name": "dolly", "samplers": [{"input": times, "output": slide}, {"input": times, "output": turn}],
+         "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}},
+                      {"sampler": 1, "target": {"node": 0, "path": "rotation"}}]}
+    ]);
+    let doc = anim_doc(
+        &b,
+        nodes,
+        json!([2, 0]),
+        animations,
+        json!({"cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]}),
+    );
+    let scene = io::load(&write_doc("anim_camera.gltf", &doc)).unwrap();
+    assert_eq!(scene.cameras.len(), 1);
+    assert!(scene.camera_is_animated(0));
+    assert!(
+        scene.instances.iter().all(|i| !i.dynamic),
+        "only the camera moves"
+    );
+    let rest = scene.camera_at(0, 0.0).unwrap();
+    assert!(
+        close3(rest.position, Vec3::new(0.0, 1.0, 2.0), 1e-6),
+        "{}",
+        rest.position
+    );
+    assert!(close3(rest.forward, Vec3::NEG_Z, 1e-6), "{}", rest.forward);
+    // At t = 1 the rig stands at x = 4 turned a quarter about +Y: the eye's offset (0, 1, 2)
+    // turns to (2, 1, 0), and it looks along -X.
+    let end = scene.camera_at(0, 1.0).unwrap();
+    assert!(
+        close3(end.position, Vec3::new(6.0, 1.0, 0.0), 1e-5),
+        "{}",
+        end.position
+    );
+    assert!(close3(end.forward, Vec3::NEG_X, 1e-5), "{}", end.forward);
+    assert!(close3(end.up, Vec3::Y, 1e-5), "{}", end.up);
+    assert_eq!(end.projection, rest.projection);
+}
+
 #[test]
 fn an_included_animated_gltf_moves_in_the_include_space() {
     write_doc("anim_included.gltf", &nested_doc());
@@ -1278,7 +1332,7 @@ fn skins_morph_targets_and_weights_load_with_warnings() {
         "{warnings:?}"
     );
     assert!(
-        has("animation 1 'wave' moves no mesh or light"),
+        has("animation 1 'wave' moves no mesh, light or camera"),
         "{warnings:?}"
     );
 }

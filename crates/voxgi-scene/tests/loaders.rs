@@ -874,6 +874,93 @@ position = [[0.0, 2.0, 0.0], [0.0, 3.0, 0.0]]
     assert_eq!(a.instances[0].transform, b.instances[0].transform);
 }
 
+/// The scene's camera follows its keyframes (eye, aim, field of view) and generators; a scene
+/// whose only animation is the camera's moves no geometry.
+#[test]
+fn a_camera_follows_its_keyframes_and_orbits() {
+    let dir = tmp("anim-camera");
+    let path = write(
+        &dir,
+        "flight.toml",
+        r#"
+[[include]]
+builtin = "cornell-box"
+
+[camera]
+position = [0.0, 1.0, 4.0]
+target = [0.0, 1.0, 0.0]
+fov = 40.0
+
+[[animation]]
+target = "camera"
+name = "flight"
+times = [0.0, 2.0]
+position = [[0.0, 1.0, 4.0], [2.0, 1.0, 4.0]]
+look_at = [[0.0, 1.0, 0.0], [2.0, 1.0, 0.0]]
+fov = [40.0, 60.0]
+"#,
+    );
+    let s = voxgi_scene::io::load(&path).expect("loads");
+    assert_eq!(s.animations.len(), 1);
+    assert_eq!(s.animations[0].duration(), 2.0);
+    assert!(s.camera_is_animated(0));
+    assert!(
+        s.animated_instances().is_empty(),
+        "a camera moves no geometry"
+    );
+    // Half way: the eye and the aim both 1 m along +x, the field of view half way.
+    let c = s.camera_at(0, 1.0).unwrap();
+    assert!(
+        close(c.position, Vec3::new(1.0, 1.0, 4.0)),
+        "{}",
+        c.position
+    );
+    assert!(close(c.forward, Vec3::NEG_Z), "{}", c.forward);
+    assert!(close(c.up, Vec3::Y), "{}", c.up);
+    match c.projection {
+        voxgi_scene::Projection::Perspective { yfov } => {
+            assert!(
+                (yfov.to_degrees() - 50.0).abs() < 1e-4,
+                "{}",
+                yfov.to_degrees()
+            )
+        }
+        p => panic!("{p:?}"),
+    }
+    // set_time moves the scene's own copy the same way.
+    assert_eq!(s.at_time(1.0).cameras[0], c);
+    // Past the last keyframe it holds (clamp).
+    assert!(close(
+        s.camera_at(0, 9.0).unwrap().position,
+        Vec3::new(2.0, 1.0, 4.0)
+    ));
+
+    // An orbit turns the camera's whole frame about the axis: a quarter period about +Y
+    // through the origin takes the eye from +z to +x, still looking at the axis.
+    let path = write(
+        &dir,
+        "orbit.toml",
+        r#"
+[camera]
+position = [0.0, 1.0, 4.0]
+target = [0.0, 1.0, 0.0]
+
+[[animation]]
+target = "camera"
+orbit = { center = [0.0, 0.0, 0.0], axis = [0.0, 1.0, 0.0], period = 8.0 }
+"#,
+    );
+    let s = voxgi_scene::io::load(&path).expect("loads");
+    let c = s.camera_at(0, 2.0).unwrap();
+    assert!(
+        close(c.position, Vec3::new(4.0, 1.0, 0.0)),
+        "{}",
+        c.position
+    );
+    assert!(close(c.forward, Vec3::NEG_X), "{}", c.forward);
+    assert!(close(c.up, Vec3::Y), "{}", c.up);
+}
+
 /// An include sampled as points and marked dynamic moves with its animation (it stood still,
 /// silently, when only instances moved), and the scene's bounds cover where it goes.
 #[test]
@@ -962,6 +1049,25 @@ fn bad_animations_are_errors_naming_the_file_and_the_animation() {
             "period",
         ),
         (
+            "camera with include keys",
+            "[camera]\nposition = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[animation]]\ntarget = \"camera\"\ntimes = [0.0]\ntranslate = [[0.0, 0.0, 0.0]]\n",
+            "a camera takes",
+        ),
+        (
+            "camera fov",
+            "[camera]\nposition = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[animation]]\ntarget = \"camera\"\ntimes = [0.0]\nfov = [200.0]\n",
+            "fov 200",
+        ),
+        (
+            "camera aims twice",
+            "[camera]\nposition = [0.0, 0.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\n\
+             [[animation]]\ntarget = \"camera\"\ntimes = [0.0]\n\
+             look_at = [[0.0, 0.0, 0.0]]\ndirection = [[0.0, 0.0, -1.0]]\n",
+            "not both",
+        ),
+        (
             "bad interpolation",
             "[[animation]]\ntarget = \"box\"\ninterpolation = \"smooth\"\ntimes = [0.0]\ntranslate = [[0.0, 0.0, 0.0]]\n",
             "smooth",
@@ -978,6 +1084,16 @@ fn bad_animations_are_errors_naming_the_file_and_the_animation() {
             "{what}: {e}"
         );
     }
+    // The builtin boxes bring their cameras; a scene without any has nothing to fly.
+    let path = write(
+        &dir,
+        "a.toml",
+        "[[animation]]\ntarget = \"camera\"\ntimes = [0.0]\nposition = [[0.0, 0.0, 1.0]]\n",
+    );
+    let e = voxgi_scene::io::load(&path)
+        .expect_err("accepted")
+        .to_string();
+    assert!(e.contains("no camera to animate"), "{e}");
 }
 
 #[test]

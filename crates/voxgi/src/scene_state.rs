@@ -171,6 +171,8 @@ impl SceneState {
                     animated_lights.extend(lights.iter().map(|(l, _)| *l));
                 }
                 AnimationTarget::Light { light, .. } => animated_lights.push(*light),
+                // The camera comes with each frame's parameters.
+                AnimationTarget::Camera { .. } => {}
             }
         }
         animated_instances.sort_unstable();

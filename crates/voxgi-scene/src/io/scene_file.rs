@@ -75,11 +75,14 @@
 //! # orbit = { center = [0, 0, 0], axis = [0, 1, 0], period = 4.0 }  # instead of keyframes
 //! # oscillate = { axis = [1, 0, 0], amplitude = 0.1, period = 2.0 } # instead of keyframes
 //! # for a light: position, direction, color ([r, g, b]) and intensity (numbers) per keyframe
+//! # for target = "camera" (the scene's camera): position, look_at or direction ([x, y, z])
+//! # and fov (degrees) per keyframe, or orbit / oscillate (the camera's frame moves rigidly)
 //! ```
 //!
 //! An include's motion is applied in world space on top of its placement (keyframe values are
 //! offsets from the rest pose); a light's keyframes replace its position, direction, colour or
-//! intensity. `Scene::set_time` applies them.
+//! intensity. A camera's keyframes replace its eye, aim and field of view, and it stays
+//! upright. `Scene::set_time` applies them; `Scene::camera_at` samples a camera alone.
 //!
 //! A point cloud that changes every frame (a live scan, a simulation's output) is an include
 //! whose `file` holds a frame number, printf-style: `file = "scan/frame_%04d.ply"` names
@@ -94,7 +97,8 @@
 //! camera is the default view. Include cycles are reported as errors.
 
 use crate::animation::{
-    Animation, AnimationTarget, Interpolation, Keyable, LightTracks, Motion, Repeat, Track,
+    Animation, AnimationTarget, CameraMotion, CameraTracks, Interpolation, Keyable, LightTracks,
+    Motion, Repeat, Track,
 };
 use crate::{AreaShape, Camera, Light, LightKind, Result, Scene, SceneError};
 use glam::{Mat4, Vec3};
@@ -135,6 +139,8 @@ struct AnimationDef {
     direction: Option<Vec<[f32; 3]>>,
     color: Option<Vec<[f32; 3]>>,
     intensity: Option<Vec<f32>>,
+    look_at: Option<Vec<[f32; 3]>>,
+    fov: Option<Vec<f32>>,
     orbit: Option<OrbitDef>,
     oscillate: Option<OscillateDef>,
 }
@@ -437,18 +443,24 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         }
     }
 
-    for (i, a) in file.animation.iter().enumerate() {
-        let anim = make_animation(a, &scene, &include_instances)
-            .map_err(|r| err(format!("animation {} ('{}'): {r}", i + 1, a.target)))?;
-        scene.animations.push(anim);
-    }
-
     if let Some(c) = &file.camera {
         if c.name.is_some() {
             return Err(err("camera: a name is for [[view]]s".into()));
         }
         let cam = make_camera(c, "scene file camera").map_err(|r| err(format!("camera: {r}")))?;
         scene.cameras.insert(0, cam);
+        // The included files' camera animations follow their cameras down the list.
+        for a in &mut scene.animations {
+            if let AnimationTarget::Camera { camera, .. } = &mut a.target {
+                *camera += 1;
+            }
+        }
+    }
+
+    for (i, a) in file.animation.iter().enumerate() {
+        let anim = make_animation(a, &scene, &include_instances)
+            .map_err(|r| err(format!("animation {} ('{}'): {r}", i + 1, a.target)))?;
+        scene.animations.push(anim);
     }
     for (i, v) in file.view.iter().enumerate() {
         let name = v
@@ -740,6 +752,50 @@ struct IncludeRange<'a> {
     dynamic: bool,
 }
 
+/// The target name of an animation that moves the scene's camera (its `[camera]`, or else the
+/// first camera of its includes).
+const CAMERA_TARGET: &str = "camera";
+
+/// An animation's `orbit` or `oscillate` generator (the caller checked there is one).
+fn generator(a: &AnimationDef) -> std::result::Result<Motion, String> {
+    match (&a.orbit, &a.oscillate) {
+        (Some(o), _) => {
+            let axis = Vec3::from(o.axis);
+            if !(Vec3::from(o.center).is_finite() && axis.is_finite() && axis.length() > 0.0) {
+                return Err("orbit: center and axis must be finite, the axis non-zero".into());
+            }
+            if !(o.period.is_finite() && o.period > 0.0) {
+                return Err(format!("orbit: period {} must be > 0 seconds", o.period));
+            }
+            Ok(Motion::Orbit {
+                center: Vec3::from(o.center),
+                axis: axis.normalize(),
+                period: o.period,
+            })
+        }
+        (None, Some(o)) => {
+            let axis = Vec3::from(o.axis);
+            if !(axis.is_finite() && axis.length() > 0.0 && o.amplitude.is_finite()) {
+                return Err(
+                    "oscillate: axis and amplitude must be finite, the axis non-zero".into(),
+                );
+            }
+            if !(o.period.is_finite() && o.period > 0.0) {
+                return Err(format!(
+                    "oscillate: period {} must be > 0 seconds",
+                    o.period
+                ));
+            }
+            Ok(Motion::Oscillate {
+                axis: axis.normalize(),
+                amplitude: o.amplitude,
+                period: o.period,
+            })
+        }
+        (None, None) => Err("nothing moves: give orbit or oscillate".into()),
+    }
+}
+
 /// One `[[animation]]` table as an `Animation` of `scene`, whose includes are `includes`.
 fn make_animation(
     a: &AnimationDef,
@@ -796,6 +852,8 @@ fn make_animation(
                 || a.direction.is_some()
                 || a.color.is_some()
                 || a.intensity.is_some()
+                || a.look_at.is_some()
+                || a.fov.is_some()
             {
                 return Err(
                     "an include takes translate, rotate, scale, orbit or oscillate, not light keys"
@@ -834,45 +892,7 @@ fn make_animation(
                         }),
                     )?,
                 },
-                (false, Some(o), None) => {
-                    let axis = Vec3::from(o.axis);
-                    if !(Vec3::from(o.center).is_finite()
-                        && axis.is_finite()
-                        && axis.length() > 0.0)
-                    {
-                        return Err(
-                            "orbit: center and axis must be finite, the axis non-zero".into()
-                        );
-                    }
-                    if !(o.period.is_finite() && o.period > 0.0) {
-                        return Err(format!("orbit: period {} must be > 0 seconds", o.period));
-                    }
-                    Motion::Orbit {
-                        center: Vec3::from(o.center),
-                        axis: axis.normalize(),
-                        period: o.period,
-                    }
-                }
-                (false, None, Some(o)) => {
-                    let axis = Vec3::from(o.axis);
-                    if !(axis.is_finite() && axis.length() > 0.0 && o.amplitude.is_finite()) {
-                        return Err(
-                            "oscillate: axis and amplitude must be finite, the axis non-zero"
-                                .into(),
-                        );
-                    }
-                    if !(o.period.is_finite() && o.period > 0.0) {
-                        return Err(format!(
-                            "oscillate: period {} must be > 0 seconds",
-                            o.period
-                        ));
-                    }
-                    Motion::Oscillate {
-                        axis: axis.normalize(),
-                        amplitude: o.amplitude,
-                        period: o.period,
-                    }
-                }
+                (false, Some(_), None) | (false, None, Some(_)) => generator(a)?,
                 (false, None, None) => {
                     return Err(
                         "nothing moves: give translate/rotate/scale keyframes, orbit or oscillate"
@@ -893,6 +913,8 @@ fn make_animation(
                 || a.scale.is_some()
                 || a.orbit.is_some()
                 || a.oscillate.is_some()
+                || a.look_at.is_some()
+                || a.fov.is_some()
             {
                 return Err(
                     "a light takes position, direction, color or intensity keyframes".into(),
@@ -920,8 +942,65 @@ fn make_animation(
                 },
             })
         }
+        ([], []) if a.target == CAMERA_TARGET => {
+            let Some(rest) = scene.cameras.first() else {
+                return Err(
+                    "the scene has no camera to animate: add a [camera] (its rest pose)".into(),
+                );
+            };
+            if a.translate.is_some()
+                || a.rotate.is_some()
+                || a.scale.is_some()
+                || a.color.is_some()
+                || a.intensity.is_some()
+            {
+                return Err(
+                    "a camera takes position, look_at, direction or fov keyframes, orbit or \
+                     oscillate"
+                        .into(),
+                );
+            }
+            if a.look_at.is_some() && a.direction.is_some() {
+                return Err("give look_at or direction keyframes, not both".into());
+            }
+            let tracks = CameraTracks {
+                position: track("position", v3(&a.position))?,
+                look_at: track("look_at", v3(&a.look_at))?,
+                direction: track("direction", v3(&a.direction))?,
+                fov: key_track(a, "fov", a.fov.clone(), interpolation, repeat)?,
+            };
+            if let Some(f) = a.fov.iter().flatten().find(|f| !(**f > 0.5 && **f < 179.0)) {
+                return Err(format!("fov {f} is not in (0.5, 179) degrees"));
+            }
+            let keyed = tracks != CameraTracks::default();
+            let motion = match (keyed, &a.orbit, &a.oscillate) {
+                (true, None, None) => CameraMotion::Tracks(tracks),
+                (false, Some(_), None) | (false, None, Some(_)) => CameraMotion::Rigid {
+                    motion: generator(a)?,
+                    inner: crate::animation::camera_frame(rest),
+                },
+                (false, None, None) => {
+                    return Err(
+                        "nothing moves: give position, look_at, direction or fov keyframes, \
+                         orbit or oscillate"
+                            .into(),
+                    );
+                }
+                _ => return Err("give keyframes, orbit or oscillate, only one of them".into()),
+            };
+            Ok(Animation {
+                name,
+                target: AnimationTarget::Camera {
+                    camera: 0,
+                    rest: rest.clone(),
+                    outer: Mat4::IDENTITY,
+                    motion,
+                },
+            })
+        }
         ([], []) => Err(format!(
-            "no include (by `name`) or light is called '{}'",
+            "no include (by `name`) or light is called '{}' (`{CAMERA_TARGET}` moves the \
+             scene's camera)",
             a.target
         )),
         _ => Err(format!(

@@ -3,6 +3,8 @@
 //! again when nothing changed), the UI laid out and drawn over it, and presenting.
 
 use super::Viewer;
+use super::input::Controller;
+use crate::camera::{Fly, Orbit};
 use crate::ground_truth::Display;
 use crate::settings::PanelActions;
 use anyhow::Result;
@@ -98,7 +100,7 @@ impl Viewer {
             self.version += 1;
             self.ground.scene_changed();
         }
-        self.params.camera = self.controller_camera();
+        self.params.camera = self.flown_camera();
         self.ground.update(
             &self.device,
             &self.queue,
@@ -109,6 +111,35 @@ impl Viewer {
             self.version,
         );
         Ok(())
+    }
+
+    /// The frame's camera: the scene's animated camera at this time while the view follows
+    /// it, else the controller's. Following keeps the controller at the animated camera, so
+    /// that moving the view (a drag, a key, a preset) starts from where the flight was, and
+    /// ends following.
+    fn flown_camera(&mut self) -> voxgi::scene::Camera {
+        let animated = self.scene.camera_is_animated(0);
+        if self
+            .flown
+            .as_ref()
+            .is_some_and(|c| *c != self.controller_camera())
+        {
+            self.fly_along = false;
+        }
+        let cam = self
+            .scene
+            .camera_at(0, self.time)
+            .filter(|_| animated && self.fly_along);
+        let Some(cam) = cam else {
+            self.flown = None;
+            return self.controller_camera();
+        };
+        self.controller = match &self.controller {
+            Controller::Orbit(_) => Controller::Orbit(Orbit::from_camera(&cam, self.scene_radius)),
+            Controller::Fly(f) => Controller::Fly(Fly::from_camera(&cam, f.speed)),
+        };
+        self.flown = Some(self.controller_camera());
+        cam
     }
 
     /// Runs the panel for this frame's input and uploads what egui needs to draw it (texture

@@ -327,6 +327,11 @@ struct Viewer {
     duration: f32,
     time: f32,
     playing: bool,
+    /// The view follows the scene's animated camera (until the user moves the view).
+    fly_along: bool,
+    /// The controller's camera as following set it last frame: another one means the user
+    /// moved the view.
+    flown: Option<voxgi::scene::Camera>,
     // Stats.
     stats: Stats,
     frames: u32,
@@ -491,6 +496,8 @@ impl Viewer {
             opened_options: (options.clone(), params.clone()),
             // The path tracer shows a still scene: play with G's cone tracing.
             playing: duration > 0.0 && args.display == Display::ConeTraced,
+            fly_along: scene.camera_is_animated(0),
+            flown: None,
             draft: options.clone(),
             options,
             controller: Controller::Orbit(Orbit::from_camera(&default_camera, orbit_distance)),

@@ -108,6 +108,8 @@ impl Viewer {
         self.duration = o.scene.duration();
         self.time = 0.0;
         self.playing = self.duration > 0.0 && self.ground.display == Display::ConeTraced;
+        self.fly_along = o.scene.camera_is_animated(0);
+        self.flown = None;
         self.scene_name = scene_label(&o.scene);
         self.cameras = o.scene.cameras.clone();
         self.first_bookmark = self.cameras.len() - super::save::views_in(Some(&o.path));

@@ -132,6 +132,13 @@ impl Viewer {
                                         .text("s"),
                                 );
                             });
+                            if self.scene.camera_is_animated(0) {
+                                ui.checkbox(&mut self.fly_along, "fly with the scene's camera")
+                                    .on_hover_text(
+                                        "the view follows the scene's camera animation; \
+                                         moving the view ends it",
+                                    );
+                            }
                         });
                     }
                     egui::CollapsingHeader::new("stats")

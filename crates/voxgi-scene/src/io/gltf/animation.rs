@@ -3,14 +3,15 @@
 //! one node hierarchy ([`Motion::Nodes`]); each animated node with meshes or lights below it
 //! (down to the next animated node) becomes one [`Animation`], named after the glTF
 //! animations that move it, and its instances are dynamic. Times before the first and after
-//! the last keyframe hold the end values (glTF has no repeat). Skinning, morph targets and
-//! their weights, and animated cameras are not supported: the loader warns and draws the
-//! meshes unposed.
+//! the last keyframe hold the end values (glTF has no repeat). A camera on an animated node
+//! (or below one) moves with it. Skinning, morph targets and their weights are not supported:
+//! the loader warns and draws the meshes unposed.
 
 use super::meshes::{check_accessor, collect};
 use super::{Placed, R, unit_quat};
 use crate::animation::{
-    Animation, AnimationTarget, Interpolation, Keyable, Motion, MotionNode, Repeat, Track,
+    Animation, AnimationTarget, CameraMotion, Interpolation, Keyable, Motion, MotionNode, Repeat,
+    Track,
 };
 use crate::{Light, Scene};
 use glam::{Mat4, Quat, Vec3};
@@ -46,7 +47,8 @@ impl NodeTracks {
 
 /// Reads the file's animations into `scene.animations`: all of them drive one hierarchy of the
 /// animated nodes, and each animated node with meshes or lights below it (before the next
-/// animated node) moves them as one target, whose instances become dynamic.
+/// animated node) moves them as one target, whose instances become dynamic; a camera below an
+/// animated node (`camera_of`: each node's camera index in `scene.cameras`) moves with it.
 pub(super) fn load_animations(
     path: &Path,
     doc: &gltf::Document,
@@ -54,6 +56,7 @@ pub(super) fn load_animations(
     scene: &mut Scene,
     placed: &[Option<Placed>],
     order: &[usize],
+    camera_of: &[Option<usize>],
 ) -> R<()> {
     use gltf::json::animation::Property;
     let root = doc.as_json();
@@ -236,6 +239,8 @@ pub(super) fn load_animations(
 
     type Group = (Vec<usize>, Vec<Mat4>, Vec<(usize, Light)>);
     let mut groups: Vec<Group> = vec![(Vec::new(), Vec::new(), Vec::new()); nodes.len()];
+    // (camera index, its animated node, its node's transform in that node's frame)
+    let mut moved_cameras: Vec<(usize, usize, Mat4)> = Vec::new();
     for &ni in order {
         let (Some(p), Some(a)) = (&placed[ni], anchor[ni]) else {
             continue;
@@ -253,12 +258,8 @@ pub(super) fn load_animations(
                 g.2.push((l, light_at(light, rel[ni])));
             }
         }
-        if p.camera {
-            log::warn!(
-                "{}: the camera on node '{}' stays in its rest pose (cameras are not animated)",
-                path.display(),
-                p.name
-            );
+        if let Some(c) = camera_of.get(ni).copied().flatten() {
+            moved_cameras.push((c, a, rel[ni]));
         }
     }
     let nodes: Arc<[MotionNode]> = nodes.into();
@@ -290,11 +291,39 @@ pub(super) fn load_animations(
             },
         });
     }
+    for (camera, a, inner) in moved_cameras {
+        let Some(rest) = scene.cameras.get(camera).cloned() else {
+            continue;
+        };
+        for &ai in &sources[a] {
+            used[ai] = true;
+        }
+        let name = sources[a]
+            .iter()
+            .map(|&ai| names[ai].as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        scene.animations.push(Animation {
+            name,
+            target: AnimationTarget::Camera {
+                camera,
+                rest,
+                outer: Mat4::IDENTITY,
+                motion: CameraMotion::Rigid {
+                    motion: Motion::Nodes {
+                        nodes: nodes.clone(),
+                        node: a,
+                    },
+                    inner,
+                },
+            },
+        });
+    }
     for (ai, name) in names.iter().enumerate() {
         if moves_nodes[ai] && !used[ai] {
             log::warn!(
-                "{}: animation {ai} '{name}' moves no mesh or light (only nodes without them, \
-                 such as skin joints; skinning is not supported)",
+                "{}: animation {ai} '{name}' moves no mesh, light or camera (only nodes without \
+                 them, such as skin joints; skinning is not supported)",
                 path.display()
             );
         }

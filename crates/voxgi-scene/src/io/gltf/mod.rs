@@ -129,10 +129,8 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
         let mut here = Placed {
             parent: parent_index,
             local,
-            name: node_name.clone(),
             instances: Vec::new(),
             lights: Vec::new(),
-            camera: false,
         };
         if let Some(gmesh) = node.mesh() {
             if doc.as_json().nodes[ni].skin.is_some() {
@@ -188,7 +186,6 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
             here.lights.push(scene.lights.len() - 1);
         }
         if let Some(c) = node.camera() {
-            here.camera = true;
             let up = world.transform_vector3(Vec3::Y);
             let up = (up - forward * up.dot(forward))
                 .try_normalize()
@@ -235,8 +232,13 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> R<Scene> {
         }
     }
     cameras.sort_by_key(|(ni, _)| *ni);
+    // Each camera node's index in the scene's cameras, for the animations that move them.
+    let mut camera_of = vec![None; doc.nodes().len()];
+    for (i, (ni, _)) in cameras.iter().enumerate() {
+        camera_of[*ni] = Some(i);
+    }
     scene.cameras = cameras.into_iter().map(|(_, c)| c).collect();
-    load_animations(path, doc, &buffers, &mut scene, &placed, &order)?;
+    load_animations(path, doc, &buffers, &mut scene, &placed, &order, &camera_of)?;
     Ok(scene)
 }
 
@@ -247,12 +249,10 @@ struct Placed {
     parent: Option<usize>,
     /// The node's transform in its parent's frame.
     local: Mat4,
-    name: String,
     /// The instances of its mesh (`Scene::instances` indices).
     instances: Vec<usize>,
     /// Its punctual light (`Scene::lights` index).
     lights: Vec<usize>,
-    camera: bool,
 }
 
 /// Runs the `gltf` crate's schema validation, after checking what its own validation indexes
