@@ -28,7 +28,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let q = points[point];
     let n = normalize(q.n.xyz);
     let c = diffuse_cone(tangent_frame(n), vec2<f32>(q.p.w, q.n.w), i);
-    let origin = q.p.xyz + n * voxels_voxel_size() * cones.origin_offset;
+    let vs = voxels_voxel_size_at(q.p.xyz);
+    let origin = q.p.xyz + n * vs * cones.origin_offset;
     results[2u * id.x] = c;
-    results[2u * id.x + 1u] = trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance);
+    results[2u * id.x + 1u] = trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance, vs);
 }

@@ -130,14 +130,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let turn = select(r3, records_turn, IRRADIANCE);
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
-        let g = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES);
+        let g = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, leaf_size(s));
         e = g.irradiance;
         ao = g.ao;
     } else {
         // Two-sided voxel: half the light from each side.
         let n = vec3<f32>(0.0, 1.0, 0.0);
-        let up = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES);
-        let down = gather_diffuse(center, -n, turn, IRRADIANCE, ALL_CONES);
+        let up = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, leaf_size(s));
+        let down = gather_diffuse(center, -n, turn, IRRADIANCE, ALL_CONES, leaf_size(s));
         e = 0.5 * (up.irradiance + down.irradiance);
         ao = 0.5 * (up.ao + down.ao);
     }

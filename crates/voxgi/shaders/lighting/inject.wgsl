@@ -41,9 +41,9 @@ fn shading_point(i: u32, light: Light) -> vec3<f32> {
     let nw = leaf_normal(i);
     let center = leaf_center(i);
     if nw.w > 0.3 {
-        return center + normalize(nw.xyz) * leaf_size() * (0.75 - leaf_surface(i));
+        return center + normalize(nw.xyz) * leaf_size(i) * (0.75 - leaf_surface(i));
     }
-    return center + to_light(light, center) * leaf_size();
+    return center + to_light(light, center) * leaf_size(i);
 }
 
 fn to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
@@ -86,7 +86,7 @@ fn leaf_inputs_changed(i: u32) -> bool {
         return true;
     }
     let center = leaf_center(i);
-    let margin = vec3<f32>(leaf_size());
+    let margin = vec3<f32>(leaf_size(i));
     if all(center >= params.moved_min.xyz - margin) && all(center <= params.moved_max.xyz + margin) {
         return true;
     }
@@ -118,7 +118,7 @@ fn moved_distance(view: ShadowView) -> f32 {
     if any(lo > hi) {
         return -3.0e38;
     }
-    return box_distance(view, lo, hi) - leaf_size();
+    return box_distance(view, lo, hi) - leaf_size_max();
 }
 
 // The leaves `mark` found changed: [0] how many, then their indices. `main` recomputes only

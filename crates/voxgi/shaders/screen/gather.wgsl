@@ -33,14 +33,15 @@ fn cone_visibility(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let dist = length(to);
     let dir = to / dist;
     let tan_half = clamp(light.size / dist, 0.01, 1.0);
-    let origin = p + n * voxels_voxel_size() * cones.origin_offset;
+    let vs = voxels_voxel_size_at(p);
+    let origin = p + n * vs * cones.origin_offset;
     // Stop before the samples' filters reach the emitter's plane: the light hangs on (or in)
     // other geometry, which must not count as its occluder. A sample of diameter d filters
     // trilinearly over the next coarser level too, so its support reaches 2d: stop where the
     // plane is 2d away, (dist - t) cos = 4 tan t.
     let cos_plane = max(abs(dot(dir, light.direction)), 0.1);
-    let stop = dist * cos_plane / (cos_plane + 4.0 * tan_half) - voxels_voxel_size();
-    return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0)).a;
+    let stop = dist * cos_plane / (cos_plane + 4.0 * tan_half) - vs;
+    return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0), vs).a;
 }
 
 fn area_visibility(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
@@ -106,6 +107,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // temporal accumulation each frame shifts the turns by less than a sixteenth
     // (frame.cone_turn, 0 in frame 0), wrapping round, so the frames between them trace many
     // more.
+    // Cones start at the finest voxels held about the point.
+    let vs = voxels_voxel_size_at(p);
     let rank = bayer4(gid.xy);
     let zenith = 2u * (reverseBits(rank >> 1u) >> 29u) + (rank & 1u);
     let turn = fract((vec2<f32>(f32(rank), f32(zenith)) + 0.5 + frame.cone_turn) / 16.0);
@@ -113,7 +116,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if LEAVES {
         g = leaf_gather(p, n);
     } else {
-        g = gather_diffuse(p, n, turn, frame.view_mode == VIEW_AO, cone_half(gid.xy));
+        g = gather_diffuse(p, n, turn, frame.view_mode == VIEW_AO, cone_half(gid.xy), vs);
     }
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);
@@ -146,8 +149,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // march fewer steps than cones of a sixteenth of the lobe each (half as wide read the
         // same means within 3 %, at 10-15 % more of the gather on Sponza).
         let tan_half = clamp(a, 0.01, 1.0);
-        let origin = p + n * voxels_voxel_size() * cones.origin_offset;
-        let spec = trace_cone(origin, n, dir, tan_half, cones.max_distance).rgb;
+        let origin = p + n * vs * cones.origin_offset;
+        let spec = trace_cone(origin, n, dir, tan_half, cones.max_distance, vs).rgb;
         // Weighted by the lobe's directional albedo, a table of the very BRDF the path tracer
         // integrates (Karis's analytic fit, used before, is 10-18 % low at roughness 0.2-0.5).
         let uv = vec2<f32>(max(dot(n, v), 1e-4), s.roughness);

@@ -3,8 +3,15 @@
 //!include voxels/sample.wgsl
 
 // Cone tracing, written once against the voxel contract (voxels/<kind>/sample.wgsl):
-// WIDE_SAMPLE, voxels_voxel_size, voxels_contains, sample_depth, sample_depth_wide and
-// sample_voxels, and nothing else of the structure. The including shader declares `cones`.
+// WIDE_SAMPLE, voxels_voxel_size, voxels_voxel_size_at, voxels_contains, sample_depth,
+// sample_depth_wide and sample_voxels, and nothing else of the structure. The including shader
+// declares `cones`.
+//
+// Every trace takes `vs`, the voxel edge it starts at (the first sample's size, the origin's
+// offset, the self-clearance's unit): the finest voxels the structure holds where the cone
+// starts (`voxels_voxel_size_at`, for a pixel), or the leaf's own (for a bounce from it). A
+// structure with one finest size (dense, octree) gives the same everywhere; clipmap levels
+// are coarser away from the camera, and a cone from a coarse leaf must clear its own voxel.
 
 // The filter size of a cone sample at distance t from a surface (normal n). A surface can
 // neither occlude nor light itself, so a sample must not read the voxels of its cone's own
@@ -16,9 +23,9 @@
 // level than the cone's width would pick).
 const SELF_CLEARANCE: f32 = 3.0;
 
-fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32) -> f32 {
-    let h = dot(p - origin, n) + voxels_voxel_size() * cones.origin_offset;
-    return clamp((h - voxels_voxel_size()) / SELF_CLEARANCE, voxels_voxel_size(), d);
+fn cone_sample_size(origin: vec3<f32>, n: vec3<f32>, p: vec3<f32>, d: f32, vs: f32) -> f32 {
+    let h = dot(p - origin, n) + vs * cones.origin_offset;
+    return clamp((h - vs) / SELF_CLEARANCE, vs, d);
 }
 
 fn outside_volume(p: vec3<f32>) -> bool {
@@ -27,8 +34,8 @@ fn outside_volume(p: vec3<f32>) -> bool {
 
 // A narrowed sample covers less: step no further than its filter reaches, so thin walls are
 // not stepped over.
-fn cone_step(d: f32, ds: f32) -> f32 {
-    return max(min(d * cones.step_factor, ds), voxels_voxel_size() * 0.25);
+fn cone_step(d: f32, ds: f32, vs: f32) -> f32 {
+    return max(min(d * cones.step_factor, ds), vs * 0.25);
 }
 
 // Opacity a of a sample of size ds, corrected for a step of length `step`.
@@ -40,20 +47,20 @@ fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
 // Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
 // length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d), which in
 // optical depth is 1 - e^(-sigma d'/d).
-fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32) -> vec4<f32> {
+fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32, vs: f32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
-    var t = voxels_voxel_size();
+    var t = vs;
     // Two loops: samples widen monotonically along a cone that leaves its surface, and once
     // they are WIDE_SAMPLE voxels across they no longer read the finest level (a quarter of the
     // fetches per step; 8 % of the gather on lavapipe).
     for (var i = 0u; i < 512u; i++) {
         let p = origin + dir * t;
-        let d = max(voxels_voxel_size(), 2.0 * tan_half * t);
-        let ds = cone_sample_size(origin, n, p, d);
-        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || ds >= WIDE_SAMPLE * voxels_voxel_size() {
+        let d = max(vs, 2.0 * tan_half * t);
+        let ds = cone_sample_size(origin, n, p, d, vs);
+        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || ds >= WIDE_SAMPLE * vs {
             break;
         }
-        let step = cone_step(d, ds);
+        let step = cone_step(d, ds, vs);
         acc = composite_sample(acc, sample_depth(p, ds, dir), step / ds);
         t += step;
     }
@@ -63,9 +70,9 @@ fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, ma
         if t >= max_dist || acc.a >= 0.995 || outside_volume(p) {
             break;
         }
-        let d = max(voxels_voxel_size(), 2.0 * tan_half * t);
-        let ds = cone_sample_size(origin, n, p, d);
-        let step = cone_step(d, ds);
+        let d = max(vs, 2.0 * tan_half * t);
+        let ds = cone_sample_size(origin, n, p, d, vs);
+        let step = cone_step(d, ds, vs);
         acc = composite_sample(acc, sample_depth_wide(p, ds, dir), step / ds);
         t += step;
     }
@@ -82,18 +89,18 @@ fn composite_sample(acc: vec4<f32>, s: vec4<f32>, k: f32) -> vec4<f32> {
 }
 
 // Ambient occlusion along one cone: opacity weighted by 1/(1 + lambda r), up to ao_radius.
-fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32) -> f32 {
+fn trace_ao(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, vs: f32) -> f32 {
     var occ = 0.0;
-    var t = voxels_voxel_size();
+    var t = vs;
     for (var i = 0u; i < 256u; i++) {
         let p = origin + dir * t;
         if t >= cones.ao_radius || occ >= 0.995 || outside_volume(p) {
             break;
         }
-        let d = max(voxels_voxel_size(), 2.0 * tan_half * t);
-        let ds = cone_sample_size(origin, n, p, d);
+        let d = max(vs, 2.0 * tan_half * t);
+        let ds = cone_sample_size(origin, n, p, d, vs);
         let s = sample_voxels(p, ds, dir);
-        let step = cone_step(d, ds);
+        let step = cone_step(d, ds, vs);
         let ca = step_opacity(clamp(s.a, 0.0, 0.9999), step, ds);
         occ += (1.0 - occ) * ca / (1.0 + cones.ao_lambda * t);
         t += step;
@@ -156,9 +163,9 @@ const ALL_CONES: u32 = 2u;
 // halves, and the reconstruction's 4x4 average sees every cone at eight turns spread over its
 // cell (the gather gives each parity a Hammersley set of its own), so the estimate keeps its
 // mean at about 60 % of the cost.
-fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32) -> Gathered {
+fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32, vs: f32) -> Gathered {
     let frame = tangent_frame(n);
-    let origin = p + n * voxels_voxel_size() * cones.origin_offset;
+    let origin = p + n * vs * cones.origin_offset;
     var e = vec3<f32>(0.0);
     var occ = 0.0;
     // Neighbouring pixels trace different cones but the same number of them, so SIMD lanes
@@ -182,12 +189,12 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, ha
         let w = c.w * w_scale;
         let d = c.xyz;
         if cones.indirect != 0u {
-            let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance);
+            let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance, vs);
             // Weights are fractions of the cosine-weighted hemisphere, whose integral is pi.
             e += PI * w * r.rgb;
         }
         if with_ao {
-            occ += w * trace_ao(origin, n, d, cones.diffuse_tan);
+            occ += w * trace_ao(origin, n, d, cones.diffuse_tan, vs);
         }
     }
     return Gathered(e, 1.0 - occ);

@@ -72,6 +72,7 @@ fn check_functions(m: &naga::Module, kind: &str, contract: &[(&str, &[&str], &st
 /// The contract: each function's argument types and result type.
 const CONTRACT: &[(&str, &[&str], &str)] = &[
     ("voxels_voxel_size", &[], "f32"),
+    ("voxels_voxel_size_at", &["vec3<f32>"], "f32"),
     ("voxels_contains", &["vec3<f32>"], "bool"),
     (
         "sample_depth",
@@ -119,7 +120,8 @@ const LEAVES: &[(&str, &[&str], &str)] = &[
     ("leaf_count", &[], "u32"),
     ("leaf_coord", &["u32"], "vec3<u32>"),
     ("leaf_center", &["u32"], "vec3<f32>"),
-    ("leaf_size", &[], "f32"),
+    ("leaf_size", &["u32"], "f32"),
+    ("leaf_size_max", &[], "f32"),
     ("leaf_albedo", &["u32"], "vec4<f32>"),
     ("leaf_normal", &["u32"], "vec4<f32>"),
     ("leaf_emission", &["u32"], "vec3<f32>"),
@@ -213,6 +215,7 @@ fn cone_tracing_uses_only_the_contract() {
         "{volume}
 const WIDE_SAMPLE: f32 = 2.0;
 fn voxels_voxel_size() -> f32 {{ return 0.1; }}
+fn voxels_voxel_size_at(p: vec3<f32>) -> f32 {{ return 0.1; }}
 fn voxels_contains(p: vec3<f32>) -> bool {{ return true; }}
 fn sample_depth(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(0.0); }}
 fn sample_depth_wide(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(0.0); }}
@@ -224,7 +227,7 @@ fn sample_voxels(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return ve
         + "@group(0) @binding(0) var<uniform> cones: Cones;
 @compute @workgroup_size(1)
 fn main() {
-    let g = gather_diffuse(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), vec2<f32>(0.0), true, ALL_CONES);
+    let g = gather_diffuse(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), vec2<f32>(0.0), true, ALL_CONES, 0.1);
 }
 ";
     validate(&parse(&src));

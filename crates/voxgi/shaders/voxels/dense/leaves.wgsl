@@ -6,7 +6,8 @@
 //                                                 another leaf before (or none)
 //   fn leaf_coord(i) -> vec3<u32>                 the leaf's finest-grid voxel
 //   fn leaf_center(i) -> vec3<f32>                its centre, metres
-//   fn leaf_size() -> f32                         its edge, metres
+//   fn leaf_size(i) -> f32                        its edge, metres
+//   fn leaf_size_max() -> f32                     the largest leaf's edge
 //   fn leaf_albedo(i) / leaf_normal(i) / leaf_emission(i)   what the build resolved
 //   fn leaf_surface(i) -> f32                     how far its centre lies in front of its
 //                                                 surface along the normal, voxels
@@ -48,7 +49,11 @@ fn leaf_center(i: u32) -> vec3<f32> {
     return voxel_center(leaf_coord(i), leaf_grid);
 }
 
-fn leaf_size() -> f32 {
+fn leaf_size(i: u32) -> f32 {
+    return leaf_grid.voxel_size;
+}
+
+fn leaf_size_max() -> f32 {
     return leaf_grid.voxel_size;
 }
 

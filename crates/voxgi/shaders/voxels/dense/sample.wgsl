@@ -5,6 +5,8 @@
 //   const WIDE_SAMPLE: f32                       samples at least this many voxels across may
 //                                                skip the finest level (sample_depth_wide)
 //   fn voxels_voxel_size() -> f32                finest voxel edge, metres
+//   fn voxels_voxel_size_at(p) -> f32            the finest voxel edge held about p (cones
+//                                                start at it: shared/cone.wgsl)
 //   fn voxels_contains(p) -> bool                p lies inside the structure's bounds
 //   fn sample_depth(p, d, dir) -> vec4<f32>      optical depth (L sigma, sigma) per sample
 //                                                diameter, filtered to diameter d, seen along dir
@@ -27,6 +29,10 @@
 @group(1) @binding(3) var voxel_sampler: sampler;
 
 fn voxels_voxel_size() -> f32 {
+    return vol.voxel_size;
+}
+
+fn voxels_voxel_size_at(p: vec3<f32>) -> f32 {
     return vol.voxel_size;
 }
 

@@ -31,7 +31,11 @@ fn leaf_center(i: u32) -> vec3<f32> {
     return leaf_tree.origin + (vec3<f32>(leaf_coord(i)) + 0.5) * leaf_tree.voxel_size;
 }
 
-fn leaf_size() -> f32 {
+fn leaf_size(i: u32) -> f32 {
+    return leaf_tree.voxel_size;
+}
+
+fn leaf_size_max() -> f32 {
     return leaf_tree.voxel_size;
 }
 

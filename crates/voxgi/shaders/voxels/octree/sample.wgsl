@@ -34,6 +34,10 @@ fn voxels_voxel_size() -> f32 {
     return tree.voxel_size;
 }
 
+fn voxels_voxel_size_at(p: vec3<f32>) -> f32 {
+    return tree.voxel_size;
+}
+
 fn voxels_contains(p: vec3<f32>) -> bool {
     return inside_tree(tree_uvw(p));
 }
