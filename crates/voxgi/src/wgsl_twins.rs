@@ -233,7 +233,7 @@ fn every_twin_has_the_wgsl_layout() {
         m,
         GpuVolume,
         "Volume",
-        [origin, resolution, voxel_size, levels, anisotropic]
+        [origin, resolution, voxel_size, levels, anisotropic, windows]
     );
     twin!(
         m,

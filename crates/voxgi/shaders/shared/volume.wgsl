@@ -12,7 +12,9 @@ struct Volume {
     levels: u32,
     // 1: six directional values per voxel above the finest level, 0: one.
     anisotropic: u32,
-    _pad: u32,
+    // Cubes of `resolution` voxels stacked along z in every texture and buffer (1; a clipmap's
+    // levels are its windows).
+    windows: u32,
 }
 
 const MAX_CONES: u32 = 16u;

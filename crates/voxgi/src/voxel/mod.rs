@@ -308,8 +308,9 @@ pub struct GpuVolume {
     pub levels: u32,
     /// 1: six directional values per voxel above the finest level, 0: one.
     pub anisotropic: u32,
-    /// Padding to 32 bytes; zero.
-    pub _pad: u32,
+    /// Cubes of `resolution` voxels stacked along z in every texture and buffer: 1, or a
+    /// clipmap's levels.
+    pub windows: u32,
 }
 
 /// Bytes of a 3D texture with `mips` levels.

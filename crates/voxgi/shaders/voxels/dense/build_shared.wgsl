@@ -116,7 +116,7 @@ fn resolve_slot(s: u32, dynamic: bool) {
     // Alpha: where the surface lies (leaves.wgsl's leaf_surface).
     textureStore(emission_out, c, vec4<f32>(a.emission, a.surface));
     // The normals feed the first level's NDF weights.
-    mark_changed(c, vol.resolution);
+    mark_changed(c, vol.resolution, vol.windows);
 }
 
 // Empties voxel `c` of the finest level.
@@ -125,6 +125,6 @@ fn clear_voxel(c: vec3<u32>) {
     textureStore(normal_out, c, vec4<f32>(0.0));
     textureStore(emission_out, c, vec4<f32>(0.0));
     textureStore(radiance_out, c, vec4<f32>(0.0));
-    mark_changed(c, vol.resolution);
+    mark_changed(c, vol.resolution, vol.windows);
 }
 

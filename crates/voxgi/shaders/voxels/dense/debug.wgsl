@@ -46,7 +46,8 @@ fn cell_value(c: vec3<i32>) -> vec4<f32> {
         return from_depth(textureLoad(radiance0, c, 0));
     }
     let n = i32(vol.resolution) >> params.level;
-    return from_depth(textureLoad(chain, c + vec3<i32>(0, 0, n * i32(params.block)), i32(params.level) - 1));
+    let block = n * i32(vol.windows) * i32(params.block);
+    return from_depth(textureLoad(chain, c + vec3<i32>(0, 0, block), i32(params.level) - 1));
 }
 
 // Finest albedo under the coarse cell `cell` (of `scale` finest voxels per side) that the ray

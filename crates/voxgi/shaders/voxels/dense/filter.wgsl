@@ -25,7 +25,8 @@ struct FilterParams {
     ndf: u32,
     // The level written, less one (0: the level above the finest).
     step: u32,
-    _pad0: u32,
+    // Cubes stacked along z in every level and block (`Volume::windows`).
+    windows: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -54,9 +55,10 @@ fn leaf_child(base: vec3<i32>, o: vec3<i32>, block: u32) -> vec4<f32> {
 // Level `params.step + 1`'s voxel `gid` in direction block `block` from its eight children.
 fn filter_voxel(gid: vec3<u32>, block: u32) {
     let n = params.dst_res;
-    let id = vec3<u32>(gid.xy, block * n + gid.z);
+    let depth = n * params.windows;
+    let id = vec3<u32>(gid.xy, block * depth + gid.z);
     var base = vec3<i32>(gid) * 2;
-    base.z += i32(block * 2u * n * params.src_blocked);
+    base.z += i32(block * 2u * depth * params.src_blocked);
     if params.mode == 0u {
         var sum = vec4<f32>(0.0);
         for (var i = 0; i < 8; i++) {
@@ -93,11 +95,12 @@ fn blocks() -> u32 {
 @compute @workgroup_size(4, 4, 4)
 fn whole(@builtin(global_invocation_id) tid: vec3<u32>) {
     let n = params.dst_res;
-    let block = tid.z / n;
+    let depth = n * params.windows;
+    let block = tid.z / depth;
     if any(tid.xy >= vec2<u32>(n)) || block >= blocks() {
         return;
     }
-    filter_voxel(vec3<u32>(tid.xy, tid.z % n), block);
+    filter_voxel(vec3<u32>(tid.xy, tid.z % depth), block);
 }
 
 // The voxels the level's list holds: x and y over the list (x up to 65,535 workgroups, as
@@ -112,13 +115,14 @@ fn listed(@builtin(global_invocation_id) tid: vec3<u32>, @builtin(num_workgroups
     if k >= atomicLoad(&counters[COUNTS + level - 1u]) {
         return;
     }
-    let i = atomicLoad(&counters[list_of(res, level) + k]);
+    let w = params.windows;
+    let i = atomicLoad(&counters[list_of(res, w, level) + k]);
     let gid = vec3<u32>(i % n, (i / n) % n, i / (n * n));
     if tid.z == 0u {
         if level < levels_above(res) {
-            mark_level(res, level + 1u, gid >> vec3<u32>(1u));
+            mark_level(res, w, level + 1u, gid >> vec3<u32>(1u));
         }
-        atomicAnd(&counters[bits_of(res, level) + i / 32u], ~(1u << (i % 32u)));
+        atomicAnd(&counters[bits_of(res, w, level) + i / 32u], ~(1u << (i % 32u)));
     }
     filter_voxel(gid, tid.z);
 }

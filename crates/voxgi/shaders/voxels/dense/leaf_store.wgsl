@@ -13,5 +13,5 @@
 fn store_leaf_radiance(i: u32, v: vec4<f32>) {
     let c = leaf_coord(i);
     textureStore(leaf_radiance_out, c, to_half(to_depth(v)));
-    mark_changed(c, leaf_grid.resolution);
+    mark_changed(c, leaf_grid.resolution, leaf_grid.windows);
 }

@@ -79,7 +79,7 @@ impl FilterPass {
         }
     }
 
-    fn steps(grid: Grid, filtering: Filtering) -> Vec<Step> {
+    fn steps(grid: Grid, windows: u32, filtering: Filtering) -> Vec<Step> {
         let res = grid.resolution;
         let levels = grid.levels();
         let mode = if filtering.anisotropic { 1 } else { 0 };
@@ -98,7 +98,7 @@ impl FilterPass {
                         src.is_some() as u32,
                         ndf as u32,
                         level - 1,
-                        0,
+                        windows,
                         0,
                         0,
                     ],
@@ -107,19 +107,21 @@ impl FilterPass {
             .collect()
     }
 
-    /// The bind groups of every level's step for a volume on `grid` with these textures (the
-    /// finest level's `radiance` and `normal`, the `chains` above) and its lists of changed
-    /// voxels (in `counters`), with their parameters: made once per volume (they bind only its
-    /// own resources).
+    /// The bind groups of every level's step for a volume on `grid` (`windows` cubes of it
+    /// stacked along z) with these textures (the finest level's `radiance` and `normal`, the
+    /// `chains` above) and its lists of changed voxels (in `counters`), with their parameters:
+    /// made once per volume (they bind only its own resources).
+    #[allow(clippy::too_many_arguments)]
     pub fn bind(
         &self,
         device: &wgpu::Device,
         grid: Grid,
+        windows: u32,
         filtering: Filtering,
         [radiance, chains, normal]: [&wgpu::Texture; 3],
         counters: &wgpu::Buffer,
     ) -> FilterBinds {
-        let steps = Self::steps(grid, filtering);
+        let steps = Self::steps(grid, windows, filtering);
         let mut bytes = vec![0u8; steps.len() * STRIDE as usize];
         for (i, s) in steps.iter().enumerate() {
             bytes[i * STRIDE as usize..i * STRIDE as usize + 32]
@@ -191,7 +193,12 @@ impl FilterPass {
         let blocks = super::chain_blocks(filtering.anisotropic);
         let whole = steps
             .iter()
-            .map(|s| [s.params[1].div_ceil(4), (s.params[1] * blocks).div_ceil(4)])
+            .map(|s| {
+                [
+                    s.params[1].div_ceil(4),
+                    (s.params[1] * blocks * windows).div_ceil(4),
+                ]
+            })
             .collect();
         FilterBinds {
             _params: params,
@@ -200,7 +207,7 @@ impl FilterPass {
             prepare,
             args,
             counters: counters.clone(),
-            bits_end: counter_words_before_lists(grid) * 4,
+            bits_end: counter_words_before_lists(grid, windows) * 4,
         }
     }
 
@@ -251,26 +258,29 @@ impl FilterPass {
     }
 }
 
-/// Words of a volume's counters on `grid` before its lists: the counters, each level's
-/// count (voxels/dense/changed.wgsl's `COUNTS`, ten levels) and its bits (a bit per voxel of
-/// each level above the finest).
-fn counter_words_before_lists(grid: Grid) -> u64 {
+/// Words of a volume's counters on `grid` (`windows` cubes of it) before its lists: the
+/// counters, each level's count (voxels/dense/changed.wgsl's `COUNTS`, ten levels) and its
+/// bits (a bit per voxel of each level above the finest).
+fn counter_words_before_lists(grid: Grid, windows: u32) -> u64 {
     let res = grid.resolution as u64;
     let top = grid.levels() as u64 - 1;
     // changed.wgsl counts ten levels above the finest (a 1024³ volume's).
     debug_assert!(top <= 10, "{top} levels above the finest");
-    let bits: u64 = (1..=top).map(|l| (res >> l).pow(3).div_ceil(32)).sum();
+    let bits: u64 = (1..=top)
+        .map(|l| ((res >> l).pow(3) * windows as u64).div_ceil(32))
+        .sum();
     18 + bits
 }
 
-/// Bytes of a volume's counters on `grid` (the twin of voxels/dense/changed.wgsl's layout):
-/// the counters and bits (`counter_words_before_lists`), then each level's list of changed
-/// voxels (room for all of them).
-pub fn counter_bytes(grid: Grid) -> u64 {
+/// Bytes of a volume's counters on `grid` (`windows` cubes of it; the twin of
+/// voxels/dense/changed.wgsl's layout): the counters and bits
+/// (`counter_words_before_lists`), then each level's list of changed voxels (room for all of
+/// them).
+pub fn counter_bytes(grid: Grid, windows: u32) -> u64 {
     let res = grid.resolution as u64;
     let top = grid.levels() as u64 - 1;
-    let lists: u64 = (1..=top).map(|l| (res >> l).pow(3)).sum();
-    (counter_words_before_lists(grid) + lists) * 4
+    let lists: u64 = (1..=top).map(|l| (res >> l).pow(3) * windows as u64).sum();
+    (counter_words_before_lists(grid, windows) + lists) * 4
 }
 
 /// The dense filter's bind groups for one volume (`FilterPass::bind`).

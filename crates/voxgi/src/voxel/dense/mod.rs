@@ -58,6 +58,7 @@ pub const KIND: KindInfo = KindInfo {
         name: "dense",
         sources: crate::wgsl![
             "voxels/dense/sample.wgsl",
+            "voxels/dense/windows.wgsl",
             "voxels/dense/leaves.wgsl",
             "voxels/dense/leaf_store.wgsl",
             "voxels/dense/changed.wgsl",
@@ -89,7 +90,7 @@ fn create(
     desc: &StructureDesc,
     previous: Option<&dyn VoxelStructure>,
 ) -> Result<Box<dyn VoxelStructure>> {
-    check_volume_fits(device, &desc.grid)?;
+    check_volume_fits(device, &desc.grid, 1)?;
     let slots = slot_capacity(
         device,
         desc.leaves.min(crate::gpu::max_entries(device, SLOT_BYTES)),
@@ -99,7 +100,15 @@ fn create(
         None => checked(device, "pipeline creation", || DensePipelines::new(device))?,
     };
     let v = checked(device, "voxel volume", || {
-        DenseVolume::new(device, &p, desc.grid, desc.filtering, slots, desc.dynamic)
+        DenseVolume::new(
+            device,
+            &p,
+            desc.grid,
+            1,
+            desc.filtering,
+            slots,
+            desc.dynamic,
+        )
     })?;
     Ok(Box::new(v))
 }
@@ -109,28 +118,36 @@ fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
     crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")
 }
 
-/// Checks that the volume's per-voxel buffers fit the device's limits.
-fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
+/// Checks that the per-voxel buffers and textures of `windows` cubes of `grid` fit the
+/// device's limits.
+pub(crate) fn check_volume_fits(device: &wgpu::Device, grid: &Grid, windows: u32) -> Result<()> {
     let l = device.limits();
-    let occupancy = (grid.resolution as u64).pow(3) * 4;
+    let occupancy = (grid.resolution as u64).pow(3) * windows as u64 * 4;
     if occupancy > l.max_storage_buffer_binding_size {
+        let cubes = if windows > 1 {
+            format!("{windows} windows of {}³ voxels", grid.resolution)
+        } else {
+            format!("a {}³ volume", grid.resolution)
+        };
         return Err(Error::TooLarge(format!(
-            "a {r}³ volume needs a {} MiB occupancy buffer, more than this GPU's {} MiB \
+            "{cubes} need a {} MiB occupancy buffer, more than this GPU's {} MiB \
              storage-buffer limit; use a voxel resolution of at most {}",
             occupancy >> 20,
             l.max_storage_buffer_binding_size >> 20,
-            ((l.max_storage_buffer_binding_size / 4) as f64)
+            ((l.max_storage_buffer_binding_size / 4 / windows as u64) as f64)
                 .cbrt()
                 .log2()
                 .floor()
                 .exp2() as u32,
-            r = grid.resolution
         )));
     }
-    if grid.resolution > l.max_texture_dimension_3d {
+    // The deepest texture: the directional mips' six blocks of every window, along z.
+    let depth = (grid.resolution * windows).max(grid.resolution / 2 * 6 * windows);
+    if grid.resolution > l.max_texture_dimension_3d || depth > l.max_texture_dimension_3d {
         return Err(Error::TooLarge(format!(
-            "a {}³ volume exceeds this GPU's 3D texture limit of {}",
-            grid.resolution, l.max_texture_dimension_3d
+            "{} stacked {}³ voxel textures ({depth} texels deep) exceed this GPU's 3D texture \
+             limit of {}",
+            windows, grid.resolution, l.max_texture_dimension_3d
         )));
     }
     Ok(())
@@ -141,6 +158,9 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid) -> Result<()> {
 pub struct DenseVolume {
     /// Where the volume lies and its finest resolution.
     pub grid: Grid,
+    /// Cubes of `grid.resolution` voxels stacked along z in every texture and buffer: 1, or a
+    /// clipmap's levels (which place them; `grid` then places the first).
+    pub windows: u32,
     /// Six directional chains (true) or one isotropic chain.
     pub anisotropic: bool,
     /// The first chain level weighs the finest voxels by their normals (`Filtering::ndf`).
@@ -246,16 +266,6 @@ struct BuildPipelines {
     accumulate: wgpu::ComputePipeline,
     prepare_slots: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
-}
-
-fn texture_3d(
-    device: &wgpu::Device,
-    label: &str,
-    res: u32,
-    mips: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    texture_3d_blocks(device, label, res, 1, mips, format)
 }
 
 /// `blocks` cubes of `res` texels stacked along z.
@@ -390,12 +400,14 @@ impl DensePipelines {
 }
 
 impl DenseVolume {
-    /// A volume on `grid`, its levels filtered as `filtering` says, with room for
-    /// `slot_capacity` occupied voxels, and for updates by dynamic geometry when `dynamic`.
+    /// A volume on `grid` (`windows` cubes of it stacked along z), its levels filtered as
+    /// `filtering` says, with room for `slot_capacity` occupied voxels, and for updates by
+    /// dynamic geometry when `dynamic`.
     pub fn new(
         device: &wgpu::Device,
         pipelines: &Arc<DensePipelines>,
         grid: Grid,
+        windows: u32,
         filtering: Filtering,
         slot_capacity: u32,
         dynamic: bool,
@@ -410,13 +422,13 @@ impl DenseVolume {
             voxel_size: grid.voxel_size,
             levels,
             anisotropic: anisotropic as u32,
-            _pad: 0,
+            windows,
         };
         let chains = texture_3d_blocks(
             device,
             "voxel radiance mips",
             res / 2,
-            chain_blocks(anisotropic),
+            chain_blocks(anisotropic) * windows,
             levels - 1,
             RADIANCE_FORMAT,
         );
@@ -426,7 +438,9 @@ impl DenseVolume {
             contents: bytemuck::bytes_of(&volume),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        let radiance = texture_3d(device, "voxel radiance", res, 1, RADIANCE_FORMAT);
+        let stacked =
+            |label: &str, format| texture_3d_blocks(device, label, res, windows, 1, format);
+        let radiance = stacked("voxel radiance", RADIANCE_FORMAT);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("voxels"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -447,17 +461,27 @@ impl DenseVolume {
                 wgpu::BindingResource::Sampler(&sampler),
             ]),
         });
-        let albedo = texture_3d(device, "voxel albedo", res, 1, ALBEDO_FORMAT);
-        let normal = texture_3d(device, "voxel normal", res, 1, NORMAL_FORMAT);
-        let emission = texture_3d(device, "voxel emission", res, 1, EMISSION_FORMAT);
+        let albedo = stacked("voxel albedo", ALBEDO_FORMAT);
+        let normal = stacked("voxel normal", NORMAL_FORMAT);
+        let emission = stacked("voxel emission", EMISSION_FORMAT);
         let slot_voxel = storage_buffer(device, "voxel slots", slots * 4, no);
         // From word 8: the levels' voxels the build and update changed (changed.wgsl).
-        let counters = storage_buffer(device, "voxel counters", filter::counter_bytes(grid), no);
+        let counters = storage_buffer(
+            device,
+            "voxel counters",
+            filter::counter_bytes(grid, windows),
+            no,
+        );
         let dyn_slots = if dynamic { slots } else { 1 };
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
         let slot_irradiance = storage_buffer(device, "voxel leaf irradiance", slots * 16, no);
-        let occupancy = storage_buffer(device, "voxel occupancy", (res as u64).pow(3) * 4, no);
+        let occupancy = storage_buffer(
+            device,
+            "voxel occupancy",
+            (res as u64).pow(3) * windows as u64 * 4,
+            no,
+        );
         let irradiance = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel irradiance"),
             layout: &Self::irradiance_layout(device),
@@ -495,12 +519,14 @@ impl DenseVolume {
         let filter_binds = pipelines.filter.bind(
             device,
             grid,
+            windows,
             filtering,
             [&radiance, &chains, &normal],
             &counters,
         );
         DenseVolume {
             grid,
+            windows,
             anisotropic,
             ndf: filtering.ndf,
             volume,
@@ -544,6 +570,7 @@ impl DenseVolume {
     fn memory_report(&self) -> Vec<(&'static str, u64)> {
         let res = self.grid.resolution;
         let aniso_mips = self.grid.levels() - 1;
+        let w = self.windows as u64;
         vec![
             ("voxel occupancy", self.occupancy.size()),
             (
@@ -556,17 +583,17 @@ impl DenseVolume {
             ),
             ("voxel dynamic sums", self.dyn_accum.size()),
             ("voxel filter lists", self.counters.size()),
-            ("voxel albedo", texture_bytes(res, 4, 1)),
-            ("voxel normal", texture_bytes(res, 4, 1)),
-            ("voxel emission", texture_bytes(res, 8, 1)),
-            ("voxel radiance", texture_bytes(res, 8, 1)),
+            ("voxel albedo", w * texture_bytes(res, 4, 1)),
+            ("voxel normal", w * texture_bytes(res, 4, 1)),
+            ("voxel emission", w * texture_bytes(res, 8, 1)),
+            ("voxel radiance", w * texture_bytes(res, 8, 1)),
             (
                 if self.anisotropic {
                     "voxel radiance mips (6 directions)"
                 } else {
                     "voxel radiance mips"
                 },
-                self.chain_blocks() as u64 * texture_bytes(res / 2, 8, aniso_mips),
+                w * self.chain_blocks() as u64 * texture_bytes(res / 2, 8, aniso_mips),
             ),
         ]
     }
@@ -847,6 +874,7 @@ impl VoxelStructure for DenseVolume {
                 device,
                 &self.pipelines,
                 self.grid,
+                self.windows,
                 Filtering {
                     anisotropic: self.anisotropic,
                     ndf: self.ndf,

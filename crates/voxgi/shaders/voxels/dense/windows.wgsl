@@ -1,0 +1,86 @@
+// Sampling the dense volume's textures (@group(1)): `windows` cubes of `resolution` voxels
+// stacked along z (`Volume::windows`; the dense volume has one, a clipmap one per level), each
+// with its finest level and its directional chains. voxels/dense/sample.wgsl reads window 0;
+// the clipmap's sample.wgsl picks windows by position and footprint.
+//
+// The resources: the volume's placement `vol`, `radiance0` (finest level, isotropic),
+// `chains` (the directional mip chains, one level above the finest, as blocks stacked along
+// z: +X, -X, +Y, -Y, +Z, -Z, each block the windows stacked; in isotropic mode one block)
+// and `voxel_sampler` (trilinear, clamp to edge).
+//
+// No branch: CPU drivers run every side of a branch that differs between SIMD lanes, and
+// even a branch no lane takes costs more on lavapipe than the fetch it would skip.
+
+//!include shared/volume.wgsl
+
+@group(1) @binding(0) var<uniform> vol: Volume;
+@group(1) @binding(1) var radiance0: texture_3d<f32>;
+@group(1) @binding(2) var chains: texture_3d<f32>;
+@group(1) @binding(3) var voxel_sampler: sampler;
+
+// Samples at least WIDE_SAMPLE voxels across read only the directional chains.
+const WIDE_SAMPLE: f32 = 2.0;
+
+// Optical depth (L sigma, sigma) at `uvw` (in [0, 1]^3 over window `w`) filtered to `lod`
+// levels above its finest (0 ..= levels - 1), seen along `dir`.
+fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32> {
+    // Half a texel inside the window, so the filter never blends the next one's voxels.
+    let inside = clamp(uvw.z, 0.5 / f32(vol.resolution), 1.0 - 0.5 / f32(vol.resolution));
+    let z = (f32(win) + select(uvw.z, inside, vol.windows > 1u)) / f32(vol.windows);
+    let fine = textureSampleLevel(radiance0, voxel_sampler, vec3<f32>(uvw.xy, z), 0.0);
+    let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir, win);
+    // Only between the finest level and the first coarse one is the finest level read.
+    return mix(fine, coarse, min(lod, 1.0));
+}
+
+// True when the pipeline serves an isotropic volume: each sample then makes one fetch, not
+// three equal ones (half the gather's time on lavapipe). Left false, the mode is read from
+// `vol` at run time.
+override ISOTROPIC_ONLY: bool = false;
+
+// Directional blocks an anisotropic sample reads: 3, every axis by its weight (seed 000 §9),
+// or 2, the two of largest weight (a third fewer fetches).
+override SAMPLE_AXES: u32 = 3u;
+
+// The directional chains of window `w` at chain level `cl` (the volume's level cl + 1).
+fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32> {
+    // Keep z half a texel inside the window at the coarser of the two levels read, so the
+    // trilinear filter never blends a neighbouring window's or direction's block.
+    let upper = min(floor(cl) + 1.0, f32(vol.levels - 2u));
+    let texels = max(f32(vol.resolution / 2u) * exp2(-upper), 1.0);
+    let z = clamp(uvw.z, 0.5 / texels, 1.0 - 0.5 / texels);
+    let window = f32(win);
+    let windows = f32(vol.windows);
+    if ISOTROPIC_ONLY {
+        return textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (window + z) / windows), cl);
+    }
+    // In isotropic mode the one block serves every axis.
+    let aniso = vol.anisotropic != 0u;
+    let block = select(
+        vec3<f32>(0.0),
+        vec3<f32>(select(1.0, 0.0, dir.x >= 0.0), select(3.0, 2.0, dir.y >= 0.0), select(5.0, 4.0, dir.z >= 0.0)),
+        aniso,
+    );
+    let blocks = select(1.0, 6.0, aniso) * windows;
+    // Each direction's block holds every window: block b, window w at b * windows + w.
+    let first = block * windows + window;
+    // Weighted by the squared direction cosines (they sum to 1).
+    let w = dir * dir;
+    if SAMPLE_AXES == 2u {
+        // The two axes of largest weight, renormalised: the third weighs at most a third, and
+        // its block is then assumed to hold the others' weighted mean.
+        let drop_x = w.x <= w.y && w.x <= w.z;
+        let drop_y = !drop_x && w.y <= w.z;
+        let b0 = select(first.x, first.y, drop_x);
+        let w0 = select(w.x, w.y, drop_x);
+        let b1 = select(select(first.y, first.z, drop_y), first.z, drop_x);
+        let w1 = select(select(w.y, w.z, drop_y), w.z, drop_x);
+        let s0 = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + b0) / blocks), cl);
+        let s1 = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + b1) / blocks), cl);
+        return (w0 * s0 + w1 * s1) / max(w0 + w1, 1e-6);
+    }
+    let x = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first.x) / blocks), cl);
+    let y = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first.y) / blocks), cl);
+    let zz = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first.z) / blocks), cl);
+    return w.x * x + w.y * y + w.z * zz;
+}
