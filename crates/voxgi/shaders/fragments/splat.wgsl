@@ -93,7 +93,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let slot = atomicAdd(&fragment_count[0], 1u);
         if slot < arrayLength(&fragments) {
             fragments[slot] = Fragment(
-                pack_coord(vec3<u32>(cell)),
+                pack_coord(vec3<u32>(cell) + vec3<u32>(0u, 0u, grid.z_offset)),
                 albedo_packed,
                 normal,
                 emission,

@@ -37,7 +37,7 @@ fn emit(cell: vec3<i32>, albedo: vec3<f32>, coverage: f32, n: vec3<f32>, emissio
     let slot = atomicAdd(&fragment_count[0], 1u);
     if slot < arrayLength(&fragments) {
         fragments[slot] = Fragment(
-            pack_coord(vec3<u32>(cell)),
+            pack_coord(vec3<u32>(cell) + vec3<u32>(0u, 0u, grid.z_offset)),
             pack4x8unorm(vec4<f32>(albedo, coverage)),
             pack2x16snorm(oct_encode(n)),
             pack_rgb9e5(emission),

@@ -14,8 +14,10 @@ struct FragmentGrid {
     voxel_size: f32,
     // 1 / voxel_size, rounded once on the host (shaders multiply, so their CPU twins agree).
     inv_voxel_size: f32,
-    _pad1: u32,
-    _pad2: u32,
+    // Added to a fragment's z: the grid is window `z_offset / resolution` of a structure with
+    // several (a clipmap's levels), stacked along z; 0 for the others.
+    z_offset: u32,
+    _pad: u32,
 }
 
 // The voxels a pass makes fragments in, bounds included (empty when hi < lo on an axis). Twin:

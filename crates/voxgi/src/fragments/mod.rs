@@ -30,16 +30,36 @@ pub struct GpuFragmentGrid {
     pub voxel_size: f32,
     /// `1 / voxel_size`.
     pub inv_voxel_size: f32,
+    /// Added to a fragment's z: window `z_offset / resolution` of a structure with several.
+    pub z_offset: u32,
     /// Padding to the WGSL struct's 32 bytes; zero.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
 
-/// The fragment buffer of one grid, and its count.
+impl GpuFragmentGrid {
+    /// Window `window` of a structure whose windows are `grid`-sized cubes stacked along z.
+    pub fn of(grid: &Grid, window: u32) -> Self {
+        GpuFragmentGrid {
+            origin: grid.origin.to_array(),
+            resolution: grid.resolution,
+            voxel_size: grid.voxel_size,
+            inv_voxel_size: 1.0 / grid.voxel_size,
+            z_offset: window * grid.resolution,
+            _pad: 0,
+        }
+    }
+}
+
+/// The fragment buffer of a structure's grids, and its count.
 pub struct Fragments {
-    /// The grid the fragments lie on (finest voxel level).
-    pub grid: Grid,
-    /// Where the fragments lie (`FragmentGrid`).
-    pub grid_uniform: wgpu::Buffer,
+    /// The grids the fragments lie on (the finest voxels): one, or a camera-following
+    /// structure's windows (`VoxelStructure::fragment_grids`), whose fragments are stacked
+    /// along z (window k's at z + k · resolution).
+    pub grids: Vec<Grid>,
+    /// Per grid: where its fragments lie (`FragmentGrid`) and where they are made
+    /// (`FragmentRegion`: the static geometry's and the points' at offset 0, the dynamic
+    /// geometry's at `REGION_STRIDE`; `set_regions`).
+    pub windows: Vec<FragmentWindow>,
     /// The fragments; its length is the capacity.
     pub buffer: wgpu::Buffer,
     /// `[0]`: fragments made by the last build, counted past the capacity.
@@ -49,8 +69,13 @@ pub struct Fragments {
     pub mark: wgpu::Buffer,
     /// Fragments `buffer` holds; a build that makes more counts them and drops the rest.
     pub capacity: u32,
-    /// Where fragments are made (`FragmentRegion`): the static geometry's and the points' at
-    /// offset 0, the dynamic geometry's at `REGION_STRIDE` (`set_regions`).
+}
+
+/// One grid's uniforms in `Fragments`.
+pub struct FragmentWindow {
+    /// Where its fragments lie (`FragmentGrid`).
+    pub grid: wgpu::Buffer,
+    /// Where they are made (`FragmentRegion`s, static at 0, dynamic at `REGION_STRIDE`).
     pub regions: wgpu::Buffer,
 }
 
@@ -68,25 +93,30 @@ pub enum Geometry {
 }
 
 impl Fragments {
-    /// Room for `capacity` fragments on `grid` (check it first with `capacity`).
-    pub fn new(device: &wgpu::Device, grid: Grid, capacity: u32) -> Self {
-        let uniform = GpuFragmentGrid {
-            origin: grid.origin.to_array(),
-            resolution: grid.resolution,
-            voxel_size: grid.voxel_size,
-            inv_voxel_size: 1.0 / grid.voxel_size,
-            _pad: [0; 2],
-        };
+    /// Room for `capacity` fragments on `grids` (check it first with `capacity`).
+    pub fn new(device: &wgpu::Device, grids: &[Grid], capacity: u32) -> Self {
         let storage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_DST
             | wgpu::BufferUsages::COPY_SRC;
+        let windows = grids
+            .iter()
+            .enumerate()
+            .map(|(k, grid)| FragmentWindow {
+                grid: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("fragment grid"),
+                    contents: bytemuck::bytes_of(&GpuFragmentGrid::of(grid, k as u32)),
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                }),
+                regions: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("fragment regions"),
+                    contents: &regions_bytes(Region::all(grid), Region::all(grid)),
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                }),
+            })
+            .collect();
         Fragments {
-            grid,
-            grid_uniform: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("fragment grid"),
-                contents: bytemuck::bytes_of(&uniform),
-                usage: wgpu::BufferUsages::UNIFORM,
-            }),
+            grids: grids.to_vec(),
+            windows,
             buffer: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("voxel fragments"),
                 size: capacity.max(1) as u64 * FRAGMENT_BYTES,
@@ -106,27 +136,41 @@ impl Fragments {
                 mapped_at_creation: false,
             }),
             capacity,
-            regions: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("fragment regions"),
-                contents: &regions_bytes(Region::all(&grid), Region::all(&grid)),
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            }),
         }
     }
 
-    /// Sets where the next build (`build`) and update (`update`) make fragments.
-    pub fn set_regions(&self, queue: &wgpu::Queue, build: Region, update: Region) {
-        queue.write_buffer(&self.regions, 0, &regions_bytes(build, update));
+    /// Moves the grids (as many as before: a camera-following structure's windows moved).
+    pub fn set_grids(&mut self, queue: &wgpu::Queue, grids: &[Grid]) {
+        debug_assert_eq!(grids.len(), self.grids.len());
+        for (k, (w, grid)) in self.windows.iter().zip(grids).enumerate() {
+            if self.grids[k] != *grid {
+                queue.write_buffer(
+                    &w.grid,
+                    0,
+                    bytemuck::bytes_of(&GpuFragmentGrid::of(grid, k as u32)),
+                );
+                self.grids[k] = *grid;
+            }
+        }
     }
 
-    /// The region a pass making fragments of `geometry` binds.
-    pub fn region(&self, geometry: Geometry) -> wgpu::BindingResource<'_> {
+    /// Sets where the next build (`build`, per grid) and update (`update`) make fragments; a
+    /// grid without an entry makes none.
+    pub fn set_regions(&self, queue: &wgpu::Queue, build: &[Region], update: &[Region]) {
+        for (k, w) in self.windows.iter().enumerate() {
+            let at = |r: &[Region]| r.get(k).copied().unwrap_or(Region::EMPTY);
+            queue.write_buffer(&w.regions, 0, &regions_bytes(at(build), at(update)));
+        }
+    }
+
+    /// The region a pass making fragments of `geometry` on grid `window` binds.
+    pub fn region(&self, window: usize, geometry: Geometry) -> wgpu::BindingResource<'_> {
         let offset = match geometry {
             Geometry::Static => 0,
             Geometry::Dynamic => REGION_STRIDE,
         };
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.regions,
+            buffer: &self.windows[window].regions,
             offset,
             size: wgpu::BufferSize::new(size_of::<GpuRegion>() as u64),
         })
@@ -324,14 +368,14 @@ pub fn triangle_table(
     })
 }
 
-/// The fragment buffer on `grid` with room for `wanted` fragments, or as many as this device's
-/// storage-buffer limit allows (a build that overflows it counts, and the pools grow).
-pub fn allocate(device: &wgpu::Device, grid: Grid, wanted: u64) -> Result<Fragments> {
+/// The fragment buffer on `grids` with room for `wanted` fragments, or as many as this
+/// device's storage-buffer limit allows (a build that overflows it counts, and the pools grow).
+pub fn allocate(device: &wgpu::Device, grids: &[Grid], wanted: u64) -> Result<Fragments> {
     let capacity = capacity(
         device,
         wanted.min(crate::gpu::max_entries(device, FRAGMENT_BYTES)),
     )?;
     crate::gpu::checked(device, "voxel fragments", || {
-        Fragments::new(device, grid, capacity)
+        Fragments::new(device, grids, capacity)
     })
 }

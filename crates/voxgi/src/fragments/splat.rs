@@ -41,12 +41,13 @@ impl SplatPass {
 
     /// The pass's bind group over `scene`'s static geometry points (`Geometry::Static`: the
     /// build's) or its dynamic clouds' (`Geometry::Dynamic`: each update's) into `fragments`
-    /// (made once per fragment buffer).
+    /// on their grid `window` (made once per fragment buffer).
     pub fn bind(
         &self,
         device: &wgpu::Device,
         scene: &GpuScene,
         fragments: &Fragments,
+        window: usize,
         which: Geometry,
     ) -> SplatBind {
         let (first, count) = points_of(scene, which);
@@ -59,12 +60,12 @@ impl SplatPass {
             label: Some("splat"),
             layout: &self.layout,
             entries: &layout::entries(vec![
-                fragments.grid_uniform.as_entire_binding(),
+                fragments.windows[window].grid.as_entire_binding(),
                 scene.points.as_entire_binding(),
                 scene.point_regions.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
-                fragments.region(which),
+                fragments.region(window, which),
                 range.as_entire_binding(),
             ]),
         });

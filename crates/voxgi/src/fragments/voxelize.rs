@@ -59,19 +59,21 @@ impl VoxelizePass {
         }
     }
 
-    /// The pass's bind group over `triangles` into `fragments` (made once per fragment buffer).
+    /// The pass's bind group over `triangles` into `fragments` on their grid `window` (made
+    /// once per fragment buffer).
     pub fn bind(
         &self,
         device: &wgpu::Device,
         scene: &GpuScene,
         triangles: &TriangleTable,
         fragments: &Fragments,
+        window: usize,
     ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxelize"),
             layout: &self.layout,
             entries: &layout::entries(vec![
-                fragments.grid_uniform.as_entire_binding(),
+                fragments.windows[window].grid.as_entire_binding(),
                 scene.vertices.as_entire_binding(),
                 scene.indices.as_entire_binding(),
                 scene.draws.as_entire_binding(),
@@ -81,11 +83,14 @@ impl VoxelizePass {
                 triangles.buffer.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
-                fragments.region(if triangles.dynamic {
-                    Geometry::Dynamic
-                } else {
-                    Geometry::Static
-                }),
+                fragments.region(
+                    window,
+                    if triangles.dynamic {
+                        Geometry::Dynamic
+                    } else {
+                        Geometry::Static
+                    },
+                ),
             ]),
         })
     }

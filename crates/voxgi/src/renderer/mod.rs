@@ -102,7 +102,7 @@ pub struct Renderer {
     bounce_globals: Option<BounceGlobals>,
     /// The bind groups of voxelize and splat, made on the first voxel update after the
     /// fragments were made anew.
-    fragment_binds: Option<order::FragmentBinds>,
+    fragment_binds: Option<Vec<order::FragmentBinds>>,
     /// The shadow and moments passes' bind groups, made on the first shadow render after the
     /// atlas was made anew.
     shadow_binds: Option<order::ShadowBinds>,
@@ -274,9 +274,9 @@ impl Renderer {
         for (c, pc) in scene.point_clouds.iter().enumerate() {
             gpu_scene.park_spare(queue, c, pc.positions.len(), parking(&grid));
         }
-        let fragments = fragments::allocate(device, grid, facts.fragments_wanted(options, &grid))?;
         let mut volume =
             (options.voxels.info().create)(device, &facts.structure_desc(options, grid), None)?;
+        let fragments = allocate_fragments(device, &facts, options, volume.as_ref())?;
         volume.bind_fragments(device, &fragments);
         let passes = checked(device, "pipeline creation", || Passes {
             shadow: ShadowPass::new(device),
@@ -307,7 +307,7 @@ impl Renderer {
         })??;
         let mut fragments = fragments;
         let mut built = false;
-        if sizing::in_doubt(device, &facts.estimate, &grid, volume.as_ref()) {
+        if sizing::in_doubt(device, &facts.estimate, volume.as_ref()) {
             let sizing = Sizing {
                 device,
                 queue,
@@ -435,18 +435,8 @@ impl Renderer {
         } else {
             None
         };
-        // The fragments depend on the grid only: a change of anisotropy keeps their grown pool.
-        let mut fragments_new = if old.voxel_resolution != new.voxel_resolution {
-            Some(fragments::allocate(
-                device,
-                grid,
-                self.facts.fragments_wanted(new, &grid),
-            )?)
-        } else {
-            None
-        };
         // Large triangles take more voxelize workgroups on a finer grid.
-        let tables_new = if fragments_new.is_some() {
+        let tables_new = if volume {
             Some(checked(device, "voxelization table", || {
                 Ok::<_, Error>((
                     triangle_table(device, &self.scene, false, &grid)?,
@@ -462,6 +452,19 @@ impl Renderer {
                 &self.facts.structure_desc(new, grid),
                 Some(self.volume.as_ref()),
             )?)
+        } else {
+            None
+        };
+        // The fragments depend on the grids only: a change of anisotropy keeps their grown
+        // pool.
+        let grids_changed = volume_new
+            .as_ref()
+            .is_some_and(|v| v.fragment_grids() != self.fragments.grids);
+        let mut fragments_new = if grids_changed {
+            let v = volume_new
+                .as_ref()
+                .expect("grids changed with a new structure");
+            Some(allocate_fragments(device, &self.facts, new, v.as_ref())?)
         } else {
             None
         };
@@ -492,7 +495,7 @@ impl Renderer {
         // as it was.
         let mut built = false;
         if let Some(v) = volume_new.as_mut()
-            && sizing::in_doubt(device, &self.facts.estimate, &grid, v.as_ref())
+            && sizing::in_doubt(device, &self.facts.estimate, v.as_ref())
         {
             let sizing = Sizing {
                 device,
@@ -660,9 +663,9 @@ impl Renderer {
             // pool grown to the limit and rebuilt forever.
             let fragments = if counts.fragments > frags {
                 let capacity = fragments::capacity(&self.device, counts.fragments)?;
-                let grid = self.fragments.grid;
+                let grids = self.fragments.grids.clone();
                 Some(checked(&self.device, "voxel fragments", || {
-                    Fragments::new(&self.device, grid, capacity)
+                    Fragments::new(&self.device, &grids, capacity)
                 })?)
             } else {
                 None
@@ -797,6 +800,21 @@ impl Renderer {
     pub fn reset_history(&mut self) {
         self.temporal.reset();
     }
+}
+
+/// The fragment buffer for `volume`'s grids, sized by the scene's estimate on them.
+fn allocate_fragments(
+    device: &wgpu::Device,
+    facts: &SceneFacts,
+    options: &RendererOptions,
+    volume: &dyn VoxelStructure,
+) -> Result<Fragments> {
+    let grids = volume.fragment_grids();
+    let wanted = grids
+        .iter()
+        .map(|g| facts.fragments_wanted(options, g))
+        .sum();
+    fragments::allocate(device, &grids, wanted)
 }
 
 /// The volume's grid around the scene.

@@ -39,7 +39,7 @@ use crate::lighting::bounces;
 use crate::lighting::inject::InjectPass;
 use crate::options::{FrameParams, IndirectShading, ShadowFilter, validate_size};
 use crate::view::camera_view_proj;
-use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, Region, VoxelWork};
+use crate::voxel::{DebugView, FrameChanges, POOL_COUNTERS, VoxelWork};
 use glam::{Mat4, Vec3};
 
 /// What `Renderer::prepare` did, for the frame it prepared.
@@ -431,6 +431,9 @@ impl Renderer {
     ) -> Option<bool> {
         let pending = std::mem::take(&mut self.pending);
         let geometry = !work.is_empty();
+        // Where the structure's windows are now (`plan` may have moved them).
+        self.fragments
+            .set_grids(&self.queue, &self.volume.fragment_grids());
         // With bounce slices, the updates after a change that gather the slices still due:
         // the direct light is stored again (bounces overwrote it), filtered, and bounced.
         let follow_up = !(geometry || pending.lights) && self.slices_left > 0;
@@ -438,8 +441,8 @@ impl Renderer {
         let relit = relight.then_some(pending.rebuild);
         self.fragments.set_regions(
             &self.queue,
-            work.build.unwrap_or(Region::EMPTY),
-            work.update.unwrap_or(Region::EMPTY),
+            work.build.as_deref().unwrap_or_default(),
+            work.update.as_deref().unwrap_or_default(),
         );
         if relight {
             self.passes.inject.prepare(
@@ -460,37 +463,39 @@ impl Renderer {
         let timer = &mut self.timer;
         let p = &self.passes;
         // Made once per fragment buffer (cleared where the fragments are made anew).
-        let fb = self.fragment_binds.get_or_insert_with(|| FragmentBinds {
-            voxelize_static: p.voxelize.bind(
-                &self.device,
-                &self.scene,
-                &self.static_triangles,
-                &self.fragments,
-            ),
-            voxelize_dynamic: p.voxelize.bind(
-                &self.device,
-                &self.scene,
-                &self.dynamic_triangles,
-                &self.fragments,
-            ),
-            splat_static: (self.scene.static_points > 0).then(|| {
-                p.splat
-                    .bind(&self.device, &self.scene, &self.fragments, Geometry::Static)
-            }),
-            splat_dynamic: (self.scene.geometry_points > self.scene.static_points).then(|| {
-                p.splat.bind(
-                    &self.device,
-                    &self.scene,
-                    &self.fragments,
-                    Geometry::Dynamic,
-                )
-            }),
+        let fb = self.fragment_binds.get_or_insert_with(|| {
+            let (device, scene, fragments) = (&self.device, &self.scene, &self.fragments);
+            (0..fragments.grids.len())
+                .map(|k| FragmentBinds {
+                    voxelize_static: p.voxelize.bind(
+                        device,
+                        scene,
+                        &self.static_triangles,
+                        fragments,
+                        k,
+                    ),
+                    voxelize_dynamic: p.voxelize.bind(
+                        device,
+                        scene,
+                        &self.dynamic_triangles,
+                        fragments,
+                        k,
+                    ),
+                    splat_static: (scene.static_points > 0)
+                        .then(|| p.splat.bind(device, scene, fragments, k, Geometry::Static)),
+                    splat_dynamic: (scene.geometry_points > scene.static_points)
+                        .then(|| p.splat.bind(device, scene, fragments, k, Geometry::Dynamic)),
+                })
+                .collect()
         });
         if work.build.is_some() && !pending.built {
             self.fragments.record_clear(encoder);
-            p.voxelize
-                .record(encoder, &self.static_triangles, &fb.voxelize_static, timer);
-            p.splat.record(encoder, fb.splat_static.as_ref(), timer);
+            // Each grid's fragments in turn (one for most structures; a clipmap's windows).
+            for b in fb.iter() {
+                p.voxelize
+                    .record(encoder, &self.static_triangles, &b.voxelize_static, timer);
+                p.splat.record(encoder, b.splat_static.as_ref(), timer);
+            }
             self.fragments.record_mark(encoder);
             cut(encoder, "voxelize");
             self.volume
@@ -499,13 +504,11 @@ impl Renderer {
         }
         if work.update.is_some() {
             self.fragments.record_truncate(encoder);
-            p.voxelize.record(
-                encoder,
-                &self.dynamic_triangles,
-                &fb.voxelize_dynamic,
-                timer,
-            );
-            p.splat.record(encoder, fb.splat_dynamic.as_ref(), timer);
+            for b in fb.iter() {
+                p.voxelize
+                    .record(encoder, &self.dynamic_triangles, &b.voxelize_dynamic, timer);
+                p.splat.record(encoder, b.splat_dynamic.as_ref(), timer);
+            }
             self.volume
                 .record_update(&self.device, encoder, &self.fragments, timer);
             cut(encoder, "update");
@@ -696,8 +699,8 @@ pub(super) struct FrameBinds {
     tonemap: Vec<wgpu::BindGroup>,
 }
 
-/// The bind groups of the passes that make fragments: made on the first voxel update after
-/// the fragment buffer was made anew.
+/// The bind groups of the passes that make fragments on one of the fragments' grids: made on
+/// the first voxel update after the fragment buffer was made anew.
 pub(super) struct FragmentBinds {
     voxelize_static: wgpu::BindGroup,
     voxelize_dynamic: wgpu::BindGroup,

@@ -17,7 +17,7 @@ use crate::fragments::{
 use crate::gpu::readback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::voxel::{Grid, POOL_COUNTERS, Region, VoxelStructure};
+use crate::voxel::{POOL_COUNTERS, Region, VoxelStructure};
 use crate::{Error, Result};
 
 /// What a counting build needs of the renderer.
@@ -30,16 +30,15 @@ pub(super) struct Sizing<'a> {
     pub splat: &'a SplatPass,
 }
 
-/// Whether `estimate` on `grid` leaves the fragments or `volume`'s leaves in doubt on this
+/// Whether `estimate` on `volume`'s grids leaves the fragments or its leaves in doubt on this
 /// device: the estimate bounds both (a fragment per voxel a triangle or point touches; a leaf
 /// per voxel with a fragment), so below both limits nothing can be refused.
 pub(super) fn in_doubt(
     device: &wgpu::Device,
     estimate: &FragmentEstimate,
-    grid: &Grid,
     volume: &dyn VoxelStructure,
 ) -> bool {
-    let bound = estimate.at(grid);
+    let bound: u64 = volume.fragment_grids().iter().map(|g| estimate.at(g)).sum();
     cfg!(not(target_arch = "wasm32"))
         && (bound > crate::gpu::max_entries(device, FRAGMENT_BYTES)
             || bound > volume.leaf_limit(device))
@@ -61,8 +60,9 @@ impl Sizing<'_> {
         fragments: &Fragments,
         volume: &mut Box<dyn VoxelStructure>,
     ) -> Result<(Option<Fragments>, bool)> {
-        let grid = volume.grid();
-        fragments.set_regions(self.queue, Region::all(&grid), Region::EMPTY);
+        let grids = volume.fragment_grids();
+        let all: Vec<Region> = grids.iter().map(Region::all).collect();
+        fragments.set_regions(self.queue, &all, &[]);
         let mut count = self.voxelize(fragments)?;
         let mut grown = None;
         if count > fragments.capacity as u64 {
@@ -73,15 +73,15 @@ impl Sizing<'_> {
                      GPU's storage-buffer limit of {} MiB holds ({limit}); lower the voxel \
                      resolution (each halving divides the fragments by about 4)",
                     self.device.limits().max_storage_buffer_binding_size >> 20,
-                    r = grid.resolution
+                    r = grids[0].resolution
                 )));
             }
             log::info!("voxels: {count} fragments counted before the first frame");
             let capacity = fragments::capacity(self.device, count)?;
             let f = crate::gpu::checked(self.device, "voxel fragments", || {
-                Fragments::new(self.device, grid, capacity)
+                Fragments::new(self.device, &grids, capacity)
             })?;
-            f.set_regions(self.queue, Region::all(&grid), Region::EMPTY);
+            f.set_regions(self.queue, &all, &[]);
             count = self.voxelize(&f)?;
             grown = Some(f);
         }
@@ -108,19 +108,21 @@ impl Sizing<'_> {
     /// Voxelizes the static geometry and the static points into `fragments`, waited for: the
     /// fragments made, counted past the capacity.
     fn voxelize(&self, fragments: &Fragments) -> Result<u64> {
-        let voxelize = self
-            .voxelize
-            .bind(self.device, self.scene, self.triangles, fragments);
-        let splat = (self.scene.static_points > 0).then(|| {
-            self.splat
-                .bind(self.device, self.scene, fragments, Geometry::Static)
-        });
         let mut timer = GpuTimer::disabled(self.queue);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         fragments.record_clear(&mut encoder);
-        self.voxelize
-            .record(&mut encoder, self.triangles, &voxelize, &mut timer);
-        self.splat.record(&mut encoder, splat.as_ref(), &mut timer);
+        for k in 0..fragments.grids.len() {
+            let voxelize =
+                self.voxelize
+                    .bind(self.device, self.scene, self.triangles, fragments, k);
+            let splat = (self.scene.static_points > 0).then(|| {
+                self.splat
+                    .bind(self.device, self.scene, fragments, k, Geometry::Static)
+            });
+            self.voxelize
+                .record(&mut encoder, self.triangles, &voxelize, &mut timer);
+            self.splat.record(&mut encoder, splat.as_ref(), &mut timer);
+        }
         fragments.record_mark(&mut encoder);
         Ok(self.read(encoder, &[(&fragments.count, 1)])?[0] as u64)
     }

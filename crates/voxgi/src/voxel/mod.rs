@@ -73,14 +73,16 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
     fn plan(&mut self, changes: &FrameChanges) -> VoxelWork {
         let grid = self.grid();
         VoxelWork {
-            build: changes.rebuild.then(|| Region::all(&grid)),
-            // Two voxels of margin: a dynamic fragment's voxel holds a vertex, or lies one
-            // voxel behind one (the solid's inner voxel), and the GPU's transform of a vertex
-            // may round across a voxel face the CPU's box does not.
-            update: changes
-                .dynamic
-                .map(|b| Region::around(&grid, b.min, b.max, 2)),
+            build: changes.rebuild.then(|| vec![Region::all(&grid)]),
+            update: changes.dynamic.map(|b| vec![dynamic_region(&grid, b)]),
         }
+    }
+
+    /// The grids its fragments lie on, the finest voxels: its own grid, or a camera-following
+    /// structure's windows (as `plan` last placed them), whose fragments are stacked along z
+    /// (window k's at z + k · resolution). Their number never changes.
+    fn fragment_grids(&self) -> Vec<Grid> {
+        vec![self.grid()]
     }
     /// The structure's kind (its name is also its WGSL folder: `shaders/voxels/<kind>/`).
     fn kind(&self) -> VoxelKind;
@@ -158,14 +160,23 @@ pub struct FrameChanges {
     pub dynamic: Option<Aabb>,
 }
 
-/// The regions a structure needs voxelized this frame (`VoxelStructure::plan`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// The regions a structure needs voxelized this frame (`VoxelStructure::plan`), one per grid
+/// of `VoxelStructure::fragment_grids` (a grid without one makes no fragments).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct VoxelWork {
-    /// Build from the static geometry and the points in this region (`record_build`).
-    pub build: Option<Region>,
-    /// Merge the dynamic geometry in this region (`record_update`; it runs even when the
-    /// region is empty, to take out the last update).
-    pub update: Option<Region>,
+    /// Build from the static geometry and the points in these regions (`record_build`).
+    pub build: Option<Vec<Region>>,
+    /// Merge the dynamic geometry in these regions (`record_update`; it runs even when they
+    /// are empty, to take out the last update).
+    pub update: Option<Vec<Region>>,
+}
+
+/// Where the dynamic geometry inside world box `b` makes fragments on `grid`. Two voxels of
+/// margin: a dynamic fragment's voxel holds a vertex, or lies one voxel behind one (the
+/// solid's inner voxel), and the GPU's transform of a vertex may round across a voxel face
+/// the CPU's box does not.
+pub fn dynamic_region(grid: &Grid, b: Aabb) -> Region {
+    Region::around(grid, b.min, b.max, 2)
 }
 
 impl VoxelWork {

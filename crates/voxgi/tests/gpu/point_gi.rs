@@ -116,7 +116,7 @@ fn splat_matches_its_cpu_twin() {
     frame(&mut renderer, &params, 8, 8);
     let (device, queue) = (&ctx().device, &ctx().queue);
     let f = renderer.fragments();
-    let grid = f.grid;
+    let grid = f.grids[0];
     let count = read_buffer_copy(device, queue, &f.count).expect("count");
     let count = bytemuck::cast_slice::<u8, u32>(&count)[0] as usize;
     let bytes = read_buffer_copy(device, queue, &f.buffer).expect("fragments");
