@@ -282,8 +282,13 @@ pub struct RendererOptions {
     /// The voxel structure: the dense volume (default) or the sparse voxel octree.
     pub voxels: VoxelKind,
     /// Voxels per side of the volume at the finest level: a power of two in 16..=512 (the
-    /// octree: 16..=1024). Default 128.
+    /// octree: 16..=1024; the clipmap: each level's, 16..=256). Default 128.
     pub voxel_resolution: u32,
+    /// The clipmap's levels (2..=8), each twice the extent of the one inside it. Default 5.
+    pub clipmap_levels: u32,
+    /// The clipmap's finest voxel edge, metres: `None` (default) makes its coarsest level
+    /// span four times the scene's cube (the camera may stand anywhere near it).
+    pub voxel_size: Option<f32>,
     /// Six directional values per voxel above the finest level (true, default) or one.
     pub anisotropic: bool,
     /// The first directional level weighs each leaf's radiance and opacity along each of the six
@@ -376,6 +381,8 @@ impl Default for RendererOptions {
             default_light: true,
             voxels: VoxelKind::DENSE,
             voxel_resolution: 128,
+            clipmap_levels: 5,
+            voxel_size: None,
             anisotropic: true,
             ndf_mips: false,
             gather_axes: 3,

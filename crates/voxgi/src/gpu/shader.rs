@@ -1,8 +1,9 @@
 //! WGSL composition: a shader names the shared files it needs with `//!include shared/NAME.wgsl`
 //! lines, which are replaced by those files (each at most once). `//!include voxels/NAME.wgsl`
-//! picks the voxel structure's own file, `voxels/<kind>/NAME.wgsl`: that is how cone tracing,
-//! written once, meets a structure. Tiny on purpose: WGSL has no modules yet, and this is all
-//! voxgi needs.
+//! picks the voxel structure's own file, `voxels/<kind>/NAME.wgsl` (or its base kind's, when
+//! it has none of that name): that is how cone tracing, written once, meets a structure.
+//! `//!include voxels/OTHER/NAME.wgsl` names another kind's file itself. Tiny on purpose:
+//! WGSL has no modules yet, and this is all voxgi needs.
 
 /// `&[(path, source)]` of WGSL files by path relative to `crates/voxgi/shaders`, their
 /// sources built in.
@@ -25,6 +26,9 @@ pub struct StructureShaders {
     /// Of those, the shaders with entry points of the structure's own passes (validated on
     /// their own by the tests).
     pub passes: &'static [&'static str],
+    /// A structure built on another (the clipmap on the dense volume's windows): the files
+    /// this one does not have are that one's.
+    pub base: Option<&'static StructureShaders>,
 }
 
 /// Every WGSL file outside the structures' folders, by path relative to `crates/voxgi/shaders`.
@@ -90,6 +94,7 @@ fn raw(name: &str, kind: Option<&StructureShaders>) -> std::borrow::Cow<'static,
     SOURCES
         .iter()
         .chain(kind.map_or(&[][..], |k| k.sources))
+        .chain(kind.and_then(|k| k.base).map_or(&[][..], |b| b.sources))
         .find(|(n, _)| *n == name)
         .map(|(_, s)| (*s).into())
         // The sources are built in: a missing one is a bug in voxgi, found by its tests.
@@ -110,7 +115,23 @@ pub fn compose_with(name: &str, kind: Option<&StructureShaders>) -> String {
     out
 }
 
+/// `name`, or the base kind's file of that name when it is a structure's file the structure
+/// does not have.
+fn resolve(name: &str, kind: Option<&StructureShaders>) -> String {
+    let Some(k) = kind else {
+        return name.to_string();
+    };
+    let own = format!("voxels/{}/", k.name);
+    match (name.strip_prefix(&own), k.base) {
+        (Some(file), Some(b)) if !k.sources.iter().any(|(n, _)| *n == name) => {
+            format!("voxels/{}/{file}", b.name)
+        }
+        _ => name.to_string(),
+    }
+}
+
 fn expand(name: &str, kind: Option<&StructureShaders>, out: &mut String, seen: &mut Vec<String>) {
+    let name = &resolve(name, kind);
     if seen.iter().any(|s| s == name) {
         return;
     }
@@ -120,12 +141,12 @@ fn expand(name: &str, kind: Option<&StructureShaders>, out: &mut String, seen: &
             let inc = inc.trim();
             match (inc.strip_prefix("voxels/"), kind) {
                 (Some(file), Some(k)) => {
-                    let own = format!("voxels/{}/", k.name);
-                    // A structure's files name each other by their full path.
-                    let path = if inc.starts_with(&own) {
+                    // A structure's files name each other (and a base kind's) by their full
+                    // path; a bare name is the kind's own file, or else its base's.
+                    let path = if file.contains('/') {
                         inc.to_string()
                     } else {
-                        format!("{own}{file}")
+                        format!("voxels/{}/{file}", k.name)
                     };
                     expand(&path, kind, out, seen)
                 }

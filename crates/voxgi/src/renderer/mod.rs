@@ -189,6 +189,8 @@ impl SceneFacts {
                 .unwrap_or_else(|| self.estimate.at(&grid) / 4)
                 .min((grid.resolution as u64).pow(3)),
             dynamic: self.dynamic,
+            levels: options.clipmap_levels,
+            voxel_size: options.voxel_size,
         }
     }
 
@@ -402,6 +404,8 @@ impl Renderer {
         let kind = old.voxels != new.voxels;
         let volume = kind
             || old.voxel_resolution != new.voxel_resolution
+            || old.clipmap_levels != new.clipmap_levels
+            || old.voxel_size != new.voxel_size
             || old.anisotropic != new.anisotropic
             || old.ndf_mips != new.ndf_mips;
         let atlas = old.shadow_map_size != new.shadow_map_size

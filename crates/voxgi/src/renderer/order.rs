@@ -147,6 +147,7 @@ impl Renderer {
             camera: params.camera.position,
             rebuild: due && self.pending.rebuild,
             dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
+            dynamic_now: self.facts.dynamic.then(|| self.state.dynamic_bounds()),
         });
         let relit = if due || !work.is_empty() {
             self.record_voxels(encoder, work, &mut |_, _| {})
@@ -265,6 +266,7 @@ impl Renderer {
             camera: params.camera.position,
             rebuild: self.pending.rebuild,
             dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
+            dynamic_now: self.facts.dynamic.then(|| self.state.dynamic_bounds()),
         });
         let rebuild = self.pending.rebuild;
         let relit = self.record_voxels(&mut encoder, work, &mut cut);
@@ -431,6 +433,9 @@ impl Renderer {
     ) -> Option<bool> {
         let pending = std::mem::take(&mut self.pending);
         let geometry = !work.is_empty();
+        // A build replaces every leaf (a camera-following structure builds when its windows
+        // move): everything is lit anew, as after a rebuild.
+        let rebuilt = pending.rebuild || work.build.is_some();
         // Where the structure's windows are now (`plan` may have moved them).
         self.fragments
             .set_grids(&self.queue, &self.volume.fragment_grids());
@@ -438,7 +443,7 @@ impl Renderer {
         // the direct light is stored again (bounces overwrote it), filtered, and bounced.
         let follow_up = !(geometry || pending.lights) && self.slices_left > 0;
         let relight = geometry || pending.lights || follow_up;
-        let relit = relight.then_some(pending.rebuild);
+        let relit = relight.then_some(rebuilt);
         self.fragments.set_regions(
             &self.queue,
             work.build.as_deref().unwrap_or_default(),
@@ -451,7 +456,7 @@ impl Renderer {
                 &self.scene,
                 &self.atlas,
                 &*self.volume,
-                pending.rebuild || pending.lights,
+                rebuilt || pending.lights,
                 // Stored bounces overwrite the radiance: it must start from the direct light
                 // again.
                 bounces::stored_bounces(&self.options, self.voxel_bounces) > 0,
@@ -552,7 +557,7 @@ impl Renderer {
             let near = pending
                 .moved
                 .map(|m| crate::lighting::bounce::near_change(m, tan));
-            bounce_globals.prepare(&self.queue, self.bounce_turn, pending.rebuild, near);
+            bounce_globals.prepare(&self.queue, self.bounce_turn, rebuilt, near);
             self.bounce_turn = self.bounce_turn.wrapping_add(1);
         }
         let bounce_globals = &*bounce_globals;

@@ -90,8 +90,9 @@ pub static SETTINGS: &[Setting] = &[
     Setting {
         key: "voxels",
         label: "voxel structure",
-        help: "The voxel structure: dense (the mip-mapped volume) or octree (the sparse voxel \
-               octree, memory in proportion to the occupied voxels).",
+        help: "The voxel structure: dense (the mip-mapped volume), octree (the sparse voxel \
+               octree, memory in proportion to the occupied voxels) or clipmap (levels that \
+               follow the camera, fine near it and coarse far away: large worlds).",
         domain: Domain::Choice(VoxelKind::names),
         changes: Changes::Voxels,
         access: Access::Options {
@@ -112,6 +113,23 @@ pub static SETTINGS: &[Setting] = &[
         domain: Domain::Resolution { min: 16 },
         changes: Changes::Voxels,
         access: access!(options int voxel_resolution),
+    },
+    Setting {
+        key: "clipmap_levels",
+        label: "clipmap levels",
+        help: "The clipmap's levels, each twice the extent of the one inside it.",
+        domain: Domain::Int { min: 2, max: 8 },
+        changes: Changes::Voxels,
+        access: access!(options int clipmap_levels),
+    },
+    Setting {
+        key: "voxel_size",
+        label: "finest voxel (m)",
+        help: "The clipmap's finest voxel edge in metres; auto: its coarsest level spans four \
+               times the scene.",
+        domain: Domain::Auto,
+        changes: Changes::Voxels,
+        access: access!(options auto voxel_size),
     },
     Setting {
         key: "anisotropic",

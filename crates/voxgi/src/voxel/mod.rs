@@ -3,9 +3,11 @@
 //! A structure is anything cone tracing can sample (DESIGN.md, seam 2). In Rust it implements
 //! `VoxelStructure`; in WGSL it provides `shaders/voxels/<kind>/sample.wgsl`, the contract of
 //! names cone tracing uses (`shaders/shared/cone.wgsl`), reading only its own `@group(1)`.
-//! Two structures: the dense mip-mapped volume (`dense/`) and the sparse voxel octree
-//! (`octree/`); `RendererOptions::voxels` picks one.
+//! Three structures: the dense mip-mapped volume (`dense/`), the sparse voxel octree
+//! (`octree/`) and clipmap cascades that follow the camera (`clipmap/`, built on the dense
+//! volume's windows); `RendererOptions::voxels` picks one.
 
+pub mod clipmap;
 pub mod cpu;
 pub mod dense;
 pub mod octree;
@@ -91,6 +93,12 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
     fn as_any(&self) -> &dyn std::any::Any;
     /// The grid of its finest voxels (the fragments' grid).
     fn grid(&self) -> Grid;
+    /// The finest voxel edge it holds about `p` (the CPU side of `voxels_voxel_size_at`):
+    /// its grid's, unless its voxels coarsen away from the camera.
+    fn voxel_size_at(&self, p: Vec3) -> f32 {
+        let _ = p;
+        self.grid().voxel_size
+    }
     /// Records a build from `fragments` (the static geometry's), replacing the previous one:
     /// leaves get albedo, normal, emission and opacity; their radiance is cleared.
     fn record_build(
@@ -158,6 +166,9 @@ pub struct FrameChanges {
     /// Dynamic geometry is to be voxelized again: where every dynamic instance is now (world
     /// space). `None` when nothing moved or the scene has no dynamic instances.
     pub dynamic: Option<Aabb>,
+    /// Where every dynamic instance is now, moved or not (for a structure that rebuilds on
+    /// its own, and must merge them again). `None` without dynamic instances.
+    pub dynamic_now: Option<Aabb>,
 }
 
 /// The regions a structure needs voxelized this frame (`VoxelStructure::plan`), one per grid
@@ -193,9 +204,12 @@ impl VoxelKind {
     pub const DENSE: VoxelKind = VoxelKind::new(&dense::KIND);
     /// The sparse voxel octree: memory in proportion to the occupied voxels.
     pub const OCTREE: VoxelKind = VoxelKind::new(&octree::KIND);
+    /// Clipmap cascades: levels that follow the camera, for large worlds.
+    pub const CLIPMAP: VoxelKind = VoxelKind::new(&clipmap::KIND);
 
     /// Every kind, in the order settings list them. A new kind is one entry here.
-    pub const ALL: &'static [VoxelKind] = &[VoxelKind::DENSE, VoxelKind::OCTREE];
+    pub const ALL: &'static [VoxelKind] =
+        &[VoxelKind::DENSE, VoxelKind::OCTREE, VoxelKind::CLIPMAP];
 
     /// Every kind's name, in the registry's order.
     pub fn names() -> Vec<&'static str> {
@@ -228,9 +242,17 @@ impl Default for VoxelKind {
 /// screen's.
 pub fn voxel_passes() -> Vec<&'static str> {
     let mut v = vec!["shadow", "moments", "voxelize", "splat"];
-    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.info().build_passes));
+    let add = |v: &mut Vec<&'static str>, names: &[&'static str]| {
+        // A kind built on another runs that one's passes: each scope once.
+        v.extend(names.iter().filter(|n| !v.contains(n)).collect::<Vec<_>>());
+    };
+    for k in VoxelKind::ALL {
+        add(&mut v, k.info().build_passes);
+    }
     v.push("inject");
-    v.extend(VoxelKind::ALL.iter().flat_map(|k| k.info().filter_passes));
+    for k in VoxelKind::ALL {
+        add(&mut v, k.info().filter_passes);
+    }
     v.push("bounce");
     v
 }

@@ -21,6 +21,10 @@ pub struct StructureDesc {
     pub leaves: u64,
     /// Whether the scene has dynamic instances (their updates need the static build kept).
     pub dynamic: bool,
+    /// A camera-following structure's levels (`RendererOptions::clipmap_levels`).
+    pub levels: u32,
+    /// A camera-following structure's finest voxel edge, metres (`None`: its own choice).
+    pub voxel_size: Option<f32>,
 }
 
 /// A kind of voxel structure, as its own module declares it.

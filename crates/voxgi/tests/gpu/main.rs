@@ -3,6 +3,7 @@
 //! in CI that is Mesa's lavapipe.
 
 mod analytic;
+mod clipmap;
 mod common;
 mod compare;
 mod contract;

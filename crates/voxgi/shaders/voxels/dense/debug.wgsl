@@ -24,7 +24,8 @@ struct DebugParams {
     level: u32,
     // The block of the chains shown (+X, -X, +Y, -Y, +Z, -Z).
     block: u32,
-    _pad1: u32,
+    // The window shown (`Volume::windows`; `vol` places it): 0, or a clipmap's level.
+    window: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -41,13 +42,18 @@ const MODE_OPACITY: u32 = 1u;
 const MODE_RADIANCE: u32 = 2u;
 const MODE_NODES: u32 = 3u;
 
+// Cell c of the shown window at a level `n` cells a side, in the stacked textures.
+fn in_window(c: vec3<i32>, n: i32) -> vec3<i32> {
+    return c + vec3<i32>(0, 0, n * i32(params.window));
+}
+
 fn cell_value(c: vec3<i32>) -> vec4<f32> {
     if params.level == 0u {
-        return from_depth(textureLoad(radiance0, c, 0));
+        return from_depth(textureLoad(radiance0, in_window(c, i32(vol.resolution)), 0));
     }
     let n = i32(vol.resolution) >> params.level;
     let block = n * i32(vol.windows) * i32(params.block);
-    return from_depth(textureLoad(chain, c + vec3<i32>(0, 0, block), i32(params.level) - 1));
+    return from_depth(textureLoad(chain, in_window(c, n) + vec3<i32>(0, 0, block), i32(params.level) - 1));
 }
 
 // Finest albedo under the coarse cell `cell` (of `scale` finest voxels per side) that the ray
@@ -63,7 +69,7 @@ fn albedo_under(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, cell: vec3<i32>, s
     var t_max = (next - o) * inv_d;
     let t_delta = abs(inv_d);
     for (var i = 0; i < 3 * scale + 3; i++) {
-        let a = textureLoad(albedo, c, 0);
+        let a = textureLoad(albedo, in_window(c, i32(vol.resolution)), 0);
         if a.a > 0.0 {
             return a.rgb;
         }
@@ -88,7 +94,7 @@ fn albedo_under(o: vec3<f32>, d: vec3<f32>, inv_d: vec3<f32>, cell: vec3<i32>, s
     for (var z = 0; z < scale; z += stride) {
         for (var y = 0; y < scale; y += stride) {
             for (var x = 0; x < scale; x += stride) {
-                let a = textureLoad(albedo, cell * scale + vec3<i32>(x, y, z), 0);
+                let a = textureLoad(albedo, in_window(cell * scale + vec3<i32>(x, y, z), i32(vol.resolution)), 0);
                 if a.a > 0.0 {
                     sum += vec4<f32>(a.rgb, 1.0);
                 }

@@ -14,7 +14,8 @@
 //   leaf_direct[i], leaf_next[i]                  per-leaf light: direct (inject) and bounced
 //
 // and voxels/<kind>/leaf_store.wgsl's store_leaf_radiance(i, premultiplied). All at
-// @group(2) (the store at @group(3)); `DenseVolume::leaves_layout` is the twin.
+// @group(2) (the store at @group(3)); `DenseVolume::leaves_layout` is the twin. The clipmap
+// takes this file as it is, with a placement.wgsl of its own.
 
 //!include shared/volume.wgsl
 
@@ -45,17 +46,8 @@ fn leaf_coord(i: u32) -> vec3<u32> {
     return voxel_coord(slot_voxel[i], leaf_grid.resolution);
 }
 
-fn leaf_center(i: u32) -> vec3<f32> {
-    return voxel_center(leaf_coord(i), leaf_grid);
-}
-
-fn leaf_size(i: u32) -> f32 {
-    return leaf_grid.voxel_size;
-}
-
-fn leaf_size_max() -> f32 {
-    return leaf_grid.voxel_size;
-}
+// Where leaves lie: voxels/<kind>/placement.wgsl (leaf_center, leaf_size, leaf_size_max).
+//!include voxels/placement.wgsl
 
 // Albedo (rgb) and opacity.
 fn leaf_albedo(i: u32) -> vec4<f32> {

@@ -47,8 +47,9 @@ impl DebugPass {
         }
     }
 
-    /// Records the view `view` (a voxel view) of mip `level` (0 = finest), reading directional
-    /// chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) above the finest level.
+    /// Records the view `view` (a voxel view) of mip `level` (0 = finest) of `vol`'s window
+    /// `window` (0 for the dense volume), placed by `placement` (a `Volume` uniform), reading
+    /// directional chain `direction` (0..6: +X, -X, +Y, -Y, +Z, -Z) above the finest level.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -56,6 +57,7 @@ impl DebugPass {
         encoder: &mut wgpu::CommandEncoder,
         t: &FrameTargets,
         vol: &DenseVolume,
+        (placement, window): (&wgpu::Buffer, u32),
         view: VoxelView,
         level: u32,
         direction: u32,
@@ -67,7 +69,7 @@ impl DebugPass {
         let block = direction.min(vol.chain_blocks() - 1);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("debug params"),
-            contents: bytemuck::cast_slice(&[mode, level, block, 0u32]),
+            contents: bytemuck::cast_slice(&[mode, level, block, window]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let chain = vol.chains.create_view(&Default::default());
@@ -78,7 +80,7 @@ impl DebugPass {
             layout: &self.layout,
             entries: &layout::entries(vec![
                 t.frame.as_entire_binding(),
-                vol.volume.as_entire_binding(),
+                placement.as_entire_binding(),
                 params.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&albedo),
                 wgpu::BindingResource::TextureView(&radiance),

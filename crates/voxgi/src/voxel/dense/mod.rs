@@ -60,6 +60,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/dense/sample.wgsl",
             "voxels/dense/windows.wgsl",
             "voxels/dense/leaves.wgsl",
+            "voxels/dense/placement.wgsl",
             "voxels/dense/leaf_store.wgsl",
             "voxels/dense/changed.wgsl",
             "voxels/dense/irradiance.wgsl",
@@ -75,6 +76,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/dense/filter.wgsl",
             "voxels/dense/debug.wgsl",
         ],
+        base: None,
     },
     sampling_layout: DenseVolume::sampling_layout,
     leaves_layout: DenseVolume::leaves_layout,
@@ -223,6 +225,18 @@ pub struct DenseVolume {
     /// The build steps' dispatch sizes, bound for the steps that write them.
     args_bind: wgpu::BindGroup,
     pipelines: Arc<DensePipelines>,
+}
+
+impl DenseVolume {
+    /// Its pipelines, for a structure built on it (the clipmap) to share.
+    pub fn pipelines(&self) -> &Arc<DensePipelines> {
+        &self.pipelines
+    }
+
+    /// Its debug pass, for a structure built on it.
+    pub fn debug_pass(&self) -> &DebugPass {
+        &self.pipelines.debug
+    }
 }
 
 /// How a step of dense_build or dense_update is dispatched.
@@ -916,6 +930,7 @@ impl VoxelStructure for DenseVolume {
             encoder,
             targets,
             self,
+            (&self.volume, 0),
             view.mode,
             view.level,
             view.direction,

@@ -76,6 +76,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/octree/octree_filter.wgsl",
             "voxels/octree/debug.wgsl",
         ],
+        base: None,
     },
     sampling_layout: OctreeVolume::sampling_layout,
     leaves_layout: OctreeVolume::leaves_layout,

@@ -1,0 +1,21 @@
+// The clipmap's levels: where each window lies. Twin: `GpuClipLevels` in
+// src/voxel/clipmap/mod.rs. Level k's voxels are 2^k times the finest; its window of
+// `resolution`³ voxels is window k of the dense volume's stacked textures, and moves with the
+// camera in steps of an eighth of itself.
+
+const MAX_CLIP_LEVELS: u32 = 8u;
+
+struct ClipLevels {
+    // Per level: its window's minimum corner (xyz), metres, and its voxel edge (w).
+    levels: array<vec4<f32>, 8>,
+    // The scene's cube, lowest and highest corner (xyz): past it there is nothing, so a
+    // window's face that lies on or beyond it needs no margin.
+    scene_lo: vec4<f32>,
+    scene_hi: vec4<f32>,
+    // Levels in use.
+    count: u32,
+    // Voxels per side of every window.
+    resolution: u32,
+    _pad0: u32,
+    _pad1: u32,
+}

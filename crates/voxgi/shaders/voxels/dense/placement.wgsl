@@ -1,0 +1,13 @@
+// Where the dense volume's leaves lie (voxels/dense/leaves.wgsl includes it): in its one grid.
+
+fn leaf_center(i: u32) -> vec3<f32> {
+    return voxel_center(leaf_coord(i), leaf_grid);
+}
+
+fn leaf_size(i: u32) -> f32 {
+    return leaf_grid.voxel_size;
+}
+
+fn leaf_size_max() -> f32 {
+    return leaf_grid.voxel_size;
+}

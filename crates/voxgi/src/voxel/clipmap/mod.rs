@@ -1,0 +1,655 @@
+//! Clipmap cascades: levels of `resolution`³ voxels centred on the camera, level k's voxels
+//! 2^k times the finest, so each level spans twice the one inside it (VXGI's 3D clipmaps; the
+//! large-world answer of every real-time voxel GI). A large world keeps fine voxels near the
+//! camera and coarse ones far away, in memory that does not grow with the world.
+//!
+//! Built on the dense volume: the levels are the windows of one `DenseVolume` (cubes stacked
+//! along z in every texture and buffer), each voxelized from its own fragments (the renderer
+//! makes a grid's fragments per level: `fragment_grids`), lit and bounced as leaves of their
+//! level's size, and filtered into its own directional mips. Cone tracing reads the finest
+//! level that holds a sample wholly and hands over to the next coarser across a band
+//! (shaders/voxels/clipmap/sample.wgsl).
+//!
+//! The windows follow the camera in steps of an eighth of themselves, on a lattice of their
+//! own voxels that starts at the scene's cube, so a voxel of a level covers the same place
+//! wherever its window is. A window stays inside the scene's cube where it can (a level wider
+//! than the scene is centred on it, as the dense volume is: at the dense volume's voxel size
+//! such a level is that volume), so no voxels are spent on the void past the world's edge.
+//! When a window moves, every level is voxelized and lit again: the cost of a move is a
+//! rebuild's (scrolling only the slabs newly inside, within a per-frame budget, is next).
+
+use super::dense::{self, DenseVolume};
+use super::registry::{KindInfo, StructureDesc};
+use super::{
+    DebugView, FrameChanges, GpuVolume, Grid, POOL_COUNTERS, Region, StructureBindings,
+    VoxelStructure, VoxelWork, dynamic_region,
+};
+use crate::fragments::Fragments;
+use crate::frame::targets::FrameTargets;
+use crate::gpu::layout;
+use crate::gpu::shader::StructureShaders;
+use crate::gpu::timer::GpuTimer;
+use crate::{Error, Result};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+/// Most levels (`MAX_CLIP_LEVELS` in shaders/voxels/clipmap/levels.wgsl).
+pub const MAX_LEVELS: u32 = 8;
+
+/// With `voxel_size` auto, the coarsest level spans this many times the scene's cube.
+const AUTO_SPAN: f32 = 4.0;
+
+/// Fragment coordinates hold 10 bits a axis: the stacked windows' depth, levels × resolution,
+/// is at most this.
+const MAX_STACK: u32 = 1024;
+
+/// Mirrors `ClipLevels` in shaders/voxels/clipmap/levels.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuClipLevels {
+    /// Per level: its window's minimum corner (xyz), metres, and its voxel edge (w).
+    pub levels: [[f32; 4]; MAX_LEVELS as usize],
+    /// The scene's cube, lowest corner (xyz; w unused).
+    pub scene_lo: [f32; 4],
+    /// Its highest corner.
+    pub scene_hi: [f32; 4],
+    /// Levels in use.
+    pub count: u32,
+    /// Voxels per side of every window.
+    pub resolution: u32,
+    /// Padding; zero.
+    pub _pad: [u32; 2],
+}
+
+/// The clipmap in the registry of kinds.
+pub const KIND: KindInfo = KindInfo {
+    name: "clipmap",
+    summary: "clipmap cascades: levels that follow the camera, fine near it and coarse far \
+              away, for worlds larger than one volume",
+    // Each level is a dense window; 256 × 4 levels fill the fragments' 10-bit coordinates.
+    max_resolution: 256,
+    // Its passes are the dense volume's.
+    build_passes: &["dense_build", "dense_update"],
+    filter_passes: &["filter"],
+    shaders: StructureShaders {
+        name: "clipmap",
+        sources: crate::wgsl![
+            "voxels/clipmap/levels.wgsl",
+            "voxels/clipmap/sample.wgsl",
+            "voxels/clipmap/placement.wgsl",
+            "voxels/clipmap/irradiance.wgsl",
+        ],
+        passes: &[],
+        base: Some(&dense::KIND.shaders),
+    },
+    sampling_layout: Clipmap::sampling_layout,
+    leaves_layout: Clipmap::leaves_layout,
+    leaf_store_layout: DenseVolume::leaf_store_layout,
+    irradiance_layout: DenseVolume::irradiance_layout,
+    sampling_constants: DenseVolume::sampling_constants,
+    create,
+};
+
+/// A clipmap for `desc`: `desc.levels` windows of `desc.grid.resolution`³ voxels, the finest
+/// `desc.voxel_size` (default: the coarsest level spans `AUTO_SPAN` times `desc.grid`, the
+/// scene's cube), placed
+/// around the scene's centre until the first frame's camera places them.
+fn create(
+    device: &wgpu::Device,
+    desc: &StructureDesc,
+    previous: Option<&dyn VoxelStructure>,
+) -> Result<Box<dyn VoxelStructure>> {
+    let res = desc.grid.resolution;
+    let count = desc.levels;
+    if !(2..=MAX_LEVELS).contains(&count) {
+        return Err(Error::Setting(format!(
+            "clipmap_levels {count} is outside 2..={MAX_LEVELS}"
+        )));
+    }
+    if count * res > MAX_STACK {
+        return Err(Error::Setting(format!(
+            "a clipmap of {count} levels of {res}³ voxels stacks {} voxels deep, past the {MAX_STACK} \
+             voxel coordinates hold: use at most {} levels at this resolution, or a lower \
+             voxel_resolution",
+            count * res,
+            MAX_STACK / res
+        )));
+    }
+    let finest = match desc.voxel_size {
+        Some(s) if s.is_finite() && s > 0.0 => s,
+        Some(s) => {
+            return Err(Error::Setting(format!(
+                "voxel_size {s} must be a positive number of metres"
+            )));
+        }
+        // The camera may stand anywhere near the scene: from within a scene's size of it,
+        // the coarsest level still holds all of it.
+        None => AUTO_SPAN * desc.grid.extent() / (res as f32 * (1u32 << (count - 1)) as f32),
+    };
+    log::info!(
+        "clipmap: {count} levels of {res}³ voxels, the finest {finest} m (level 0 spans {} m, \
+         level {} {} m)",
+        finest * res as f32,
+        count - 1,
+        finest * res as f32 * (1u32 << (count - 1)) as f32
+    );
+    let base = Grid {
+        origin: Vec3::ZERO,
+        voxel_size: finest,
+        resolution: res,
+    };
+    dense::check_volume_fits(device, &base, count)?;
+    let pipelines = match previous {
+        Some(p) => p
+            .as_any()
+            .downcast_ref::<Clipmap>()
+            .map(|c| c.inner.pipelines().clone())
+            .or_else(|| {
+                p.as_any()
+                    .downcast_ref::<DenseVolume>()
+                    .map(|d| d.pipelines().clone())
+            }),
+        None => None,
+    };
+    let pipelines = match pipelines {
+        Some(p) => p,
+        None => crate::gpu::checked(device, "pipeline creation", || {
+            dense::DensePipelines::new(device)
+        })?,
+    };
+    // Every level holds about as many surface voxels as the scene's cube at this resolution.
+    let wanted = (desc.leaves * count as u64).min((res as u64).pow(3) * count as u64);
+    let slots = crate::gpu::pool_capacity(
+        device,
+        wanted.min(crate::gpu::max_entries(device, dense::SLOT_BYTES)),
+        dense::SLOT_BYTES,
+        "occupied voxels",
+    )?;
+    let inner = crate::gpu::checked(device, "voxel volume", || {
+        DenseVolume::new(
+            device,
+            &pipelines,
+            base,
+            count,
+            desc.filtering,
+            slots,
+            desc.dynamic,
+        )
+    })?;
+    let scene = (desc.grid.origin, desc.grid.origin + desc.grid.extent());
+    let centre = (scene.0 + scene.1) * 0.5;
+    let levels = (0..count)
+        .map(|k| {
+            let s = finest * (1u32 << k) as f32;
+            let mut g = Grid {
+                origin: Vec3::ZERO,
+                voxel_size: s,
+                resolution: res,
+            };
+            g.origin = placed_origin(&g, scene, centre);
+            g
+        })
+        .collect();
+    Ok(Box::new(Clipmap::new(device, inner, levels, scene)))
+}
+
+/// The origin of a window like `g` for a camera at `camera` in a scene whose cube spans
+/// `scene`: centred on the camera, moved back inside the cube on each axis where it would
+/// poke out (centred on the cube where it is wider), on the lattice of its steps (an eighth of
+/// the window) from the cube's corner, so that its voxels lie where the level's always lie.
+fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
+    let half = Vec3::splat(g.extent() * 0.5);
+    let middle = (lo + hi) * 0.5;
+    let inside = camera.clamp(lo + half.min(middle - lo), hi - half.min(hi - middle));
+    let step = window_step(g);
+    lo + ((inside - lo) / step).round() * step - half
+}
+
+/// How far a window moves at a time: an eighth of it (at least a voxel).
+fn window_step(g: &Grid) -> f32 {
+    g.voxel_size * (g.resolution / 8).max(1) as f32
+}
+
+/// Clipmap cascades (the module's documentation says how).
+pub struct Clipmap {
+    /// The levels' voxels, one window each.
+    inner: DenseVolume,
+    /// Each level's window: where it lies, its voxel edge, its resolution.
+    levels: Vec<Grid>,
+    /// `GpuClipLevels` of `levels`, for sampling and for the leaves.
+    clip: wgpu::Buffer,
+    /// Whether `clip` holds `levels` as they are (written at the next build otherwise).
+    clip_current: std::sync::atomic::AtomicBool,
+    /// A `Volume` uniform placing one level's window, for the debug views.
+    debug_placement: wgpu::Buffer,
+    /// The scene's cube (its lowest and highest corner): the windows stay inside it where
+    /// they can, and their lattices start at its corner.
+    scene: (Vec3, Vec3),
+    /// The first frame's camera has placed the windows.
+    placed: bool,
+    sampling: wgpu::BindGroup,
+    leaves: wgpu::BindGroup,
+}
+
+impl Clipmap {
+    fn new(
+        device: &wgpu::Device,
+        inner: DenseVolume,
+        levels: Vec<Grid>,
+        scene: (Vec3, Vec3),
+    ) -> Self {
+        let clip = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("clipmap levels"),
+            contents: bytemuck::bytes_of(&clip_levels(&levels, scene)),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let debug_placement = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("clipmap debug placement"),
+            size: size_of::<GpuVolume>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let (sampling, leaves) = Self::bind_groups(device, &inner, &clip);
+        Clipmap {
+            inner,
+            levels,
+            clip,
+            clip_current: true.into(),
+            debug_placement,
+            scene,
+            placed: false,
+            sampling,
+            leaves,
+        }
+    }
+
+    /// The sampling group (the dense volume's with the levels) and the leaves' group.
+    fn bind_groups(
+        device: &wgpu::Device,
+        inner: &DenseVolume,
+        clip: &wgpu::Buffer,
+    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("voxels"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let sampling = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("clipmap sampling"),
+            layout: &Self::sampling_layout(device),
+            entries: &layout::entries(vec![
+                inner.volume.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view(&inner.radiance)),
+                wgpu::BindingResource::TextureView(&view(&inner.chains)),
+                wgpu::BindingResource::Sampler(&sampler),
+                clip.as_entire_binding(),
+            ]),
+        });
+        let leaves = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("clipmap leaves"),
+            layout: &Self::leaves_layout(device),
+            entries: &layout::entries(vec![
+                inner.volume.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view(&inner.albedo)),
+                wgpu::BindingResource::TextureView(&view(&inner.normal)),
+                wgpu::BindingResource::TextureView(&view(&inner.emission)),
+                inner.slot_voxel.as_entire_binding(),
+                inner.counters.as_entire_binding(),
+                inner.slot_direct.as_entire_binding(),
+                inner.slot_next.as_entire_binding(),
+                clip.as_entire_binding(),
+            ]),
+        });
+        (sampling, leaves)
+    }
+
+    /// The layout of @group(1), twin of shaders/voxels/clipmap/sample.wgsl: the dense volume's
+    /// and the levels at binding 4.
+    pub fn sampling_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let texture = |binding| {
+            layout::texture(
+                binding,
+                c,
+                wgpu::TextureSampleType::Float { filterable: true },
+                wgpu::TextureViewDimension::D3,
+            )
+        };
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("clipmap sampling"),
+            entries: &[
+                layout::uniform(0, c, false),
+                texture(1),
+                texture(2),
+                layout::sampler(3, c),
+                layout::uniform(4, c, false),
+            ],
+        })
+    }
+
+    /// The layout of @group(2) of the lighting passes, twin of voxels/dense/leaves.wgsl with
+    /// shaders/voxels/clipmap/placement.wgsl: the dense volume's and the levels at binding 8.
+    pub fn leaves_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let c = wgpu::ShaderStages::COMPUTE;
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("clipmap leaves"),
+            entries: &[
+                layout::uniform(0, c, false),
+                layout::texture_3d_load(1, c),
+                layout::texture_3d_load(2, c),
+                layout::texture_3d_load(3, c),
+                layout::storage(4, c, true),
+                layout::storage(5, c, false),
+                layout::storage(6, c, false),
+                layout::storage(7, c, false),
+                layout::uniform(8, c, false),
+            ],
+        })
+    }
+
+    /// Each level's window: where it lies, its voxel edge, its resolution.
+    pub fn levels(&self) -> &[Grid] {
+        &self.levels
+    }
+
+    /// The levels' voxels: the dense volume whose windows they are.
+    pub fn volume(&self) -> &DenseVolume {
+        &self.inner
+    }
+
+    /// Moves the windows whose place for the camera at `camera` (`placed_origin`) lies more
+    /// than a step from where they are (all of them the first time); whether any moved.
+    fn follow(&mut self, camera: Vec3) -> bool {
+        let mut moved = false;
+        for g in &mut self.levels {
+            let origin = placed_origin(g, self.scene, camera);
+            let strayed = (origin - g.origin).abs().max_element() > window_step(g) * 1.001;
+            if (!self.placed || strayed) && origin != g.origin {
+                g.origin = origin;
+                moved = true;
+            }
+        }
+        moved |= !self.placed;
+        self.placed = true;
+        if moved {
+            self.clip_current
+                .store(false, std::sync::atomic::Ordering::Relaxed);
+        }
+        moved
+    }
+
+    /// Records the levels' placement into `clip` when it changed since the last time.
+    fn record_placement(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder) {
+        if self
+            .clip_current
+            .swap(true, std::sync::atomic::Ordering::Relaxed)
+        {
+            return;
+        }
+        let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("clipmap levels (staging)"),
+            contents: bytemuck::bytes_of(&clip_levels(&self.levels, self.scene)),
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.clip, 0, staging.size());
+    }
+}
+
+/// sample.wgsl's `inside_by`: how far inside window `g` the point `p` lies, in its voxels,
+/// counting only the faces inside the scene's cube `(lo, hi)` (negative outside the window).
+fn inside_by(g: &Grid, (lo, hi): (Vec3, Vec3), p: Vec3) -> f32 {
+    let n = g.resolution as f32;
+    let q = (p - g.origin) / g.voxel_size;
+    if q.cmplt(Vec3::ZERO).any() || q.cmpgt(Vec3::splat(n)).any() {
+        return -1.0;
+    }
+    let half = 0.5 * g.voxel_size;
+    let open_lo = g.origin.cmpgt(lo + half);
+    let open_hi = (g.origin + n * g.voxel_size).cmplt(hi - half);
+    let far = Vec3::splat(1e9);
+    Vec3::select(open_lo, q, far)
+        .min(Vec3::select(open_hi, Vec3::splat(n) - q, far))
+        .min_element()
+}
+
+/// The levels in the scene's cube `scene` as the shaders read them.
+fn clip_levels(levels: &[Grid], (lo, hi): (Vec3, Vec3)) -> GpuClipLevels {
+    let mut l = GpuClipLevels {
+        levels: [[0.0; 4]; MAX_LEVELS as usize],
+        scene_lo: lo.extend(0.0).to_array(),
+        scene_hi: hi.extend(0.0).to_array(),
+        count: levels.len() as u32,
+        resolution: levels[0].resolution,
+        _pad: [0; 2],
+    };
+    for (k, g) in levels.iter().enumerate() {
+        l.levels[k] = [g.origin.x, g.origin.y, g.origin.z, g.voxel_size];
+    }
+    l
+}
+
+impl VoxelStructure for Clipmap {
+    /// Follows the camera: a window it strayed from moves, and every level is voxelized and
+    /// lit again (with the dynamic geometry where it is now).
+    fn plan(&mut self, changes: &FrameChanges) -> VoxelWork {
+        let moved = self.follow(changes.camera);
+        let all = || self.levels.iter().map(Region::all).collect::<Vec<_>>();
+        let around = |b| {
+            self.levels
+                .iter()
+                .map(|g| dynamic_region(g, b))
+                .collect::<Vec<_>>()
+        };
+        if changes.rebuild || moved {
+            return VoxelWork {
+                build: Some(all()),
+                update: changes.dynamic.or(changes.dynamic_now).map(around),
+            };
+        }
+        VoxelWork {
+            build: None,
+            update: changes.dynamic.map(around),
+        }
+    }
+
+    fn fragment_grids(&self) -> Vec<Grid> {
+        self.levels.clone()
+    }
+
+    fn kind(&self) -> super::VoxelKind {
+        super::VoxelKind::CLIPMAP
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn grid(&self) -> Grid {
+        self.levels[0]
+    }
+
+    fn voxel_size_at(&self, p: Vec3) -> f32 {
+        // sample.wgsl's voxels_voxel_size_at: the finest level with MARGIN + BAND + 1 voxels
+        // of its window around p.
+        let room = 6.5;
+        self.levels
+            .iter()
+            .find(|g| inside_by(g, self.scene, p) >= room)
+            .unwrap_or(self.levels.last().expect("levels"))
+            .voxel_size
+    }
+
+    fn record_build(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        self.record_placement(device, encoder);
+        self.inner.record_build(device, encoder, fragments, timer);
+    }
+
+    fn record_update(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        fragments: &Fragments,
+        timer: &mut GpuTimer,
+    ) {
+        self.record_placement(device, encoder);
+        self.inner.record_update(device, encoder, fragments, timer);
+    }
+
+    fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments) {
+        self.inner.bind_fragments(device, fragments);
+    }
+
+    fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
+        self.inner.record_filter(encoder, timer);
+    }
+
+    fn pool_counter(&self) -> &wgpu::Buffer {
+        self.inner.pool_counter()
+    }
+
+    fn leaf_capacity(&self) -> u64 {
+        self.inner.leaf_capacity()
+    }
+
+    fn leaf_limit(&self, device: &wgpu::Device) -> u64 {
+        self.inner.leaf_limit(device)
+    }
+
+    fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
+        self.inner.needs_growth(counted)
+    }
+
+    fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> Result<()> {
+        self.inner.grow(device, counted)?;
+        let (sampling, leaves) = Self::bind_groups(device, &self.inner, &self.clip);
+        self.sampling = sampling;
+        self.leaves = leaves;
+        Ok(())
+    }
+
+    fn memory(&self) -> Vec<(&'static str, u64)> {
+        self.inner.memory()
+    }
+
+    fn bindings(&self) -> StructureBindings<'_> {
+        let inner = self.inner.bindings();
+        StructureBindings {
+            sampling: &self.sampling,
+            leaves: &self.leaves,
+            ..inner
+        }
+    }
+
+    /// The voxel views of level `view.level` (its finest voxels and their directional mips
+    /// are the level's own: the view shows the level's window at its finest).
+    fn record_debug(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        view: DebugView,
+        timer: &mut GpuTimer,
+    ) {
+        let k = view.level.min(self.levels.len() as u32 - 1);
+        let g = self.levels[k as usize];
+        let placement = GpuVolume {
+            origin: g.origin.to_array(),
+            resolution: g.resolution,
+            voxel_size: g.voxel_size,
+            levels: g.levels(),
+            anisotropic: self.inner.anisotropic as u32,
+            windows: self.levels.len() as u32,
+        };
+        let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("clipmap debug placement (staging)"),
+            contents: bytemuck::bytes_of(&placement),
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.debug_placement, 0, staging.size());
+        self.inner.debug_pass().record(
+            device,
+            encoder,
+            targets,
+            &self.inner,
+            (&self.debug_placement, k),
+            view.mode,
+            0,
+            view.direction,
+            timer,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn windows_snap_to_their_own_lattice_and_nest() {
+        let camera = Vec3::new(3.37, -1.2, 40.05);
+        let scene = (
+            Vec3::new(-100.31, -50.0, -60.0),
+            Vec3::new(99.69, 150.0, 140.0),
+        );
+        let anchor = scene.0;
+        let levels: Vec<Grid> = (0..5)
+            .map(|k| {
+                let mut g = Grid {
+                    origin: Vec3::ZERO,
+                    voxel_size: 0.1 * (1 << k) as f32,
+                    resolution: 64,
+                };
+                g.origin = placed_origin(&g, scene, camera);
+                g
+            })
+            .collect();
+        for (k, g) in levels.iter().enumerate() {
+            // On the level's lattice: origins are whole steps (8 voxels) from the anchor.
+            let steps = (g.origin - anchor) / window_step(g);
+            assert!(
+                (steps - steps.round()).abs().max_element() < 1e-3,
+                "level {k}: {steps}"
+            );
+            // The camera within half a step of the centre.
+            let centre = g.origin + Vec3::splat(g.extent() * 0.5);
+            assert!((camera - centre).abs().max_element() <= window_step(g) * 0.5 + 1e-4);
+            // Inside the next coarser level.
+            if let Some(c) = levels.get(k + 1) {
+                assert!(g.origin.cmpge(c.origin).all(), "level {k} pokes out below");
+                let (hi, chi) = (g.origin + g.extent(), c.origin + c.extent());
+                assert!(hi.cmple(chi).all(), "level {k} pokes out above");
+            }
+        }
+    }
+
+    #[test]
+    fn windows_stay_inside_the_scene_and_a_wide_one_is_centred_on_it() {
+        let scene = (Vec3::ZERO, Vec3::splat(6.4));
+        let grid = |s: f32| Grid {
+            origin: Vec3::ZERO,
+            voxel_size: s,
+            resolution: 32,
+        };
+        // A camera outside the scene: the window holding 3.2 m slides back inside it.
+        let camera = Vec3::new(-2.0, 3.0, 8.0);
+        let near = |a: Vec3, b: Vec3| a.abs_diff_eq(b, 1e-5);
+        let o = placed_origin(&grid(0.1), scene, camera);
+        assert!(near(o, Vec3::new(0.0, 1.6, 3.2)), "{o}");
+        // The window as wide as the scene is the scene's cube, wherever the camera is.
+        let o = placed_origin(&grid(0.2), scene, camera);
+        assert!(near(o, Vec3::ZERO), "{o}");
+        // Wider: centred on the scene.
+        let o = placed_origin(&grid(0.4), scene, camera);
+        assert!(near(o, Vec3::splat(-3.2)), "{o}");
+    }
+}
