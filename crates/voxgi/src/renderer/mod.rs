@@ -826,11 +826,12 @@ fn grid(facts: &SceneFacts, options: &RendererOptions) -> Grid {
     Grid::around(facts.bounds.min, facts.bounds.max, options.voxel_resolution)
 }
 
-/// Where a cloud's unused point slots wait: a grid's side below its corner, outside the voxels
-/// of every resolution on the same bounds (a coarser grid reaches farther out, by at most
-/// half of this side), so the splat makes no fragment of them.
+/// Where a cloud's unused point slots wait: 64 sides of the scene's grid below its corner,
+/// outside the voxels of every structure on the same bounds (a coarser dense grid reaches
+/// farther out by at most half a side, a clipmap's coarsest level with the automatic voxel
+/// size by a side and a half), so the splat makes no fragment of them.
 pub(crate) fn parking(grid: &Grid) -> glam::Vec3 {
-    grid.origin - glam::Vec3::splat(grid.extent())
+    grid.origin - glam::Vec3::splat(64.0 * grid.extent())
 }
 
 fn composite_pass(

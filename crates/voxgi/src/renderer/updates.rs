@@ -212,7 +212,7 @@ impl Renderer {
         for &p in &pc.positions {
             local.grow(p);
         }
-        let park = super::parking(&self.volume.grid());
+        let park = super::parking(&super::grid(&self.facts, &self.options));
         let room = self.scene.cloud_ranges[cloud].len();
         self.scene
             .set_cloud_points(&self.queue, cloud, &pc, &neighbours, park);
