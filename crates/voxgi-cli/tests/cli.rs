@@ -471,6 +471,16 @@ fn render_time_samples_the_scene_file_animations() {
     assert!(error_line(&bad).contains("--time"), "{}", error_line(&bad));
 }
 
+/// Small frames, each a still of its own (no temporal accumulation), so that frames rendered
+/// apart can be compared to the byte.
+const SMALL_STILLS: [&str; 5] = [
+    "--size",
+    "32x24",
+    "--voxel-resolution",
+    "32",
+    "--temporal=false",
+];
+
 /// A camera flight: each frame of a sequence is seen from where the camera's keyframes put it
 /// then, byte for byte the still of a scene whose fixed camera stands at that pose; the
 /// geometry does not move, so the frames differ only by the view.
@@ -489,13 +499,7 @@ fn a_camera_flight_renders_each_frame_from_its_pose() {
                look_at = [[0.28, 0.27, 0.3], [0.28, 0.27, 0.3]]\nfov = [40.0, 50.0]\n",
     )
     .unwrap();
-    let common = [
-        "--size",
-        "32x24",
-        "--voxel-resolution",
-        "32",
-        "--temporal=false",
-    ];
+    let common = SMALL_STILLS;
     let pattern = dir.join("fly_%02d.png");
     let mut args = vec![
         "render",
@@ -564,13 +568,7 @@ fn image_sequences_equal_renders_at_each_time() {
     );
     let dir = tmp("sequence");
     std::fs::create_dir_all(&dir).unwrap();
-    let common = [
-        "--size",
-        "32x24",
-        "--voxel-resolution",
-        "32",
-        "--temporal=false",
-    ];
+    let common = SMALL_STILLS;
     let pattern = dir.join("seq_%03d.png");
     let mut args = vec![
         "render",

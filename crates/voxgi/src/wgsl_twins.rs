@@ -38,6 +38,10 @@ fn modules() -> Vec<naga::Module> {
         crate::gpu::shader::compose_with("lighting/blend.wgsl", Some(VoxelKind::DENSE.shaders()));
     let bounce =
         crate::gpu::shader::compose_with("lighting/bounce.wgsl", Some(VoxelKind::DENSE.shaders()));
+    let clipmap = crate::gpu::shader::compose_with(
+        "voxels/clipmap/sample.wgsl",
+        Some(VoxelKind::CLIPMAP.shaders()),
+    );
     [
         compose("screen/composite.wgsl"),
         compose("screen/gbuffer.wgsl"),
@@ -50,6 +54,7 @@ fn modules() -> Vec<naga::Module> {
         bounce,
         inject,
         octree,
+        clipmap,
     ]
     .iter()
     .map(|s| module(s))
@@ -255,9 +260,15 @@ fn every_twin_has_the_wgsl_layout() {
         m,
         GpuFragmentGrid,
         "FragmentGrid",
-        [origin, resolution, voxel_size, inv_voxel_size]
+        [origin, resolution, voxel_size, inv_voxel_size, z_offset]
     );
     twin!(m, GpuRegion, "FragmentRegion", [lo, hi]);
+    twin!(
+        m,
+        crate::voxel::clipmap::GpuClipLevels,
+        "ClipLevels",
+        [levels, scene_lo, scene_hi, count, resolution]
+    );
     twin!(
         m,
         GpuInjectParams,

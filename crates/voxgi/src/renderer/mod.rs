@@ -193,14 +193,6 @@ impl SceneFacts {
             voxel_size: options.voxel_size,
         }
     }
-
-    /// Fragments the first buffer on `grid` has room for: the options' capacity, or the
-    /// scene's estimate.
-    fn fragments_wanted(&self, options: &RendererOptions, grid: &Grid) -> u64 {
-        options
-            .fragment_capacity
-            .unwrap_or_else(|| self.estimate.at(grid))
-    }
 }
 
 impl Renderer {
@@ -309,7 +301,7 @@ impl Renderer {
         })??;
         let mut fragments = fragments;
         let mut built = false;
-        if sizing::in_doubt(device, &facts.estimate, volume.as_ref()) {
+        if sizing::in_doubt(device, &facts.estimate, facts.bounds, volume.as_ref()) {
             let sizing = Sizing {
                 device,
                 queue,
@@ -499,7 +491,7 @@ impl Renderer {
         // as it was.
         let mut built = false;
         if let Some(v) = volume_new.as_mut()
-            && sizing::in_doubt(device, &self.facts.estimate, v.as_ref())
+            && sizing::in_doubt(device, &self.facts.estimate, self.facts.bounds, v.as_ref())
         {
             let sizing = Sizing {
                 device,
@@ -814,10 +806,10 @@ fn allocate_fragments(
     volume: &dyn VoxelStructure,
 ) -> Result<Fragments> {
     let grids = volume.fragment_grids();
-    let wanted = grids
-        .iter()
-        .map(|g| facts.fragments_wanted(options, g))
-        .sum();
+    let wanted = match options.fragment_capacity {
+        Some(n) => n,
+        None => sizing::estimate_on(&facts.estimate, facts.bounds, &grids),
+    };
     fragments::allocate(device, &grids, wanted)
 }
 

@@ -436,9 +436,12 @@ impl Renderer {
         // A build replaces every leaf (a camera-following structure builds when its windows
         // move): everything is lit anew, as after a rebuild.
         let rebuilt = pending.rebuild || work.build.is_some();
-        // Where the structure's windows are now (`plan` may have moved them).
-        self.fragments
-            .set_grids(&self.queue, &self.volume.fragment_grids());
+        // Where the structure's windows are now (`plan` may have moved them). A build done
+        // while the renderer was made (`Sizing`) holds the windows of then: moved, it is done
+        // again.
+        let grids = self.volume.fragment_grids();
+        let windows_moved = grids != self.fragments.grids;
+        self.fragments.set_grids(&self.queue, &grids);
         // With bounce slices, the updates after a change that gather the slices still due:
         // the direct light is stored again (bounces overwrote it), filtered, and bounced.
         let follow_up = !(geometry || pending.lights) && self.slices_left > 0;
@@ -493,7 +496,7 @@ impl Renderer {
                 })
                 .collect()
         });
-        if work.build.is_some() && !pending.built {
+        if work.build.is_some() && (!pending.built || windows_moved) {
             self.fragments.record_clear(encoder);
             // Each grid's fragments in turn (one for most structures; a clipmap's windows).
             for b in fb.iter() {

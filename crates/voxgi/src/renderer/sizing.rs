@@ -17,8 +17,9 @@ use crate::fragments::{
 use crate::gpu::readback;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::voxel::{POOL_COUNTERS, Region, VoxelStructure};
+use crate::voxel::{Grid, POOL_COUNTERS, Region, VoxelStructure};
 use crate::{Error, Result};
+use voxgi_scene::Aabb;
 
 /// What a counting build needs of the renderer.
 pub(super) struct Sizing<'a> {
@@ -30,15 +31,30 @@ pub(super) struct Sizing<'a> {
     pub splat: &'a SplatPass,
 }
 
+/// The fragments a scene within `bounds` makes on `grids`: the estimate on each, for a grid
+/// narrower than the scene (a clipmap's finer windows) the share of the scene's surface its
+/// window can hold, as the square of the ratio of their sides (surfaces grow with area).
+pub(super) fn estimate_on(estimate: &FragmentEstimate, bounds: Aabb, grids: &[Grid]) -> u64 {
+    let side = bounds.size().max_element().max(1e-6);
+    grids
+        .iter()
+        .map(|g| {
+            let share = (g.extent() / side).min(1.0).powi(2) as f64;
+            (estimate.at(g) as f64 * share).ceil() as u64
+        })
+        .sum()
+}
+
 /// Whether `estimate` on `volume`'s grids leaves the fragments or its leaves in doubt on this
 /// device: the estimate bounds both (a fragment per voxel a triangle or point touches; a leaf
 /// per voxel with a fragment), so below both limits nothing can be refused.
 pub(super) fn in_doubt(
     device: &wgpu::Device,
     estimate: &FragmentEstimate,
+    bounds: Aabb,
     volume: &dyn VoxelStructure,
 ) -> bool {
-    let bound: u64 = volume.fragment_grids().iter().map(|g| estimate.at(g)).sum();
+    let bound = estimate_on(estimate, bounds, &volume.fragment_grids());
     cfg!(not(target_arch = "wasm32"))
         && (bound > crate::gpu::max_entries(device, FRAGMENT_BYTES)
             || bound > volume.leaf_limit(device))

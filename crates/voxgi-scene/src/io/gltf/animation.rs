@@ -264,18 +264,23 @@ pub(super) fn load_animations(
     }
     let nodes: Arc<[MotionNode]> = nodes.into();
     let mut used = vec![false; root.animations.len()];
+    // The name of the target animated node `a` moves (the glTF animations that move it, now
+    // counted as used).
+    let mut named = |a: usize| {
+        for &ai in &sources[a] {
+            used[ai] = true;
+        }
+        sources[a]
+            .iter()
+            .map(|&ai| names[ai].as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     for (a, (instances, inner, lights)) in groups.into_iter().enumerate() {
         if instances.is_empty() && lights.is_empty() {
             continue;
         }
-        for &ai in &sources[a] {
-            used[ai] = true;
-        }
-        let name = sources[a]
-            .iter()
-            .map(|&ai| names[ai].as_str())
-            .collect::<Vec<_>>()
-            .join(", ");
+        let name = named(a);
         scene.animations.push(Animation {
             name,
             target: AnimationTarget::Instances {
@@ -295,14 +300,7 @@ pub(super) fn load_animations(
         let Some(rest) = scene.cameras.get(camera).cloned() else {
             continue;
         };
-        for &ai in &sources[a] {
-            used[ai] = true;
-        }
-        let name = sources[a]
-            .iter()
-            .map(|&ai| names[ai].as_str())
-            .collect::<Vec<_>>()
-            .join(", ");
+        let name = named(a);
         scene.animations.push(Animation {
             name,
             target: AnimationTarget::Camera {

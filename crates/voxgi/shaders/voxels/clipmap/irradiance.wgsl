@@ -13,17 +13,22 @@
 // The fast shading reads a window of 5 x 5 x 2 leaves around the pixel.
 const LOOKUP_ROOM: f32 = 4.0;
 
+// The level `irradiance_grid` chose: its leaves only, never the next window's in the stack.
+var<private> lookup_level: u32;
+
 fn irradiance_grid(p: vec3<f32>) -> vec3<f32> {
     let k = level_holding(p, 0.0, LOOKUP_ROOM);
+    lookup_level = k;
     let local = level_uvw(p, k) * f32(clip.resolution);
     return local + vec3<f32>(0.0, 0.0, f32(k * clip.resolution));
 }
 
 fn leaf_irradiance_at(c: vec3<i32>) -> vec4<u32> {
     let r = i32(clip.resolution);
-    let top = vec3<i32>(r, r, r * i32(clip.count));
-    let inside = all(c >= vec3<i32>(0)) && all(c < top);
-    let u = vec3<u32>(clamp(c, vec3<i32>(0), top - 1));
+    let bottom = vec3<i32>(0, 0, r * i32(lookup_level));
+    let top = bottom + vec3<i32>(r);
+    let inside = all(c >= bottom) && all(c < top);
+    let u = vec3<u32>(clamp(c, bottom, top - 1));
     let occ = irradiance_occupancy[voxel_index(u, clip.resolution)];
     // A lock value (past the capacity) reads as a slot past the records.
     let slot = occ - 2u;

@@ -10,8 +10,9 @@
 //! level that holds a sample wholly and hands over to the next coarser across a band
 //! (shaders/voxels/clipmap/sample.wgsl).
 //!
-//! The windows follow the camera in steps of an eighth of themselves, on a lattice of their
-//! own voxels that starts at the scene's cube, so a voxel of a level covers the same place
+//! The windows follow the camera by steps of an eighth of themselves (a window moves when its
+//! place for the camera lies two steps or more from where it is, so a camera that wavers does
+//! not move it to and fro), on a lattice of their own voxels that starts at the scene's cube, so a voxel of a level covers the same place
 //! wherever its window is. A window stays inside the scene's cube where it can (a level wider
 //! than the scene is centred on it, as the dense volume is: at the dense volume's voxel size
 //! such a level is that volume), so no voxels are spent on the void past the world's edge.
@@ -201,6 +202,11 @@ fn create(
 fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
     let half = Vec3::splat(g.extent() * 0.5);
     let middle = (lo + hi) * 0.5;
+    // Wider than the cube: centred on it, unsnapped (snapped, it could leave a sliver of the
+    // scene out; it never moves, so no other window of its level needs its lattice).
+    if g.extent() > (hi - lo).max_element() * (1.0 + 1e-5) {
+        return middle - half;
+    }
     let inside = camera.clamp(lo + half.min(middle - lo), hi - half.min(hi - middle));
     let step = window_step(g);
     lo + ((inside - lo) / step).round() * step - half
@@ -278,31 +284,31 @@ impl Clipmap {
             mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
+        let radiance = [view(&inner.radiance), view(&inner.chains)];
+        let mut resources = DenseVolume::sampling_resources(&inner.volume, &radiance, &sampler);
+        resources.push(clip.as_entire_binding());
         let sampling = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("clipmap sampling"),
             layout: &Self::sampling_layout(device),
-            entries: &layout::entries(vec![
-                inner.volume.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view(&inner.radiance)),
-                wgpu::BindingResource::TextureView(&view(&inner.chains)),
-                wgpu::BindingResource::Sampler(&sampler),
-                clip.as_entire_binding(),
-            ]),
+            entries: &layout::entries(resources),
         });
+        let surface = [
+            view(&inner.albedo),
+            view(&inner.normal),
+            view(&inner.emission),
+        ];
+        let slots = [
+            &inner.slot_voxel,
+            &inner.counters,
+            &inner.slot_direct,
+            &inner.slot_next,
+        ];
+        let mut resources = DenseVolume::leaves_resources(&inner.volume, &surface, slots);
+        resources.push(clip.as_entire_binding());
         let leaves = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("clipmap leaves"),
             layout: &Self::leaves_layout(device),
-            entries: &layout::entries(vec![
-                inner.volume.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view(&inner.albedo)),
-                wgpu::BindingResource::TextureView(&view(&inner.normal)),
-                wgpu::BindingResource::TextureView(&view(&inner.emission)),
-                inner.slot_voxel.as_entire_binding(),
-                inner.counters.as_entire_binding(),
-                inner.slot_direct.as_entire_binding(),
-                inner.slot_next.as_entire_binding(),
-                clip.as_entire_binding(),
-            ]),
+            entries: &layout::entries(resources),
         });
         (sampling, leaves)
     }
@@ -310,44 +316,22 @@ impl Clipmap {
     /// The layout of @group(1), twin of shaders/voxels/clipmap/sample.wgsl: the dense volume's
     /// and the levels at binding 4.
     pub fn sampling_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let texture = |binding| {
-            layout::texture(
-                binding,
-                c,
-                wgpu::TextureSampleType::Float { filterable: true },
-                wgpu::TextureViewDimension::D3,
-            )
-        };
+        let mut entries = DenseVolume::sampling_entries();
+        entries.push(layout::uniform(4, wgpu::ShaderStages::COMPUTE, false));
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("clipmap sampling"),
-            entries: &[
-                layout::uniform(0, c, false),
-                texture(1),
-                texture(2),
-                layout::sampler(3, c),
-                layout::uniform(4, c, false),
-            ],
+            entries: &entries,
         })
     }
 
     /// The layout of @group(2) of the lighting passes, twin of voxels/dense/leaves.wgsl with
     /// shaders/voxels/clipmap/placement.wgsl: the dense volume's and the levels at binding 8.
     pub fn leaves_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let c = wgpu::ShaderStages::COMPUTE;
+        let mut entries = DenseVolume::leaves_entries();
+        entries.push(layout::uniform(8, wgpu::ShaderStages::COMPUTE, false));
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("clipmap leaves"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::texture_3d_load(1, c),
-                layout::texture_3d_load(2, c),
-                layout::texture_3d_load(3, c),
-                layout::storage(4, c, true),
-                layout::storage(5, c, false),
-                layout::storage(6, c, false),
-                layout::storage(7, c, false),
-                layout::uniform(8, c, false),
-            ],
+            entries: &entries,
         })
     }
 
@@ -362,7 +346,8 @@ impl Clipmap {
     }
 
     /// Moves the windows whose place for the camera at `camera` (`placed_origin`) lies more
-    /// than a step from where they are (all of them the first time); whether any moved.
+    /// than a step from where they are, that is two steps or more (all of them the first
+    /// time); whether any moved.
     fn follow(&mut self, camera: Vec3) -> bool {
         let mut moved = false;
         for g in &mut self.levels {

@@ -465,15 +465,14 @@ impl DenseVolume {
             mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
+        let radiance_views = [
+            radiance.create_view(&Default::default()),
+            chains.create_view(&Default::default()),
+        ];
         let sampling = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel sampling"),
             layout: &Self::sampling_layout(device),
-            entries: &layout::entries(vec![
-                volume.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&radiance.create_view(&Default::default())),
-                wgpu::BindingResource::TextureView(&chains.create_view(&Default::default())),
-                wgpu::BindingResource::Sampler(&sampler),
-            ]),
+            entries: &layout::entries(Self::sampling_resources(&volume, &radiance_views, &sampler)),
         });
         let albedo = stacked("voxel albedo", ALBEDO_FORMAT);
         let normal = stacked("voxel normal", NORMAL_FORMAT);
@@ -505,19 +504,15 @@ impl DenseVolume {
             ]),
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let surface = [view(&albedo), view(&normal), view(&emission)];
         let leaves = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel leaves"),
             layout: &Self::leaves_layout(device),
-            entries: &layout::entries(vec![
-                volume.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view(&albedo)),
-                wgpu::BindingResource::TextureView(&view(&normal)),
-                wgpu::BindingResource::TextureView(&view(&emission)),
-                slot_voxel.as_entire_binding(),
-                counters.as_entire_binding(),
-                slot_direct.as_entire_binding(),
-                slot_next.as_entire_binding(),
-            ]),
+            entries: &layout::entries(Self::leaves_resources(
+                &volume,
+                &surface,
+                [&slot_voxel, &counters, &slot_direct, &slot_next],
+            )),
         });
         let leaf_store = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxel leaf store"),
@@ -626,6 +621,14 @@ impl DenseVolume {
     /// sampler. Layouts with the same entries are one layout to wgpu, so each pass makes its
     /// own and binds the volume's `sampling` group.
     pub fn sampling_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel sampling"),
+            entries: &Self::sampling_entries(),
+        })
+    }
+
+    /// `sampling_layout`'s entries (bindings 0 to 3), for a structure built on the volume.
+    pub fn sampling_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         let c = wgpu::ShaderStages::COMPUTE;
         let texture = |binding| {
             layout::texture(
@@ -635,33 +638,64 @@ impl DenseVolume {
                 wgpu::TextureViewDimension::D3,
             )
         };
-        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("voxel sampling"),
-            entries: &[
-                layout::uniform(0, c, false),
-                texture(1),
-                texture(2),
-                layout::sampler(3, c),
-            ],
-        })
+        vec![
+            layout::uniform(0, c, false),
+            texture(1),
+            texture(2),
+            layout::sampler(3, c),
+        ]
+    }
+
+    /// The resources of `sampling_layout`'s entries: the `volume` uniform, the views of the
+    /// finest radiance and the chains, the sampler.
+    pub fn sampling_resources<'a>(
+        volume: &'a wgpu::Buffer,
+        views: &'a [wgpu::TextureView; 2],
+        sampler: &'a wgpu::Sampler,
+    ) -> Vec<wgpu::BindingResource<'a>> {
+        vec![
+            volume.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&views[0]),
+            wgpu::BindingResource::TextureView(&views[1]),
+            wgpu::BindingResource::Sampler(sampler),
+        ]
     }
 
     /// The layout of @group(2) of the lighting passes, twin of voxels/dense/leaves.wgsl.
     pub fn leaves_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-        let c = wgpu::ShaderStages::COMPUTE;
         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("voxel leaves"),
-            entries: &[
-                layout::uniform(0, c, false),
-                layout::texture_3d_load(1, c),
-                layout::texture_3d_load(2, c),
-                layout::texture_3d_load(3, c),
-                layout::storage(4, c, true),
-                layout::storage(5, c, false),
-                layout::storage(6, c, false),
-                layout::storage(7, c, false),
-            ],
+            entries: &Self::leaves_entries(),
         })
+    }
+
+    /// `leaves_layout`'s entries (bindings 0 to 7), for a structure built on the volume.
+    pub fn leaves_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+        let c = wgpu::ShaderStages::COMPUTE;
+        vec![
+            layout::uniform(0, c, false),
+            layout::texture_3d_load(1, c),
+            layout::texture_3d_load(2, c),
+            layout::texture_3d_load(3, c),
+            layout::storage(4, c, true),
+            layout::storage(5, c, false),
+            layout::storage(6, c, false),
+            layout::storage(7, c, false),
+        ]
+    }
+
+    /// The resources of `leaves_layout`'s entries: the `volume` uniform, the views of the
+    /// albedo, normal and emission, and the slots' voxels, the counters, the slots' direct
+    /// and bounced light.
+    pub fn leaves_resources<'a>(
+        volume: &'a wgpu::Buffer,
+        views: &'a [wgpu::TextureView; 3],
+        slots: [&'a wgpu::Buffer; 4],
+    ) -> Vec<wgpu::BindingResource<'a>> {
+        let mut r = vec![volume.as_entire_binding()];
+        r.extend(views.iter().map(wgpu::BindingResource::TextureView));
+        r.extend(slots.map(|b| b.as_entire_binding()));
+        r
     }
 
     /// The layout of @group(3) of the gather, twin of voxels/dense/irradiance.wgsl: the
