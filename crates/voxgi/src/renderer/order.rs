@@ -143,11 +143,12 @@ impl Renderer {
         let moved = due && (self.pending.rebuild || self.pending.geometry);
         // The structure's per-frame step: it may ask for voxels of its own (a camera-following
         // structure) even when nothing changed.
+        let dynamic_now = self.facts.dynamic.then(|| self.state.dynamic_bounds());
         let work = self.volume.plan(&FrameChanges {
             camera: params.camera.position,
             rebuild: due && self.pending.rebuild,
-            dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
-            dynamic_now: self.facts.dynamic.then(|| self.state.dynamic_bounds()),
+            dynamic: dynamic_now.filter(|_| moved),
+            dynamic_now,
         });
         let relit = if due || !work.is_empty() {
             self.record_voxels(encoder, work, &mut |_, _| {})
@@ -262,11 +263,12 @@ impl Renderer {
         self.record_shadows(&mut encoder, false);
         cut(&mut encoder, "shadow");
         let moved = self.pending.rebuild || self.pending.geometry;
+        let dynamic_now = self.facts.dynamic.then(|| self.state.dynamic_bounds());
         let work = self.volume.plan(&FrameChanges {
             camera: params.camera.position,
             rebuild: self.pending.rebuild,
-            dynamic: (moved && self.facts.dynamic).then(|| self.state.dynamic_bounds()),
-            dynamic_now: self.facts.dynamic.then(|| self.state.dynamic_bounds()),
+            dynamic: dynamic_now.filter(|_| moved),
+            dynamic_now,
         });
         let rebuild = self.pending.rebuild;
         let relit = self.record_voxels(&mut encoder, work, &mut cut);

@@ -140,44 +140,15 @@ fn create(
         voxel_size: finest,
         resolution: res,
     };
-    dense::check_volume_fits(device, &base, count)?;
-    let pipelines = match previous {
-        Some(p) => p
-            .as_any()
-            .downcast_ref::<Clipmap>()
-            .map(|c| c.inner.pipelines().clone())
-            .or_else(|| {
-                p.as_any()
-                    .downcast_ref::<DenseVolume>()
-                    .map(|d| d.pipelines().clone())
-            }),
-        None => None,
-    };
-    let pipelines = match pipelines {
-        Some(p) => p,
-        None => crate::gpu::checked(device, "pipeline creation", || {
-            dense::DensePipelines::new(device)
-        })?,
-    };
+    let previous = previous.and_then(|p| {
+        let any = p.as_any();
+        any.downcast_ref::<Clipmap>()
+            .map(Clipmap::volume)
+            .or_else(|| any.downcast_ref::<DenseVolume>())
+    });
     // Every level holds about as many surface voxels as the scene's cube at this resolution.
-    let wanted = (desc.leaves * count as u64).min((res as u64).pow(3) * count as u64);
-    let slots = crate::gpu::pool_capacity(
-        device,
-        wanted.min(crate::gpu::max_entries(device, dense::SLOT_BYTES)),
-        dense::SLOT_BYTES,
-        "occupied voxels",
-    )?;
-    let inner = crate::gpu::checked(device, "voxel volume", || {
-        DenseVolume::new(
-            device,
-            &pipelines,
-            base,
-            count,
-            desc.filtering,
-            slots,
-            desc.dynamic,
-        )
-    })?;
+    let leaves = (desc.leaves * count as u64).min((res as u64).pow(3) * count as u64);
+    let inner = DenseVolume::create(device, base, count, desc, leaves, previous)?;
     let scene = (desc.grid.origin, desc.grid.origin + desc.grid.extent());
     let centre = (scene.0 + scene.1) * 0.5;
     let levels = (0..count)

@@ -92,26 +92,8 @@ fn create(
     desc: &StructureDesc,
     previous: Option<&dyn VoxelStructure>,
 ) -> Result<Box<dyn VoxelStructure>> {
-    check_volume_fits(device, &desc.grid, 1)?;
-    let slots = slot_capacity(
-        device,
-        desc.leaves.min(crate::gpu::max_entries(device, SLOT_BYTES)),
-    )?;
-    let p = match previous.and_then(|v| v.as_any().downcast_ref::<DenseVolume>()) {
-        Some(v) => v.pipelines.clone(),
-        None => checked(device, "pipeline creation", || DensePipelines::new(device))?,
-    };
-    let v = checked(device, "voxel volume", || {
-        DenseVolume::new(
-            device,
-            &p,
-            desc.grid,
-            1,
-            desc.filtering,
-            slots,
-            desc.dynamic,
-        )
-    })?;
+    let previous = previous.and_then(|v| v.as_any().downcast_ref::<DenseVolume>());
+    let v = DenseVolume::create(device, desc.grid, 1, desc, desc.leaves, previous)?;
     Ok(Box::new(v))
 }
 
@@ -122,7 +104,7 @@ fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
 
 /// Checks that the per-voxel buffers and textures of `windows` cubes of `grid` fit the
 /// device's limits.
-pub(crate) fn check_volume_fits(device: &wgpu::Device, grid: &Grid, windows: u32) -> Result<()> {
+fn check_volume_fits(device: &wgpu::Device, grid: &Grid, windows: u32) -> Result<()> {
     let l = device.limits();
     let occupancy = (grid.resolution as u64).pow(3) * windows as u64 * 4;
     if occupancy > l.max_storage_buffer_binding_size {
@@ -228,9 +210,38 @@ pub struct DenseVolume {
 }
 
 impl DenseVolume {
-    /// Its pipelines, for a structure built on it (the clipmap) to share.
-    pub fn pipelines(&self) -> &Arc<DensePipelines> {
-        &self.pipelines
+    /// A volume of `windows` cubes of `grid`, filtered and made dynamic as `desc` says, with
+    /// room for `leaves` occupied voxels (as many as the device allows), sharing the pipelines
+    /// of `previous`; errors name what does not fit the device. The dense kind's `create` and
+    /// a structure built on the volume (the clipmap) make theirs here.
+    pub(crate) fn create(
+        device: &wgpu::Device,
+        grid: Grid,
+        windows: u32,
+        desc: &StructureDesc,
+        leaves: u64,
+        previous: Option<&DenseVolume>,
+    ) -> Result<DenseVolume> {
+        check_volume_fits(device, &grid, windows)?;
+        let slots = slot_capacity(
+            device,
+            leaves.min(crate::gpu::max_entries(device, SLOT_BYTES)),
+        )?;
+        let p = match previous {
+            Some(v) => v.pipelines.clone(),
+            None => checked(device, "pipeline creation", || DensePipelines::new(device))?,
+        };
+        checked(device, "voxel volume", || {
+            DenseVolume::new(
+                device,
+                &p,
+                grid,
+                windows,
+                desc.filtering,
+                slots,
+                desc.dynamic,
+            )
+        })
     }
 
     /// Its debug pass, for a structure built on it.
