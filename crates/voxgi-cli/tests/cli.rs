@@ -641,6 +641,41 @@ fn image_sequences_equal_renders_at_each_time() {
 
 /// Every setting of the library's table is a flag of `render` and `bench`, named as its key,
 /// and a row of the scene-file documentation.
+/// A 600 m field of arrayed blocks: the dense volume and the octree render it with a warning
+/// that names their voxel width and the clipmap; the clipmap renders it without one.
+#[test]
+fn a_world_too_large_for_one_volume_is_pointed_to_the_clipmap() {
+    let town = tmp("wide_town.toml");
+    std::fs::write(
+        &town,
+        "[[include]]\nbuiltin = \"cube\"\nscale = [600.0, 0.5, 600.0]\n\n\
+         [[include]]\nbuiltin = \"cube\"\nscale = [20.0, 12.0, 20.0]\ntranslate = [-250.0, 6.0, -250.0]\n\
+         array = { count = [6, 1, 6], spacing = [100.0, 0.0, 100.0] }\n\n\
+         [camera]\nposition = [-200.0, 2.0, -200.0]\ntarget = [0.0, 5.0, 0.0]\n",
+    )
+    .unwrap();
+    for (voxels, warned) in [("dense", true), ("octree", true), ("clipmap", false)] {
+        let o = voxgi(&[
+            "render",
+            town.to_str().unwrap(),
+            "-o",
+            tmp(&format!("wide_{voxels}.png")).to_str().unwrap(),
+            "--size",
+            "24x16",
+            "--voxel-resolution",
+            "32",
+            "--voxels",
+            voxels,
+            "--temporal=false",
+        ]);
+        let err = stderr(&o);
+        assert!(o.status.success(), "{voxels}: {err}");
+        // 600 m over the 30 inner voxels of 32 (a voxel of margin each side): 20 m voxels.
+        let says = err.contains("voxels = \"clipmap\"") && err.contains("20.0 m wide");
+        assert_eq!(says, warned, "{voxels}: {err}");
+    }
+}
+
 #[test]
 fn every_setting_is_a_flag_and_documented() {
     let docs = std::fs::read_to_string(

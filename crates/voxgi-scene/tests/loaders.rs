@@ -1451,6 +1451,92 @@ target = [0.0, 0.0, 0.0]
     assert!(e.contains("[[view]]"), "{e}");
 }
 
+#[test]
+fn an_array_include_places_copies_that_share_its_meshes() {
+    let dir = tmp("array");
+    let main = write(
+        &dir,
+        "array.toml",
+        r#"[[include]]
+builtin = "cube"
+translate = [1.0, 2.0, 3.0]
+scale = [2.0, 1.0, 1.0]
+array = { count = [3, 1, 2], spacing = [10.0, 0.0, -5.0] }
+"#,
+    );
+    let scene = io::load(&main).unwrap();
+    // One mesh, six instances: the copies add transforms, not triangles.
+    assert_eq!(scene.meshes.len(), 1);
+    assert_eq!(scene.instances.len(), 6);
+    assert!(scene.instances.iter().all(|i| i.mesh == 0));
+    // Copy (i, k) is the include moved by (10 i, 0, -5 k) in the world, after its own scale:
+    // the cube's corner (0.5, 0.5, 0.5) lands at (1 + 1 + 10 i, 2.5, 3.5 - 5 k).
+    let corner = Vec3::splat(0.5);
+    for (n, inst) in scene.instances.iter().enumerate() {
+        let (i, k) = ((n % 3) as f32, (n / 3) as f32);
+        let p = inst.transform.transform_point3(corner);
+        assert!(
+            close(p, Vec3::new(2.0 + 10.0 * i, 2.5, 3.5 - 5.0 * k)),
+            "copy {n}: {p}"
+        );
+    }
+
+    let bad = [
+        ("count = [0, 1, 1]", "at least 1"),
+        ("count = [1000, 1, 1000]", "at most 65536"),
+        ("count = [2, 1, 1], spacing = [nan, 0.0, 0.0]", "finite"),
+    ];
+    for (array, says) in bad {
+        let f = write(
+            &dir,
+            "bad.toml",
+            format!("[[include]]\nbuiltin = \"cube\"\narray = {{ {array} }}\n"),
+        );
+        let e = io::load(&f).unwrap_err().to_string();
+        assert!(e.contains("include 1") && e.contains(says), "{array}: {e}");
+    }
+    // The Cornell box holds an area light: copying its meshes would leave the copies' lamps
+    // dark, so it is refused.
+    let f = write(
+        &dir,
+        "lit.toml",
+        "[[include]]\nbuiltin = \"cornell-box\"\narray = { count = [2, 1, 1], spacing = [3.0, 0.0, 0.0] }\n",
+    );
+    let e = io::load(&f).unwrap_err().to_string();
+    assert!(e.contains("lights") && e.contains("once per copy"), "{e}");
+}
+
+/// examples/town.toml is what its comment says: a town over 500 m across, sixteen Sponzas
+/// sharing one set of meshes, and a camera that walks at 5 m/s, then drives at 20 m/s.
+#[test]
+fn the_town_example_is_a_town_of_shared_copies_and_a_flight() {
+    let Some(_) = shared_scenes() else { return };
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/town.toml");
+    let scene = io::load(&file).unwrap();
+    let size = scene.bounds().size();
+    assert!(size.x >= 500.0 && size.z >= 500.0, "{size}");
+    // Sponza's OBJ holds 20-odd meshes: sixteen copies add instances, not meshes.
+    assert!(scene.meshes.len() < 50, "{} meshes", scene.meshes.len());
+    assert!(
+        scene.instances.len() > 600,
+        "{} instances",
+        scene.instances.len()
+    );
+    assert!(
+        scene.triangle_count() > 1_500_000,
+        "{}",
+        scene.triangle_count()
+    );
+    let at = |t: f32| scene.camera_at(0, t).expect("the flight").position;
+    // Linear keyframes: the speeds are exact up to f32 rounding of positions 230 m out.
+    let walk = at(16.0).distance(at(0.0)) / 16.0;
+    let drive = at(35.0).distance(at(16.0)) / 19.0;
+    assert!(
+        (walk - 5.0).abs() < 1e-3 && (drive - 20.0).abs() < 0.02,
+        "{walk} {drive}"
+    );
+}
+
 /// An ASCII PLY of points (no attributes) for sequence tests.
 fn points_ply(points: &[[f32; 3]]) -> String {
     let mut s = format!(

@@ -267,7 +267,9 @@ fn every_twin_has_the_wgsl_layout() {
         m,
         crate::voxel::clipmap::GpuClipLevels,
         "ClipLevels",
-        [levels, scene_lo, scene_hi, count, resolution]
+        [
+            levels, scene_lo, scene_hi, bounds_lo, bounds_hi, count, resolution
+        ]
     );
     twin!(
         m,

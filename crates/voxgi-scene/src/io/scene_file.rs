@@ -13,6 +13,8 @@
 //! translate = [0.0, 0.0, 0.0]      # metres (default 0)
 //! rotate = [0.0, 90.0, 0.0]        # degrees about X, then Y, then Z (default 0)
 //! scale = 0.01                     # number or [x, y, z], non-zero (default 1)
+//! # array = { count = [4, 1, 4], spacing = [60.0, 0.0, 60.0] }  # copies on a lattice,
+//! #                                #   world metres apart, sharing the meshes (meshes only)
 //! dynamic = false                  # the included instances may move (default false)
 //! # fps = 30.0                     # a sequence of point files (see below), frames a second
 //! # repeat = "loop"                #   past its last frame: "clamp" (hold it, default) | "loop"
@@ -180,7 +182,23 @@ struct Include {
     fps: Option<f32>,
     /// Past a sequence's last frame: "clamp" or "loop".
     repeat: Option<String>,
+    /// Copies of the include on a lattice, sharing its meshes.
+    array: Option<ArrayDef>,
 }
+
+/// `array = { count = [nx, ny, nz], spacing = [sx, sy, sz] }`: the include placed again at
+/// every `(i sx, j sy, k sz)` (world metres, added to its translation), its meshes stored once.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ArrayDef {
+    count: [u32; 3],
+    #[serde(default)]
+    spacing: [f32; 3],
+}
+
+/// The most copies one `array` makes: enough for a city of blocks, few enough that a typo
+/// (a count of 10000) is an error and not a hang.
+const MAX_ARRAY_COPIES: u64 = 1 << 16;
 
 /// An include's meshes as point clouds: `"vertices"` (the meshes' vertices) or a number (the
 /// surfaces sampled on a lattice of that many metres, `pointcloud::sample_surfaces`).
@@ -418,8 +436,22 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
         // area lights.
         crate::io::emitters::promote_emissive_quads(&mut sub);
         crate::io::emitters::promote_emissive_points(&mut sub);
+        let copies = match &inc.array {
+            Some(a) => array_offsets(a, &sub).map_err(|r| err(format!("{what}: {r}")))?,
+            None => vec![Vec3::ZERO],
+        };
         let (first, first_cloud) = (scene.instances.len(), scene.point_clouds.len());
         scene.append(sub, transform, inc.dynamic);
+        // The copies are instances of the meshes just appended: a town of a hundred buildings
+        // holds each building's triangles once.
+        let placed = first..scene.instances.len();
+        for offset in &copies[1..] {
+            for i in placed.clone() {
+                let mut copy = scene.instances[i].clone();
+                copy.transform = Mat4::from_translation(*offset) * copy.transform;
+                scene.instances.push(copy);
+            }
+        }
         include_instances.push(IncludeRange {
             name: inc.name.as_deref(),
             instances: first..scene.instances.len(),
@@ -476,6 +508,45 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
 
 /// An include's sequence of point files (`file` holds a frame number): a scene of its first
 /// frame's cloud, with the sequence playing in it.
+/// The offsets of an include's `array` copies, the first zero (the include itself); `sub` is
+/// what the include holds: copies share meshes, so it may hold nothing else.
+fn array_offsets(a: &ArrayDef, sub: &Scene) -> std::result::Result<Vec<Vec3>, String> {
+    let copies: u64 = a.count.iter().map(|&n| n as u64).product();
+    if a.count.contains(&0) || copies > MAX_ARRAY_COPIES {
+        return Err(format!(
+            "array.count {:?} must be at least 1 on each axis and make at most {MAX_ARRAY_COPIES} \
+             copies",
+            a.count
+        ));
+    }
+    let spacing = Vec3::from(a.spacing);
+    if !spacing.is_finite() {
+        return Err("array.spacing must be finite".into());
+    }
+    let holds = [
+        (sub.lights.len(), "lights"),
+        (sub.point_clouds.len(), "point clouds"),
+        (sub.animations.len(), "animations"),
+        (sub.cameras.len(), "cameras"),
+    ];
+    if let Some((n, what)) = holds.iter().find(|(n, _)| *n > 0) {
+        return Err(format!(
+            "`array` copies meshes, and this include also holds {n} {what} (emissive faces \
+             become area lights): include it once per copy instead"
+        ));
+    }
+    let [nx, ny, nz] = a.count;
+    let mut v = Vec::with_capacity(copies as usize);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                v.push(spacing * Vec3::new(i as f32, j as f32, k as f32));
+            }
+        }
+    }
+    Ok(v)
+}
+
 fn open_sequence(pattern: &Path, inc: &Include) -> std::result::Result<Scene, String> {
     if !inc.dynamic {
         return Err(

@@ -2,9 +2,12 @@
 //
 // Conservative and exact: a fragment is emitted for every voxel whose closed box the triangle
 // touches (Akenine-Moller's separating-axis test), so thin and axis-aligned triangles leave no
-// holes and the result does not depend on rasterization rules. One workgroup per table entry:
-// a triangle, or a share of a large one's columns along the dominant axis (where the
-// triangle's plane spans at most three voxels), which its threads divide.
+// holes and the result does not depend on rasterization rules. Two kinds of table entry: a
+// small triangle (at most a few columns along its dominant axis, where its plane spans at most
+// three voxels) takes one thread (`small`, 64 a workgroup: most of a detailed mesh's
+// triangles, which would leave 63 threads of a workgroup idle and, on a CPU driver, pay a
+// workgroup's start each); any other triangle, or a share of a large one's columns, takes a
+// workgroup (`main`), whose threads divide its columns.
 
 //!include shared/scene.wgsl
 //!include shared/fragment.wgsl
@@ -16,7 +19,8 @@
 @group(0) @binding(4) var<storage, read> materials: array<Material>;
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 @group(0) @binding(6) var texture_sampler: sampler;
-// Per workgroup: draw index, first index, base vertex, and the share of the triangle's columns
+// Entry 0: the number of small entries (x). Then the small entries, then the workgroups':
+// draw index, first index, base vertex, and the share of the triangle's columns
 // (chunk | chunks << 16; 0: all of them).
 @group(0) @binding(7) var<storage, read> triangles: array<vec4<u32>>;
 @group(0) @binding(8) var<storage, read_write> fragments: array<Fragment>;
@@ -80,17 +84,32 @@ fn tri_box_overlap(center: vec3<f32>, h: f32, a: vec3<f32>, b: vec3<f32>, c: vec
     return !separated(n, v0, v1, v2, h);
 }
 
+// One small triangle per thread.
+@compute @workgroup_size(64)
+fn small(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let t = gid.x + gid.y * nwg.x * 64u;
+    if t >= triangles[0].x {
+        return;
+    }
+    voxelize_entry(triangles[1u + t], 0u, 1u);
+}
+
+// One triangle, or a share of its columns, per workgroup.
 @compute @workgroup_size(64)
 fn main(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    let t = wg.x + wg.y * nwg.x;
+    let t = 1u + triangles[0].x + wg.x + wg.y * nwg.x;
     if t >= arrayLength(&triangles) {
         return;
     }
-    let info = triangles[t];
+    voxelize_entry(triangles[t], lane, 64u);
+}
+
+// Voxelizes table entry `info`: its columns from `first` on, every `stride`-th.
+fn voxelize_entry(info: vec4<u32>, first: u32, stride: u32) {
     let draw = draws[info.x];
     let m = materials[draw.material];
     let ia = indices[info.y] + info.z;
@@ -149,7 +168,7 @@ fn main(
     let begin = chunk * CHUNK_COLUMNS;
     let end = select(min(total, begin + CHUNK_COLUMNS), total, chunk + 1u >= chunks);
     let d = dot(n, a);
-    for (var k = begin + lane; k < end; k += 64u) {
+    for (var k = begin + first; k < end; k += stride) {
         let cu = lo[u] + i32(k % nu);
         let cv = lo[v] + i32(k / nu);
         // The plane's depth over the column's square (|n_w| is the largest component, so the

@@ -288,9 +288,12 @@ impl FragmentEstimate {
 /// The triangles voxelize reads: per workgroup, a triangle's draw, first index and base
 /// vertex, and which share of its voxel columns the workgroup takes (`chunk | chunks << 16`).
 pub struct TriangleTable {
-    /// `[u32; 4]` per workgroup; one zero entry when empty.
+    /// `[u32; 4]` per entry: a header (the small entries' count), the small triangles, then
+    /// the workgroups' entries (shaders/fragments/voxelize.wgsl).
     pub buffer: wgpu::Buffer,
-    /// Entries in the table (workgroups voxelize dispatches).
+    /// Small triangles, one thread each.
+    pub small: u32,
+    /// Workgroup entries: larger triangles, or shares of a large one's columns.
     pub count: u32,
     /// The dynamic instances' triangles (their fragments carry coverage), or the static ones'.
     pub dynamic: bool,
@@ -301,6 +304,10 @@ pub struct TriangleTable {
 /// silently: one workgroup for a triangle over a 1024³ grid's whole floor made a fifth of its
 /// fragments. Larger triangles are split over several workgroups.
 pub const CHUNK_COLUMNS: u32 = 64 * 512;
+
+/// A triangle whose longest edge spans at most this many voxels covers at most 16 columns
+/// along its dominant axis ((2 + 2)²): one thread voxelizes it.
+const SMALL_EDGE: f32 = 2.0;
 
 /// How many workgroups voxelize a triangle whose longest edge is `edge` metres on `grid`:
 /// its projection on the dominant plane fits a square of that side, so it covers at most
@@ -321,7 +328,7 @@ pub fn triangle_table(
     dynamic: bool,
     grid: &Grid,
 ) -> Result<TriangleTable> {
-    let mut t: Vec<[u32; 4]> = Vec::new();
+    let (mut small, mut t): (Vec<[u32; 4]>, Vec<[u32; 4]>) = (Vec::new(), Vec::new());
     for call in scene.calls.iter().filter(|c| c.dynamic == dynamic) {
         // The visible surface of an area light is not voxelized, neither as an emitter (its
         // light reaches surfaces as the light's direct term, shaded per pixel and injected per
@@ -332,6 +339,12 @@ pub fn triangle_table(
             continue;
         }
         for (first, &edge) in call.indices.clone().step_by(3).zip(&call.edges) {
+            // A dynamic instance may be scaled up past its uploaded size: its triangles keep
+            // the workgroups that share any number of columns.
+            if !dynamic && edge <= SMALL_EDGE * grid.voxel_size {
+                small.push([call.draw, first, call.base_vertex as u32, 0]);
+                continue;
+            }
             let n = chunks(edge, grid);
             for chunk in 0..n {
                 t.push([call.draw, first, call.base_vertex as u32, chunk | n << 16]);
@@ -339,16 +352,19 @@ pub fn triangle_table(
         }
     }
     let n = t.len() as u32;
-    if t.is_empty() {
-        t.push([0; 4]);
-    }
+    let s = small.len() as u32;
+    let t: Vec<[u32; 4]> = std::iter::once([s, 0, 0, 0])
+        .chain(small)
+        .chain(t)
+        .collect();
     let bytes = size_of_val(t.as_slice()) as u64;
     let limit = device.limits().max_storage_buffer_binding_size;
     if bytes > limit {
         return Err(Error::TooLarge(format!(
-            "the scene's drawn triangles need a {} MiB voxelization table ({n} workgroups), \
+            "the scene's drawn triangles need a {} MiB voxelization table ({} entries), \
              more than this GPU's storage-buffer limit of {} MiB",
             bytes >> 20,
+            t.len(),
             limit >> 20
         )));
     }
@@ -363,6 +379,7 @@ pub fn triangle_table(
     });
     Ok(TriangleTable {
         buffer,
+        small: s,
         count: n,
         dynamic,
     })

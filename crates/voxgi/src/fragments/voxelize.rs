@@ -8,7 +8,10 @@ use crate::gpu_scene::GpuScene;
 
 /// The voxelize compute pass (shaders/fragments/voxelize.wgsl): its pipeline and bind group layout.
 pub struct VoxelizePass {
+    /// A workgroup per triangle (or share of a large one's columns).
     pipeline: wgpu::ComputePipeline,
+    /// A thread per small triangle.
+    small: wgpu::ComputePipeline,
     /// For the dynamic geometry: fragments weighted by how much of their voxel is inside.
     dynamic: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -40,11 +43,12 @@ impl VoxelizePass {
             ],
         });
         let layouts = [Some(&layout)];
-        let make = |coverage: f64| {
-            crate::gpu::shader::grouped_pipeline(
+        let make = |coverage: f64, entry: &str| {
+            crate::gpu::shader::grouped_pipeline_entry(
                 device,
                 "voxelize",
                 "fragments/voxelize.wgsl",
+                entry,
                 &layouts,
                 &[
                     ("DYNAMIC_COVERAGE", coverage),
@@ -53,8 +57,9 @@ impl VoxelizePass {
             )
         };
         VoxelizePass {
-            pipeline: make(0.0),
-            dynamic: make(1.0),
+            pipeline: make(0.0, "main"),
+            small: make(0.0, "small"),
+            dynamic: make(1.0, "main"),
             layout,
         }
     }
@@ -95,7 +100,8 @@ impl VoxelizePass {
         })
     }
 
-    /// Records the pass over `triangles`, one workgroup per triangle, appending to `fragments` and
+    /// Records the pass over `triangles` (a thread per small triangle, a workgroup per other
+    /// table entry), appending to `fragments` and
     /// its count; clear the count first (`Fragments::record_clear`). A dynamic table's fragments
     /// carry coverage. Timed as "voxelize".
     pub fn record(
@@ -109,16 +115,21 @@ impl VoxelizePass {
             label: Some("voxelize"),
             timestamp_writes: timer.compute("voxelize"),
         });
-        if triangles.count == 0 {
-            return;
-        }
-        pass.set_pipeline(if triangles.dynamic {
-            &self.dynamic
-        } else {
-            &self.pipeline
-        });
         pass.set_bind_group(0, bind, &[]);
-        let (x, y) = layout::groups_2d(triangles.count, 1);
-        pass.dispatch_workgroups(x, y, 1);
+        // Only static tables hold small triangles (`triangle_table`).
+        if triangles.small > 0 {
+            pass.set_pipeline(&self.small);
+            let (x, y) = layout::groups_2d(triangles.small, 64);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        if triangles.count > 0 {
+            pass.set_pipeline(if triangles.dynamic {
+                &self.dynamic
+            } else {
+                &self.pipeline
+            });
+            let (x, y) = layout::groups_2d(triangles.count, 1);
+            pass.dispatch_workgroups(x, y, 1);
+        }
     }
 }

@@ -222,6 +222,18 @@ pub fn grouped_pipeline(
     pipeline_with(device, label, file, None, "main", layouts, constants)
 }
 
+/// `grouped_pipeline` of entry point `entry` (a pass of several steps in one file).
+pub fn grouped_pipeline_entry(
+    device: &wgpu::Device,
+    label: &str,
+    file: &str,
+    entry: &str,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    pipeline_with(device, label, file, None, entry, layouts, constants)
+}
+
 /// `grouped_pipeline` for a shader that reaches voxel structure `kind` (`voxels/` includes).
 pub fn voxel_pipeline(
     device: &wgpu::Device,

@@ -46,7 +46,7 @@ use crate::screen::tonemap::TonemapPass;
 use crate::screen::upsample::UpsamplePass;
 use crate::settings::{Changes, changes_between};
 use crate::view::lit_scene;
-use crate::voxel::{Filtering, Grid, POOL_COUNTERS, StructureDesc, VoxelStructure};
+use crate::voxel::{Filtering, Grid, POOL_COUNTERS, StructureDesc, VoxelKind, VoxelStructure};
 use crate::{Error, Result};
 use glam::Vec3;
 use sizing::Sizing;
@@ -180,6 +180,7 @@ impl SceneFacts {
     fn structure_desc(&self, options: &RendererOptions, grid: Grid) -> StructureDesc {
         StructureDesc {
             grid,
+            bounds: self.bounds,
             filtering: Filtering {
                 anisotropic: options.anisotropic,
                 ndf: options.ndf_mips,
@@ -255,6 +256,10 @@ impl Renderer {
             casts: scene.lights.iter().map(|l| l.cast_shadows).collect(),
             glossy: gather::has_glossy(scene, gpu_scene.point_count),
         };
+        let across = (facts.bounds.max - facts.bounds.min).max_element();
+        if let Some(w) = coarse_voxels(across, &grid(&facts, options), options.voxels) {
+            log::warn!("{w}");
+        }
         let atlas = plan_atlas(
             device,
             queue,
@@ -816,6 +821,26 @@ fn allocate_fragments(
 /// The volume's grid around the scene.
 fn grid(facts: &SceneFacts, options: &RendererOptions) -> Grid {
     Grid::around(facts.bounds.min, facts.bounds.max, options.voxel_resolution)
+}
+
+/// Voxels wider than this cannot tell a doorway from a wall or a person from the air: the
+/// indirect light near the camera is then a blur of the whole block.
+const COARSE_VOXEL: f32 = 1.0;
+
+/// The warning for a structure of one fixed grid `grid` (dense, octree) over a scene `across`
+/// metres wide whose voxels are coarser than `COARSE_VOXEL`: the scene is too large for it,
+/// and the clipmap is the answer.
+pub fn coarse_voxels(across: f32, grid: &Grid, kind: VoxelKind) -> Option<String> {
+    (kind != VoxelKind::CLIPMAP && grid.voxel_size > COARSE_VOXEL).then(|| {
+        format!(
+            "the scene is {across:.0} m across, so the {} structure's {}³ voxels are {:.1} m \
+             wide and the indirect light near the camera is coarse: voxels = \"clipmap\" \
+             (--voxels clipmap) keeps fine voxels near the camera and coarse ones far away",
+            kind.name(),
+            grid.resolution,
+            grid.voxel_size
+        )
+    })
 }
 
 /// Where a cloud's unused point slots wait: 64 sides of the scene's grid below its corner,

@@ -15,6 +15,9 @@ use crate::gpu::shader::StructureShaders;
 pub struct StructureDesc {
     /// The grid of its finest voxels (the fragments' grid).
     pub grid: Grid,
+    /// The scene's bounds, which `grid` is around (a camera-following structure keeps its
+    /// windows within them).
+    pub bounds: voxgi_scene::Aabb,
     /// How it filters its levels.
     pub filtering: Filtering,
     /// Occupied voxels its pools start with room for (they grow when a build counts more).

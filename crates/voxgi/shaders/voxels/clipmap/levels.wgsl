@@ -8,10 +8,14 @@ const MAX_CLIP_LEVELS: u32 = 8u;
 struct ClipLevels {
     // Per level: its window's minimum corner (xyz), metres, and its voxel edge (w).
     levels: array<vec4<f32>, 8>,
-    // The scene's cube, lowest and highest corner (xyz): past it there is nothing, so a
-    // window's face that lies on or beyond it needs no margin.
+    // The scene's cube, lowest and highest corner (xyz): cones stop at it, as at the dense
+    // volume's faces.
     scene_lo: vec4<f32>,
     scene_hi: vec4<f32>,
+    // The scene's bounds (xyz), inside the cube: past them there is nothing, so a window's
+    // face that lies on or beyond them needs no margin.
+    bounds_lo: vec4<f32>,
+    bounds_hi: vec4<f32>,
     // Levels in use.
     count: u32,
     // Voxels per side of every window.

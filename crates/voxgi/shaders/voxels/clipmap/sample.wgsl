@@ -47,13 +47,13 @@ fn level_uvw(p: vec3<f32>, k: u32) -> vec3<f32> {
 }
 
 // How far inside level k's window p lies, in its voxels (negative outside), counting only
-// the faces inside the scene's cube: past the others there is nothing the level lacks.
+// the faces inside the scene's bounds: past the others there is nothing the level lacks.
 fn inside_by(p: vec3<f32>, k: u32) -> f32 {
     let l = clip.levels[k];
     let n = f32(clip.resolution);
     let q = (p - l.xyz) / l.w;
-    let open_lo = l.xyz > clip.scene_lo.xyz + 0.5 * l.w;
-    let open_hi = l.xyz + n * l.w < clip.scene_hi.xyz - 0.5 * l.w;
+    let open_lo = l.xyz > clip.bounds_lo.xyz + 0.5 * l.w;
+    let open_hi = l.xyz + n * l.w < clip.bounds_hi.xyz - 0.5 * l.w;
     let far = vec3<f32>(1e9);
     let m = min(select(far, q, open_lo), select(far, vec3<f32>(n) - q, open_hi));
     // Outside the window itself nothing of it holds p.

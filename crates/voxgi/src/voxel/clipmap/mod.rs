@@ -12,10 +12,12 @@
 //!
 //! The windows follow the camera by steps of an eighth of themselves (a window moves when its
 //! place for the camera lies two steps or more from where it is, so a camera that wavers does
-//! not move it to and fro), on a lattice of their own voxels that starts at the scene's cube, so a voxel of a level covers the same place
-//! wherever its window is. A window stays inside the scene's cube where it can (a level wider
-//! than the scene is centred on it, as the dense volume is: at the dense volume's voxel size
-//! such a level is that volume), so no voxels are spent on the void past the world's edge.
+//! not move it to and fro), on a lattice of their own voxels that starts at the scene's bounds'
+//! corner, so a voxel of a level covers the same place wherever its window is. A window stays
+//! inside the scene's bounds on each axis where it can, and is centred on them on an axis
+//! where it is wider (a town 30 m tall: every level holds all of its height, none of the
+//! ground below it; a level wider than the scene on every axis is the dense volume there), so
+//! no voxels are spent on the void past the world's edge.
 //! When a window moves, every level is voxelized and lit again: the cost of a move is a
 //! rebuild's (scrolling only the slabs newly inside, within a per-frame budget, is next).
 
@@ -55,6 +57,11 @@ pub struct GpuClipLevels {
     pub scene_lo: [f32; 4],
     /// Its highest corner.
     pub scene_hi: [f32; 4],
+    /// The scene's bounds, lowest corner (xyz; w unused): windows' faces past them need no
+    /// margin.
+    pub bounds_lo: [f32; 4],
+    /// Their highest corner.
+    pub bounds_hi: [f32; 4],
     /// Levels in use.
     pub count: u32,
     /// Voxels per side of every window.
@@ -150,7 +157,12 @@ fn create(
     let leaves = (desc.leaves * count as u64).min((res as u64).pow(3) * count as u64);
     let inner = DenseVolume::create(device, base, count, desc, leaves, previous)?;
     let scene = (desc.grid.origin, desc.grid.origin + desc.grid.extent());
-    let centre = (scene.0 + scene.1) * 0.5;
+    // An empty scene's bounds are inverted: the grid's cube stands in for them.
+    let bounds = match desc.bounds {
+        b if b.min.cmple(b.max).all() => (b.min, b.max),
+        _ => scene,
+    };
+    let centre = (bounds.0 + bounds.1) * 0.5;
     let levels = (0..count)
         .map(|k| {
             let s = finest * (1u32 << k) as f32;
@@ -159,28 +171,34 @@ fn create(
                 voxel_size: s,
                 resolution: res,
             };
-            g.origin = placed_origin(&g, scene, centre);
+            g.origin = placed_origin(&g, bounds, centre);
             g
         })
         .collect();
-    Ok(Box::new(Clipmap::new(device, inner, levels, scene)))
+    Ok(Box::new(Clipmap::new(device, inner, levels, scene, bounds)))
 }
 
-/// The origin of a window like `g` for a camera at `camera` in a scene whose cube spans
-/// `scene`: centred on the camera, moved back inside the cube on each axis where it would
-/// poke out (centred on the cube where it is wider), on the lattice of its steps (an eighth of
-/// the window) from the cube's corner, so that its voxels lie where the level's always lie.
+/// The origin of a window like `g` for a camera at `camera` in a scene whose bounds span
+/// `(lo, hi)`: on each axis centred on the camera, moved back inside the bounds where it would
+/// poke out, on the lattice of its steps (an eighth of the window) from their corner, so that
+/// its voxels lie where the level's always lie; centred on the bounds, unsnapped, on an axis
+/// where it is wider than they are (snapped, it could leave a sliver of the scene out; it
+/// never moves along that axis, so no other window of its level needs its lattice there).
 fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
-    let half = Vec3::splat(g.extent() * 0.5);
-    let middle = (lo + hi) * 0.5;
-    // Wider than the cube: centred on it, unsnapped (snapped, it could leave a sliver of the
-    // scene out; it never moves, so no other window of its level needs its lattice).
-    if g.extent() > (hi - lo).max_element() * (1.0 + 1e-5) {
-        return middle - half;
-    }
-    let inside = camera.clamp(lo + half.min(middle - lo), hi - half.min(hi - middle));
-    let step = window_step(g);
-    lo + ((inside - lo) / step).round() * step - half
+    let (w, half, step) = (g.extent(), g.extent() * 0.5, window_step(g));
+    let axis = |lo: f32, hi: f32, c: f32| {
+        let middle = (lo + hi) * 0.5;
+        if w > (hi - lo) * (1.0 + 1e-5) {
+            return middle - half;
+        }
+        let inside = c.clamp(lo + half.min(middle - lo), hi - half.min(hi - middle));
+        lo + ((inside - lo) / step).round() * step - half
+    };
+    Vec3::new(
+        axis(lo.x, hi.x, camera.x),
+        axis(lo.y, hi.y, camera.y),
+        axis(lo.z, hi.z, camera.z),
+    )
 }
 
 /// How far a window moves at a time: an eighth of it (at least a voxel).
@@ -200,9 +218,11 @@ pub struct Clipmap {
     clip_current: std::sync::atomic::AtomicBool,
     /// A `Volume` uniform placing one level's window, for the debug views.
     debug_placement: wgpu::Buffer,
-    /// The scene's cube (its lowest and highest corner): the windows stay inside it where
-    /// they can, and their lattices start at its corner.
+    /// The scene's cube (its lowest and highest corner): cones stop at it.
     scene: (Vec3, Vec3),
+    /// The scene's bounds: the windows stay inside them where they can, and their lattices
+    /// start at their corner.
+    bounds: (Vec3, Vec3),
     /// The first frame's camera has placed the windows.
     placed: bool,
     sampling: wgpu::BindGroup,
@@ -215,10 +235,11 @@ impl Clipmap {
         inner: DenseVolume,
         levels: Vec<Grid>,
         scene: (Vec3, Vec3),
+        bounds: (Vec3, Vec3),
     ) -> Self {
         let clip = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("clipmap levels"),
-            contents: bytemuck::bytes_of(&clip_levels(&levels, scene)),
+            contents: bytemuck::bytes_of(&clip_levels(&levels, scene, bounds)),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let debug_placement = device.create_buffer(&wgpu::BufferDescriptor {
@@ -235,6 +256,7 @@ impl Clipmap {
             clip_current: true.into(),
             debug_placement,
             scene,
+            bounds,
             placed: false,
             sampling,
             leaves,
@@ -322,7 +344,7 @@ impl Clipmap {
     fn follow(&mut self, camera: Vec3) -> bool {
         let mut moved = false;
         for g in &mut self.levels {
-            let origin = placed_origin(g, self.scene, camera);
+            let origin = placed_origin(g, self.bounds, camera);
             let strayed = (origin - g.origin).abs().max_element() > window_step(g) * 1.001;
             if (!self.placed || strayed) && origin != g.origin {
                 g.origin = origin;
@@ -348,7 +370,7 @@ impl Clipmap {
         }
         let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("clipmap levels (staging)"),
-            contents: bytemuck::bytes_of(&clip_levels(&self.levels, self.scene)),
+            contents: bytemuck::bytes_of(&clip_levels(&self.levels, self.scene, self.bounds)),
             usage: wgpu::BufferUsages::COPY_SRC,
         });
         encoder.copy_buffer_to_buffer(&staging, 0, &self.clip, 0, staging.size());
@@ -356,7 +378,7 @@ impl Clipmap {
 }
 
 /// sample.wgsl's `inside_by`: how far inside window `g` the point `p` lies, in its voxels,
-/// counting only the faces inside the scene's cube `(lo, hi)` (negative outside the window).
+/// counting only the faces inside the scene's bounds `(lo, hi)` (negative outside the window).
 fn inside_by(g: &Grid, (lo, hi): (Vec3, Vec3), p: Vec3) -> f32 {
     let n = g.resolution as f32;
     let q = (p - g.origin) / g.voxel_size;
@@ -372,12 +394,14 @@ fn inside_by(g: &Grid, (lo, hi): (Vec3, Vec3), p: Vec3) -> f32 {
         .min_element()
 }
 
-/// The levels in the scene's cube `scene` as the shaders read them.
-fn clip_levels(levels: &[Grid], (lo, hi): (Vec3, Vec3)) -> GpuClipLevels {
+/// The levels in the scene's cube `scene` and bounds `bounds` as the shaders read them.
+fn clip_levels(levels: &[Grid], (lo, hi): (Vec3, Vec3), bounds: (Vec3, Vec3)) -> GpuClipLevels {
     let mut l = GpuClipLevels {
         levels: [[0.0; 4]; MAX_LEVELS as usize],
         scene_lo: lo.extend(0.0).to_array(),
         scene_hi: hi.extend(0.0).to_array(),
+        bounds_lo: bounds.0.extend(0.0).to_array(),
+        bounds_hi: bounds.1.extend(0.0).to_array(),
         count: levels.len() as u32,
         resolution: levels[0].resolution,
         _pad: [0; 2],
@@ -434,7 +458,7 @@ impl VoxelStructure for Clipmap {
         let room = 6.5;
         self.levels
             .iter()
-            .find(|g| inside_by(g, self.scene, p) >= room)
+            .find(|g| inside_by(g, self.bounds, p) >= room)
             .unwrap_or(self.levels.last().expect("levels"))
             .voxel_size
     }
@@ -607,5 +631,24 @@ mod tests {
         // Wider: centred on the scene.
         let o = placed_origin(&grid(0.4), scene, camera);
         assert!(near(o, Vec3::splat(-3.2)), "{o}");
+    }
+
+    #[test]
+    fn over_a_flat_world_windows_hold_its_whole_height() {
+        // A town 64 m wide and 3 m tall; a window of 32 voxels of 0.2 m (6.4 m).
+        let bounds = (Vec3::ZERO, Vec3::new(64.0, 3.0, 64.0));
+        let g = Grid {
+            origin: Vec3::ZERO,
+            voxel_size: 0.2,
+            resolution: 32,
+        };
+        for camera in [Vec3::new(20.0, 1.7, 30.0), Vec3::new(20.0, 150.0, 30.0)] {
+            let o = placed_origin(&g, bounds, camera);
+            // Along y, wider than the town: centred on it, wherever the camera is.
+            assert!((o.y - (1.5 - 3.2)).abs() < 1e-5, "{camera}: {o}");
+            // Along x and z, the camera within half a 0.8 m step of the centre, on the lattice.
+            let xz = glam::Vec2::new(o.x, o.z);
+            assert!(xz.abs_diff_eq(glam::Vec2::new(16.8, 27.2), 1e-4), "{o}");
+        }
     }
 }

@@ -97,6 +97,9 @@ fn create(
     Ok(Box::new(v))
 }
 
+/// Slot pools more than this many times the last build's count shrink.
+const SHRINK_BELOW: u64 = 4;
+
 /// Checks a slot capacity (occupied voxels) against the device's storage-buffer limit.
 fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
     crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")
@@ -921,13 +924,23 @@ impl VoxelStructure for DenseVolume {
         crate::gpu::max_entries(device, SLOT_BYTES)
     }
 
+    /// Past the capacity, or far below it: a first guess at the device's limit (a scene whose
+    /// estimate passes it, a town) holds ten times what it needs.
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
         counted[0] > self.slot_capacity
+            || self.slot_capacity as u64 > SHRINK_BELOW * (counted[0] as u64).max(1024)
     }
 
+    /// To the count when it overflowed; half as much again when shrinking, so that the next
+    /// builds' counts (a moved window, moved objects) still fit.
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {
-        let slots =
-            crate::gpu::pool_capacity(device, counted[0] as u64, SLOT_BYTES, "occupied voxels")?;
+        let count = counted[0] as u64;
+        let wanted = if count > self.slot_capacity as u64 {
+            count
+        } else {
+            (count * 3 / 2).min(crate::gpu::max_entries(device, SLOT_BYTES))
+        };
+        let slots = crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")?;
         let grown = crate::gpu::checked(device, "voxel pools", || {
             DenseVolume::new(
                 device,

@@ -223,8 +223,9 @@ impl OctreeVolume {
                 limits.max_texture_dimension_2d
             )));
         }
-        // The build's sums are the larger per-slot buffer.
-        too_big("leaf slots", pools.slots as u64 * ACCUM_WORDS * 4)?;
+        // The build's scratch (a flag bit per tile, then the sums per slot) is the larger
+        // per-slot buffer.
+        too_big("leaf slots", scratch_bytes(tiles, pools.slots as u64))?;
         let max_dim = limits.max_texture_dimension_3d;
         let too_many = |bricks: u64| {
             crate::Error::TooLarge(format!(
@@ -589,7 +590,9 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn leaf_limit(&self, device: &wgpu::Device) -> u64 {
-        max_binding(device) / (ACCUM_WORDS * 4)
+        // The build's scratch holds the tiles' flags before the slots' sums.
+        (max_binding(device) / 4).saturating_sub(scratch_bytes(self.layout.tiles as u64, 0) / 4)
+            / ACCUM_WORDS
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
@@ -673,6 +676,6 @@ struct UpdateBase {
 
 /// Bytes of the build's scratch for `tiles` tiles and `slots` leaf slots (`block_words` and
 /// `sums_of` in build_shared.wgsl).
-fn scratch_bytes(tiles: u64, slots: u64) -> u64 {
+pub(super) fn scratch_bytes(tiles: u64, slots: u64) -> u64 {
     (tiles / 8 + 2 + slots * ACCUM_WORDS) * 4
 }

@@ -35,14 +35,17 @@ impl OctreePools {
     /// must not fail where the scene itself would fit (growth then reports a real excess).
     pub fn within(self, max_binding: u64) -> Self {
         let mut p = self;
-        p.slots = p
-            .slots
-            .min((max_binding / (ACCUM_WORDS * 4)).min(u32::MAX as u64) as u32);
         while p.node_bytes() > max_binding && p.leaf_tiles > 64 {
             p.leaf_tiles /= 2;
             p.even_tiles = (p.even_tiles / 2).max(64);
             p.odd_tiles = (p.odd_tiles / 2).max(64);
         }
+        // The build's scratch holds the tiles' flags, then the slots' sums.
+        let tiles = 1 + p.leaf_tiles as u64 + p.even_tiles as u64 + p.odd_tiles as u64;
+        let flags = super::scratch_bytes(tiles, 0);
+        p.slots = p.slots.min(
+            (max_binding.saturating_sub(flags) / (ACCUM_WORDS * 4)).min(u32::MAX as u64) as u32,
+        );
         p
     }
 
@@ -117,6 +120,20 @@ mod tests {
             (g.slots, g.leaf_tiles, g.even_tiles, g.odd_tiles),
             (5000, 150, 64, 64)
         );
+    }
+
+    /// The first guess for a town at 512³ was cut to the slots' sums alone, and its build's
+    /// scratch (the tiles' flags first) passed lavapipe's 128 MiB binding by 0.7 MiB.
+    #[test]
+    fn a_guess_within_a_binding_limit_leaves_room_for_the_build_scratch() {
+        let limit = 128u64 << 20;
+        let p = OctreePools::for_leaves(20_000_000).within(limit);
+        let tiles = 1 + p.leaf_tiles as u64 + p.even_tiles as u64 + p.odd_tiles as u64;
+        let scratch = super::super::scratch_bytes(tiles, p.slots as u64);
+        assert!(scratch <= limit, "{scratch} > {limit}");
+        // And no more room than that: one more slot would pass it.
+        assert!(scratch + ACCUM_WORDS * 4 > limit, "{scratch}");
+        assert!(p.node_bytes() <= limit);
     }
 
     #[test]
