@@ -66,6 +66,11 @@ pub(crate) struct App {
     cpu: bool,
     /// Orbit or fly (F toggles), as the viewer's.
     controller: Controller,
+    /// Follow the scene's camera flight, if it has one: on until the view is moved by hand,
+    /// on again when a double click goes back to the scene's camera.
+    fly_along: bool,
+    /// The camera the flight last set, to tell when the view was moved by hand since.
+    flown: Option<voxgi::scene::Camera>,
     /// How long the fly keys were held since the last frame.
     held: camera::HeldKeys,
     scene_radius: f32,
@@ -270,6 +275,8 @@ async fn run() -> Result<()> {
         options,
         params,
         controller,
+        fly_along: true,
+        flown: None,
         held: camera::HeldKeys::default(),
         scene,
         display: traced::Display::Cones,
@@ -368,7 +375,7 @@ impl App {
             let (m, secs) = self.held.take(web_time::Instant::now());
             f.step(m, secs);
         }
-        self.params.camera = self.controller.camera();
+        self.params.camera = self.flown_camera();
 
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
@@ -578,9 +585,42 @@ impl App {
             self.scene_radius * 2.0,
         ));
         self.held = camera::HeldKeys::default();
+        self.fly_along = true;
+        self.flown = None;
         page::set_controller(false);
         // A cut to another view: nothing of the last view's history belongs in it.
         self.renderer.reset_history();
+    }
+
+    /// This frame's camera: the scene's flight at the time shown while it has one and the view
+    /// was not moved by hand since it was followed (a drag, the wheel or a fly key stops it), the
+    /// orbit or fly camera otherwise. Following, the controller is kept on the flight, so that
+    /// leaving it starts from where the flight was.
+    fn flown_camera(&mut self) -> voxgi::scene::Camera {
+        if self
+            .flown
+            .as_ref()
+            .is_some_and(|c| *c != self.controller.camera())
+        {
+            self.fly_along = false;
+        }
+        let flight = if self.fly_along && self.scene.camera_is_animated(0) {
+            self.scene.camera_at(0, self.time)
+        } else {
+            None
+        };
+        let Some(cam) = flight else {
+            self.flown = None;
+            return self.controller.camera();
+        };
+        self.controller = match &self.controller {
+            Controller::Orbit(_) => {
+                Controller::Orbit(camera::Orbit::from_camera(&cam, self.scene_radius))
+            }
+            Controller::Fly(f) => Controller::Fly(camera::Fly::from_camera(&cam, f.speed)),
+        };
+        self.flown = Some(self.controller.camera());
+        cam
     }
 
     /// The page lost the keyboard's focus: no key is held any more.
