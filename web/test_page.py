@@ -157,6 +157,16 @@ def mean(img, box, fx0, fy0, fx1, fy1):
     return [t / max(n, 1) for t in total]
 
 
+def change_over_frames(page, path):
+    """How much the picture changes over two frames: the canvas shot, two more frames, shot
+    again (saved as `path`_0.png and _1.png); their `difference`."""
+    more_frames(page, 2)
+    a = shot(page, f"{path}_0.png")
+    more_frames(page, 2)
+    b = shot(page, f"{path}_1.png")
+    return difference(a, b)
+
+
 def difference(a, b):
     """Mean absolute difference per channel, 0..255."""
     pa, pb = a.load(), b.load()
@@ -309,20 +319,12 @@ def main():
         assert bounces == "2", f"the file's [settings] bounces = 2 is not shown: {bounces}"
         # A moving frame re-voxelizes the block and bounces twice: seconds on SwiftShader,
         # and the animation advances at most a quarter of a second a frame.
-        more_frames(page, 2)
-        t0 = shot(page, f"{out}/moving_0.png")
-        more_frames(page, 2)
-        t1 = shot(page, f"{out}/moving_1.png")
-        moving = difference(t0, t1)
+        moving = change_over_frames(page, f"{out}/moving")
         # Paused (Space), the same frames' difference is the accumulation's noise alone.
         page.keyboard.press("Space")
         play = page.evaluate("document.getElementById('play').textContent")
         assert play == "play the animation", f"Space did not pause: {play!r}"
-        more_frames(page, 2)
-        p0 = shot(page, f"{out}/paused_0.png")
-        more_frames(page, 2)
-        p1 = shot(page, f"{out}/paused_1.png")
-        still = difference(p0, p1)
+        still = change_over_frames(page, f"{out}/paused")
         say(
             f"cornell-moving.toml: the picture changed by {moving:.2f} of 255 playing, "
             f"{still:.2f} paused"
@@ -344,22 +346,14 @@ def main():
             "#file", files=[{"name": "flight.toml", "mimeType": "text/plain", "buffer": flight}]
         )
         wait_scene(page, "flight.toml")
-        more_frames(page, 2)
-        f0 = shot(page, f"{out}/flight_0.png")
-        more_frames(page, 2)
-        f1 = shot(page, f"{out}/flight_1.png")
-        flying = difference(f0, f1)
+        flying = change_over_frames(page, f"{out}/flight")
         canvas = page.locator("#voxgi").bounding_box()
         cx, cy = canvas["x"] + canvas["width"] / 2, canvas["y"] + canvas["height"] / 2
         page.mouse.move(cx, cy)
         page.mouse.down()
         page.mouse.move(cx + 30, cy, steps=3)
         page.mouse.up()
-        more_frames(page, 2)
-        h0 = shot(page, f"{out}/by_hand_0.png")
-        more_frames(page, 2)
-        h1 = shot(page, f"{out}/by_hand_1.png")
-        by_hand = difference(h0, h1)
+        by_hand = change_over_frames(page, f"{out}/by_hand")
         say(
             f"flight.toml: the picture changed by {flying:.2f} of 255 flying, "
             f"{by_hand:.2f} once dragged (still playing)"

@@ -170,6 +170,9 @@ pub struct DenseSampler<'a> {
     pub grid: Grid,
     /// Whether `chains` holds six directional blocks (stacked along z) rather than one.
     pub anisotropic: bool,
+    /// Cubes of `grid.resolution` voxels stacked along z in both textures (`Volume::windows`:
+    /// 1, or a clipmap's levels).
+    pub windows: u32,
     /// The finest level: stored (L sigma, sigma) per voxel.
     pub radiance0: &'a Texture3d,
     /// The levels above the finest, from half the resolution down: stored (L sigma, sigma).
@@ -185,26 +188,46 @@ impl DenseSampler<'_> {
         uvw.cmpge(Vec3::ZERO).all() && uvw.cmple(Vec3::ONE).all()
     }
 
-    /// `sample_chains`, with every axis read (`SAMPLE_AXES` = 3).
-    fn chains(&self, uvw: Vec3, cl: f32, dir: Vec3) -> Vec4 {
+    /// `sample_chains` of window `win`, with every axis read (`SAMPLE_AXES` = 3).
+    fn chains(&self, uvw: Vec3, cl: f32, dir: Vec3, win: u32) -> Vec4 {
         let levels = self.grid.levels() as f32;
         let upper = (cl.floor() + 1.0).min(levels - 2.0);
         let texels = ((self.grid.resolution / 2) as f32 * (-upper).exp2()).max(1.0);
         let z = uvw.z.clamp(0.5 / texels, 1.0 - 0.5 / texels);
+        let (window, windows) = (win as f32, self.windows as f32);
         if !self.anisotropic {
-            return self.chains.sample(Vec3::new(uvw.x, uvw.y, z), cl);
+            return self
+                .chains
+                .sample(Vec3::new(uvw.x, uvw.y, (window + z) / windows), cl);
         }
+        // Each direction's block holds every window: block b, window w at b · windows + w.
         let block = Vec3::new(
             if dir.x >= 0.0 { 0.0 } else { 1.0 },
             if dir.y >= 0.0 { 2.0 } else { 3.0 },
             if dir.z >= 0.0 { 4.0 } else { 5.0 },
-        );
+        ) * windows
+            + window;
         let w = dir * dir;
         let at = |b: f32| {
             self.chains
-                .sample(Vec3::new(uvw.x, uvw.y, (z + b) / 6.0), cl)
+                .sample(Vec3::new(uvw.x, uvw.y, (z + b) / (6.0 * windows)), cl)
         };
         w.x * at(block.x) + w.y * at(block.y) + w.z * at(block.z)
+    }
+
+    /// `window_depth`: optical depth at `uvw` over window `win`, filtered to `lod` levels
+    /// above its finest, seen along `dir`.
+    pub fn window_depth(&self, uvw: Vec3, lod: f32, dir: Vec3, win: u32) -> Vec4 {
+        let n = self.grid.resolution as f32;
+        let inside = if self.windows > 1 {
+            uvw.z.clamp(0.5 / n, 1.0 - 0.5 / n)
+        } else {
+            uvw.z
+        };
+        let z = (win as f32 + inside) / self.windows as f32;
+        let fine = self.radiance0.sample(Vec3::new(uvw.x, uvw.y, z), 0.0);
+        let coarse = self.chains(uvw, (lod - 1.0).max(0.0), dir, win);
+        fine.lerp(coarse, lod.min(1.0))
     }
 
     /// `sample_depth`: optical depth per sample diameter, filtered to `diameter`.
@@ -216,9 +239,7 @@ impl DenseSampler<'_> {
         let vs = self.grid.voxel_size;
         let top = self.grid.levels() as f32 - 1.0;
         let lod = (diameter / vs).max(1.0).log2().clamp(0.0, top);
-        let fine = self.radiance0.sample(uvw, 0.0);
-        let coarse = self.chains(uvw, (lod - 1.0).max(0.0), dir);
-        fine.lerp(coarse, lod.min(1.0))
+        self.window_depth(uvw, lod, dir, 0)
     }
 
     /// `sample_voxels`: premultiplied radiance and opacity.

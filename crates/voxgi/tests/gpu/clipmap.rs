@@ -1,7 +1,7 @@
 //! The clipmap against the dense volume it is built from, and its levels' hand-over.
 
 use crate::common::*;
-use crate::contract::run_probes;
+use crate::contract::{Errors, random_probes, read_chain, run_probes};
 use voxgi::scene::builtin;
 use voxgi::scene::glam::Vec3;
 use voxgi::voxel::Grid;
@@ -20,9 +20,9 @@ fn dense() -> RendererOptions {
 }
 
 /// A clipmap whose finest voxels are the dense volume's and whose finest level is as wide as
-/// the scene's cube lies exactly on the dense volume's grid (the windows stay inside the
-/// cube, on a lattice from its corner), wherever the camera is: it renders the dense
-/// volume's picture. Not to the bit: the samples' texture coordinates are normalised over
+/// the scene's cube lies exactly on the dense volume's grid (a window wider than the scene's
+/// bounds is centred on them), wherever the camera is: it renders the dense volume's
+/// picture. Not to the bit: the samples' texture coordinates are normalised over
 /// two stacked windows, so filter weights round differently; measured 2e-6 apart (HDR) on
 /// lavapipe, 1e-3 allows other drivers' 8-bit filter weights.
 #[test]
@@ -130,6 +130,85 @@ fn levels_hand_over_without_a_step() {
         assert!(
             step_max < 0.1 * (max - min),
             "a step of {step_max} across {min}..{max} at x = {face}"
+        );
+    }
+}
+
+/// `sample_voxels` on the GPU equals its CPU twin (`Clipmap::sample_voxels_cpu` over the
+/// levels' textures read back): the Cornell box in three levels of 16³ around a camera low in
+/// the box, probed at random points over the coarsest level (and a little past it), in random
+/// directions, with diameters of one to 24 finest voxels, so that samples fall in every level,
+/// in the hand-over bands and past the windows. Both anisotropic and isotropic. The tolerance
+/// is the dense twin's (`filtering_tolerance`): each level's read is the dense volume's.
+#[test]
+fn sample_voxels_matches_its_cpu_twin() {
+    let scene = builtin::cornell_box();
+    let b = scene.swept_bounds();
+    let dense_voxel = Grid::around(b.min, b.max, 32).voxel_size;
+    for anisotropic in [true, false] {
+        let options = RendererOptions {
+            voxels: VoxelKind::CLIPMAP,
+            voxel_resolution: 16,
+            clipmap_levels: 3,
+            voxel_size: Some(dense_voxel * 0.75),
+            anisotropic,
+            ..dense()
+        };
+        let mut r = renderer(&scene, &options);
+        let camera =
+            voxgi::scene::Camera::look_at(Vec3::new(0.2, 0.1, 0.4), Vec3::new(0.3, 0.2, 0.1), 60.0);
+        frame(&mut r, &clamped(&camera), 16, 16);
+        let clip = r.structure::<Clipmap>().expect("a clipmap");
+        let volume = clip.volume();
+        let (radiance0, chains) = (read_chain(&volume.radiance), read_chain(&volume.chains));
+        let cpu = voxgi::voxel::cpu::DenseSampler {
+            grid: volume.grid,
+            anisotropic,
+            windows: clip.levels().len() as u32,
+            radiance0: &radiance0,
+            chains: &chains,
+        };
+        let finest = clip.levels()[0].voxel_size;
+        // A third of the probes over each level's window (and a little past it), diameters
+        // of one to 24 finest voxels.
+        let probes: Vec<[f32; 8]> = clip
+            .levels()
+            .iter()
+            .flat_map(|g| random_probes(*g, 256, 1.0))
+            .enumerate()
+            .map(|(i, mut q)| {
+                q[3] = finest * 24f32.powf((i as f32 * 0.618_034).fract());
+                q
+            })
+            .collect();
+        let gpu = run_probes(&r, &probes);
+        let mut errors = Errors::default();
+        let (mut nonzero, mut levels_used, mut bands) = (0, [0usize; 3], 0);
+        for (q, g) in probes.iter().zip(gpu) {
+            let p = Vec3::new(q[0], q[1], q[2]);
+            let dir = Vec3::new(q[4], q[5], q[6]);
+            let want = clip.sample_voxels_cpu(&cpu, p, q[3], dir);
+            errors.add((g - want).abs().max_element(), || {
+                format!("sample_voxels({p}, {}, {dir}): GPU {g}, CPU {want}", q[3])
+            });
+            nonzero += (want.w > 0.01) as usize;
+            let (k, w) = clip.level_at(p, q[3]);
+            levels_used[k] += 1;
+            bands += (w < 1.0 && k + 1 < levels_used.len()) as usize;
+        }
+        errors.check(
+            filtering_tolerance(),
+            &format!("clipmap probe (anisotropic {anisotropic})"),
+        );
+        assert!(
+            nonzero > probes.len() / 4,
+            "only {nonzero} samples see voxels"
+        );
+        eprintln!("levels read {levels_used:?}, {bands} in a hand-over band");
+        // The probes read every level, and some read two (in a hand-over band).
+        assert!(
+            levels_used.iter().all(|&n| n > 20) && bands > 20,
+            "levels read {levels_used:?}, in bands {bands}"
         );
     }
 }

@@ -234,7 +234,7 @@ fn main() {
 }
 
 /// A mip chain read back from an fp16 3D texture.
-fn read_chain(t: &wgpu::Texture) -> Texture3d {
+pub fn read_chain(t: &wgpu::Texture) -> Texture3d {
     let levels = (0..t.mip_level_count())
         .map(|mip| {
             let bytes = read_texture_3d(&ctx().device, &ctx().queue, t, mip).expect("readback");
@@ -272,7 +272,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 /// Random probes: points over the volume and a little outside it (where the answer is 0),
 /// diameters of one to `max_voxels` voxels, directions over the sphere; a fixed LCG, so the
 /// test is the same every run. Each probe is (p, diameter, dir, 0).
-fn random_probes(grid: voxgi::voxel::Grid, n: usize, max_voxels: f32) -> Vec<[f32; 8]> {
+pub fn random_probes(grid: voxgi::voxel::Grid, n: usize, max_voxels: f32) -> Vec<[f32; 8]> {
     let mut seed = 0x2545_f491_u32;
     let mut rnd = move || {
         seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
@@ -384,6 +384,7 @@ fn probe_matches_cpu(anisotropic: bool) {
     let cpu = DenseSampler {
         grid,
         anisotropic,
+        windows: 1,
         radiance0: &radiance0,
         chains: &chains,
     };
@@ -626,7 +627,7 @@ fn octree_interpolation_is_continuous_across_bricks() {
 
 /// The differences of many probes from their twins: the worst (with what it was) and the mean.
 #[derive(Default)]
-struct Errors {
+pub struct Errors {
     worst: f32,
     at: String,
     sum: f64,
@@ -634,7 +635,7 @@ struct Errors {
 }
 
 impl Errors {
-    fn add(&mut self, err: f32, what: impl FnOnce() -> String) {
+    pub fn add(&mut self, err: f32, what: impl FnOnce() -> String) {
         if err > self.worst || self.count == 0 {
             self.worst = err;
             self.at = what();
@@ -644,7 +645,7 @@ impl Errors {
     }
 
     /// Asserts the worst and the mean within `(worst, mean)`.
-    fn check(&self, (worst, mean): (f32, f32), what: &str) {
+    pub fn check(&self, (worst, mean): (f32, f32), what: &str) {
         let m = (self.sum / self.count.max(1) as f64) as f32;
         eprintln!(
             "{what}: worst difference {:.2e}, mean {m:.2e} over {} probes",

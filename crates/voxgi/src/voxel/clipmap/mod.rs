@@ -43,6 +43,12 @@ pub const MAX_LEVELS: u32 = 8;
 /// With `voxel_size` auto, the coarsest level spans this many times the scene's cube.
 const AUTO_SPAN: f32 = 4.0;
 
+/// Voxels a sample's filter needs inside a window beyond its diameter (`MARGIN` in
+/// shaders/voxels/clipmap/sample.wgsl).
+const MARGIN: f32 = 1.5;
+/// Voxels over which a level hands over to the next coarser (`BAND` there).
+const BAND: f32 = 4.0;
+
 /// Fragment coordinates hold 10 bits a axis: the stacked windows' depth, levels × resolution,
 /// is at most this.
 const MAX_STACK: u32 = 1024;
@@ -338,6 +344,53 @@ impl Clipmap {
         &self.inner
     }
 
+    /// The level a sample of `diameter` at `p` reads (sample.wgsl's `sample_depth`): the
+    /// finest that holds it with room, and its weight against the next coarser (1 past the
+    /// hand-over band).
+    pub fn level_at(&self, p: Vec3, diameter: f32) -> (usize, f32) {
+        let weight = |k: usize| {
+            let room = MARGIN + diameter / self.levels[k].voxel_size;
+            ((inside_by(&self.levels[k], self.bounds, p) - room) / BAND).clamp(0.0, 1.0)
+        };
+        let last = self.levels.len() - 1;
+        let (mut k, mut w) = (last, weight(last));
+        for j in (0..last).rev() {
+            let wj = weight(j);
+            if wj > 0.0 {
+                (k, w) = (j, wj);
+            }
+        }
+        (k, w)
+    }
+
+    /// The CPU twin of shaders/voxels/clipmap/sample.wgsl's `sample_voxels` over `voxels`,
+    /// the levels' textures read back (a `DenseSampler` of `volume()`): the finest level that
+    /// holds the sample with room, handing over to the next across `BAND` voxels.
+    pub fn sample_voxels_cpu(
+        &self,
+        voxels: &super::cpu::DenseSampler,
+        p: Vec3,
+        diameter: f32,
+        dir: Vec3,
+    ) -> glam::Vec4 {
+        let (k, w) = self.level_at(p, diameter);
+        let last = self.levels.len() - 1;
+        let depth = |k: usize| {
+            let g = &self.levels[k];
+            let top = voxels.grid.levels() as f32 - 1.0;
+            let lod = (diameter / g.voxel_size).max(1.0).log2().clamp(0.0, top);
+            let uvw = ((p - g.origin) / g.extent()).clamp(Vec3::ZERO, Vec3::ONE);
+            voxels.window_depth(uvw, lod, dir, k as u32)
+        };
+        let fine = depth(k);
+        let outer = if k == last {
+            glam::Vec4::ZERO
+        } else {
+            depth(k + 1)
+        };
+        super::cpu::from_depth(outer.lerp(fine, w))
+    }
+
     /// Moves the windows whose place for the camera at `camera` (`placed_origin`) lies more
     /// than a step from where they are, that is two steps or more (all of them the first
     /// time); whether any moved.
@@ -455,7 +508,7 @@ impl VoxelStructure for Clipmap {
     fn voxel_size_at(&self, p: Vec3) -> f32 {
         // sample.wgsl's voxels_voxel_size_at: the finest level with MARGIN + BAND + 1 voxels
         // of its window around p.
-        let room = 6.5;
+        let room = MARGIN + BAND + 1.0;
         self.levels
             .iter()
             .find(|g| inside_by(g, self.bounds, p) >= room)
