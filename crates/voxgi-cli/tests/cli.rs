@@ -639,8 +639,6 @@ fn image_sequences_equal_renders_at_each_time() {
     assert!(error_line(&o).contains("%04d"), "{}", error_line(&o));
 }
 
-/// Every setting of the library's table is a flag of `render` and `bench`, named as its key,
-/// and a row of the scene-file documentation.
 /// A 600 m field of arrayed blocks: the dense volume and the octree render it with a warning
 /// that names their voxel width and the clipmap; the clipmap renders it without one.
 #[test]
@@ -676,6 +674,8 @@ fn a_world_too_large_for_one_volume_is_pointed_to_the_clipmap() {
     }
 }
 
+/// Every setting of the library's table is a flag of `render` and `bench`, named as its key,
+/// and a row of the scene-file documentation.
 #[test]
 fn every_setting_is_a_flag_and_documented() {
     let docs = std::fs::read_to_string(

@@ -1485,6 +1485,7 @@ array = { count = [3, 1, 2], spacing = [10.0, 0.0, -5.0] }
         ("count = [0, 1, 1]", "at least 1"),
         ("count = [1000, 1, 1000]", "at most 65536"),
         ("count = [2, 1, 1], spacing = [nan, 0.0, 0.0]", "finite"),
+        ("count = [1, 3, 1], spacing = [5.0, 0.0, 5.0]", "0 along y"),
     ];
     for (array, says) in bad {
         let f = write(

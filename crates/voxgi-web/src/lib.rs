@@ -640,6 +640,10 @@ impl App {
             }
         };
         self.held = camera::HeldKeys::default();
+        // Switching is not moving: a flight followed goes on.
+        if self.flown.is_some() {
+            self.flown = Some(self.controller.camera());
+        }
         page::set_controller(matches!(self.controller, Controller::Fly(_)));
     }
 

@@ -506,8 +506,6 @@ pub fn load_with_settings(path: &Path) -> Result<(Scene, Option<toml::Table>)> {
     Ok((scene, file.settings))
 }
 
-/// An include's sequence of point files (`file` holds a frame number): a scene of its first
-/// frame's cloud, with the sequence playing in it.
 /// The offsets of an include's `array` copies, the first zero (the include itself); `sub` is
 /// what the include holds: copies share meshes, so it may hold nothing else.
 fn array_offsets(a: &ArrayDef, sub: &Scene) -> std::result::Result<Vec<Vec3>, String> {
@@ -522,6 +520,15 @@ fn array_offsets(a: &ArrayDef, sub: &Scene) -> std::result::Result<Vec<Vec3>, St
     let spacing = Vec3::from(a.spacing);
     if !spacing.is_finite() {
         return Err("array.spacing must be finite".into());
+    }
+    let stacked = (0..3).find(|&i| a.count[i] > 1 && a.spacing[i] == 0.0);
+    if let Some(i) = stacked {
+        return Err(format!(
+            "array.spacing is 0 along {} where count makes {} copies: they would lie on each \
+             other",
+            ["x", "y", "z"][i],
+            a.count[i]
+        ));
     }
     let holds = [
         (sub.lights.len(), "lights"),
@@ -547,6 +554,8 @@ fn array_offsets(a: &ArrayDef, sub: &Scene) -> std::result::Result<Vec<Vec3>, St
     Ok(v)
 }
 
+/// An include's sequence of point files (`file` holds a frame number): a scene of its first
+/// frame's cloud, with the sequence playing in it.
 fn open_sequence(pattern: &Path, inc: &Include) -> std::result::Result<Scene, String> {
     if !inc.dynamic {
         return Err(

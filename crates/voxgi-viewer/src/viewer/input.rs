@@ -351,6 +351,10 @@ impl Viewer {
                         Controller::Orbit(Orbit::from_camera(&cam, self.scene_radius))
                     }
                 };
+                // Switching is not moving: a flight followed goes on.
+                if self.flown.is_some() {
+                    self.flown = Some(self.controller_camera());
+                }
             }
             KeyCode::KeyH => self.frame_selection(),
             KeyCode::Escape => self.selected_light = None,

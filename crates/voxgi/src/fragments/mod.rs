@@ -305,9 +305,11 @@ pub struct TriangleTable {
 /// fragments. Larger triangles are split over several workgroups.
 pub const CHUNK_COLUMNS: u32 = 64 * 512;
 
-/// A triangle whose longest edge spans at most this many voxels covers at most 16 columns
-/// along its dominant axis ((2 + 2)²): one thread voxelizes it.
-const SMALL_EDGE: f32 = 2.0;
+/// A triangle whose longest edge spans at most this many of the finest voxels covers at most
+/// 324 columns along its dominant axis ((16 + 2)²): one thread voxelizes it, within the 512
+/// columns a thread of a large triangle's workgroup may take (`CHUNK_COLUMNS`, a CPU driver's
+/// loop budget).
+const SMALL_EDGE: f32 = 16.0;
 
 /// How many workgroups voxelize a triangle whose longest edge is `edge` metres on `grid`:
 /// its projection on the dominant plane fits a square of that side, so it covers at most
@@ -320,13 +322,16 @@ pub fn chunks(edge: f32, grid: &Grid) -> u32 {
         .clamp(1.0, 65535.0) as u32
 }
 
-/// The triangle table of the static (`dynamic` false) or the dynamic instances on `grid`. An
-/// error when the table would not fit one storage binding of this device.
+/// The triangle table of the static (`dynamic` false) or the dynamic instances on `grid`,
+/// whose structure's finest voxels are `finest` metres (a clipmap's finest level is finer than
+/// the scene's grid: small triangles are small there). An error when the table would not fit
+/// one storage binding of this device.
 pub fn triangle_table(
     device: &wgpu::Device,
     scene: &GpuScene,
     dynamic: bool,
     grid: &Grid,
+    finest: f32,
 ) -> Result<TriangleTable> {
     let (mut small, mut t): (Vec<[u32; 4]>, Vec<[u32; 4]>) = (Vec::new(), Vec::new());
     for call in scene.calls.iter().filter(|c| c.dynamic == dynamic) {
@@ -341,7 +346,7 @@ pub fn triangle_table(
         for (first, &edge) in call.indices.clone().step_by(3).zip(&call.edges) {
             // A dynamic instance may be scaled up past its uploaded size: its triangles keep
             // the workgroups that share any number of columns.
-            if !dynamic && edge <= SMALL_EDGE * grid.voxel_size {
+            if !dynamic && edge <= SMALL_EDGE * finest.min(grid.voxel_size) {
                 small.push([call.draw, first, call.base_vertex as u32, 0]);
                 continue;
             }

@@ -300,8 +300,8 @@ impl Renderer {
         })?;
         let (static_triangles, dynamic_triangles) = checked(device, "voxelization table", || {
             Ok::<_, Error>((
-                triangle_table(device, &gpu_scene, false, &grid)?,
-                triangle_table(device, &gpu_scene, true, &grid)?,
+                triangle_table(device, &gpu_scene, false, &grid, volume.grid().voxel_size)?,
+                triangle_table(device, &gpu_scene, true, &grid, volume.grid().voxel_size)?,
             ))
         })??;
         let mut fragments = fragments;
@@ -436,17 +436,6 @@ impl Renderer {
         } else {
             None
         };
-        // Large triangles take more voxelize workgroups on a finer grid.
-        let tables_new = if volume {
-            Some(checked(device, "voxelization table", || {
-                Ok::<_, Error>((
-                    triangle_table(device, &self.scene, false, &grid)?,
-                    triangle_table(device, &self.scene, true, &grid)?,
-                ))
-            })??)
-        } else {
-            None
-        };
         let mut volume_new = if volume {
             Some((new.voxels.info().create)(
                 device,
@@ -455,6 +444,17 @@ impl Renderer {
             )?)
         } else {
             None
+        };
+        // Large triangles take more voxelize workgroups on a finer grid.
+        let tables_new = match &volume_new {
+            Some(v) => Some(checked(device, "voxelization table", || {
+                let finest = v.grid().voxel_size;
+                Ok::<_, Error>((
+                    triangle_table(device, &self.scene, false, &grid, finest)?,
+                    triangle_table(device, &self.scene, true, &grid, finest)?,
+                ))
+            })??),
+            None => None,
         };
         // The fragments depend on the grids only: a change of anisotropy keeps their grown
         // pool.

@@ -107,6 +107,16 @@ impl Sizing<'_> {
             volume.bind_fragments(self.device, f);
             let pools = self.build(f, volume.as_ref())?;
             if !volume.needs_growth(&pools) {
+                // A first guess far above the count gives the room back (and builds again,
+                // so that the counters hold this build's counts).
+                if volume.shrink(self.device, &pools)? {
+                    log::info!(
+                        "voxels: {} occupied voxels counted before the first frame; the pools \
+                         shrink to them",
+                        pools[0]
+                    );
+                    continue;
+                }
                 built = true;
                 break;
             }

@@ -140,6 +140,19 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
     /// Makes room for what a build counted; the contents are lost (the next build refills
     /// them). On an error (out of memory, a device limit) the structure is left as it was.
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()>;
+    /// Gives back room far beyond what a build counted (`counted`, `pool_counter`'s words),
+    /// keeping some headroom; whether it did (the contents are then lost). Asked only after
+    /// the counting build before the first frame, whose first guess may be the device's limit;
+    /// a structure whose pools follow their counts on their own (`needs_growth`) keeps the
+    /// default, which does nothing.
+    fn shrink(
+        &mut self,
+        device: &wgpu::Device,
+        counted: &[u32; POOL_COUNTERS],
+    ) -> crate::Result<bool> {
+        let _ = (device, counted);
+        Ok(false)
+    }
     /// Bytes per GPU resource.
     fn memory(&self) -> Vec<(&'static str, u64)>;
     /// What the passes bind of the structure: its sampling group, its leaves, their radiance

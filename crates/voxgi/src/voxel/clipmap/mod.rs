@@ -570,6 +570,14 @@ impl VoxelStructure for Clipmap {
         Ok(())
     }
 
+    fn shrink(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> Result<bool> {
+        let shrunk = self.inner.shrink(device, counted)?;
+        if shrunk {
+            (self.sampling, self.leaves) = Self::bind_groups(device, &self.inner, &self.clip);
+        }
+        Ok(shrunk)
+    }
+
     fn memory(&self) -> Vec<(&'static str, u64)> {
         self.inner.memory()
     }

@@ -213,6 +213,27 @@ pub struct DenseVolume {
 }
 
 impl DenseVolume {
+    /// The volume made again with `slots` slots (the contents are lost: the next build
+    /// refills them).
+    fn resize(&mut self, device: &wgpu::Device, slots: u32) -> crate::Result<()> {
+        let grown = crate::gpu::checked(device, "voxel pools", || {
+            DenseVolume::new(
+                device,
+                &self.pipelines,
+                self.grid,
+                self.windows,
+                Filtering {
+                    anisotropic: self.anisotropic,
+                    ndf: self.ndf,
+                },
+                slots,
+                self.dynamic,
+            )
+        })?;
+        *self = grown;
+        Ok(())
+    }
+
     /// A volume of `windows` cubes of `grid`, filtered and made dynamic as `desc` says, with
     /// room for `leaves` occupied voxels (as many as the device allows), sharing the pipelines
     /// of `previous`; errors name what does not fit the device. The dense kind's `create` and
@@ -924,39 +945,32 @@ impl VoxelStructure for DenseVolume {
         crate::gpu::max_entries(device, SLOT_BYTES)
     }
 
-    /// Past the capacity, or far below it: a first guess at the device's limit (a scene whose
-    /// estimate passes it, a town) holds ten times what it needs.
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
         counted[0] > self.slot_capacity
-            || self.slot_capacity as u64 > SHRINK_BELOW * (counted[0] as u64).max(1024)
     }
 
-    /// To the count when it overflowed; half as much again when shrinking, so that the next
-    /// builds' counts (a moved window, moved objects) still fit.
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {
-        let count = counted[0] as u64;
-        let wanted = if count > self.slot_capacity as u64 {
-            count
-        } else {
-            (count * 3 / 2).min(crate::gpu::max_entries(device, SLOT_BYTES))
-        };
-        let slots = crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")?;
-        let grown = crate::gpu::checked(device, "voxel pools", || {
-            DenseVolume::new(
-                device,
-                &self.pipelines,
-                self.grid,
-                self.windows,
-                Filtering {
-                    anisotropic: self.anisotropic,
-                    ndf: self.ndf,
-                },
-                slots,
-                self.dynamic,
-            )
-        })?;
-        *self = grown;
-        Ok(())
+        let slots =
+            crate::gpu::pool_capacity(device, counted[0] as u64, SLOT_BYTES, "occupied voxels")?;
+        self.resize(device, slots)
+    }
+
+    /// Far above the count (a first guess at the device's limit, which a scene whose estimate
+    /// passes it gets: a town's held ten times what it needed), to half as much again as the
+    /// count, so that later builds' counts (a moved window, moved objects) still fit.
+    fn shrink(
+        &mut self,
+        device: &wgpu::Device,
+        counted: &[u32; POOL_COUNTERS],
+    ) -> crate::Result<bool> {
+        let count = (counted[0] as u64).max(1024);
+        if (self.slot_capacity as u64) <= SHRINK_BELOW * count {
+            return Ok(false);
+        }
+        let slots =
+            crate::gpu::pool_capacity(device, count * 3 / 2, SLOT_BYTES, "occupied voxels")?;
+        self.resize(device, slots)?;
+        Ok(true)
     }
 
     fn memory(&self) -> Vec<(&'static str, u64)> {
