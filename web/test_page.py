@@ -157,6 +157,18 @@ def mean(img, box, fx0, fy0, fx1, fy1):
     return [t / max(n, 1) for t in total]
 
 
+def drag(page, offsets):
+    """A left-button drag on the canvas from its centre through `offsets` (pixels from the
+    centre, each reached in a few steps)."""
+    canvas = page.locator("#voxgi").bounding_box()
+    cx, cy = canvas["x"] + canvas["width"] / 2, canvas["y"] + canvas["height"] / 2
+    page.mouse.move(cx, cy)
+    page.mouse.down()
+    for dx, dy in offsets:
+        page.mouse.move(cx + dx, cy + dy, steps=4)
+    page.mouse.up()
+
+
 def change_over_frames(page, path):
     """How much the picture changes over two frames: the canvas shot, two more frames, shot
     again (saved as `path`_0.png and _1.png); their `difference`."""
@@ -232,13 +244,7 @@ def main():
 
         # An orbit drag turns the view.
         n = frames(page)
-        canvas = page.locator("#voxgi").bounding_box()
-        cx, cy = canvas["x"] + canvas["width"] / 2, canvas["y"] + canvas["height"] / 2
-        page.mouse.move(cx, cy)
-        page.mouse.down()
-        page.mouse.move(cx + 60, cy, steps=4)
-        page.mouse.move(cx + 120, cy + 10, steps=4)
-        page.mouse.up()
+        drag(page, [(60, 0), (120, 10)])
         wait_frames(page, n + 2, FRAMES_S)
         turned = shot(page, f"{out}/turned.png")
         d = difference(before, turned)
@@ -347,12 +353,7 @@ def main():
         )
         wait_scene(page, "flight.toml")
         flying = change_over_frames(page, f"{out}/flight")
-        canvas = page.locator("#voxgi").bounding_box()
-        cx, cy = canvas["x"] + canvas["width"] / 2, canvas["y"] + canvas["height"] / 2
-        page.mouse.move(cx, cy)
-        page.mouse.down()
-        page.mouse.move(cx + 30, cy, steps=3)
-        page.mouse.up()
+        drag(page, [(30, 0)])
         by_hand = change_over_frames(page, f"{out}/by_hand")
         say(
             f"flight.toml: the picture changed by {flying:.2f} of 255 flying, "
