@@ -286,6 +286,10 @@ pub struct RendererOptions {
     pub voxel_resolution: u32,
     /// The clipmap's levels (2..=8), each twice the extent of the one inside it. Default 5.
     pub clipmap_levels: u32,
+    /// The most clipmap windows rebuilt in one frame (0: every window that moved). A window
+    /// whose turn has not come stays where it was, valid, and cones read the coarser levels
+    /// past it. Default 1.
+    pub clipmap_budget: u32,
     /// The clipmap's finest voxel edge, metres: `None` (default) makes its coarsest level
     /// span four times the scene's cube (the camera may stand anywhere near it).
     pub voxel_size: Option<f32>,
@@ -382,6 +386,7 @@ impl Default for RendererOptions {
             voxels: VoxelKind::DENSE,
             voxel_resolution: 128,
             clipmap_levels: 5,
+            clipmap_budget: 1,
             voxel_size: None,
             anisotropic: true,
             ndf_mips: false,

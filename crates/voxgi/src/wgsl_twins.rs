@@ -268,7 +268,7 @@ fn every_twin_has_the_wgsl_layout() {
         crate::voxel::clipmap::GpuClipLevels,
         "ClipLevels",
         [
-            levels, scene_lo, scene_hi, bounds_lo, bounds_hi, count, resolution
+            levels, scene_lo, scene_hi, bounds_lo, bounds_hi, count, resolution, rebuilt
         ]
     );
     twin!(
@@ -338,25 +338,42 @@ fn every_twin_has_the_wgsl_layout() {
 /// The octree's layout constants, which Rust and WGSL both define, agree.
 #[test]
 fn octree_constants_agree_with_the_wgsl() {
-    let src = crate::gpu::shader::compose_with(
-        "voxels/octree/octree_update.wgsl",
-        Some(VoxelKind::OCTREE.shaders()),
-    );
-    let m = module(&src);
-    let constant = |name: &str| -> u64 {
-        let (_, c) = m
-            .constants
-            .iter()
-            .find(|(_, c)| c.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("octree_update.wgsl: no const {name}"));
-        match m.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::U32(v)) => v as u64,
-            naga::Expression::Literal(naga::Literal::I32(v)) => v as u64,
-            naga::Expression::Literal(naga::Literal::AbstractInt(v)) => v as u64,
-            ref e => panic!("octree_update.wgsl: {name} = {e:?}"),
-        }
-    };
     for (name, rust) in crate::voxel::octree::SHARED_CONSTANTS {
-        assert_eq!(constant(name), *rust, "{name}: WGSL and Rust differ");
+        let wgsl = shader_constant("voxels/octree/octree_update.wgsl", VoxelKind::OCTREE, name);
+        assert_eq!(wgsl, *rust, "{name}: WGSL and Rust differ");
+    }
+}
+
+#[test]
+fn dense_constants_agree_with_the_wgsl() {
+    for (name, rust) in crate::voxel::dense::SHARED_CONSTANTS {
+        let wgsl = shader_constant("voxels/dense/dense_update.wgsl", VoxelKind::DENSE, name);
+        assert_eq!(wgsl, *rust, "{name}: WGSL and Rust differ");
+    }
+    // Every clipmap level is a window of the slot pool.
+    let windows = shader_constant(
+        "voxels/dense/dense_update.wgsl",
+        VoxelKind::DENSE,
+        "MAX_WINDOWS",
+    );
+    assert!(crate::voxel::clipmap::MAX_LEVELS as u64 <= windows);
+}
+
+/// The value of the literal `const` `name` in shader `file` composed for `kind`.
+fn shader_constant(file: &str, kind: VoxelKind, name: &str) -> u64 {
+    let m = module(&crate::gpu::shader::compose_with(
+        file,
+        Some(kind.shaders()),
+    ));
+    let (_, c) = m
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("{file}: no const {name}"));
+    match m.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => v as u64,
+        naga::Expression::Literal(naga::Literal::I32(v)) => v as u64,
+        naga::Expression::Literal(naga::Literal::AbstractInt(v)) => v as u64,
+        ref e => panic!("{file}: {name} = {e:?}"),
     }
 }

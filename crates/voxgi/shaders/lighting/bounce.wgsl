@@ -69,7 +69,7 @@ fn slice_of(c: vec3<u32>) -> u32 {
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = dispatch_index(gid, nwg);
-    if s >= leaf_count() {
+    if !leaf_exists(s) {
         return;
     }
     let p = leaf_center(s);
@@ -105,7 +105,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             return;
         }
         s = gathered[list_start() + 1u + s];
-    } else if s >= leaf_count() {
+    } else if !leaf_exists(s) {
         return;
     }
     let c = leaf_coord(s);

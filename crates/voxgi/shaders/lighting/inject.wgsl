@@ -131,7 +131,7 @@ fn moved_distance(view: ShadowView) -> f32 {
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = dispatch_index(gid, nwg);
-    if s >= leaf_count() {
+    if !leaf_exists(s) {
         return;
     }
     if leaf_inputs_changed(s) {

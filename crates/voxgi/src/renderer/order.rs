@@ -149,6 +149,7 @@ impl Renderer {
             rebuild: due && self.pending.rebuild,
             dynamic: dynamic_now.filter(|_| moved),
             dynamic_now,
+            budget: self.options.clipmap_budget,
         });
         let relit = if due || !work.is_empty() {
             self.record_voxels(encoder, work, &mut |_, _| {})
@@ -269,6 +270,7 @@ impl Renderer {
             rebuild: self.pending.rebuild,
             dynamic: dynamic_now.filter(|_| moved),
             dynamic_now,
+            budget: self.options.clipmap_budget,
         });
         let rebuild = self.pending.rebuild;
         let relit = self.record_voxels(&mut encoder, work, &mut cut);
@@ -435,9 +437,11 @@ impl Renderer {
     ) -> Option<bool> {
         let pending = std::mem::take(&mut self.pending);
         let geometry = !work.is_empty();
-        // A build replaces every leaf (a camera-following structure builds when its windows
-        // move): everything is lit anew, as after a rebuild.
-        let rebuilt = pending.rebuild || work.build.is_some();
+        // A build replaces every leaf: everything is lit anew, as after a rebuild. Not one of
+        // some windows (a camera-following structure's that moved), whose new leaves are
+        // what the lighting passes find new.
+        let rebuilt = pending.rebuild || (work.build.is_some() && !work.partial);
+        self.volume.record_plan(&self.device, encoder);
         // Where the structure's windows are now (`plan` may have moved them). A build done
         // while the renderer was made (`Sizing`) holds the windows of then: moved, it is done
         // again.
@@ -500,8 +504,11 @@ impl Renderer {
         });
         if work.build.is_some() && (!pending.built || windows_moved) {
             self.fragments.record_clear(encoder);
-            // Each grid's fragments in turn (one for most structures; a clipmap's windows).
-            for b in fb.iter() {
+            // Each grid's fragments in turn (one for most structures; a clipmap's windows),
+            // where the build has a region.
+            let regions = work.build.as_deref().unwrap_or_default();
+            let built = |k: usize| regions.get(k).is_some_and(|r| !r.is_empty());
+            for (_, b) in fb.iter().enumerate().filter(|(k, _)| built(*k)) {
                 p.voxelize
                     .record(encoder, &self.static_triangles, &b.voxelize_static, timer);
                 p.splat.record(encoder, b.splat_static.as_ref(), timer);

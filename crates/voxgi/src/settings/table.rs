@@ -123,6 +123,15 @@ pub static SETTINGS: &[Setting] = &[
         access: access!(options int clipmap_levels),
     },
     Setting {
+        key: "clipmap_budget",
+        label: "clipmap windows a frame",
+        help: "The most clipmap windows voxelized again in one frame as the camera moves (0: \
+               every window that moved); the others wait at their places, still valid.",
+        domain: Domain::Int { min: 0, max: 8 },
+        changes: Changes::Frame,
+        access: access!(options int clipmap_budget),
+    },
+    Setting {
         key: "voxel_size",
         label: "finest voxel (m)",
         help: "The clipmap's finest voxel edge in metres; auto: its coarsest level spans four \

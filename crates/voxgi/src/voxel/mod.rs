@@ -77,7 +77,15 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
         VoxelWork {
             build: changes.rebuild.then(|| vec![Region::all(&grid)]),
             update: changes.dynamic.map(|b| vec![dynamic_region(&grid, b)]),
+            partial: false,
         }
+    }
+
+    /// Records what the lighting passes read of `plan`'s choices before a voxel update's
+    /// passes (a camera-following structure: where its windows are now, which it rebuilt
+    /// alone). The default, for a structure whose placement never changes, is nothing.
+    fn record_plan(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder) {
+        let _ = (device, encoder);
     }
 
     /// The grids its fragments lie on, the finest voxels: its own grid, or a camera-following
@@ -182,6 +190,9 @@ pub struct FrameChanges {
     /// Where every dynamic instance is now, moved or not (for a structure that rebuilds on
     /// its own, and must merge them again). `None` without dynamic instances.
     pub dynamic_now: Option<Aabb>,
+    /// Windows a camera-following structure may rebuild this frame, at most
+    /// (`RendererOptions::clipmap_budget`; 0: no limit).
+    pub budget: u32,
 }
 
 /// The regions a structure needs voxelized this frame (`VoxelStructure::plan`), one per grid
@@ -193,6 +204,11 @@ pub struct VoxelWork {
     /// Merge the dynamic geometry in these regions (`record_update`; it runs even when they
     /// are empty, to take out the last update).
     pub update: Option<Vec<Region>>,
+    /// The build rebuilds only the grids whose region is not empty, and the other grids'
+    /// leaves keep their slots and light (a camera-following structure's windows that moved):
+    /// for the lighting passes not a rebuild, only the rebuilt grids' leaves are new
+    /// (`leaf_is_new`).
+    pub partial: bool,
 }
 
 /// Where the dynamic geometry inside world box `b` makes fragments on `grid`. Two voxels of

@@ -187,47 +187,83 @@ fn sequence_of_moves(options: &RendererOptions) {
     }
 }
 
-/// The clipmap's windows follow the camera: once it has moved past their steps, the levels
-/// hold, to the bit, what a clipmap made at the new place holds, and the frame is the fresh
-/// one's.
+/// The clipmap's windows follow the camera within the frame's budget: each frame moves at
+/// most `clipmap_budget` windows (the farthest strayed first), and once they have caught up
+/// the levels hold, to the bit, what a clipmap made at the new place holds, and the frame is
+/// the fresh one's (the windows rebuilt alone, the others' leaves kept; with bounce slices,
+/// once the slices have had their turns).
 #[test]
 fn a_clipmap_that_followed_the_camera_equals_one_made_there() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
-    let options = RendererOptions {
-        voxels: voxgi::VoxelKind::CLIPMAP,
-        // Automatic voxel size: the coarsest spans four times the box's cube, the finest a
-        // quarter of it.
-        clipmap_levels: 5,
-        ..options()
-    };
-    let levels = |r: &Renderer| {
-        r.structure::<voxgi::voxel::clipmap::Clipmap>()
-            .expect("a clipmap")
-            .levels()
-            .to_vec()
-    };
-    let mut r = renderer(&scene, &options);
-    let mut p = params(&r);
-    frame(&mut r, &p, SIZE, SIZE);
-    let before = levels(&r);
-    // Into the box, past the finest level's step (an eighth of its window).
-    p.camera.position = Vec3::new(0.2, 0.2, 0.3);
-    let got = frame(&mut r, &p, SIZE, SIZE);
-    let after = levels(&r);
-    // The finer levels follow; those as wide as the box's cube stay on it.
-    for k in 0..2 {
-        assert_ne!(
-            before[k].origin, after[k].origin,
-            "level {k} did not follow"
+    for (budget, slices) in [(1, 1), (0, 1), (1, 3)] {
+        let options = RendererOptions {
+            voxels: voxgi::VoxelKind::CLIPMAP,
+            // Automatic voxel size: the coarsest spans four times the box's cube, the finest
+            // a quarter of it.
+            clipmap_levels: 5,
+            clipmap_budget: budget,
+            bounce_slices: slices,
+            ..options()
+        };
+        let levels = |r: &Renderer| {
+            r.structure::<voxgi::voxel::clipmap::Clipmap>()
+                .expect("a clipmap")
+                .levels()
+                .to_vec()
+        };
+        let mut r = renderer(&scene, &options);
+        let mut p = params(&r);
+        frame(&mut r, &p, SIZE, SIZE);
+        let before = levels(&r);
+        // Into the box, past the finest level's step (an eighth of its window).
+        p.camera.position = Vec3::new(0.2, 0.2, 0.3);
+        let mut got = frame(&mut r, &p, SIZE, SIZE);
+        let mut was = levels(&r);
+        let mut moves = vec![moved_windows(&before, &was)];
+        // As many frames again as there are levels: the budget lets them all catch up; and
+        // the slices' turns after the last move (one voxel bounce).
+        for _ in 0..options.clipmap_levels + slices {
+            got = frame(&mut r, &p, SIZE, SIZE);
+            let now = levels(&r);
+            moves.push(moved_windows(&was, &now));
+            was = now;
+        }
+        let most = if budget == 0 { 5 } else { budget as usize };
+        assert!(
+            moves.iter().all(|m| m.len() <= most),
+            "budget {budget}: windows moved per frame {moves:?}"
         );
+        // The finer levels followed; those as wide as the box's cube stay on it.
+        let after = levels(&r);
+        for k in 0..2 {
+            assert_ne!(
+                before[k].origin, after[k].origin,
+                "level {k} did not follow"
+            );
+        }
+        if budget == 1 {
+            // The finest strayed farthest in its own steps: it moves first, then level 1.
+            assert_eq!(moves[..2], [vec![0], vec![1]], "the order of the moves");
+        } else {
+            assert_eq!(moves[0], vec![0, 1], "every window that strayed, at once");
+        }
+        let mut fresh = renderer(&scene, &options);
+        let want = frame(&mut fresh, &p, SIZE, SIZE);
+        assert_eq!(levels(&fresh), after, "the windows a fresh clipmap places");
+        let what = format!("budget {budget}, {slices} slices");
+        assert_same_image(&got, &want, &format!("{what}: after the camera moved"));
+        for ((name, a), (_, b)) in volume_bytes(&r).iter().zip(volume_bytes(&fresh).iter()) {
+            assert!(
+                a == b,
+                "{what}: the levels' {name} differs from a fresh clipmap's"
+            );
+        }
     }
-    let mut fresh = renderer(&scene, &options);
-    let want = frame(&mut fresh, &p, SIZE, SIZE);
-    assert_eq!(levels(&fresh), after, "the windows a fresh clipmap places");
-    assert_same_image(&got, &want, "after the camera moved");
-    for ((name, a), (_, b)) in volume_bytes(&r).iter().zip(volume_bytes(&fresh).iter()) {
-        assert!(a == b, "the levels' {name} differs from a fresh clipmap's");
-    }
+}
+
+/// The levels whose windows differ between `a` and `b`.
+fn moved_windows(a: &[voxgi::voxel::Grid], b: &[voxgi::voxel::Grid]) -> Vec<usize> {
+    (0..a.len()).filter(|&k| a[k] != b[k]).collect()
 }
 
 /// How far apart two renderers' HDR images may be when their octrees hold the same voxels in

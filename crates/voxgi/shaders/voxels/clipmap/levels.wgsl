@@ -20,6 +20,7 @@ struct ClipLevels {
     count: u32,
     // Voxels per side of every window.
     resolution: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // A bit per level the last voxel work rebuilt alone (the others kept their leaves).
+    rebuilt: u32,
+    _pad: u32,
 }

@@ -25,3 +25,8 @@ fn leaf_size(i: u32) -> f32 {
 fn leaf_size_max() -> f32 {
     return leaf_clip.levels[leaf_clip.count - 1u].w;
 }
+
+// Window `w` (level w) was rebuilt alone by the last build: every leaf of it is new.
+fn leaf_window_rebuilt(w: u32) -> bool {
+    return (leaf_clip.rebuilt & (1u << w)) != 0u;
+}

@@ -8,10 +8,11 @@
 // The fragments, as voxelize (or any other source) left them: the only input.
 @group(0) @binding(1) var<storage, read> fragments: array<Fragment>;
 @group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
-// [0] slots (occupied voxels, counted past the capacity), [1] slots of the previous build,
-// [2] slots of the static geometry (slots below are static, above dynamic), [3] entries of
-// `touched` of this update, [4] of the previous update, [5] fragments of the static geometry
-// (those from there on are the dynamic geometry's).
+// [0] slots asked for (occupied voxels, counted past the capacity) of every window, [1] the
+// most any window asked for (its part of the pool must hold them), [3] entries of `touched` of
+// this update, [4] of the previous update, [5] fragments of the static geometry (those from
+// there on are the dynamic geometry's), [7] a bit per window the next build rebuilds (set by
+// the host; the others keep their slots); each window's own words (slots.wgsl).
 @group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>>;
 // Per voxel: 0 empty, 2 + slot once allocated, LOCKED while allocating (or past capacity).
 @group(0) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>>;
@@ -33,6 +34,7 @@
 @group(0) @binding(11) var<storage, read_write> dyn_accum: array<atomic<u32>>;
 // The voxels written since the last filter, listed for the filter (changed.wgsl).
 //!include voxels/changed.wgsl
+//!include voxels/slots.wgsl
 
 // Indirect dispatch arguments: [0..3] over slots, [3..6] over fragments, [6..9] over
 // `touched`. Only the prepare kernels bind them (a buffer cannot be storage and indirect in
@@ -73,6 +75,46 @@ fn stored_fragments() -> u32 {
 
 fn slot_limit() -> u32 {
     return arrayLength(&slot_voxel);
+}
+
+const REBUILD: u32 = 7u;
+
+// The window voxel `v` (a linear index through the stacked cubes) lies in.
+fn window_of_voxel(v: u32) -> u32 {
+    let r = vol.resolution;
+    return v / (r * r * r);
+}
+
+// Whether the build rebuilds window `w`.
+fn rebuilding(w: u32) -> bool {
+    return (atomicLoad(&counters[REBUILD]) & (1u << w)) != 0u;
+}
+
+// A slot for voxel `v`, in its window's part: its index, or past the pool (`slot_limit()`)
+// when the part is full (counted all the same, so the host sees how many it needs).
+fn take_slot(v: u32) -> u32 {
+    let w = window_of_voxel(v);
+    let k = atomicAdd(&counters[window_word(w, W_COUNT)], 1u);
+    let c = window_slots(vol.windows);
+    if k >= c {
+        return slot_limit();
+    }
+    return w * c + k;
+}
+
+// The pool's totals from the windows' counts (words 0 and 1), and the dispatch over the slots
+// that hold leaves. Only the kernels that bind the arguments.
+fn count_windows() {
+    var total = 0u;
+    var most = 0u;
+    for (var w = 0u; w < vol.windows; w++) {
+        let n = atomicLoad(&counters[window_word(w, W_COUNT)]);
+        total += n;
+        most = max(most, n);
+    }
+    atomicStore(&counters[0], total);
+    atomicStore(&counters[1], most);
+    write_args(0u, slots_end(vol.windows));
 }
 
 // Adds fragment `f`'s attributes to slot `s`'s static or dynamic sums.

@@ -11,8 +11,9 @@ const REDONE: u32 = 6u;
 // Per level above the finest (the first at index 0): how many voxels its list holds.
 const COUNTS: u32 = 8u;
 const MAX_LEVELS: u32 = 10u;
-// The levels' bits, then their lists.
-const BITS: u32 = COUNTS + MAX_LEVELS;
+// After the slot pool's words per window (slots.wgsl, eight windows of four words): the
+// levels' bits, then their lists.
+const BITS: u32 = COUNTS + MAX_LEVELS + 32u;
 
 // Levels above the finest of a volume `res` voxels a side (a power of two).
 fn levels_above(res: u32) -> u32 {

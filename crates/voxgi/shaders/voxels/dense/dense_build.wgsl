@@ -1,27 +1,41 @@
 // dense_build: voxel fragments -> the dense volume's finest level. Integer atomics average the
 // fragments of each voxel, so the result does not depend on thread order (deterministic).
 //
-// Entry points, in the order the host runs them:
-//   begin           remember the previous slot count, reset the counters
-//   clear_previous  zero the voxels the previous build filled (cheaper than clearing N^3)
+// Entry points, in the order the host runs them (after dense_update's restore has taken the
+// last update out, and with the windows to rebuild in counters[REBUILD]: all of them, or the
+// levels a clipmap moves this frame; every other window keeps its slots and sums):
+//   begin           remember each rebuilt window's slot count, reset it; the clear's dispatch
+//   clear_previous  zero the voxels the rebuilt windows filled (cheaper than clearing N^3)
 //   prepare_fragments / prepare_slots  indirect dispatch sizes from the counters
-//   allocate        one slot per occupied voxel
+//   allocate        one slot per occupied voxel, in its window's part of the pool
 //   accumulate      integer sums per slot
 //   resolve         averages -> albedo/opacity, normal, emission textures
 //
-// The slots it allocates are the static ones (`counters[2]`); dense_update merges the dynamic
-// geometry's fragments on top.
+// The slots it allocates are the static ones (each window's W_STATIC); dense_update merges the
+// dynamic geometry's fragments on top.
 
 //!include voxels/build_shared.wgsl
 
 @compute @workgroup_size(1)
 fn begin() {
-    atomicStore(&counters[1], atomicLoad(&counters[0]));
-    atomicStore(&counters[0], 0u);
-    atomicStore(&counters[2], 0u);
+    var end = 0u;
+    let c = window_slots(vol.windows);
+    for (var w = 0u; w < vol.windows; w++) {
+        if !rebuilding(w) {
+            continue;
+        }
+        let n = atomicLoad(&counters[window_word(w, W_COUNT)]);
+        atomicStore(&counters[window_word(w, W_PREVIOUS)], n);
+        atomicStore(&counters[window_word(w, W_COUNT)], 0u);
+        atomicStore(&counters[window_word(w, W_STATIC)], 0u);
+        if n > 0u {
+            end = w * c + min(n, c);
+        }
+    }
     atomicStore(&counters[3], 0u);
     atomicStore(&counters[4], 0u);
     atomicStore(&counters[5], 0u);
+    write_args(0u, end);
 }
 
 @compute @workgroup_size(1)
@@ -34,16 +48,27 @@ fn prepare_fragments() {
 @compute @workgroup_size(1)
 fn prepare_slots() {
     // Every slot so far is the static geometry's. Kept as counted (past the capacity), so an
-    // overflow still shows in counters[0] after an update frees the dynamic slots.
-    let slots = atomicLoad(&counters[0]);
-    atomicStore(&counters[2], slots);
-    write_args(0u, min(slots, slot_limit()));
+    // overflow still shows after an update frees the dynamic slots.
+    for (var w = 0u; w < vol.windows; w++) {
+        if rebuilding(w) {
+            atomicStore(&counters[window_word(w, W_STATIC)], atomicLoad(&counters[window_word(w, W_COUNT)]));
+        }
+    }
+    count_windows();
+}
+
+// Slot `s` lies in a rebuilt window, below `word`'s count of it: the window's slot and whether.
+fn rebuilt_slot(s: u32, word: u32) -> bool {
+    let c = window_slots(vol.windows);
+    let w = s / c;
+    return w < vol.windows && rebuilding(w)
+        && s - w * c < min(atomicLoad(&counters[window_word(w, word)]), c);
 }
 
 @compute @workgroup_size(64)
 fn clear_previous(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = flat(gid, nwg);
-    if s >= min(atomicLoad(&counters[1]), arrayLength(&slot_voxel)) {
+    if !rebuilt_slot(s, W_PREVIOUS) {
         return;
     }
     clear_voxel(voxel_coord(slot_voxel[s], vol.resolution));
@@ -56,6 +81,9 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         return;
     }
     let v = voxel_index(unpack_coord(fragments[i].coord), vol.resolution);
+    if !rebuilding(window_of_voxel(v)) {
+        return;
+    }
     // The first fragment of a voxel takes it; the weak exchange may fail spuriously, so retry
     // while the voxel is still unclaimed.
     for (var tries = 0u; tries < 64u; tries++) {
@@ -63,8 +91,8 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         if r.exchanged {
             // Counted even past the capacity, so the host can see how many slots it needs;
             // voxels beyond it stay unallocated (LOCKED) and are skipped.
-            let s = atomicAdd(&counters[0], 1u);
-            if s < arrayLength(&slot_voxel) {
+            let s = take_slot(v);
+            if s < slot_limit() {
                 slot_voxel[s] = v;
                 atomicStore(&occupancy[v], s + 2u);
             }
@@ -85,7 +113,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let f = fragments[i];
     let v = voxel_index(unpack_coord(f.coord), vol.resolution);
     let o = atomicLoad(&occupancy[v]);
-    if o < 2u || o == LOCKED {
+    if o < 2u || o == LOCKED || !rebuilding(window_of_voxel(v)) {
         return;
     }
     add_fragment(o - 2u, f, false);
@@ -94,7 +122,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = flat(gid, nwg);
-    if s >= min(atomicLoad(&counters[0]), arrayLength(&slot_voxel)) {
+    if !rebuilt_slot(s, W_COUNT) {
         return;
     }
     resolve_slot(s, false);

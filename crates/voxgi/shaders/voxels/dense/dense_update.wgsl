@@ -39,7 +39,7 @@ fn restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     for (var k = 0u; k < DYN_LIST; k++) {
         atomicStore(&dyn_accum[s * DYN_STRIDE + k], 0u);
     }
-    if s < atomicLoad(&counters[2]) {
+    if slot_static(s, vol.windows) {
         resolve_slot(s, false);
     } else {
         let v = slot_voxel[s];
@@ -51,7 +51,9 @@ fn restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
 // After `restore`: the slots above the static ones are free again.
 @compute @workgroup_size(1)
 fn free() {
-    atomicStore(&counters[0], atomicLoad(&counters[2]));
+    for (var w = 0u; w < vol.windows; w++) {
+        atomicStore(&counters[window_word(w, W_COUNT)], atomicLoad(&counters[window_word(w, W_STATIC)]));
+    }
 }
 
 fn push_touched(s: u32) {
@@ -72,7 +74,7 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     for (var tries = 0u; tries < 64u; tries++) {
         let r = atomicCompareExchangeWeak(&occupancy[v], 0u, LOCKED);
         if r.exchanged {
-            let s = atomicAdd(&counters[0], 1u);
+            let s = take_slot(v);
             if s < slot_limit() {
                 slot_voxel[s] = v;
                 atomicStore(&occupancy[v], s + 2u);
@@ -87,7 +89,7 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         if r.old_value != 0u {
             let s = r.old_value - 2u;
             // A static voxel the dynamic geometry shares: listed once.
-            if s < atomicLoad(&counters[2]) && atomicExchange(&dyn_accum[s * DYN_STRIDE + DYN_FLAG], 1u) == 0u {
+            if slot_static(s, vol.windows) && atomicExchange(&dyn_accum[s * DYN_STRIDE + DYN_FLAG], 1u) == 0u {
                 push_touched(s);
             }
             return;
@@ -113,7 +115,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 
 @compute @workgroup_size(1)
 fn prepare() {
-    write_args(0u, min(atomicLoad(&counters[0]), slot_limit()));
+    count_windows();
     write_args(6u, min(atomicLoad(&counters[3]), slot_limit()));
 }
 

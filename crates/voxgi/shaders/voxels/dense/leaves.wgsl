@@ -1,8 +1,10 @@
 // The dense volume's leaves: the occupied finest voxels, one slot each. The lighting passes
 // (inject, bounce, bounce_store) reach a structure's leaves through these names only:
 //
-//   fn leaf_count() -> u32                        leaves of the last build
-//   fn leaf_is_new(i) -> bool                     made by the last update: its slot held
+//   fn leaf_exists(i) -> bool                     slot i holds a leaf (a dispatch over
+//                                                 `leaf_dispatch` reaches every slot that does)
+//   fn leaf_is_new(i) -> bool                     made by the last update or a build of
+//                                                 part of the structure: its slot held
 //                                                 another leaf before (or none)
 //   fn leaf_coord(i) -> vec3<u32>                 the leaf's finest-grid voxel
 //   fn leaf_center(i) -> vec3<f32>                its centre, metres
@@ -25,7 +27,7 @@
 @group(2) @binding(3) var leaf_emission_tex: texture_3d<f32>;
 // Per slot: the voxel's linear index.
 @group(2) @binding(4) var<storage, read> slot_voxel: array<u32>;
-// [0]: slots of the last build (counted past the capacity).
+// The slots each window holds (voxels/dense/slots.wgsl).
 // Read-write: the leaf stores list the voxels they write in it for the filter (changed.wgsl).
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>>;
 // Per leaf: direct radiance (rgb) and opacity, kept for the bounces.
@@ -33,13 +35,17 @@
 // Per leaf: the last bounce's outgoing radiance and opacity.
 @group(2) @binding(7) var<storage, read_write> leaf_next: array<vec4<f32>>;
 
-fn leaf_count() -> u32 {
-    return min(atomicLoad(&counters[0]), arrayLength(&slot_voxel));
+//!include voxels/slots.wgsl
+
+fn leaf_exists(i: u32) -> bool {
+    return slot_filled(i, leaf_grid.windows);
 }
 
-// Slots above the static geometry's are handed out anew by every update (dense_update).
+// Slots above a window's static geometry's are handed out anew by every update
+// (dense_update); a window the last build rebuilt alone has new leaves in every slot
+// (`leaf_window_rebuilt` of voxels/<kind>/placement.wgsl).
 fn leaf_is_new(i: u32) -> bool {
-    return i >= atomicLoad(&counters[2]);
+    return !slot_static(i, leaf_grid.windows) || leaf_window_rebuilt(i / window_slots(leaf_grid.windows));
 }
 
 fn leaf_coord(i: u32) -> vec3<u32> {

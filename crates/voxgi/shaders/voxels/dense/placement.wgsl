@@ -11,3 +11,8 @@ fn leaf_size(i: u32) -> f32 {
 fn leaf_size_max() -> f32 {
     return leaf_grid.voxel_size;
 }
+
+// The volume is always built whole: its leaves are new only where an update made them.
+fn leaf_window_rebuilt(w: u32) -> bool {
+    return false;
+}

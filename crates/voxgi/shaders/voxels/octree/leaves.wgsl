@@ -14,8 +14,8 @@
 // The header (its word 0: slots of the last build, counted past the capacity), then the nodes.
 @group(2) @binding(4) var<storage, read> leaf_nodes: array<u32>;
 
-fn leaf_count() -> u32 {
-    return min(leaf_nodes[0], leaf_tree.slots);
+fn leaf_exists(i: u32) -> bool {
+    return i < min(leaf_nodes[0], leaf_tree.slots);
 }
 
 // An update hands out the slots after the static build's anew (octree_update.wgsl).

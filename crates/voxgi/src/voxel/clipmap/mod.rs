@@ -18,8 +18,11 @@
 //! where it is wider (a town 30 m tall: every level holds all of its height, none of the
 //! ground below it; a level wider than the scene on every axis is the dense volume there), so
 //! no voxels are spent on the void past the world's edge.
-//! When a window moves, every level is voxelized and lit again: the cost of a move is a
-//! rebuild's (scrolling only the slabs newly inside, within a per-frame budget, is next).
+//! A window that moves is voxelized and lit again alone: each window owns a part of the
+//! volume's slots (voxels/dense/slots.wgsl), so the others keep their leaves, and their light
+//! (their bounces gather in `bounce_slices` turns). A frame moves at most
+//! `RendererOptions::clipmap_budget` windows; the others wait at their old places, valid,
+//! until their turn (scrolling only the slabs newly inside a window is not built).
 
 use super::dense::{self, DenseVolume};
 use super::registry::{KindInfo, StructureDesc};
@@ -72,8 +75,10 @@ pub struct GpuClipLevels {
     pub count: u32,
     /// Voxels per side of every window.
     pub resolution: u32,
+    /// A bit per level the last voxel work rebuilt alone (its leaves are all new).
+    pub rebuilt: u32,
     /// Padding; zero.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
 
 /// The clipmap in the registry of kinds.
@@ -231,6 +236,10 @@ pub struct Clipmap {
     bounds: (Vec3, Vec3),
     /// The first frame's camera has placed the windows.
     placed: bool,
+    /// A bit per level the build `plan` asked for rebuilds (`None`: `plan` asked for none).
+    rebuilding: Option<u32>,
+    /// That build rebuilds some levels alone (the others keep their leaves and light).
+    partial: bool,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
 }
@@ -245,7 +254,7 @@ impl Clipmap {
     ) -> Self {
         let clip = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("clipmap levels"),
-            contents: bytemuck::bytes_of(&clip_levels(&levels, scene, bounds)),
+            contents: bytemuck::bytes_of(&clip_levels(&levels, scene, bounds, 0)),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let debug_placement = device.create_buffer(&wgpu::BufferDescriptor {
@@ -264,6 +273,8 @@ impl Clipmap {
             scene,
             bounds,
             placed: false,
+            rebuilding: None,
+            partial: false,
             sampling,
             leaves,
         }
@@ -391,26 +402,43 @@ impl Clipmap {
         super::cpu::from_depth(outer.lerp(fine, w))
     }
 
-    /// Moves the windows whose place for the camera at `camera` (`placed_origin`) lies more
-    /// than a step from where they are, that is two steps or more (all of them the first
-    /// time); whether any moved.
-    fn follow(&mut self, camera: Vec3) -> bool {
-        let mut moved = false;
-        for g in &mut self.levels {
-            let origin = placed_origin(g, self.bounds, camera);
-            let strayed = (origin - g.origin).abs().max_element() > window_step(g) * 1.001;
-            if (!self.placed || strayed) && origin != g.origin {
-                g.origin = origin;
-                moved = true;
+    /// Plans the windows' moves for the camera at `camera`: each window whose place for it
+    /// (`placed_origin`) lies more than a step from where it is (two steps or more) wants to
+    /// move; at most `budget` of them move this frame (0: all), those that strayed farthest
+    /// (in their own steps) first, the finer first among equals; the others wait where they
+    /// are, still valid. Every window is placed the first time and when `everything` is to
+    /// be rebuilt. Returns a bit per level that moved, and whether that is all of them
+    /// anyway.
+    fn follow(&mut self, camera: Vec3, budget: u32, everything: bool) -> (u32, bool) {
+        let all = (1u32 << self.levels.len()) - 1;
+        if everything || !self.placed {
+            for g in &mut self.levels {
+                g.origin = placed_origin(g, self.bounds, camera);
             }
+            self.placed = true;
+            return (all, true);
         }
-        moved |= !self.placed;
-        self.placed = true;
-        if moved {
-            self.clip_current
-                .store(false, std::sync::atomic::Ordering::Relaxed);
+        let mut wanting: Vec<(usize, f32)> = self
+            .levels
+            .iter()
+            .enumerate()
+            .filter_map(|(k, g)| {
+                let origin = placed_origin(g, self.bounds, camera);
+                let stray = (origin - g.origin).abs().max_element() / window_step(g);
+                (stray > 1.001).then_some((k, stray))
+            })
+            .collect();
+        wanting.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        if budget > 0 {
+            wanting.truncate(budget as usize);
         }
-        moved
+        let mut moved = 0;
+        for (k, _) in wanting {
+            let g = &mut self.levels[k];
+            g.origin = placed_origin(g, self.bounds, camera);
+            moved |= 1 << k;
+        }
+        (moved, false)
     }
 
     /// Records the levels' placement into `clip` when it changed since the last time.
@@ -423,7 +451,12 @@ impl Clipmap {
         }
         let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("clipmap levels (staging)"),
-            contents: bytemuck::bytes_of(&clip_levels(&self.levels, self.scene, self.bounds)),
+            contents: bytemuck::bytes_of(&clip_levels(
+                &self.levels,
+                self.scene,
+                self.bounds,
+                self.rebuilding.filter(|_| self.partial).unwrap_or(0),
+            )),
             usage: wgpu::BufferUsages::COPY_SRC,
         });
         encoder.copy_buffer_to_buffer(&staging, 0, &self.clip, 0, staging.size());
@@ -447,8 +480,14 @@ fn inside_by(g: &Grid, (lo, hi): (Vec3, Vec3), p: Vec3) -> f32 {
         .min_element()
 }
 
-/// The levels in the scene's cube `scene` and bounds `bounds` as the shaders read them.
-fn clip_levels(levels: &[Grid], (lo, hi): (Vec3, Vec3), bounds: (Vec3, Vec3)) -> GpuClipLevels {
+/// The levels in the scene's cube `scene` and bounds `bounds` as the shaders read them, with
+/// `rebuilt` the levels the last voxel work rebuilt alone.
+fn clip_levels(
+    levels: &[Grid],
+    (lo, hi): (Vec3, Vec3),
+    bounds: (Vec3, Vec3),
+    rebuilt: u32,
+) -> GpuClipLevels {
     let mut l = GpuClipLevels {
         levels: [[0.0; 4]; MAX_LEVELS as usize],
         scene_lo: lo.extend(0.0).to_array(),
@@ -457,7 +496,8 @@ fn clip_levels(levels: &[Grid], (lo, hi): (Vec3, Vec3), bounds: (Vec3, Vec3)) ->
         bounds_hi: bounds.1.extend(0.0).to_array(),
         count: levels.len() as u32,
         resolution: levels[0].resolution,
-        _pad: [0; 2],
+        rebuilt,
+        _pad: 0,
     };
     for (k, g) in levels.iter().enumerate() {
         l.levels[k] = [g.origin.x, g.origin.y, g.origin.z, g.voxel_size];
@@ -466,27 +506,59 @@ fn clip_levels(levels: &[Grid], (lo, hi): (Vec3, Vec3), bounds: (Vec3, Vec3)) ->
 }
 
 impl VoxelStructure for Clipmap {
-    /// Follows the camera: a window it strayed from moves, and every level is voxelized and
-    /// lit again (with the dynamic geometry where it is now).
+    /// Follows the camera within the frame's budget (`follow`): the windows that move are
+    /// voxelized and lit again, alone (the others keep their leaves and light), with the
+    /// dynamic geometry where it is now; a rebuild places and builds every window.
     fn plan(&mut self, changes: &FrameChanges) -> VoxelWork {
-        let moved = self.follow(changes.camera);
-        let all = || self.levels.iter().map(Region::all).collect::<Vec<_>>();
-        let around = |b| {
-            self.levels
+        let (moved, everything) = self.follow(changes.camera, changes.budget, changes.rebuild);
+        let around = |levels: &[Grid], b| {
+            levels
                 .iter()
                 .map(|g| dynamic_region(g, b))
                 .collect::<Vec<_>>()
         };
-        if changes.rebuild || moved {
-            return VoxelWork {
-                build: Some(all()),
-                update: changes.dynamic.or(changes.dynamic_now).map(around),
-            };
+        let (rebuilding, partial) = (self.rebuilding, self.partial);
+        let work = if moved != 0 {
+            let build = self
+                .levels
+                .iter()
+                .enumerate()
+                .map(|(k, g)| {
+                    if moved & (1 << k) != 0 {
+                        Region::all(g)
+                    } else {
+                        Region::EMPTY
+                    }
+                })
+                .collect();
+            self.rebuilding = Some(moved);
+            self.partial = !everything;
+            VoxelWork {
+                build: Some(build),
+                update: changes
+                    .dynamic
+                    .or(changes.dynamic_now)
+                    .map(|b| around(&self.levels, b)),
+                partial: !everything,
+            }
+        } else {
+            self.rebuilding = None;
+            self.partial = false;
+            VoxelWork {
+                build: None,
+                update: changes.dynamic.map(|b| around(&self.levels, b)),
+                partial: false,
+            }
+        };
+        if moved != 0 || (rebuilding, partial) != (self.rebuilding, self.partial) {
+            self.clip_current
+                .store(false, std::sync::atomic::Ordering::Relaxed);
         }
-        VoxelWork {
-            build: None,
-            update: changes.dynamic.map(around),
-        }
+        work
+    }
+
+    fn record_plan(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder) {
+        self.record_placement(device, encoder);
     }
 
     fn fragment_grids(&self) -> Vec<Grid> {
@@ -524,7 +596,10 @@ impl VoxelStructure for Clipmap {
         timer: &mut GpuTimer,
     ) {
         self.record_placement(device, encoder);
-        self.inner.record_build(device, encoder, fragments, timer);
+        let all = (1 << self.levels.len()) - 1;
+        let rebuild = self.rebuilding.unwrap_or(all);
+        self.inner
+            .build_windows(device, encoder, fragments, rebuild, timer);
     }
 
     fn record_update(

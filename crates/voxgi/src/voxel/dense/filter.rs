@@ -251,16 +251,21 @@ impl FilterPass {
             }
         }
         if all {
-            // The build's writes listed voxels a whole filter has redone: from the redone
-            // count (word 6) through the counts and every level's bits.
-            encoder.clear_buffer(&binds.counters, 24, Some(binds.bits_end - 24));
+            // The build's writes listed voxels a whole filter has redone: the redone count
+            // (word 6) and the levels' counts, and every level's bits (not the windows' slot
+            // counts between them, nor the rebuild word 7, which the next build sets).
+            encoder.clear_buffer(&binds.counters, 24, Some(4));
+            encoder.clear_buffer(&binds.counters, 32, Some(WINDOW_WORDS * 4 - 32));
+            let bits = (WINDOW_WORDS + WINDOW_COUNTER_WORDS) * 4;
+            encoder.clear_buffer(&binds.counters, bits, Some(binds.bits_end - bits));
         }
     }
 }
 
 /// Words of a volume's counters on `grid` (`windows` cubes of it) before its lists: the
-/// counters, each level's count (voxels/dense/changed.wgsl's `COUNTS`, ten levels) and its
-/// bits (a bit per voxel of each level above the finest).
+/// counters, each level's count (voxels/dense/changed.wgsl's `COUNTS`, ten levels), the
+/// windows' slot counts, and each level's bits (a bit per voxel of each level above the
+/// finest).
 fn counter_words_before_lists(grid: Grid, windows: u32) -> u64 {
     let res = grid.resolution as u64;
     let top = grid.levels() as u64 - 1;
@@ -269,8 +274,18 @@ fn counter_words_before_lists(grid: Grid, windows: u32) -> u64 {
     let bits: u64 = (1..=top)
         .map(|l| ((res >> l).pow(3) * windows as u64).div_ceil(32))
         .sum();
-    18 + bits
+    WINDOW_WORDS + WINDOW_COUNTER_WORDS + bits
 }
+
+/// Where the windows' slot counts begin in a volume's counters (`WINDOW_WORDS` in
+/// voxels/dense/slots.wgsl), after the fixed words and ten levels' counts.
+pub(crate) const WINDOW_WORDS: u64 = 18;
+/// The most windows a volume's slots are parted into (`MAX_WINDOWS` there).
+pub(crate) const MAX_WINDOWS: u64 = 8;
+/// Words per window (`WINDOW_STRIDE` there).
+pub(crate) const WINDOW_STRIDE: u64 = 4;
+/// The windows' words.
+const WINDOW_COUNTER_WORDS: u64 = MAX_WINDOWS * WINDOW_STRIDE;
 
 /// Bytes of a volume's counters on `grid` (`windows` cubes of it; the twin of
 /// voxels/dense/changed.wgsl's layout): the counters and bits

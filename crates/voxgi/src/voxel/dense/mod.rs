@@ -63,6 +63,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/dense/placement.wgsl",
             "voxels/dense/leaf_store.wgsl",
             "voxels/dense/changed.wgsl",
+            "voxels/dense/slots.wgsl",
             "voxels/dense/irradiance.wgsl",
             "voxels/dense/build_shared.wgsl",
             "voxels/dense/dense_build.wgsl",
@@ -96,6 +97,20 @@ fn create(
     let v = DenseVolume::create(device, desc.grid, 1, desc, desc.leaves, previous)?;
     Ok(Box::new(v))
 }
+
+/// The counters' word of the windows a build rebuilds (`REBUILD` in build_shared.wgsl).
+const REBUILD_WORD: u64 = 7;
+
+/// The constants the Rust side shares with the build's WGSL, by their WGSL names (a test
+/// compares them).
+pub const SHARED_CONSTANTS: &[(&str, u64)] = &[
+    ("ACCUM_STRIDE", ACCUM_STRIDE),
+    ("DYN_STRIDE", DYN_STRIDE),
+    ("REBUILD", REBUILD_WORD),
+    ("WINDOW_WORDS", filter::WINDOW_WORDS),
+    ("MAX_WINDOWS", filter::MAX_WINDOWS),
+    ("WINDOW_STRIDE", filter::WINDOW_STRIDE),
+];
 
 /// Slot pools more than this many times the last build's count shrink.
 const SHRINK_BELOW: u64 = 4;
@@ -154,14 +169,17 @@ pub struct DenseVolume {
     pub ndf: bool,
     /// The volume's placement as a `GpuVolume` uniform.
     pub volume: wgpu::Buffer,
-    /// Occupied voxels the slot buffers hold.
+    /// Occupied voxels the slot buffers hold: `windows` parts of `window_slots`.
     pub slot_capacity: u32,
-    /// `[0]` occupied voxels (slots, counted past the capacity), `[1]` slots of the previous
-    /// build, `[2]` slots of the static geometry, `[3]` and `[4]` slots the dynamic geometry
-    /// touched in this and the previous update (see dense_update.wgsl), `[6]` the voxels above
-    /// the finest the last filter redid (one for all its directions; 0 when it filtered
-    /// everything, after a build), from `[8]` on each level's voxels with a changed child,
-    /// counted, as bits and as lists (voxels/dense/changed.wgsl).
+    /// Occupied voxels each window's part of the slots holds (voxels/dense/slots.wgsl).
+    pub window_slots: u32,
+    /// `[0]` occupied voxels (slots asked for, past the capacity), `[1]` the most a window
+    /// asked for, `[3]` and `[4]` slots the dynamic geometry touched in this and the previous
+    /// update (see dense_update.wgsl), `[6]` the voxels above the finest the last filter redid
+    /// (one for all its directions; 0 when it filtered everything, after a build), `[7]` a bit
+    /// per window the next build rebuilds, from `[8]` each level's count of voxels with a
+    /// changed child, from `[18]` each window's slot counts (`WINDOW_WORDS`), then the levels'
+    /// bits and lists (voxels/dense/changed.wgsl).
     pub counters: wgpu::Buffer,
     /// Per finest voxel (x fastest): 0 empty, 2 + slot once allocated, or a lock value while
     /// allocating or past the capacity.
@@ -409,7 +427,14 @@ impl DensePipelines {
             })
         };
         let m = shader::module_for(device, "voxels/dense/dense_build.wgsl", &KIND.shaders);
-        let b = |entry: &str| pipe(&m, "dense_build", entry, entry.starts_with("prepare"));
+        let b = |entry: &str| {
+            pipe(
+                &m,
+                "dense_build",
+                entry,
+                matches!(entry, "begin" | "prepare_fragments" | "prepare_slots"),
+            )
+        };
         let build = BuildPipelines {
             begin: b("begin"),
             clear_previous: b("clear_previous"),
@@ -464,7 +489,10 @@ impl DenseVolume {
         let anisotropic = filtering.anisotropic;
         let res = grid.resolution;
         let levels = grid.levels();
-        let slots = slot_capacity.max(1) as u64;
+        // Whole parts per window, four slots at least, so that the shaders find a part's size
+        // from the buffer's length.
+        let window_slots = (slot_capacity / windows).max(4);
+        let slots = window_slots as u64 * windows as u64;
         let volume = GpuVolume {
             origin: grid.origin.to_array(),
             resolution: res,
@@ -575,6 +603,7 @@ impl DenseVolume {
             ndf: filtering.ndf,
             volume,
             slot_capacity: slots as u32,
+            window_slots,
             counters,
             occupancy,
             slot_voxel,
@@ -754,23 +783,57 @@ impl DenseVolume {
 
     /// Records a build from `fragments`: forget the previous build and clear what it filled,
     /// then allocate a slot per occupied voxel, sum its fragments and resolve the finest level.
-    fn build(
+    /// Records a build of the windows in `rebuild` (a bit each) from `fragments`: every other
+    /// window keeps its slots, sums and textures (a clipmap rebuilding the levels that moved).
+    /// The last update is taken out of every window first (the static build is what an update
+    /// merges into).
+    pub(crate) fn build_windows(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         fragments: &Fragments,
+        rebuild: u32,
         timer: &mut GpuTimer,
     ) {
         let bind = self
             .fragment_bind
             .get(fragments, || self.build_bind_group(device, fragments));
+        if self.dynamic {
+            let u = &self.pipelines.update;
+            let restore = [
+                (&u.begin, Run::Prepare),
+                (&u.restore, Run::Indirect(24)),
+                (&u.free, Run::One),
+            ];
+            self.run_steps(encoder, "dense_build", &bind, &restore, timer);
+        }
+        let mask = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dense_build windows (staging)"),
+            contents: bytemuck::bytes_of(&rebuild),
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        encoder.copy_buffer_to_buffer(&mask, 0, &self.counters, REBUILD_WORD * 4, 4);
         let b = &self.pipelines.build;
-        // The previous build's slots, from its own dispatch size over them.
-        let forget = [(&b.begin, Run::One), (&b.clear_previous, Run::Indirect(0))];
+        // The rebuilt windows' previous slots, from begin's dispatch size over them.
+        let forget = [
+            (&b.begin, Run::Prepare),
+            (&b.clear_previous, Run::Indirect(0)),
+        ];
         self.run_steps(encoder, "dense_build", &bind, &forget, timer);
-        encoder.clear_buffer(&self.occupancy, 0, None);
-        encoder.clear_buffer(&self.accum, 0, None);
-        encoder.clear_buffer(&self.dyn_accum, 0, None);
+        let all = (1u32 << self.windows) - 1;
+        if rebuild & all == all {
+            encoder.clear_buffer(&self.occupancy, 0, None);
+            encoder.clear_buffer(&self.accum, 0, None);
+            encoder.clear_buffer(&self.dyn_accum, 0, None);
+        } else {
+            // Each window's voxels and slots are one range of their buffers.
+            let voxels = (self.grid.resolution as u64).pow(3) * 4;
+            let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
+            for w in (0..self.windows as u64).filter(|w| rebuild & (1 << w) != 0) {
+                encoder.clear_buffer(&self.occupancy, w * voxels, Some(voxels));
+                encoder.clear_buffer(&self.accum, w * sums, Some(sums));
+            }
+        }
         let steps = [
             (&b.prepare_fragments, Run::Prepare),
             (&b.allocate, Run::Indirect(12)),
@@ -779,7 +842,10 @@ impl DenseVolume {
             (&b.resolve, Run::Indirect(0)),
         ];
         self.run_steps(encoder, "dense_build", &bind, &steps, timer);
-        self.built.store(true, std::sync::atomic::Ordering::Relaxed);
+        // A build of some windows lists what it wrote for the filter, as updates do.
+        if rebuild & all == all {
+            self.built.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
     }
 
     /// Records an update by the dynamic fragments (those past the build's): undo the
@@ -911,7 +977,7 @@ impl VoxelStructure for DenseVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        self.build(device, encoder, fragments, timer);
+        self.build_windows(device, encoder, fragments, (1 << self.windows) - 1, timer);
     }
 
     fn record_update(
@@ -946,12 +1012,13 @@ impl VoxelStructure for DenseVolume {
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
-        counted[0] > self.slot_capacity
+        // Word 1: the most a window asked for.
+        counted[1] > self.window_slots
     }
 
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> crate::Result<()> {
-        let slots =
-            crate::gpu::pool_capacity(device, counted[0] as u64, SLOT_BYTES, "occupied voxels")?;
+        let wanted = counted[1] as u64 * self.windows as u64;
+        let slots = crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")?;
         self.resize(device, slots)
     }
 
@@ -963,12 +1030,13 @@ impl VoxelStructure for DenseVolume {
         device: &wgpu::Device,
         counted: &[u32; POOL_COUNTERS],
     ) -> crate::Result<bool> {
-        let count = (counted[0] as u64).max(1024);
-        if (self.slot_capacity as u64) <= SHRINK_BELOW * count {
+        // Per window: each part holds the most any window asked for.
+        let count = (counted[1] as u64).max(1024);
+        if (self.window_slots as u64) <= SHRINK_BELOW * count {
             return Ok(false);
         }
-        let slots =
-            crate::gpu::pool_capacity(device, count * 3 / 2, SLOT_BYTES, "occupied voxels")?;
+        let wanted = count * 3 / 2 * self.windows as u64;
+        let slots = crate::gpu::pool_capacity(device, wanted, SLOT_BYTES, "occupied voxels")?;
         self.resize(device, slots)?;
         Ok(true)
     }
