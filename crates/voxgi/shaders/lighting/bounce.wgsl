@@ -9,9 +9,11 @@
 //!include shared/cone.wgsl
 //!include voxels/leaves.wgsl
 //!include shared/irradiance_record.wgsl
+//!include voxels/carry.wgsl
 
 // Which leaves gather this update (`bounce_slices`). With `count` > 1 and not `all`, `mark`
-// lists those whose slice is `turn` (and the new ones, and those near moved geometry) and
+// lists those whose slice is `turn` (and those near moved geometry, and the new ones, unless
+// their structure names a leaf whose kept light they start from: voxels/<kind>/carry.wgsl) and
 // re-emits, at every other leaf, the irradiance it last gathered in this bounce of an update
 // on top of its direct light of now; `list` sizes the gather's dispatch to the list, and
 // `main` gathers at the listed leaves only.
@@ -74,7 +76,19 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let p = leaf_center(s);
     let near = all(p >= slices.near_min.xyz) && all(p <= slices.near_max.xyz);
-    if leaf_is_new(s) || near || slice_of(leaf_coord(s)) == slices.turn {
+    var gather = near || slice_of(leaf_coord(s)) == slices.turn;
+    // A new leaf has nothing kept: it gathers now, or starts from the light of the leaf its
+    // structure names (reading only leaves that are not new, whose kept light no thread
+    // writes here).
+    if leaf_is_new(s) && !gather {
+        let source = leaf_carry_source(s);
+        if source == NO_LEAF {
+            gather = true;
+        } else {
+            keep(s, kept(source));
+        }
+    }
+    if gather {
         let k = atomicAdd(&listing[0], 1u);
         gathered[list_start() + 1u + k] = s;
     } else {

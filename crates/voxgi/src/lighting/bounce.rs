@@ -151,6 +151,7 @@ impl BouncePass {
         let voxels = kind.sampling_layout(device);
         let leaves = kind.leaves_layout(device);
         let store = kind.leaf_store_layout(device);
+        let irradiance_lookup = kind.irradiance_layout(device);
         let [iso, axes] = kind.sampling_constants(anisotropic, 3);
         let gather = |irradiance: bool| {
             voxel_pipeline(
@@ -179,7 +180,13 @@ impl BouncePass {
                 "lighting/bounce.wgsl",
                 kind.shaders(),
                 "mark",
-                &[Some(&mark_globals), None, Some(&leaves)],
+                // The structure's irradiance lookup: its `leaf_carry_source` may read it.
+                &[
+                    Some(&mark_globals),
+                    None,
+                    Some(&leaves),
+                    Some(&irradiance_lookup),
+                ],
             ),
             list: voxel_pipeline_entry(
                 device,
@@ -312,6 +319,7 @@ impl BouncePass {
                 pass.set_pipeline(&self.mark);
                 pass.set_bind_group(0, mark_globals, &[]);
                 pass.set_bind_group(2, bound.leaves, &[]);
+                pass.set_bind_group(3, bound.irradiance, &[]);
                 pass.dispatch_workgroups_indirect(args, offset);
             }
             let mut pass = pass(encoder, timer);

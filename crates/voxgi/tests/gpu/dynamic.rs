@@ -261,6 +261,63 @@ fn a_clipmap_that_followed_the_camera_equals_one_made_there() {
     }
 }
 
+/// With bounce slices, a clipmap window that moves does not gather at all its new leaves at
+/// once: each starts from the kept light of the next coarser level's leaf around it until its
+/// turn comes (voxels/clipmap/carry.wgsl). In the frame the finest window moves, some of its
+/// voxels hold carried light (they differ from a full gather's), and the window's light stays
+/// within a fifth of the full gather's: a coarser leaf is twice as wide, its cones start
+/// farther out and pass the near walls' corners, so it gathers more (the bound is the carried
+/// light's error, which lasts until the leaves' turns, `bounce_slices` updates at most).
+#[test]
+fn a_moved_clipmap_window_starts_from_the_coarser_light() {
+    let (scene, _) = cornell_with_cube((0.40, 0.15));
+    let c = ctx();
+    let finest = |slices: u32| -> Vec<f32> {
+        let options = RendererOptions {
+            voxels: voxgi::VoxelKind::CLIPMAP,
+            clipmap_levels: 5,
+            clipmap_budget: 1,
+            bounce_slices: slices,
+            ..options()
+        };
+        let mut r = renderer(&scene, &options);
+        let mut p = params(&r);
+        frame(&mut r, &p, SIZE, SIZE);
+        let before = r
+            .structure::<voxgi::voxel::clipmap::Clipmap>()
+            .unwrap()
+            .levels()
+            .to_vec();
+        p.camera.position = Vec3::new(0.2, 0.2, 0.3);
+        frame(&mut r, &p, SIZE, SIZE);
+        let clipmap = r.structure::<voxgi::voxel::clipmap::Clipmap>().unwrap();
+        assert_eq!(moved_windows(&before, clipmap.levels()), vec![0]);
+        let v = clipmap.volume();
+        let bytes = readback::read_texture_3d(&c.device, &c.queue, &v.radiance, 0).unwrap();
+        let halves: &[u16] = bytemuck::cast_slice(&bytes);
+        // Level 0's window: the first of the stacked cubes.
+        let texels = (v.grid.resolution as usize).pow(3);
+        halves[..4 * texels]
+            .iter()
+            .map(|&h| readback::f16_to_f32(h))
+            .collect()
+    };
+    let (carried, full) = (finest(4), finest(1));
+    let differ = carried
+        .chunks(4)
+        .zip(full.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    let light = |v: &[f32]| v.chunks(4).map(|t| t[0] + t[1] + t[2]).sum::<f32>();
+    let (a, b) = (light(&carried), light(&full));
+    eprintln!("{differ} voxels hold carried light; the window's light {a} against {b}");
+    assert!(differ > 0, "every new leaf gathered at once");
+    assert!(
+        (a / b - 1.0).abs() < 0.2,
+        "carried {a} against gathered {b}"
+    );
+}
+
 /// The levels whose windows differ between `a` and `b`.
 fn moved_windows(a: &[voxgi::voxel::Grid], b: &[voxgi::voxel::Grid]) -> Vec<usize> {
     (0..a.len()).filter(|&k| a[k] != b[k]).collect()

@@ -98,6 +98,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/clipmap/sample.wgsl",
             "voxels/clipmap/placement.wgsl",
             "voxels/clipmap/irradiance.wgsl",
+            "voxels/clipmap/carry.wgsl",
         ],
         passes: &[],
         base: Some(&dense::KIND.shaders),

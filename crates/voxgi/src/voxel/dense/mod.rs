@@ -64,6 +64,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/dense/leaf_store.wgsl",
             "voxels/dense/changed.wgsl",
             "voxels/dense/slots.wgsl",
+            "voxels/dense/carry.wgsl",
             "voxels/dense/irradiance.wgsl",
             "voxels/dense/build_shared.wgsl",
             "voxels/dense/dense_build.wgsl",

@@ -62,6 +62,7 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/octree/tree.wgsl",
             "voxels/octree/sample.wgsl",
             "voxels/octree/leaves.wgsl",
+            "voxels/octree/carry.wgsl",
             "voxels/octree/leaf_store.wgsl",
             "voxels/octree/irradiance.wgsl",
             "voxels/octree/build_shared.wgsl",
