@@ -24,8 +24,8 @@ struct Blend {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = dispatch_index(gid, nwg);
-    if !leaf_exists(s) {
+    let s = leaf_slot(dispatch_index(gid, nwg));
+    if s == NO_LEAF {
         return;
     }
     var goal = leaf_direct[s];

@@ -70,8 +70,8 @@ fn slice_of(c: vec3<u32>) -> u32 {
 
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = dispatch_index(gid, nwg);
-    if !leaf_exists(s) {
+    let s = leaf_slot(dispatch_index(gid, nwg));
+    if s == NO_LEAF {
         return;
     }
     let p = leaf_center(s);
@@ -119,8 +119,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
             return;
         }
         s = gathered[list_start() + 1u + s];
-    } else if !leaf_exists(s) {
-        return;
+    } else {
+        s = leaf_slot(s);
+        if s == NO_LEAF {
+            return;
+        }
     }
     let c = leaf_coord(s);
     let albedo = leaf_albedo(s);

@@ -130,8 +130,8 @@ fn moved_distance(view: ShadowView) -> f32 {
 
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = dispatch_index(gid, nwg);
-    if !leaf_exists(s) {
+    let s = leaf_slot(dispatch_index(gid, nwg));
+    if s == NO_LEAF {
         return;
     }
     if leaf_inputs_changed(s) {

@@ -117,6 +117,7 @@ fn every_structure_defines_the_voxel_contract() {
 /// The leaves' contract of the lighting passes: names, signatures, and the groups (2 for the
 /// leaves, 3 for their radiance store).
 const LEAVES: &[(&str, &[&str], &str)] = &[
+    ("leaf_slot", &["u32"], "u32"),
     ("leaf_exists", &["u32"], "bool"),
     ("leaf_is_new", &["u32"], "bool"),
     ("leaf_coord", &["u32"], "vec3<u32>"),

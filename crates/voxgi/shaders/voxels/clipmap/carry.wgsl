@@ -4,8 +4,6 @@
 // in its turn; so a window that moves need not gather all its leaves at once. At @group(3): the
 // volume's occupancy, the binding 0 of `irradiance_layout`.
 
-const NO_LEAF: u32 = 0xffffffffu;
-
 // Per voxel of the stacked windows (x fastest): 0 empty, 2 + slot once allocated.
 @group(3) @binding(0) var<storage, read> carry_occupancy: array<u32>;
 

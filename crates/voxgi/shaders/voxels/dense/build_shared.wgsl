@@ -102,8 +102,8 @@ fn take_slot(v: u32) -> u32 {
     return w * c + k;
 }
 
-// The pool's totals from the windows' counts (words 0 and 1), and the dispatch over the slots
-// that hold leaves. Only the kernels that bind the arguments.
+// The pool's totals from the windows' counts (words 0 and 1), and the dispatch over the
+// leaves. Only the kernels that bind the arguments.
 fn count_windows() {
     var total = 0u;
     var most = 0u;
@@ -114,7 +114,12 @@ fn count_windows() {
     }
     atomicStore(&counters[0], total);
     atomicStore(&counters[1], most);
-    write_args(0u, slots_end(vol.windows));
+    // One thread a leaf: `leaf_slot` finds its slot.
+    var filled = 0u;
+    for (var w = 0u; w < vol.windows; w++) {
+        filled += window_filled(w, vol.windows);
+    }
+    write_args(0u, filled);
 }
 
 // Adds fragment `f`'s attributes to slot `s`'s static or dynamic sums.

@@ -121,8 +121,9 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let s = flat(gid, nwg);
-    if !rebuilt_slot(s, W_COUNT) {
+    // prepare_slots' dispatch: a thread per filled slot of every window.
+    let s = filled_slot(flat(gid, nwg), vol.windows);
+    if s == 0xffffffffu || !rebuilt_slot(s, W_COUNT) {
         return;
     }
     resolve_slot(s, false);

@@ -1,8 +1,10 @@
 // The dense volume's leaves: the occupied finest voxels, one slot each. The lighting passes
 // (inject, bounce, bounce_store) reach a structure's leaves through these names only:
 //
-//   fn leaf_exists(i) -> bool                     slot i holds a leaf (a dispatch over
-//                                                 `leaf_dispatch` reaches every slot that does)
+//   fn leaf_slot(t) -> u32                        the slot of leaf t, numbered 0.. as a
+//                                                 dispatch over `leaf_dispatch` numbers its
+//                                                 threads, or NO_LEAF past the last leaf
+//   fn leaf_exists(i) -> bool                     slot i holds a leaf
 //   fn leaf_is_new(i) -> bool                     made by the last update or a build of
 //                                                 part of the structure: its slot held
 //                                                 another leaf before (or none)
@@ -36,6 +38,12 @@
 @group(2) @binding(7) var<storage, read_write> leaf_next: array<vec4<f32>>;
 
 //!include voxels/slots.wgsl
+
+const NO_LEAF: u32 = 0xffffffffu;
+
+fn leaf_slot(t: u32) -> u32 {
+    return filled_slot(t, leaf_grid.windows);
+}
 
 fn leaf_exists(i: u32) -> bool {
     return slot_filled(i, leaf_grid.windows);

@@ -41,15 +41,18 @@ fn slot_static(s: u32, windows: u32) -> bool {
     return w < windows && s - w * c < atomicLoad(&counters[window_word(w, W_STATIC)]);
 }
 
-// One past the last slot that holds a leaf (what a dispatch over the leaves covers).
-fn slots_end(windows: u32) -> u32 {
+// The slot of the t-th filled slot, through the windows' parts in turn (leaving out their
+// free slots: a dispatch over the parts' whole length would run threads for nothing), or
+// 0xffffffff past the last.
+fn filled_slot(t: u32, windows: u32) -> u32 {
     let c = window_slots(windows);
-    var end = 0u;
+    var first = 0u;
     for (var w = 0u; w < windows; w++) {
         let n = window_filled(w, windows);
-        if n > 0u {
-            end = w * c + n;
+        if t < first + n {
+            return w * c + t - first;
         }
+        first += n;
     }
-    return end;
+    return 0xffffffffu;
 }

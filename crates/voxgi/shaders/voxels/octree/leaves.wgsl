@@ -14,6 +14,12 @@
 // The header (its word 0: slots of the last build, counted past the capacity), then the nodes.
 @group(2) @binding(4) var<storage, read> leaf_nodes: array<u32>;
 
+const NO_LEAF: u32 = 0xffffffffu;
+
+fn leaf_slot(t: u32) -> u32 {
+    return select(NO_LEAF, t, leaf_exists(t));
+}
+
 fn leaf_exists(i: u32) -> bool {
     return i < min(leaf_nodes[0], leaf_tree.slots);
 }
