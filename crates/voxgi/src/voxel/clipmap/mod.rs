@@ -213,6 +213,27 @@ fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
     )
 }
 
+/// The windows of `levels` that move for a camera at `camera` in a scene whose bounds are
+/// `bounds`, a bit each: of those whose place (`placed_origin`) lies more than a step from
+/// where they are, at most `budget` (0: all), those that strayed farthest in their own steps
+/// first, the finer first among equals.
+fn moves(levels: &[Grid], bounds: (Vec3, Vec3), camera: Vec3, budget: u32) -> u32 {
+    let mut wanting: Vec<(usize, f32)> = levels
+        .iter()
+        .enumerate()
+        .filter_map(|(k, g)| {
+            let origin = placed_origin(g, bounds, camera);
+            let stray = (origin - g.origin).abs().max_element() / window_step(g);
+            (stray > 1.001).then_some((k, stray))
+        })
+        .collect();
+    wanting.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    if budget > 0 {
+        wanting.truncate(budget as usize);
+    }
+    wanting.iter().fold(0, |m, (k, _)| m | 1 << k)
+}
+
 /// How far a window moves at a time: an eighth of it (at least a voxel).
 fn window_step(g: &Grid) -> f32 {
     g.voxel_size * (g.resolution / 8).max(1) as f32
@@ -419,25 +440,11 @@ impl Clipmap {
             self.placed = true;
             return (all, true);
         }
-        let mut wanting: Vec<(usize, f32)> = self
-            .levels
-            .iter()
-            .enumerate()
-            .filter_map(|(k, g)| {
-                let origin = placed_origin(g, self.bounds, camera);
-                let stray = (origin - g.origin).abs().max_element() / window_step(g);
-                (stray > 1.001).then_some((k, stray))
-            })
-            .collect();
-        wanting.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-        if budget > 0 {
-            wanting.truncate(budget as usize);
-        }
-        let mut moved = 0;
-        for (k, _) in wanting {
-            let g = &mut self.levels[k];
-            g.origin = placed_origin(g, self.bounds, camera);
-            moved |= 1 << k;
+        let moved = moves(&self.levels, self.bounds, camera, budget);
+        for (k, g) in self.levels.iter_mut().enumerate() {
+            if moved & (1 << k) != 0 {
+                g.origin = placed_origin(g, self.bounds, camera);
+            }
         }
         (moved, false)
     }
@@ -768,6 +775,48 @@ mod tests {
         // Wider: centred on the scene.
         let o = placed_origin(&grid(0.4), scene, camera);
         assert!(near(o, Vec3::splat(-3.2)), "{o}");
+    }
+
+    #[test]
+    fn a_budget_moves_the_farthest_strayed_windows_and_the_others_wait() {
+        let bounds = (Vec3::splat(-500.0), Vec3::splat(500.0));
+        // Four levels of 32 voxels from 0.25 m: steps of 1, 2, 4 and 8 m.
+        let start = Vec3::ZERO;
+        let mut levels: Vec<Grid> = (0..4)
+            .map(|k| {
+                let mut g = Grid {
+                    origin: Vec3::ZERO,
+                    voxel_size: 0.25 * (1 << k) as f32,
+                    resolution: 32,
+                };
+                g.origin = placed_origin(&g, bounds, start);
+                g
+            })
+            .collect();
+        // 5 m along x: level 0's place is 5 steps away, level 1's 3 (it rounds to 6 m), level
+        // 2's one (within its two: it stays), level 3's none.
+        let camera = Vec3::new(5.0, 0.0, 0.0);
+        assert_eq!(
+            moves(&levels, bounds, camera, 0),
+            0b0011,
+            "every window that strayed"
+        );
+        assert_eq!(
+            moves(&levels, bounds, camera, 1),
+            0b0001,
+            "the farthest strayed first"
+        );
+        assert_eq!(
+            moves(&levels, bounds, camera, 8),
+            0b0011,
+            "no more than strayed"
+        );
+        // Level 0 moved: level 1's turn, whose stray has not changed.
+        levels[0].origin = placed_origin(&levels[0], bounds, camera);
+        assert_eq!(moves(&levels, bounds, camera, 1), 0b0010);
+        // A camera back at the start: the moved window strays back, the waiting one never
+        // left.
+        assert_eq!(moves(&levels, bounds, start, 0), 0b0001);
     }
 
     #[test]
