@@ -162,7 +162,7 @@ fn every_twin_has_the_wgsl_layout() {
         m,
         GpuSlices,
         "Slices",
-        [count, turn, all, capacity, near_min, near_max]
+        [count, turn, all, capacity, near_min, near_max, carry]
     );
     twin!(m, GpuDraw, "Draw", [model, normal_matrix, material, light]);
     twin!(

@@ -30,6 +30,12 @@ struct Slices {
     // (min above max) when nothing moved.
     near_min: vec4<f32>,
     near_max: vec4<f32>,
+    // 1: a new leaf may start from the kept light `leaf_carry_source` names; 0: it gathers
+    // (the pixels read its irradiance record, which only a gather writes).
+    carry: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> cones: Cones;
@@ -81,7 +87,7 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     // structure names (reading only leaves that are not new, whose kept light no thread
     // writes here).
     if leaf_is_new(s) && !gather {
-        let source = leaf_carry_source(s);
+        let source = select(NO_LEAF, leaf_carry_source(s), slices.carry != 0u);
         if source == NO_LEAF {
             gather = true;
         } else {

@@ -35,6 +35,11 @@ pub struct GpuSlices {
     pub near_min: [f32; 4],
     /// The box's highest corner.
     pub near_max: [f32; 4],
+    /// 1: a new leaf may start from the kept light its structure names
+    /// (`leaf_carry_source`); 0: it gathers at once (its irradiance record is read).
+    pub carry: u32,
+    /// Padding; zero.
+    pub _pad: [u32; 3],
 }
 
 /// Where leaves gather at once after dynamic geometry moved within `moved` (world space), with
@@ -70,13 +75,17 @@ pub struct BounceGlobals {
 
 impl BounceGlobals {
     /// Sets which leaves gather in the next update's bounces: those of slice `turn` and those
-    /// inside `near` (`near_change`), or all of them when nothing is kept yet or `all`.
+    /// inside `near` (`near_change`), or all of them when nothing is kept yet or `all`; new
+    /// leaves too, unless `carry` lets them start from the kept light their structure names
+    /// (not when the bounce keeps irradiance records for the pixels: a carried leaf would
+    /// show its slot's previous record).
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
         turn: u32,
         all: bool,
         near: Option<voxgi_scene::Aabb>,
+        carry: bool,
     ) {
         let count = self.slices;
         let all = all || self.fresh;
@@ -90,6 +99,8 @@ impl BounceGlobals {
             capacity: self.capacity,
             near_min,
             near_max,
+            carry: carry as u32,
+            _pad: [0; 3],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&s));
         self.fresh = false;

@@ -569,7 +569,9 @@ impl Renderer {
             let near = pending
                 .moved
                 .map(|m| crate::lighting::bounce::near_change(m, tan));
-            bounce_globals.prepare(&self.queue, self.bounce_turn, rebuilt, near);
+            // Leaves whose irradiance the pixels read cannot start from another's light.
+            let carry = !bounces::leaves(&self.options);
+            bounce_globals.prepare(&self.queue, self.bounce_turn, rebuilt, near, carry);
             self.bounce_turn = self.bounce_turn.wrapping_add(1);
         }
         let bounce_globals = &*bounce_globals;
