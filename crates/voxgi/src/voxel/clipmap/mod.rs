@@ -718,6 +718,27 @@ impl VoxelStructure for Clipmap {
 mod tests {
     use super::*;
 
+    /// `count` levels of `resolution`³ voxels from `finest` metres, placed for `camera`.
+    fn placed_levels(
+        count: u32,
+        finest: f32,
+        resolution: u32,
+        bounds: (Vec3, Vec3),
+        camera: Vec3,
+    ) -> Vec<Grid> {
+        (0..count)
+            .map(|k| {
+                let mut g = Grid {
+                    origin: Vec3::ZERO,
+                    voxel_size: finest * (1 << k) as f32,
+                    resolution,
+                };
+                g.origin = placed_origin(&g, bounds, camera);
+                g
+            })
+            .collect()
+    }
+
     #[test]
     fn windows_snap_to_their_own_lattice_and_nest() {
         let camera = Vec3::new(3.37, -1.2, 40.05);
@@ -726,17 +747,7 @@ mod tests {
             Vec3::new(99.69, 150.0, 140.0),
         );
         let anchor = scene.0;
-        let levels: Vec<Grid> = (0..5)
-            .map(|k| {
-                let mut g = Grid {
-                    origin: Vec3::ZERO,
-                    voxel_size: 0.1 * (1 << k) as f32,
-                    resolution: 64,
-                };
-                g.origin = placed_origin(&g, scene, camera);
-                g
-            })
-            .collect();
+        let levels = placed_levels(5, 0.1, 64, scene, camera);
         for (k, g) in levels.iter().enumerate() {
             // On the level's lattice: origins are whole steps (8 voxels) from the anchor.
             let steps = (g.origin - anchor) / window_step(g);
@@ -782,17 +793,7 @@ mod tests {
         let bounds = (Vec3::splat(-500.0), Vec3::splat(500.0));
         // Four levels of 32 voxels from 0.25 m: steps of 1, 2, 4 and 8 m.
         let start = Vec3::ZERO;
-        let mut levels: Vec<Grid> = (0..4)
-            .map(|k| {
-                let mut g = Grid {
-                    origin: Vec3::ZERO,
-                    voxel_size: 0.25 * (1 << k) as f32,
-                    resolution: 32,
-                };
-                g.origin = placed_origin(&g, bounds, start);
-                g
-            })
-            .collect();
+        let mut levels = placed_levels(4, 0.25, 32, bounds, start);
         // 5 m along x: level 0's place is 5 steps away, level 1's 3 (it rounds to 6 m), level
         // 2's one (within its two: it stays), level 3's none.
         let camera = Vec3::new(5.0, 0.0, 0.0);
