@@ -318,6 +318,63 @@ fn a_moved_clipmap_window_starts_from_the_coarser_light() {
     );
 }
 
+/// A clipmap frame that moves one window voxelizes and builds that window alone: every other
+/// window keeps its static slots, each holding the voxel it held, and its counts (the budget
+/// bounds the voxels rebuilt a frame by a window's).
+#[test]
+fn a_moved_clipmap_window_leaves_the_others_slots_alone() {
+    let (scene, _) = cornell_with_cube((0.40, 0.15));
+    let c = ctx();
+    let options = RendererOptions {
+        voxels: voxgi::VoxelKind::CLIPMAP,
+        clipmap_levels: 5,
+        clipmap_budget: 1,
+        ..options()
+    };
+    // Per window: its count words (slots.wgsl: from word 18, four a window) and the voxels of
+    // its filled slots.
+    let parts = |r: &Renderer| -> Vec<(Vec<u32>, Vec<u32>)> {
+        let v = r
+            .structure::<voxgi::voxel::clipmap::Clipmap>()
+            .unwrap()
+            .volume();
+        let words = readback::read_buffer_copy(&c.device, &c.queue, &v.counters).unwrap();
+        let words: &[u32] = bytemuck::cast_slice(&words);
+        let slots = readback::read_buffer_copy(&c.device, &c.queue, &v.slot_voxel).unwrap();
+        let slots: &[u32] = bytemuck::cast_slice(&slots);
+        let part = v.window_slots as usize;
+        (0..v.windows as usize)
+            .map(|w| {
+                let counts = words[18 + 4 * w..18 + 4 * w + 3].to_vec();
+                // The static geometry's slots (the dynamic cube's are merged anew by every
+                // update, in whatever order the atomics hand them out).
+                let kept = (counts[2] as usize).min(part);
+                (counts, slots[w * part..w * part + kept].to_vec())
+            })
+            .collect()
+    };
+    let mut r = renderer(&scene, &options);
+    let mut p = params(&r);
+    frame(&mut r, &p, SIZE, SIZE);
+    let before = parts(&r);
+    p.camera.position = Vec3::new(0.2, 0.2, 0.3);
+    frame(&mut r, &p, SIZE, SIZE);
+    let after = parts(&r);
+    let filled: Vec<usize> = after.iter().map(|(_, s)| s.len()).collect();
+    // The finest window, outside the box at first, holds its walls once the camera is in.
+    assert!(
+        filled.iter().all(|&n| n > 0),
+        "a window without leaves: {filled:?}"
+    );
+    assert_ne!(
+        before[0].1, after[0].1,
+        "the finest window moved: new leaves"
+    );
+    for w in 1..before.len() {
+        assert!(before[w] == after[w], "window {w} was rebuilt");
+    }
+}
+
 /// The levels whose windows differ between `a` and `b`.
 fn moved_windows(a: &[voxgi::voxel::Grid], b: &[voxgi::voxel::Grid]) -> Vec<usize> {
     (0..a.len()).filter(|&k| a[k] != b[k]).collect()
