@@ -196,15 +196,7 @@ fn sequence_of_moves(options: &RendererOptions) {
 fn a_clipmap_that_followed_the_camera_equals_one_made_there() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
     for (budget, slices) in [(1, 1), (0, 1), (1, 3)] {
-        let options = RendererOptions {
-            voxels: voxgi::VoxelKind::CLIPMAP,
-            // Automatic voxel size: the coarsest spans four times the box's cube, the finest
-            // a quarter of it.
-            clipmap_levels: 5,
-            clipmap_budget: budget,
-            bounce_slices: slices,
-            ..options()
-        };
+        let options = clipmap_options(budget, slices);
         let levels = |r: &Renderer| {
             r.structure::<voxgi::voxel::clipmap::Clipmap>()
                 .expect("a clipmap")
@@ -215,8 +207,7 @@ fn a_clipmap_that_followed_the_camera_equals_one_made_there() {
         let mut p = params(&r);
         frame(&mut r, &p, SIZE, SIZE);
         let before = levels(&r);
-        // Into the box, past the finest level's step (an eighth of its window).
-        p.camera.position = Vec3::new(0.2, 0.2, 0.3);
+        p.camera.position = INTO_THE_BOX;
         let mut got = frame(&mut r, &p, SIZE, SIZE);
         let mut was = levels(&r);
         let mut moves = vec![moved_windows(&before, &was)];
@@ -273,13 +264,7 @@ fn a_moved_clipmap_window_starts_from_the_coarser_light() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
     let c = ctx();
     let finest = |slices: u32| -> Vec<f32> {
-        let options = RendererOptions {
-            voxels: voxgi::VoxelKind::CLIPMAP,
-            clipmap_levels: 5,
-            clipmap_budget: 1,
-            bounce_slices: slices,
-            ..options()
-        };
+        let options = clipmap_options(1, slices);
         let mut r = renderer(&scene, &options);
         let mut p = params(&r);
         frame(&mut r, &p, SIZE, SIZE);
@@ -288,7 +273,7 @@ fn a_moved_clipmap_window_starts_from_the_coarser_light() {
             .unwrap()
             .levels()
             .to_vec();
-        p.camera.position = Vec3::new(0.2, 0.2, 0.3);
+        p.camera.position = INTO_THE_BOX;
         frame(&mut r, &p, SIZE, SIZE);
         let clipmap = r.structure::<voxgi::voxel::clipmap::Clipmap>().unwrap();
         assert_eq!(moved_windows(&before, clipmap.levels()), vec![0]);
@@ -325,12 +310,7 @@ fn a_moved_clipmap_window_starts_from_the_coarser_light() {
 fn a_moved_clipmap_window_leaves_the_others_slots_alone() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
     let c = ctx();
-    let options = RendererOptions {
-        voxels: voxgi::VoxelKind::CLIPMAP,
-        clipmap_levels: 5,
-        clipmap_budget: 1,
-        ..options()
-    };
+    let options = clipmap_options(1, 1);
     // Per window: its count words (slots.wgsl: from word 18, four a window) and the voxels of
     // its filled slots.
     let parts = |r: &Renderer| -> Vec<(Vec<u32>, Vec<u32>)> {
@@ -357,7 +337,7 @@ fn a_moved_clipmap_window_leaves_the_others_slots_alone() {
     let mut p = params(&r);
     frame(&mut r, &p, SIZE, SIZE);
     let before = parts(&r);
-    p.camera.position = Vec3::new(0.2, 0.2, 0.3);
+    p.camera.position = INTO_THE_BOX;
     frame(&mut r, &p, SIZE, SIZE);
     let after = parts(&r);
     let filled: Vec<usize> = after.iter().map(|(_, s)| s.len()).collect();
@@ -374,6 +354,22 @@ fn a_moved_clipmap_window_leaves_the_others_slots_alone() {
         assert!(before[w] == after[w], "window {w} was rebuilt");
     }
 }
+
+/// The clipmap tests' options: five levels of automatic voxel size (the coarsest spans four
+/// times the box's cube, the finest a quarter of it), `budget` windows a frame, `slices`.
+fn clipmap_options(budget: u32, slices: u32) -> RendererOptions {
+    RendererOptions {
+        voxels: voxgi::VoxelKind::CLIPMAP,
+        clipmap_levels: 5,
+        clipmap_budget: budget,
+        bounce_slices: slices,
+        ..options()
+    }
+}
+
+/// Where the clipmap tests move the camera from the box's: into the box, past the finest
+/// level's step (an eighth of its window).
+const INTO_THE_BOX: Vec3 = Vec3::new(0.2, 0.2, 0.3);
 
 /// The levels whose windows differ between `a` and `b`.
 fn moved_windows(a: &[voxgi::voxel::Grid], b: &[voxgi::voxel::Grid]) -> Vec<usize> {

@@ -258,10 +258,9 @@ pub struct Clipmap {
     bounds: (Vec3, Vec3),
     /// The first frame's camera has placed the windows.
     placed: bool,
-    /// A bit per level the build `plan` asked for rebuilds (`None`: `plan` asked for none).
-    rebuilding: Option<u32>,
-    /// That build rebuilds some levels alone (the others keep their leaves and light).
-    partial: bool,
+    /// A bit per level the build `plan` last asked for rebuilds alone (the others keep their
+    /// leaves and light); 0 when it asked for none or for all of them.
+    rebuilt_alone: u32,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
 }
@@ -295,8 +294,7 @@ impl Clipmap {
             scene,
             bounds,
             placed: false,
-            rebuilding: None,
-            partial: false,
+            rebuilt_alone: 0,
             sampling,
             leaves,
         }
@@ -463,7 +461,7 @@ impl Clipmap {
                 &self.levels,
                 self.scene,
                 self.bounds,
-                self.rebuilding.filter(|_| self.partial).unwrap_or(0),
+                self.rebuilt_alone,
             )),
             usage: wgpu::BufferUsages::COPY_SRC,
         });
@@ -525,7 +523,7 @@ impl VoxelStructure for Clipmap {
                 .map(|g| dynamic_region(g, b))
                 .collect::<Vec<_>>()
         };
-        let (rebuilding, partial) = (self.rebuilding, self.partial);
+        let was = self.rebuilt_alone;
         let work = if moved != 0 {
             let build = self
                 .levels
@@ -539,8 +537,7 @@ impl VoxelStructure for Clipmap {
                     }
                 })
                 .collect();
-            self.rebuilding = Some(moved);
-            self.partial = !everything;
+            self.rebuilt_alone = if everything { 0 } else { moved };
             VoxelWork {
                 build: Some(build),
                 update: changes
@@ -550,15 +547,14 @@ impl VoxelStructure for Clipmap {
                 partial: !everything,
             }
         } else {
-            self.rebuilding = None;
-            self.partial = false;
+            self.rebuilt_alone = 0;
             VoxelWork {
                 build: None,
                 update: changes.dynamic.map(|b| around(&self.levels, b)),
                 partial: false,
             }
         };
-        if moved != 0 || (rebuilding, partial) != (self.rebuilding, self.partial) {
+        if moved != 0 || was != self.rebuilt_alone {
             self.clip_current
                 .store(false, std::sync::atomic::Ordering::Relaxed);
         }
@@ -604,8 +600,11 @@ impl VoxelStructure for Clipmap {
         timer: &mut GpuTimer,
     ) {
         self.record_placement(device, encoder);
-        let all = (1 << self.levels.len()) - 1;
-        let rebuild = self.rebuilding.unwrap_or(all);
+        // Every level on a rebuild, and for the build that counts the pools (no plan yet).
+        let rebuild = match self.rebuilt_alone {
+            0 => self.inner.every_window(),
+            some => some,
+        };
         self.inner
             .build_windows(device, encoder, fragments, rebuild, timer);
     }

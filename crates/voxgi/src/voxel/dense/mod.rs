@@ -287,6 +287,11 @@ impl DenseVolume {
         })
     }
 
+    /// A bit for each of its windows (a build of all of them).
+    pub(crate) fn every_window(&self) -> u32 {
+        (1 << self.windows) - 1
+    }
+
     /// Its debug pass, for a structure built on it.
     pub fn debug_pass(&self) -> &DebugPass {
         &self.pipelines.debug
@@ -821,7 +826,7 @@ impl DenseVolume {
             (&b.clear_previous, Run::Indirect(0)),
         ];
         self.run_steps(encoder, "dense_build", &bind, &forget, timer);
-        let all = (1u32 << self.windows) - 1;
+        let all = self.every_window();
         if rebuild & all == all {
             encoder.clear_buffer(&self.occupancy, 0, None);
             encoder.clear_buffer(&self.accum, 0, None);
@@ -978,7 +983,7 @@ impl VoxelStructure for DenseVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        self.build_windows(device, encoder, fragments, (1 << self.windows) - 1, timer);
+        self.build_windows(device, encoder, fragments, self.every_window(), timer);
     }
 
     fn record_update(
