@@ -465,13 +465,9 @@ fn agrees_with_the_path_tracer(
     // alone give 0.067 (see the direct-light comparison) and the 128-spp reference's noise
     // most of the rest; 0.16 leaves room for other drivers, while a lost bounce or a wrong
     // cone weight shows as a 15 % region error above before it moves FLIP much. The clipmap
-    // (five levels, the box's front in its finer ones) measured 0.165: 0.17.
-    let bound = if kind == VoxelKind::CLIPMAP {
-        0.17
-    } else {
-        0.16
-    };
-    assert!(c.flip_mean < bound, "{kind:?}: mean FLIP {}", c.flip_mean);
+    // (five levels, the box's front in its finer ones) measured 0.149, its coarser levels'
+    // mips the finer ones' inside them (0.165 voxelized from the geometry).
+    assert!(c.flip_mean < 0.16, "{kind:?}: mean FLIP {}", c.flip_mean);
 }
 
 /// Draws `acc`'s running mean into a fresh `Rgba8Unorm` texture and reads it back.

@@ -61,11 +61,11 @@ fn inside_by(p: vec3<f32>, k: u32) -> f32 {
     return select(min(m.x, min(m.y, m.z)), -1.0, outside);
 }
 
-// How wholly level k holds a sample of `diameter` at p: 1 from BAND voxels past the room it
-// needs, down to 0 at it.
-fn level_weight(p: vec3<f32>, diameter: f32, k: u32) -> f32 {
+// How far past the room a sample of `diameter` at p needs level k's window holds it, in
+// metres (negative where it does not).
+fn level_reach(p: vec3<f32>, diameter: f32, k: u32) -> f32 {
     let room = MARGIN + diameter / clip.levels[k].w;
-    return clamp((inside_by(p, k) - room) / BAND, 0.0, 1.0);
+    return (inside_by(p, k) - room) * clip.levels[k].w;
 }
 
 // The finest level with at least `room` voxels plus the diameter around p (the coarsest when
@@ -86,15 +86,23 @@ fn level_depth(p: vec3<f32>, diameter: f32, dir: vec3<f32>, k: u32) -> vec4<f32>
 }
 
 // Optical depth per sample diameter: (L sigma, sigma).
+//
+// A level takes a sample over from the next coarser across BAND of its voxels, and only where
+// that one holds the sample wholly, itself BAND of its voxels past its own hand-over (its reach,
+// `level_reach`, counts at most as far past that): two levels blend, never three, and the
+// picture has no step where windows lie closer than their bands (a small resolution, or a
+// window waiting its turn to move).
 fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     // The finest level that holds the sample at all, and how far it is from handing over.
     var k = clip.count - 1u;
-    var w = level_weight(pos, diameter, k);
+    var reach = level_reach(pos, diameter, k);
+    var w = clamp(reach / (BAND * clip.levels[k].w), 0.0, 1.0);
     for (var j = i32(clip.count) - 2; j >= 0; j--) {
-        let wj = level_weight(pos, diameter, u32(j));
-        let take = wj > 0.0;
+        let s = clip.levels[j].w;
+        reach = min(level_reach(pos, diameter, u32(j)), reach - BAND * clip.levels[j + 1].w);
+        let take = reach > 0.0;
         k = select(k, u32(j), take);
-        w = select(w, wj, take);
+        w = select(w, clamp(reach / (BAND * s), 0.0, 1.0), take);
     }
     let coarser = min(k + 1u, clip.count - 1u);
     let fine = level_depth(pos, diameter, dir, k);

@@ -12,8 +12,10 @@
 //!
 //! The windows follow the camera by steps of an eighth of themselves (a window moves when its
 //! place for the camera lies two steps or more from where it is, so a camera that wavers does
-//! not move it to and fro), on a lattice of their own voxels that starts at the scene's bounds'
-//! corner, so a voxel of a level covers the same place wherever its window is. A window stays
+//! not move it to and fro), on a lattice of their own voxels that starts at the window centred
+//! on the scene's bounds, so a voxel of a level covers the same place wherever its window is,
+//! and each level's voxels are whole groups of the finer level's (its mips can be the finer
+//! level's where they overlap: nest.rs). A window stays (within half a step)
 //! inside the scene's bounds on each axis where it can, and is centred on them on an axis
 //! where it is wider (a town 30 m tall: every level holds all of its height, none of the
 //! ground below it; a level wider than the scene on every axis is the dense volume there), so
@@ -23,6 +25,8 @@
 //! (their bounces gather in `bounce_slices` turns). A frame moves at most
 //! `RendererOptions::clipmap_budget` windows; the others wait at their old places, valid,
 //! until their turn (scrolling only the slabs newly inside a window is not built).
+
+mod nest;
 
 use super::dense::{self, DenseVolume};
 use super::registry::{KindInfo, StructureDesc};
@@ -38,6 +42,8 @@ use crate::gpu::timer::GpuTimer;
 use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use nest::{Nest, NestPass};
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 /// Most levels (`MAX_CLIP_LEVELS` in shaders/voxels/clipmap/levels.wgsl).
@@ -90,7 +96,7 @@ pub const KIND: KindInfo = KindInfo {
     max_resolution: 256,
     // Its passes are the dense volume's.
     build_passes: &["dense_build", "dense_update"],
-    filter_passes: &["filter"],
+    filter_passes: &["filter", "nest"],
     shaders: StructureShaders {
         name: "clipmap",
         sources: crate::wgsl![
@@ -99,8 +105,9 @@ pub const KIND: KindInfo = KindInfo {
             "voxels/clipmap/placement.wgsl",
             "voxels/clipmap/irradiance.wgsl",
             "voxels/clipmap/carry.wgsl",
+            "voxels/clipmap/nest.wgsl",
         ],
-        passes: &[],
+        passes: &["voxels/clipmap/nest.wgsl"],
         base: Some(&dense::KIND.shaders),
     },
     sampling_layout: Clipmap::sampling_layout,
@@ -159,6 +166,7 @@ fn create(
         voxel_size: finest,
         resolution: res,
     };
+    let previous_clipmap = previous.and_then(|p| p.as_any().downcast_ref::<Clipmap>());
     let previous = previous.and_then(|p| {
         let any = p.as_any();
         any.downcast_ref::<Clipmap>()
@@ -187,15 +195,22 @@ fn create(
             g
         })
         .collect();
-    Ok(Box::new(Clipmap::new(device, inner, levels, scene, bounds)))
+    let nest_pass = match previous_clipmap {
+        Some(p) => p.nest_pass.clone(),
+        None => Arc::new(NestPass::new(device, inner.filter().0.layout())),
+    };
+    Ok(Box::new(Clipmap::new(
+        device, inner, nest_pass, levels, scene, bounds,
+    )))
 }
 
 /// The origin of a window like `g` for a camera at `camera` in a scene whose bounds span
 /// `(lo, hi)`: on each axis centred on the camera, moved back inside the bounds where it would
-/// poke out, on the lattice of its steps (an eighth of the window) from their corner, so that
-/// its voxels lie where the level's always lie; centred on the bounds, unsnapped, on an axis
-/// where it is wider than they are (snapped, it could leave a sliver of the scene out; it
-/// never moves along that axis, so no other window of its level needs its lattice there).
+/// poke out (within half a step), on the lattice of its steps (an eighth of the window) from
+/// the window centred on the bounds, so that its voxels lie where the level's always lie;
+/// centred on the bounds on an axis where it is wider than they are. Every level's lattice
+/// starts from its centred window, so a finer window lies a whole number of the coarser one's
+/// voxels in (eight times some number, with steps of an eighth of 128 voxels: nest.rs).
 fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
     let (w, half, step) = (g.extent(), g.extent() * 0.5, window_step(g));
     let axis = |lo: f32, hi: f32, c: f32| {
@@ -204,7 +219,7 @@ fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
             return middle - half;
         }
         let inside = c.clamp(lo + half.min(middle - lo), hi - half.min(hi - middle));
-        lo + ((inside - lo) / step).round() * step - half
+        middle - half + ((inside - middle) / step).round() * step
     };
     Vec3::new(
         axis(lo.x, hi.x, camera.x),
@@ -254,7 +269,7 @@ pub struct Clipmap {
     /// The scene's cube (its lowest and highest corner): cones stop at it.
     scene: (Vec3, Vec3),
     /// The scene's bounds: the windows stay inside them where they can, and their lattices
-    /// start at their corner.
+    /// start at the windows centred on them.
     bounds: (Vec3, Vec3),
     /// The first frame's camera has placed the windows.
     placed: bool,
@@ -263,12 +278,16 @@ pub struct Clipmap {
     rebuilt_alone: u32,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
+    /// The coarser levels filtered from the finer ones where they overlap, after each filter.
+    nest: Nest,
+    nest_pass: Arc<NestPass>,
 }
 
 impl Clipmap {
     fn new(
         device: &wgpu::Device,
         inner: DenseVolume,
+        nest_pass: Arc<NestPass>,
         levels: Vec<Grid>,
         scene: (Vec3, Vec3),
         bounds: (Vec3, Vec3),
@@ -285,7 +304,11 @@ impl Clipmap {
             mapped_at_creation: false,
         });
         let (sampling, leaves) = Self::bind_groups(device, &inner, &clip);
+        let mut nest = Nest::new(device, &nest_pass, &inner);
+        nest.place(&levels, inner.grid.levels() - 1);
         Clipmap {
+            nest,
+            nest_pass,
             inner,
             levels,
             clip,
@@ -298,6 +321,13 @@ impl Clipmap {
             sampling,
             leaves,
         }
+    }
+
+    /// The bind groups over a volume made again (its pools resized).
+    fn rebind(&mut self, device: &wgpu::Device) {
+        (self.sampling, self.leaves) = Self::bind_groups(device, &self.inner, &self.clip);
+        self.nest = Nest::new(device, &self.nest_pass, &self.inner);
+        self.place_nest();
     }
 
     /// The sampling group (the dense volume's with the levels) and the leaves' group.
@@ -376,19 +406,22 @@ impl Clipmap {
     }
 
     /// The level a sample of `diameter` at `p` reads (sample.wgsl's `sample_depth`): the
-    /// finest that holds it with room, and its weight against the next coarser (1 past the
-    /// hand-over band).
+    /// finest whose reach (past the room it needs, and at most `BAND` voxels of the next
+    /// coarser past that one's) is positive, and its weight against the next coarser (1 past
+    /// the hand-over band).
     pub fn level_at(&self, p: Vec3, diameter: f32) -> (usize, f32) {
-        let weight = |k: usize| {
-            let room = MARGIN + diameter / self.levels[k].voxel_size;
-            ((inside_by(&self.levels[k], self.bounds, p) - room) / BAND).clamp(0.0, 1.0)
+        let reach = |k: usize| {
+            let g = &self.levels[k];
+            (inside_by(g, self.bounds, p) - (MARGIN + diameter / g.voxel_size)) * g.voxel_size
         };
+        let weight = |k: usize, r: f32| (r / (BAND * self.levels[k].voxel_size)).clamp(0.0, 1.0);
         let last = self.levels.len() - 1;
-        let (mut k, mut w) = (last, weight(last));
+        let mut r = reach(last);
+        let (mut k, mut w) = (last, weight(last, r));
         for j in (0..last).rev() {
-            let wj = weight(j);
-            if wj > 0.0 {
-                (k, w) = (j, wj);
+            r = reach(j).min(r - BAND * self.levels[j + 1].voxel_size);
+            if r > 0.0 {
+                (k, w) = (j, weight(j, r));
             }
         }
         (k, w)
@@ -436,6 +469,7 @@ impl Clipmap {
                 g.origin = placed_origin(g, self.bounds, camera);
             }
             self.placed = true;
+            self.place_nest();
             return (all, true);
         }
         let moved = moves(&self.levels, self.bounds, camera, budget);
@@ -444,11 +478,18 @@ impl Clipmap {
                 g.origin = placed_origin(g, self.bounds, camera);
             }
         }
+        self.place_nest();
         (moved, false)
     }
 
-    /// Records the levels' placement into `clip` when it changed since the last time.
+    fn place_nest(&mut self) {
+        self.nest.place(&self.levels, self.inner.grid.levels() - 1);
+    }
+
+    /// Records the levels' placement into `clip` (and the nest's steps into its parameters)
+    /// when it changed since the last time.
     fn record_placement(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder) {
+        self.nest.record_params(device, encoder);
         if self
             .clip_current
             .swap(true, std::sync::atomic::Ordering::Relaxed)
@@ -626,6 +667,8 @@ impl VoxelStructure for Clipmap {
 
     fn record_filter(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut GpuTimer) {
         self.inner.record_filter(encoder, timer);
+        self.nest
+            .record(encoder, &self.nest_pass, &self.inner, timer);
     }
 
     fn pool_counter(&self) -> &wgpu::Buffer {
@@ -646,22 +689,22 @@ impl VoxelStructure for Clipmap {
 
     fn grow(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> Result<()> {
         self.inner.grow(device, counted)?;
-        let (sampling, leaves) = Self::bind_groups(device, &self.inner, &self.clip);
-        self.sampling = sampling;
-        self.leaves = leaves;
+        self.rebind(device);
         Ok(())
     }
 
     fn shrink(&mut self, device: &wgpu::Device, counted: &[u32; POOL_COUNTERS]) -> Result<bool> {
         let shrunk = self.inner.shrink(device, counted)?;
         if shrunk {
-            (self.sampling, self.leaves) = Self::bind_groups(device, &self.inner, &self.clip);
+            self.rebind(device);
         }
         Ok(shrunk)
     }
 
     fn memory(&self) -> Vec<(&'static str, u64)> {
-        self.inner.memory()
+        let mut m = self.inner.memory();
+        m.push(("clipmap nest", self.nest.memory()));
+        m
     }
 
     fn bindings(&self) -> StructureBindings<'_> {
@@ -745,10 +788,11 @@ mod tests {
             Vec3::new(-100.31, -50.0, -60.0),
             Vec3::new(99.69, 150.0, 140.0),
         );
-        let anchor = scene.0;
         let levels = placed_levels(5, 0.1, 64, scene, camera);
         for (k, g) in levels.iter().enumerate() {
-            // On the level's lattice: origins are whole steps (8 voxels) from the anchor.
+            // On the level's lattice: origins are whole steps (8 voxels) from the window
+            // centred on the scene.
+            let anchor = (scene.0 + scene.1) * 0.5 - Vec3::splat(g.extent() * 0.5);
             let steps = (g.origin - anchor) / window_step(g);
             assert!(
                 (steps - steps.round()).abs().max_element() < 1e-3,
@@ -757,8 +801,15 @@ mod tests {
             // The camera within half a step of the centre.
             let centre = g.origin + Vec3::splat(g.extent() * 0.5);
             assert!((camera - centre).abs().max_element() <= window_step(g) * 0.5 + 1e-4);
-            // Inside the next coarser level.
+            // Inside the next coarser level, a whole number of its voxels in, a multiple of
+            // four (the nest copies its mips up to texels of four voxels).
             if let Some(c) = levels.get(k + 1) {
+                let o = (g.origin - c.origin) / c.voxel_size;
+                assert!(
+                    (o / 4.0 - (o / 4.0).round()).abs().max_element() < 1e-3,
+                    "level {k} lies {o} voxels into level {}",
+                    k + 1
+                );
                 assert!(g.origin.cmpge(c.origin).all(), "level {k} pokes out below");
                 let (hi, chi) = (g.origin + g.extent(), c.origin + c.extent());
                 assert!(hi.cmple(chi).all(), "level {k} pokes out above");
@@ -775,7 +826,7 @@ mod tests {
             resolution: 32,
         };
         // A camera outside the scene: the window holding 3.2 m slides back inside it.
-        let camera = Vec3::new(-2.0, 3.0, 8.0);
+        let camera = Vec3::new(-2.0, 3.1, 8.0);
         let near = |a: Vec3, b: Vec3| a.abs_diff_eq(b, 1e-5);
         let o = placed_origin(&grid(0.1), scene, camera);
         assert!(near(o, Vec3::new(0.0, 1.6, 3.2)), "{o}");
@@ -828,7 +879,7 @@ mod tests {
             voxel_size: 0.2,
             resolution: 32,
         };
-        for camera in [Vec3::new(20.0, 1.7, 30.0), Vec3::new(20.0, 150.0, 30.0)] {
+        for camera in [Vec3::new(20.0, 1.7, 30.1), Vec3::new(20.0, 150.0, 30.1)] {
             let o = placed_origin(&g, bounds, camera);
             // Along y, wider than the town: centred on it, wherever the camera is.
             assert!((o.y - (1.5 - 3.2)).abs() < 1e-5, "{camera}: {o}");

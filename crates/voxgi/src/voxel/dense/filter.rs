@@ -211,6 +211,12 @@ impl FilterPass {
         }
     }
 
+    /// The layout of the steps' bind group (`FilterBinds::step`), for passes that run
+    /// filter.wgsl's code on a volume's levels (the clipmap's nest).
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
     /// Records the filtering of the levels above the finest, coarsest last, each level
     /// reading the one below it (the finest level's `radiance` for the first) and writing
     /// every block of `chains` (`binds`, from `bind`): with `all` (after a build) every voxel,
@@ -296,6 +302,14 @@ pub fn counter_bytes(grid: Grid, windows: u32) -> u64 {
     let top = grid.levels() as u64 - 1;
     let lists: u64 = (1..=top).map(|l| (res >> l).pow(3) * windows as u64).sum();
     (counter_words_before_lists(grid, windows) + lists) * 4
+}
+
+impl FilterBinds {
+    /// The bind group of the step writing chain level `c` (reading the one below, or the
+    /// finest level for 0), and its dynamic offset.
+    pub fn step(&self, c: u32) -> (&wgpu::BindGroup, u32) {
+        (&self.binds[c as usize], (c as u64 * STRIDE) as u32)
+    }
 }
 
 /// The dense filter's bind groups for one volume (`FilterPass::bind`).

@@ -296,6 +296,11 @@ impl DenseVolume {
     pub fn debug_pass(&self) -> &DebugPass {
         &self.pipelines.debug
     }
+
+    /// Its filter pass and its steps' bind groups, for a structure built on it.
+    pub fn filter(&self) -> (&filter::FilterPass, &filter::FilterBinds) {
+        (&self.pipelines.filter, &self.filter_binds)
+    }
 }
 
 /// How a step of dense_build or dense_update is dispatched.
