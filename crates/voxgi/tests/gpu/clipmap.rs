@@ -221,7 +221,7 @@ fn sample_voxels_matches_its_cpu_twin() {
 /// and directions inside level 0 (clear of its faces by more than a filter's reach), over the
 /// levels' textures read back, directional and isotropic. Copies of the same texels at the
 /// same places: the only difference is the texture coordinates' rounding, measured 2e-5 of
-/// 4.4 on lavapipe; 1e-4 of the largest value allows another driver's. Filtered from level
+/// 4.6 on lavapipe; 1e-4 of the largest value allows another driver's. Filtered from level
 /// 1's own finest voxels instead (its texels not copied), the worst is 3.7.
 #[test]
 fn inside_a_finer_level_the_coarser_one_reads_its_mips() {
@@ -261,15 +261,15 @@ fn inside_a_finer_level_the_coarser_one_reads_its_mips() {
             chains: &chains,
         };
         // Level 0's samples keep half a texel of the level above the one read (a chain
-        // texel of 8 voxels) inside its window.
-        let margin = 5.0 * fine.voxel_size;
+        // texel of 8 voxels) inside its window, and the probes spread 5 % past the grid.
+        let margin = 6.0 * fine.voxel_size;
         let inner = Grid {
             origin: fine.origin + Vec3::splat(margin),
             voxel_size: (fine.extent() - 2.0 * margin) / fine.resolution as f32,
             resolution: fine.resolution,
         };
         // random_probes spreads 5 % past the grid: the margin keeps that inside level 0.
-        let probes = random_probes(inner, 300, 1.0);
+        let probes = random_probes(inner, 600, 1.0);
 
         let (mut worst, mut largest, mut seen) = (0.0f32, 0.0f32, 0);
         for q in &probes {

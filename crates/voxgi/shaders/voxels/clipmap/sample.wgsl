@@ -5,9 +5,9 @@
 //
 // A sample reads the finest level that holds it wholly: its position at least MARGIN voxels
 // plus its diameter inside the level's window (the filter of a sample of diameter d at its
-// mip reaches about d around it). Within BAND voxels of that limit it hands over to the next
-// coarser level, linearly, so neither a camera move nor a cone crossing a level's border shows
-// a step. Reads only @group(1): windows.wgsl's resources and `clip` at binding 4.
+// mip reaches about d around it), where the next coarser level holds it wholly too. Within
+// BAND voxels of that limit it hands over to the next coarser level, linearly, so neither a
+// camera move nor a cone crossing a level's border shows a step (`sample_depth`). Reads only @group(1): windows.wgsl's resources and `clip` at binding 4.
 // `Clipmap::sampling_layout` is its twin.
 
 //!include voxels/dense/windows.wgsl
@@ -24,7 +24,7 @@ fn voxels_voxel_size() -> f32 {
     return clip.levels[0].w;
 }
 
-// The finest level whose window holds p with room for a cone's first samples.
+// The level that holds p with room for a cone's first samples (`level_holding`).
 fn voxels_voxel_size_at(p: vec3<f32>) -> f32 {
     return clip.levels[level_holding(p, 0.0, MARGIN + BAND + 1.0)].w;
 }
@@ -64,17 +64,22 @@ fn inside_by(p: vec3<f32>, k: u32) -> f32 {
 // How far past the room a sample of `diameter` at p needs level k's window holds it, in
 // metres (negative where it does not).
 fn level_reach(p: vec3<f32>, diameter: f32, k: u32) -> f32 {
-    let room = MARGIN + diameter / clip.levels[k].w;
-    return (inside_by(p, k) - room) * clip.levels[k].w;
+    return level_reach_with(p, diameter, MARGIN, k);
 }
 
-// The finest level with at least `room` voxels plus the diameter around p (the coarsest when
-// none has).
+// How far past `room` voxels plus the diameter level k's window holds p, in metres.
+fn level_reach_with(p: vec3<f32>, diameter: f32, room: f32, k: u32) -> f32 {
+    return (inside_by(p, k) - room - diameter / clip.levels[k].w) * clip.levels[k].w;
+}
+
+// The finest level with at least `room` voxels plus the diameter around p, its reach carried
+// as `sample_depth` carries it (the coarsest when none has).
 fn level_holding(p: vec3<f32>, diameter: f32, room: f32) -> u32 {
     var k = clip.count - 1u;
+    var reach = level_reach_with(p, diameter, room, k);
     for (var j = i32(clip.count) - 2; j >= 0; j--) {
-        let need = room + diameter / clip.levels[j].w;
-        k = select(k, u32(j), inside_by(p, u32(j)) >= need);
+        reach = min(level_reach_with(p, diameter, room, u32(j)), reach - BAND * clip.levels[j + 1].w);
+        k = select(k, u32(j), reach >= 0.0);
     }
     return k;
 }

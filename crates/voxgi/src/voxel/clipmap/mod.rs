@@ -15,8 +15,8 @@
 //! not move it to and fro), on a lattice of their own voxels that starts at the window centred
 //! on the scene's bounds, so a voxel of a level covers the same place wherever its window is,
 //! and each level's voxels are whole groups of the finer level's (its mips can be the finer
-//! level's where they overlap: nest.rs). A window stays (within half a step)
-//! inside the scene's bounds on each axis where it can, and is centred on them on an axis
+//! level's where they overlap: nest.rs). A window stays inside the scene's bounds on each
+//! axis where it can (reaching just past a bound it meets), and is centred on them on an axis
 //! where it is wider (a town 30 m tall: every level holds all of its height, none of the
 //! ground below it; a level wider than the scene on every axis is the dense volume there), so
 //! no voxels are spent on the void past the world's edge.
@@ -205,12 +205,13 @@ fn create(
 }
 
 /// The origin of a window like `g` for a camera at `camera` in a scene whose bounds span
-/// `(lo, hi)`: on each axis centred on the camera, moved back inside the bounds where it would
-/// poke out (within half a step), on the lattice of its steps (an eighth of the window) from
-/// the window centred on the bounds, so that its voxels lie where the level's always lie;
-/// centred on the bounds on an axis where it is wider than they are. Every level's lattice
-/// starts from its centred window, so a finer window lies a whole number of the coarser one's
-/// voxels in (eight times some number, with steps of an eighth of 128 voxels: nest.rs).
+/// `(lo, hi)`: on each axis centred on the camera, on the lattice of its steps (an eighth of
+/// the window) from the window centred on the bounds, so that its voxels lie where the level's
+/// always lie; where it would poke out of the bounds, moved back to the lattice point that just
+/// reaches the bound (so that face counts as closed: past it there is nothing); centred on
+/// the bounds on an axis where it is wider than they are. Every level's lattice starts from
+/// its centred window, so a finer window lies a whole number of the coarser one's voxels from
+/// it (a multiple of eight with steps of an eighth of 128 voxels: nest.rs).
 fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
     let (w, half, step) = (g.extent(), g.extent() * 0.5, window_step(g));
     let axis = |lo: f32, hi: f32, c: f32| {
@@ -218,8 +219,17 @@ fn placed_origin(g: &Grid, (lo, hi): (Vec3, Vec3), camera: Vec3) -> Vec3 {
         if w > (hi - lo) * (1.0 + 1e-5) {
             return middle - half;
         }
-        let inside = c.clamp(lo + half.min(middle - lo), hi - half.min(hi - middle));
-        middle - half + ((inside - middle) / step).round() * step
+        let steps = (c - middle) / step;
+        let (first, last) = ((lo + half - middle) / step, (hi - half - middle) / step);
+        // The lattice point at or past the bound (a thousandth of a step for rounding).
+        let j = if steps <= first {
+            (first + 1e-3).floor()
+        } else if steps >= last {
+            (last - 1e-3).ceil()
+        } else {
+            steps.round()
+        };
+        middle - half + j * step
     };
     Vec3::new(
         axis(lo.x, hi.x, camera.x),
@@ -410,10 +420,7 @@ impl Clipmap {
     /// coarser past that one's) is positive, and its weight against the next coarser (1 past
     /// the hand-over band).
     pub fn level_at(&self, p: Vec3, diameter: f32) -> (usize, f32) {
-        let reach = |k: usize| {
-            let g = &self.levels[k];
-            (inside_by(g, self.bounds, p) - (MARGIN + diameter / g.voxel_size)) * g.voxel_size
-        };
+        let reach = |k: usize| self.reach(p, diameter, MARGIN, k);
         let weight = |k: usize, r: f32| (r / (BAND * self.levels[k].voxel_size)).clamp(0.0, 1.0);
         let last = self.levels.len() - 1;
         let mut r = reach(last);
@@ -425,6 +432,29 @@ impl Clipmap {
             }
         }
         (k, w)
+    }
+
+    /// sample.wgsl's `level_reach`: how far past `room` voxels plus `diameter` level `k`'s
+    /// window holds `p`, in metres.
+    fn reach(&self, p: Vec3, diameter: f32, room: f32, k: usize) -> f32 {
+        let g = &self.levels[k];
+        (inside_by(g, self.bounds, p) - (room + diameter / g.voxel_size)) * g.voxel_size
+    }
+
+    /// sample.wgsl's `level_holding`: the finest level whose reach (`room` voxels), carried as
+    /// `level_at` carries it, is not negative.
+    fn level_holding(&self, p: Vec3, diameter: f32, room: f32) -> usize {
+        let last = self.levels.len() - 1;
+        let (mut k, mut r) = (last, self.reach(p, diameter, room, last));
+        for j in (0..last).rev() {
+            r = self
+                .reach(p, diameter, room, j)
+                .min(r - BAND * self.levels[j + 1].voxel_size);
+            if r >= 0.0 {
+                k = j;
+            }
+        }
+        k
     }
 
     /// The CPU twin of shaders/voxels/clipmap/sample.wgsl's `sample_voxels` over `voxels`,
@@ -623,14 +653,9 @@ impl VoxelStructure for Clipmap {
     }
 
     fn voxel_size_at(&self, p: Vec3) -> f32 {
-        // sample.wgsl's voxels_voxel_size_at: the finest level with MARGIN + BAND + 1 voxels
-        // of its window around p.
-        let room = MARGIN + BAND + 1.0;
-        self.levels
-            .iter()
-            .find(|g| inside_by(g, self.bounds, p) >= room)
-            .unwrap_or(self.levels.last().expect("levels"))
-            .voxel_size
+        // sample.wgsl's voxels_voxel_size_at: the level a sample there reads, with MARGIN +
+        // BAND + 1 voxels of its window around p.
+        self.levels[self.level_holding(p, 0.0, MARGIN + BAND + 1.0)].voxel_size
     }
 
     fn record_build(
@@ -836,6 +861,33 @@ mod tests {
         // Wider: centred on the scene.
         let o = placed_origin(&grid(0.4), scene, camera);
         assert!(near(o, Vec3::splat(-3.2)), "{o}");
+    }
+
+    #[test]
+    fn at_a_bound_every_window_reaches_it_and_the_finer_ones_stay_inside_the_coarser() {
+        // Bounds 6.7 m along x (no whole number of steps); windows of 32 voxels from 0.05 m.
+        let bounds = (Vec3::ZERO, Vec3::new(6.7, 6.7, 6.7));
+        for camera in [Vec3::new(0.3, 3.0, 3.0), Vec3::new(6.6, 3.0, 3.0)] {
+            let levels = placed_levels(3, 0.05, 32, bounds, camera);
+            for (k, g) in levels.iter().enumerate() {
+                let (o, e) = (g.origin.x, g.origin.x + g.extent());
+                // The face at the bound the camera is near lies on or past it (closed), by less
+                // than a step.
+                let past = if camera.x < 1.0 { -o } else { e - 6.7 };
+                assert!(
+                    (-1e-4..window_step(g)).contains(&past),
+                    "level {k}: [{o}, {e}] for {camera}"
+                );
+                // Inside the next coarser level, but past the bounds.
+                if let Some(c) = levels.get(k + 1) {
+                    let (co, ce) = (c.origin.x, c.origin.x + c.extent());
+                    assert!(
+                        o.max(0.0) >= co - 1e-4 && e.min(6.7) <= ce + 1e-4,
+                        "level {k}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

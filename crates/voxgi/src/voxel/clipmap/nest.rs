@@ -52,15 +52,17 @@ impl NestStep {
 /// the second, chain level by chain level: where the finer window overlaps it on a lattice of
 /// its voxels, the texels that overlap it (copied where wholly inside and on the finer
 /// window's lattice, filtered again from their children otherwise). A window whose voxels do
-/// not meet the finer window's lattice (an axis where one is centred on the scene and the
-/// other is not) keeps its own.
+/// not meet the finer window's lattice (only windows of fewer than 16 voxels, whose steps are
+/// single voxels) keeps its own.
 pub fn nest_steps(levels: &[Grid], chain_levels: u32) -> Vec<NestStep> {
     let mut steps = Vec::new();
     for k in 1..levels.len() {
         let (finer, g) = (&levels[k - 1], &levels[k]);
         let n = g.resolution as i32;
         let at = (finer.origin - g.origin) / g.voxel_size;
-        if (at - at.round()).abs().max_element() > 1e-3 {
+        // Placed on their lattices the windows lie whole voxels apart; a quarter of a voxel
+        // allows the rounding of origins far from the world's origin.
+        if (at - at.round()).abs().max_element() > 0.25 {
             continue;
         }
         // The finer window's corner and its overlap with this one, in this one's voxels.
@@ -211,6 +213,12 @@ impl Nest {
     /// The nest of `volume`'s windows (its levels' textures), placed later by `place`.
     pub fn new(device: &wgpu::Device, pass: &NestPass, volume: &DenseVolume) -> Self {
         let chain_levels = volume.grid.levels() - 1;
+        // The top level's `finer` is the level below it: a different mip from its own.
+        debug_assert!(
+            chain_levels >= 2,
+            "a clipmap of {}³ voxels",
+            volume.grid.resolution
+        );
         // `moved` (restoring and nesting every window's chain levels), then the steps.
         let most = 3 * (volume.windows as u64 - 1) * chain_levels as u64;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -382,8 +390,8 @@ mod tests {
 
     #[test]
     fn a_window_off_the_finer_lattice_keeps_its_own_and_a_strayed_one_nests_its_overlap() {
-        // Half a voxel off: nothing nested.
-        let off = [level(Vec3::new(8.5, 8.0, 8.0), 1.0), level(Vec3::ZERO, 2.0)];
+        // Half a coarse voxel off: nothing nested.
+        let off = [level(Vec3::new(9.0, 8.0, 8.0), 1.0), level(Vec3::ZERO, 2.0)];
         assert!(nest_steps(&off, 4).is_empty());
         // The finer window poking out below along x (a coarser window waiting its turn): only
         // the overlap, voxels [0, 6), is nested. Chain 0: texels [0, 3), from -1 in the finer
