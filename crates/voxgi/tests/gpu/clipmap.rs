@@ -6,6 +6,7 @@ use voxgi::scene::builtin;
 use voxgi::scene::glam::Vec3;
 use voxgi::voxel::Grid;
 use voxgi::voxel::clipmap::Clipmap;
+use voxgi::voxel::cpu::{DenseSampler, Texture3d};
 use voxgi::{RendererOptions, VoxelKind};
 
 /// The dense volume's options for the Cornell box at 32³, one bounce, every frame a still.
@@ -16,6 +17,49 @@ fn dense() -> RendererOptions {
         shadow_map_size: 256,
         temporal: false,
         ..RendererOptions::default()
+    }
+}
+
+/// The Cornell box in three clipmap levels of `resolution`³ voxels, the finest `finest` times
+/// the dense volume's 32³ voxel, rendered once from a camera low in the box.
+fn three_levels_in_the_box(resolution: u32, finest: f32, anisotropic: bool) -> voxgi::Renderer {
+    let scene = builtin::cornell_box();
+    let b = scene.swept_bounds();
+    let dense_voxel = Grid::around(b.min, b.max, 32).voxel_size;
+    let options = RendererOptions {
+        voxels: VoxelKind::CLIPMAP,
+        voxel_resolution: resolution,
+        clipmap_levels: 3,
+        voxel_size: Some(dense_voxel * finest),
+        anisotropic,
+        ..dense()
+    };
+    let mut r = renderer(&scene, &options);
+    let camera =
+        voxgi::scene::Camera::look_at(Vec3::new(0.2, 0.1, 0.4), Vec3::new(0.3, 0.2, 0.1), 60.0);
+    frame(&mut r, &clamped(&camera), 16, 16);
+    r
+}
+
+/// A clipmap's levels read back: the finest voxels and the chains.
+fn read_levels(clip: &Clipmap) -> (Texture3d, Texture3d) {
+    (
+        read_chain(&clip.volume().radiance),
+        read_chain(&clip.volume().chains),
+    )
+}
+
+/// The dense CPU twin over levels read back (`read_levels`).
+fn cpu_levels<'a>(
+    clip: &Clipmap,
+    (radiance0, chains): &'a (Texture3d, Texture3d),
+) -> DenseSampler<'a> {
+    DenseSampler {
+        grid: clip.volume().grid,
+        anisotropic: clip.volume().anisotropic,
+        windows: clip.levels().len() as u32,
+        radiance0,
+        chains,
     }
 }
 
@@ -144,32 +188,11 @@ fn levels_hand_over_without_a_step() {
 /// is the dense twin's (`filtering_tolerance`): each level's read is the dense volume's.
 #[test]
 fn sample_voxels_matches_its_cpu_twin() {
-    let scene = builtin::cornell_box();
-    let b = scene.swept_bounds();
-    let dense_voxel = Grid::around(b.min, b.max, 32).voxel_size;
     for anisotropic in [true, false] {
-        let options = RendererOptions {
-            voxels: VoxelKind::CLIPMAP,
-            voxel_resolution: 16,
-            clipmap_levels: 3,
-            voxel_size: Some(dense_voxel * 0.75),
-            anisotropic,
-            ..dense()
-        };
-        let mut r = renderer(&scene, &options);
-        let camera =
-            voxgi::scene::Camera::look_at(Vec3::new(0.2, 0.1, 0.4), Vec3::new(0.3, 0.2, 0.1), 60.0);
-        frame(&mut r, &clamped(&camera), 16, 16);
+        let r = three_levels_in_the_box(16, 0.75, anisotropic);
         let clip = r.structure::<Clipmap>().expect("a clipmap");
-        let volume = clip.volume();
-        let (radiance0, chains) = (read_chain(&volume.radiance), read_chain(&volume.chains));
-        let cpu = voxgi::voxel::cpu::DenseSampler {
-            grid: volume.grid,
-            anisotropic,
-            windows: clip.levels().len() as u32,
-            radiance0: &radiance0,
-            chains: &chains,
-        };
+        let levels = read_levels(clip);
+        let cpu = cpu_levels(clip, &levels);
         let finest = clip.levels()[0].voxel_size;
         // A third of the probes over each level's window (and a little past it), diameters
         // of one to 24 finest voxels.
@@ -225,22 +248,8 @@ fn sample_voxels_matches_its_cpu_twin() {
 /// 1's own finest voxels instead (its texels not copied), the worst is 3.7.
 #[test]
 fn inside_a_finer_level_the_coarser_one_reads_its_mips() {
-    let scene = builtin::cornell_box();
-    let b = scene.swept_bounds();
-    let dense_voxel = Grid::around(b.min, b.max, 32).voxel_size;
     for anisotropic in [true, false] {
-        let options = RendererOptions {
-            voxels: VoxelKind::CLIPMAP,
-            voxel_resolution: 32,
-            clipmap_levels: 3,
-            voxel_size: Some(dense_voxel * 0.375),
-            anisotropic,
-            ..dense()
-        };
-        let mut r = renderer(&scene, &options);
-        let camera =
-            voxgi::scene::Camera::look_at(Vec3::new(0.2, 0.1, 0.4), Vec3::new(0.3, 0.2, 0.1), 60.0);
-        frame(&mut r, &clamped(&camera), 16, 16);
+        let r = three_levels_in_the_box(32, 0.375, anisotropic);
         let clip = r.structure::<Clipmap>().expect("a clipmap");
         let (fine, coarse) = (clip.levels()[0], clip.levels()[1]);
         // Windows step by an eighth of themselves (4 voxels of 32): level 0's corner lies an
@@ -251,15 +260,8 @@ fn inside_a_finer_level_the_coarser_one_reads_its_mips() {
             o.abs_diff_eq(o.round(), 1e-3) && (o.round() % 2.0).abs().max_element() < 0.5,
             "level 0 lies {o} voxels into level 1"
         );
-        let volume = clip.volume();
-        let (radiance0, chains) = (read_chain(&volume.radiance), read_chain(&volume.chains));
-        let cpu = voxgi::voxel::cpu::DenseSampler {
-            grid: volume.grid,
-            anisotropic,
-            windows: clip.levels().len() as u32,
-            radiance0: &radiance0,
-            chains: &chains,
-        };
+        let levels = read_levels(clip);
+        let cpu = cpu_levels(clip, &levels);
         // Level 0's samples keep half a texel of the level above the one read (a chain
         // texel of 8 voxels) inside its window, and the probes spread 5 % past the grid.
         let margin = 6.0 * fine.voxel_size;
