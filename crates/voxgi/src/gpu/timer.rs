@@ -7,6 +7,9 @@
 use crate::{Error, Result};
 use wgpu_profiler::{GpuProfiler, GpuProfilerQuery, GpuProfilerSettings, GpuTimerQueryResult};
 
+/// Frames the profiler holds between reads: `headless::render` renders a few before it reads.
+const MAX_PENDING: usize = 16;
+
 /// Per-pass timestamp scopes: inert when disabled or when the device lacks
 /// `TIMESTAMP_QUERY`.
 pub struct GpuTimer {
@@ -26,6 +29,9 @@ struct Profiling {
     /// A frame's queries were resolved into an encoder: the frame ends once that encoder has
     /// been submitted (the next frame, or `read`).
     resolved: bool,
+    /// Frames ended and not read yet (the profiler keeps at most `MAX_PENDING`, dropping the
+    /// newest but one beyond).
+    pending: usize,
     /// The scopes of every frame read, for a trace, when kept.
     trace: Option<Vec<GpuTimerQueryResult>>,
 }
@@ -37,8 +43,7 @@ impl GpuTimer {
         let settings = GpuProfilerSettings {
             enable_timer_queries: true,
             enable_debug_groups: false,
-            // Frames between reads: `headless::render` renders a few before it reads.
-            max_num_pending_frames: 16,
+            max_num_pending_frames: MAX_PENDING,
         };
         GpuTimer {
             on: on
@@ -52,6 +57,7 @@ impl GpuTimer {
                     open: Vec::new(),
                     names: Vec::new(),
                     resolved: false,
+                    pending: 0,
                     trace: None,
                 }),
             period_ns: queue.get_timestamp_period(),
@@ -78,9 +84,11 @@ impl GpuTimer {
     pub fn begin_frame(&mut self) {
         if let Some(p) = &mut self.on
             && std::mem::take(&mut p.resolved)
-            && let Err(e) = p.profiler.end_frame()
         {
-            log::warn!("pass timing: {e}");
+            match p.profiler.end_frame() {
+                Ok(()) => p.pending = (p.pending + 1).min(MAX_PENDING),
+                Err(e) => log::warn!("pass timing: {e}"),
+            }
         }
     }
 
@@ -131,7 +139,24 @@ impl GpuTimer {
                 reason: e.to_string(),
             })?;
         let mut out: Vec<(&'static str, f64)> = Vec::new();
-        while let Some(frame) = p.profiler.process_finished_frame(period) {
+        // The readback's map callbacks run in whichever thread polls the device: on a device
+        // shared between threads, another one's, a moment after this thread's wait returned.
+        // Until they have run the last frame is not finished, and its times would show up in
+        // the next read instead (a flaky test saw a relit frame's list with the rebuild before).
+        let waiting = std::time::Instant::now();
+        while p.pending > 0 {
+            let Some(frame) = p.profiler.process_finished_frame(period) else {
+                if waiting.elapsed() > std::time::Duration::from_secs(30) {
+                    return Err(Error::Gpu {
+                        context: "timestamps".into(),
+                        reason: "their readback did not complete within 30 s".into(),
+                    });
+                }
+                let _ = device.poll(wgpu::PollType::Poll);
+                std::thread::yield_now();
+                continue;
+            };
+            p.pending -= 1;
             for scope in &frame {
                 let Some(name) = p.names.iter().find(|n| **n == scope.label) else {
                     continue;
