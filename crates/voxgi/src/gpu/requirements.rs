@@ -4,9 +4,14 @@
 use crate::{Error, Result};
 
 /// The features to request for voxgi: none are required; timestamp queries are asked for
-/// when the adapter has them, for per-pass timing (`Renderer::enable_timing`).
+/// when the adapter has them, for per-pass timing (`Renderer::enable_timing`), and between
+/// passes too where it allows (copies that belong to a pass's scope).
 pub fn required_features(adapter: &wgpu::Adapter) -> wgpu::Features {
-    adapter.features() & wgpu::Features::TIMESTAMP_QUERY
+    let timing = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+    if timing.is_empty() {
+        return timing;
+    }
+    timing | (adapter.features() & wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
 }
 
 /// The limits to request: wgpu's defaults, with buffer and texture sizes raised to what the

@@ -112,6 +112,26 @@ impl GpuTimer {
         self.query(label)?.render_pass_timestamp_writes()
     }
 
+    /// Records `work` (copies, outside any pass) into `encoder` in a scope named `label`, timed
+    /// where the device has `TIMESTAMP_QUERY_INSIDE_ENCODERS` (and only there).
+    pub fn encoder<T>(
+        &mut self,
+        label: &'static str,
+        encoder: &mut wgpu::CommandEncoder,
+        work: impl FnOnce(&mut wgpu::CommandEncoder) -> T,
+    ) -> T {
+        let Some(p) = &mut self.on else {
+            return work(encoder);
+        };
+        if !p.names.contains(&label) {
+            p.names.push(label);
+        }
+        let q = p.profiler.begin_query(label, encoder);
+        let out = work(encoder);
+        p.profiler.end_query(encoder, q);
+        out
+    }
+
     /// Records the resolve of this frame's timestamps; call once after the last pass.
     pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
         let Some(p) = &mut self.on else {

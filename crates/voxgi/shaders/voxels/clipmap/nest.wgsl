@@ -11,7 +11,8 @@
 // its leaves', and the chains can always be made from them again (after the finer window
 // moved, the texels it left are filtered again: `restore` steps, with nothing to copy).
 // Windows are nested finest first, so a texel deep inside copies what the finest window
-// holding it made. Twin: `NestParams` in src/voxel/clipmap/nest.rs.
+// holding it made. A box copied whole (no texel astride) is a texture copy instead of this
+// pass (nest.rs: `copy_step`). Twin: `NestParams` in src/voxel/clipmap/nest.rs.
 
 //!include voxels/dense/filter.wgsl
 

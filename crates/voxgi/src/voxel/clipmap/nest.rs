@@ -39,6 +39,14 @@ pub struct NestStep {
 }
 
 impl NestStep {
+    /// Whether every texel of its box is copied (none filtered).
+    fn copies_only(&self) -> bool {
+        let p = &self.params;
+        p.size.iter().all(|&v| v > 0)
+            && p.copy_lo == p.lo
+            && (0..3).all(|i| p.copy_hi[i] == p.lo[i] + p.size[i] as i32)
+    }
+
     /// The same box filtered again from its children, nothing copied.
     fn restoring(mut self) -> Self {
         self.params.copy_lo = [0; 3];
@@ -326,23 +334,84 @@ impl Nest {
         }
         let (_, filter) = volume.filter();
         let blocks = volume.chain_blocks();
-        let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("nest"),
-            timestamp_writes: timer.compute("nest"),
-        });
-        cpass.set_pipeline(&pass.pipeline);
-        for (i, s) in steps.iter().enumerate() {
-            let (group, offset) = filter.step(s.chain);
-            cpass.set_bind_group(0, group, &[offset]);
-            let at = ((first + i) as u64 * STRIDE) as u32;
-            cpass.set_bind_group(1, &self.binds[s.chain as usize], &[at]);
-            let size = s.params.size;
-            cpass.dispatch_workgroups(
-                size[0].div_ceil(4),
-                size[1].div_ceil(4),
-                (size[2] * blocks).div_ceil(4),
-            );
+        // A step that only copies (its box wholly inside the finer window and on its lattice:
+        // every step of the chain levels whose texels are at most the windows' offset, all
+        // the texels but a few hundred) is a texture copy, a block at a time; the others filter
+        // and copy in the pass. Steps run in order: each reads what the steps before wrote.
+        let mut at = 0;
+        while at < steps.len() {
+            let copies = steps[at..].iter().take_while(|s| s.copies_only()).count();
+            if copies > 0 {
+                timer.encoder("nest", encoder, |encoder| {
+                    for s in &steps[at..at + copies] {
+                        copy_step(encoder, volume, s, blocks);
+                    }
+                });
+            }
+            at += copies;
+            let filters = steps[at..].iter().take_while(|s| !s.copies_only()).count();
+            if filters == 0 {
+                continue;
+            }
+            let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("nest"),
+                timestamp_writes: timer.compute("nest"),
+            });
+            cpass.set_pipeline(&pass.pipeline);
+            for (i, s) in steps[at..at + filters].iter().enumerate() {
+                let (group, offset) = filter.step(s.chain);
+                cpass.set_bind_group(0, group, &[offset]);
+                let param = ((first + at + i) as u64 * STRIDE) as u32;
+                cpass.set_bind_group(1, &self.binds[s.chain as usize], &[param]);
+                let size = s.params.size;
+                cpass.dispatch_workgroups(
+                    size[0].div_ceil(4),
+                    size[1].div_ceil(4),
+                    (size[2] * blocks).div_ceil(4),
+                );
+            }
+            at += filters;
         }
+    }
+}
+
+/// Copies step `s`'s box (all of it copied: `NestStep::copies_only`) from the finer window's
+/// chain level above, block by block (`blocks` directions stacked along z, each holding the
+/// windows stacked along z).
+fn copy_step(encoder: &mut wgpu::CommandEncoder, volume: &DenseVolume, s: &NestStep, blocks: u32) {
+    let p = &s.params;
+    let n = volume.grid.resolution >> (s.chain + 1);
+    let (m, w, k) = (n / 2, volume.windows, p.window);
+    let lo = IVec3::from(p.copy_lo).as_uvec3();
+    let from = (IVec3::from(p.copy_lo) - IVec3::from(p.finer_lo)).as_uvec3();
+    for b in 0..blocks {
+        encoder.copy_texture_to_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &volume.chains,
+                mip_level: s.chain + 1,
+                origin: wgpu::Origin3d {
+                    x: from.x,
+                    y: from.y,
+                    z: b * m * w + (k - 1) * m + from.z,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyTextureInfo {
+                texture: &volume.chains,
+                mip_level: s.chain,
+                origin: wgpu::Origin3d {
+                    x: lo.x,
+                    y: lo.y,
+                    z: b * n * w + k * n + lo.z,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::Extent3d {
+                width: p.size[0],
+                height: p.size[1],
+                depth_or_array_layers: p.size[2],
+            },
+        );
     }
 }
 
@@ -374,6 +443,9 @@ mod tests {
             (c0.copy_lo, c0.copy_hi, c0.finer_lo),
             ([2; 3], [6; 3], [2; 3])
         );
+        // Boxes wholly copied are texture copies; the others run the pass.
+        let copied: Vec<bool> = steps.iter().map(NestStep::copies_only).collect();
+        assert_eq!(copied, [true, true, false, false]);
         // Chain 1 (texels of 4): [1, 3), copied.
         let c1 = steps[1].params;
         assert_eq!(
