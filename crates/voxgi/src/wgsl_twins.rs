@@ -268,7 +268,8 @@ fn every_twin_has_the_wgsl_layout() {
         crate::voxel::clipmap::GpuClipLevels,
         "ClipLevels",
         [
-            levels, scene_lo, scene_hi, bounds_lo, bounds_hi, count, resolution, rebuilt
+            levels, scene_lo, scene_hi, bounds_lo, bounds_hi, count, resolution, rebuilt, kept,
+            kept_by
         ]
     );
     twin!(

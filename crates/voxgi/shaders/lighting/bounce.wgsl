@@ -74,6 +74,26 @@ fn slice_of(c: vec3<u32>) -> u32 {
     return h % slices.count;
 }
 
+// `leaf_next`'s opacity where `stash` parked a kept light (no leaf's opacity is negative).
+const STASHED: f32 = -1.0;
+
+// Before `mark`, after a build of part of the structure: a new leaf whose voxel a leaf held
+// before the build (`leaf_kept_self`, voxels/<kind>/carry.wgsl: a clipmap window that moved
+// and overlaps its old place) reads that leaf's kept light, before `mark` lets the new leaves
+// write theirs over the slots (the old leaves' slots are new leaves' now). It parks it in its
+// own `leaf_next`, which `mark` or the gather writes after.
+@compute @workgroup_size(64)
+fn stash(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let s = leaf_slot(dispatch_index(gid, nwg));
+    if s == NO_LEAF || !leaf_is_new(s) {
+        return;
+    }
+    let t = leaf_kept_self(s);
+    if t != NO_LEAF {
+        leaf_next[s] = vec4<f32>(kept(t), STASHED);
+    }
+}
+
 @compute @workgroup_size(64)
 fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let s = leaf_slot(dispatch_index(gid, nwg));
@@ -83,12 +103,15 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let p = leaf_center(s);
     let near = all(p >= slices.near_min.xyz) && all(p <= slices.near_max.xyz);
     var gather = near || slice_of(leaf_coord(s)) == slices.turn;
-    // A new leaf has nothing kept: it gathers now, or starts from the light of the leaf its
-    // structure names (reading only leaves that are not new, whose kept light no thread
-    // writes here).
+    // A new leaf has nothing kept: it gathers now, or starts from the light `stash` read of
+    // the leaf that held its voxel before, or from the light of the leaf its structure names
+    // (reading only leaves that are not new, whose kept light no thread writes here).
     if leaf_is_new(s) && !gather {
+        let stashed = leaf_next[s];
         let source = select(NO_LEAF, leaf_carry_source(s), slices.carry != 0u);
-        if source == NO_LEAF {
+        if slices.carry != 0u && stashed.w == STASHED {
+            keep(s, stashed.xyz);
+        } else if source == NO_LEAF {
             gather = true;
         } else {
             keep(s, kept(source));

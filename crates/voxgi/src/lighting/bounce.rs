@@ -71,6 +71,9 @@ pub struct BounceGlobals {
     fresh: bool,
     /// The next update's bounces gather at a list of leaves (`prepare`).
     listed: bool,
+    /// The next update's new leaves may keep the light of the leaves that held their voxels
+    /// before a build of part of the structure (`prepare`'s `kept`).
+    stash: bool,
 }
 
 impl BounceGlobals {
@@ -78,7 +81,9 @@ impl BounceGlobals {
     /// inside `near` (`near_change`), or all of them when nothing is kept yet or `all`; new
     /// leaves too, unless `carry` lets them start from the kept light their structure names
     /// (not when the bounce keeps irradiance records for the pixels: a carried leaf would
-    /// show its slot's previous record).
+    /// show its slot's previous record); with `carry` and `kept` (a build of part of the
+    /// structure, whose new leaves may lie where leaves lay before) first from the light of
+    /// the leaf that held their voxel (`leaf_kept_self`).
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
@@ -86,6 +91,7 @@ impl BounceGlobals {
         all: bool,
         near: Option<voxgi_scene::Aabb>,
         carry: bool,
+        kept: bool,
     ) {
         let count = self.slices;
         let all = all || self.fresh;
@@ -105,6 +111,7 @@ impl BounceGlobals {
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&s));
         self.fresh = false;
         self.listed = count > 1 && !all;
+        self.stash = self.listed && carry && kept;
     }
 
     /// Bytes of the kept irradiance and the lists (none with one slice).
@@ -125,7 +132,8 @@ pub struct BouncePass {
     gather_irradiance: Option<wgpu::ComputePipeline>,
     globals: wgpu::BindGroupLayout,
     store: wgpu::ComputePipeline,
-    /// `mark` and `list` (bounce slices) and their `@group(0)`.
+    /// `stash`, `mark` and `list` (bounce slices) and their `@group(0)`.
+    stash: wgpu::ComputePipeline,
     mark: wgpu::ComputePipeline,
     list: wgpu::ComputePipeline,
     mark_globals: wgpu::BindGroupLayout,
@@ -162,8 +170,19 @@ impl BouncePass {
         let voxels = kind.sampling_layout(device);
         let leaves = kind.leaves_layout(device);
         let store = kind.leaf_store_layout(device);
-        let irradiance_lookup = kind.irradiance_layout(device);
+        let carry = kind.carry_layout(device);
         let [iso, axes] = kind.sampling_constants(anisotropic, 3);
+        let mark = |entry| {
+            voxel_pipeline_entry(
+                device,
+                "bounce",
+                "lighting/bounce.wgsl",
+                kind.shaders(),
+                entry,
+                // What the structure's carry functions read.
+                &[Some(&mark_globals), None, Some(&leaves), Some(&carry)],
+            )
+        };
         let gather = |irradiance: bool| {
             voxel_pipeline(
                 device,
@@ -185,20 +204,8 @@ impl BouncePass {
                 &[None, None, Some(&leaves), Some(&store)],
                 &[],
             ),
-            mark: voxel_pipeline_entry(
-                device,
-                "bounce",
-                "lighting/bounce.wgsl",
-                kind.shaders(),
-                "mark",
-                // The structure's irradiance lookup: its `leaf_carry_source` may read it.
-                &[
-                    Some(&mark_globals),
-                    None,
-                    Some(&leaves),
-                    Some(&irradiance_lookup),
-                ],
-            ),
+            mark: mark("mark"),
+            stash: mark("stash"),
             list: voxel_pipeline_entry(
                 device,
                 "bounce",
@@ -288,6 +295,7 @@ impl BouncePass {
             slices: slices.max(1),
             fresh: true,
             listed: false,
+            stash: false,
         }
     }
 
@@ -327,10 +335,15 @@ impl BouncePass {
         if globals.listed {
             {
                 let mut pass = pass(encoder, timer);
-                pass.set_pipeline(&self.mark);
                 pass.set_bind_group(0, mark_globals, &[]);
                 pass.set_bind_group(2, bound.leaves, &[]);
-                pass.set_bind_group(3, bound.irradiance, &[]);
+                pass.set_bind_group(3, bound.carry, &[]);
+                // `stash` reads the kept light of old leaves before `mark` writes new ones'.
+                if globals.stash {
+                    pass.set_pipeline(&self.stash);
+                    pass.dispatch_workgroups_indirect(args, offset);
+                }
+                pass.set_pipeline(&self.mark);
                 pass.dispatch_workgroups_indirect(args, offset);
             }
             let mut pass = pass(encoder, timer);

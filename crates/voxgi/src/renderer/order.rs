@@ -571,7 +571,9 @@ impl Renderer {
                 .map(|m| crate::lighting::bounce::near_change(m, tan));
             // Leaves whose irradiance the pixels read cannot start from another's light.
             let carry = !bounces::leaves(&self.options);
-            bounce_globals.prepare(&self.queue, self.bounce_turn, rebuilt, near, carry);
+            // A build of some windows: their new leaves may lie where leaves lay before.
+            let kept = work.partial && work.build.is_some();
+            bounce_globals.prepare(&self.queue, self.bounce_turn, rebuilt, near, carry, kept);
             self.bounce_turn = self.bounce_turn.wrapping_add(1);
         }
         let bounce_globals = &*bounce_globals;

@@ -309,6 +309,9 @@ pub struct StructureBindings<'a> {
     /// The irradiance lookup (`voxels/<kind>/irradiance.wgsl`), `@group(3)` of the gather:
     /// the record of the leaf at a voxel coordinate.
     pub irradiance: &'a wgpu::BindGroup,
+    /// What a new leaf's light may start from (`voxels/<kind>/carry.wgsl`), `@group(3)` of
+    /// the bounce's `stash` and `mark`.
+    pub carry: &'a wgpu::BindGroup,
     /// Per leaf slot, what the last bounce kept for the fast shading
     /// (`IndirectShading::Leaves`): a `vec4<u32>` record of irradiance, occlusion and normal
     /// (shaders/lighting/bounce.wgsl).

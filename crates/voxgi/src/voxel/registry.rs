@@ -54,6 +54,9 @@ pub struct KindInfo {
     pub leaf_store_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
     /// The layout of `@group(3)` of the gather, its irradiance lookup.
     pub irradiance_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
+    /// The layout of `@group(3)` of the bounce's `stash` and `mark`, what its carry.wgsl reads
+    /// (where a new leaf's light may start from).
+    pub carry_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
     /// Values for the `override` constants of its sample.wgsl: (anisotropic, gather axes).
     pub sampling_constants: fn(bool, u32) -> [(&'static str, f64); 2],
     /// Makes one. `previous`, the structure it replaces (of any kind), lends its pipelines
@@ -108,6 +111,11 @@ impl VoxelKind {
     /// The layout of @group(3) of the gather, the structure's irradiance lookup.
     pub fn irradiance_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
         (self.0.irradiance_layout)(device)
+    }
+
+    /// The layout of @group(3) of the bounce's `stash` and `mark`, the structure's carry.
+    pub fn carry_layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        (self.0.carry_layout)(device)
     }
 
     /// Values for the `override` constants of the structure's sample.wgsl.

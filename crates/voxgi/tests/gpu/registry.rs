@@ -30,6 +30,7 @@ static STAND_IN: KindInfo = KindInfo {
     leaves_layout: dense::KIND.leaves_layout,
     leaf_store_layout: dense::KIND.leaf_store_layout,
     irradiance_layout: dense::KIND.irradiance_layout,
+    carry_layout: dense::KIND.carry_layout,
     sampling_constants: dense::KIND.sampling_constants,
     create: stand_in,
 };

@@ -22,5 +22,9 @@ struct ClipLevels {
     resolution: u32,
     // A bit per level the last voxel work rebuilt alone (the others kept their leaves).
     rebuilt: u32,
-    _pad: u32,
+    // The rebuilt level whose window's occupancy before the build is kept (voxels/carry.wgsl),
+    // or none (MAX_CLIP_LEVELS).
+    kept: u32,
+    // Where its voxels lay before, against where they lie now: old = new + kept_by (xyz).
+    kept_by: vec4<i32>,
 }

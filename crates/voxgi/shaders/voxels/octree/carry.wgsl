@@ -4,3 +4,7 @@
 fn leaf_carry_source(i: u32) -> u32 {
     return NO_LEAF;
 }
+
+fn leaf_kept_self(i: u32) -> u32 {
+    return NO_LEAF;
+}

@@ -22,7 +22,9 @@
 //! no voxels are spent on the void past the world's edge.
 //! A window that moves is voxelized and lit again alone: each window owns a part of the
 //! volume's slots (voxels/dense/slots.wgsl), so the others keep their leaves, and their light
-//! (their bounces gather in `bounce_slices` turns). A frame moves at most
+//! (their bounces gather in `bounce_slices` turns); its own leaves where it overlaps its old
+//! place keep the light of the leaves that held their voxels (a copy of its occupancy is made
+//! before its build: voxels/clipmap/carry.wgsl), the others start from the coarser level's. A frame moves at most
 //! `RendererOptions::clipmap_budget` windows; the others wait at their old places, valid,
 //! until their turn (scrolling only the slabs newly inside a window is not built).
 
@@ -41,7 +43,7 @@ use crate::gpu::shader::StructureShaders;
 use crate::gpu::timer::GpuTimer;
 use crate::{Error, Result};
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{IVec3, Vec3};
 use nest::{Nest, NestPass};
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
@@ -83,8 +85,11 @@ pub struct GpuClipLevels {
     pub resolution: u32,
     /// A bit per level the last voxel work rebuilt alone (its leaves are all new).
     pub rebuilt: u32,
-    /// Padding; zero.
-    pub _pad: u32,
+    /// The rebuilt level whose window's occupancy before the build is kept, or `MAX_LEVELS`.
+    pub kept: u32,
+    /// Where its voxels lay before against where they lie now: old = new + `kept_by` (xyz; w
+    /// unused).
+    pub kept_by: [i32; 4],
 }
 
 /// The clipmap in the registry of kinds.
@@ -114,6 +119,7 @@ pub const KIND: KindInfo = KindInfo {
     leaves_layout: Clipmap::leaves_layout,
     leaf_store_layout: DenseVolume::leaf_store_layout,
     irradiance_layout: DenseVolume::irradiance_layout,
+    carry_layout: Clipmap::carry_layout,
     sampling_constants: DenseVolume::sampling_constants,
     create,
 };
@@ -286,8 +292,16 @@ pub struct Clipmap {
     /// A bit per level the build `plan` last asked for rebuilds alone (the others keep their
     /// leaves and light); 0 when it asked for none or for all of them.
     rebuilt_alone: u32,
+    /// The finest level `plan` last moved alone and how far (in its voxels, old minus new
+    /// corner): its window's occupancy is copied into `kept_occupancy` before its build, so
+    /// its new leaves keep the light of the leaves that held their voxels (carry.wgsl).
+    kept: Option<(u32, IVec3)>,
+    /// One window's occupancy (`resolution`³ words).
+    kept_occupancy: wgpu::Buffer,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
+    /// What its new leaves' light starts from: the occupancy and `kept_occupancy`.
+    carry: wgpu::BindGroup,
     /// The coarser levels filtered from the finer ones where they overlap, after each filter.
     nest: Nest,
     nest_pass: Arc<NestPass>,
@@ -304,7 +318,7 @@ impl Clipmap {
     ) -> Self {
         let clip = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("clipmap levels"),
-            contents: bytemuck::bytes_of(&clip_levels(&levels, scene, bounds, 0)),
+            contents: bytemuck::bytes_of(&clip_levels(&levels, scene, bounds, 0, None)),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let debug_placement = device.create_buffer(&wgpu::BufferDescriptor {
@@ -313,7 +327,8 @@ impl Clipmap {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (sampling, leaves) = Self::bind_groups(device, &inner, &clip);
+        let kept_occupancy = kept_occupancy(device, &inner);
+        let (sampling, leaves, carry) = Self::bind_groups(device, &inner, &clip, &kept_occupancy);
         let mut nest = Nest::new(device, &nest_pass, &inner);
         nest.place(&levels, inner.grid.levels() - 1);
         Clipmap {
@@ -328,24 +343,31 @@ impl Clipmap {
             bounds,
             placed: false,
             rebuilt_alone: 0,
+            kept: None,
+            kept_occupancy,
             sampling,
             leaves,
+            carry,
         }
     }
 
     /// The bind groups over a volume made again (its pools resized).
     fn rebind(&mut self, device: &wgpu::Device) {
-        (self.sampling, self.leaves) = Self::bind_groups(device, &self.inner, &self.clip);
+        self.kept_occupancy = kept_occupancy(device, &self.inner);
+        (self.sampling, self.leaves, self.carry) =
+            Self::bind_groups(device, &self.inner, &self.clip, &self.kept_occupancy);
         self.nest = Nest::new(device, &self.nest_pass, &self.inner);
         self.place_nest();
     }
 
-    /// The sampling group (the dense volume's with the levels) and the leaves' group.
+    /// The sampling group (the dense volume's with the levels), the leaves' group and the
+    /// carry group (the occupancy now and the kept one).
     fn bind_groups(
         device: &wgpu::Device,
         inner: &DenseVolume,
         clip: &wgpu::Buffer,
-    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        kept_occupancy: &wgpu::Buffer,
+    ) -> (wgpu::BindGroup, wgpu::BindGroup, wgpu::BindGroup) {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("voxels"),
@@ -380,7 +402,32 @@ impl Clipmap {
             layout: &Self::leaves_layout(device),
             entries: &layout::entries(resources),
         });
-        (sampling, leaves)
+        let carry = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("clipmap carry"),
+            layout: &Self::carry_layout(device),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: inner.occupancy.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: kept_occupancy.as_entire_binding(),
+                },
+            ],
+        });
+        (sampling, leaves, carry)
+    }
+
+    /// The layout of @group(3) of the bounce's `stash` and `mark`, twin of
+    /// shaders/voxels/clipmap/carry.wgsl: the occupancy (binding 0) and a moved window's
+    /// occupancy before its build (binding 2).
+    pub fn carry_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        let c = wgpu::ShaderStages::COMPUTE;
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("clipmap carry"),
+            entries: &[layout::storage(0, c, true), layout::storage(2, c, true)],
+        })
     }
 
     /// The layout of @group(1), twin of shaders/voxels/clipmap/sample.wgsl: the dense volume's
@@ -533,6 +580,7 @@ impl Clipmap {
                 self.scene,
                 self.bounds,
                 self.rebuilt_alone,
+                self.kept,
             )),
             usage: wgpu::BufferUsages::COPY_SRC,
         });
@@ -558,12 +606,14 @@ fn inside_by(g: &Grid, (lo, hi): (Vec3, Vec3), p: Vec3) -> f32 {
 }
 
 /// The levels in the scene's cube `scene` and bounds `bounds` as the shaders read them, with
-/// `rebuilt` the levels the last voxel work rebuilt alone.
+/// `rebuilt` the levels the last voxel work rebuilt alone and `kept` the one whose old
+/// occupancy is kept (`Clipmap::kept`).
 fn clip_levels(
     levels: &[Grid],
     (lo, hi): (Vec3, Vec3),
     bounds: (Vec3, Vec3),
     rebuilt: u32,
+    kept: Option<(u32, IVec3)>,
 ) -> GpuClipLevels {
     let mut l = GpuClipLevels {
         levels: [[0.0; 4]; MAX_LEVELS as usize],
@@ -574,7 +624,8 @@ fn clip_levels(
         count: levels.len() as u32,
         resolution: levels[0].resolution,
         rebuilt,
-        _pad: 0,
+        kept: kept.map_or(MAX_LEVELS, |(k, _)| k),
+        kept_by: kept.map_or([0; 4], |(_, by)| by.extend(0).to_array()),
     };
     for (k, g) in levels.iter().enumerate() {
         l.levels[k] = [g.origin.x, g.origin.y, g.origin.z, g.voxel_size];
@@ -582,12 +633,35 @@ fn clip_levels(
     l
 }
 
+/// A buffer for one window's occupancy (`Clipmap::kept`).
+fn kept_occupancy(device: &wgpu::Device, inner: &DenseVolume) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("clipmap kept occupancy"),
+        size: (inner.grid.resolution as u64).pow(3) * 4,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 impl VoxelStructure for Clipmap {
     /// Follows the camera within the frame's budget (`follow`): the windows that move are
     /// voxelized and lit again, alone (the others keep their leaves and light), with the
     /// dynamic geometry where it is now; a rebuild places and builds every window.
     fn plan(&mut self, changes: &FrameChanges) -> VoxelWork {
+        let before = self.levels.clone();
         let (moved, everything) = self.follow(changes.camera, changes.budget, changes.rebuild);
+        let was_kept = self.kept;
+        // The finest level moved alone keeps its old occupancy for its leaves' light.
+        self.kept = (moved != 0 && !everything).then(|| {
+            let k = moved.trailing_zeros();
+            let (old, new) = (&before[k as usize], &self.levels[k as usize]);
+            (
+                k,
+                ((new.origin - old.origin) / new.voxel_size)
+                    .round()
+                    .as_ivec3(),
+            )
+        });
         let around = |levels: &[Grid], b| {
             levels
                 .iter()
@@ -625,7 +699,7 @@ impl VoxelStructure for Clipmap {
                 partial: false,
             }
         };
-        if moved != 0 || was != self.rebuilt_alone {
+        if moved != 0 || was != self.rebuilt_alone || was_kept != self.kept {
             self.clip_current
                 .store(false, std::sync::atomic::Ordering::Relaxed);
         }
@@ -671,6 +745,16 @@ impl VoxelStructure for Clipmap {
             0 => self.inner.every_window(),
             some => some,
         };
+        if let (Some((k, _)), true) = (self.kept, self.rebuilt_alone != 0) {
+            let size = self.kept_occupancy.size();
+            encoder.copy_buffer_to_buffer(
+                &self.inner.occupancy,
+                k as u64 * size,
+                &self.kept_occupancy,
+                0,
+                size,
+            );
+        }
         self.inner
             .build_windows(device, encoder, fragments, rebuild, timer);
     }
@@ -729,6 +813,7 @@ impl VoxelStructure for Clipmap {
     fn memory(&self) -> Vec<(&'static str, u64)> {
         let mut m = self.inner.memory();
         m.push(("clipmap nest", self.nest.memory()));
+        m.push(("clipmap kept occupancy", self.kept_occupancy.size()));
         m
     }
 
@@ -737,6 +822,7 @@ impl VoxelStructure for Clipmap {
         StructureBindings {
             sampling: &self.sampling,
             leaves: &self.leaves,
+            carry: &self.carry,
             ..inner
         }
     }

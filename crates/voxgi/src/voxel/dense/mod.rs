@@ -84,6 +84,8 @@ pub const KIND: KindInfo = KindInfo {
     leaves_layout: DenseVolume::leaves_layout,
     leaf_store_layout: DenseVolume::leaf_store_layout,
     irradiance_layout: DenseVolume::irradiance_layout,
+    // Its carry.wgsl reads nothing: any group fits.
+    carry_layout: DenseVolume::irradiance_layout,
     sampling_constants: DenseVolume::sampling_constants,
     create,
 };
@@ -1062,6 +1064,7 @@ impl VoxelStructure for DenseVolume {
             leaves: &self.leaves,
             leaf_store: &self.leaf_store,
             irradiance: &self.irradiance,
+            carry: &self.irradiance,
             leaf_irradiance: &self.slot_irradiance,
             // The build's prepare_slots writes one thread per slot at offset 0.
             leaf_dispatch: (&self.args, 0),

@@ -83,6 +83,8 @@ pub const KIND: KindInfo = KindInfo {
     leaves_layout: OctreeVolume::leaves_layout,
     leaf_store_layout: OctreeVolume::leaf_store_layout,
     irradiance_layout: OctreeVolume::irradiance_layout,
+    // Its carry.wgsl reads nothing: any group fits.
+    carry_layout: OctreeVolume::irradiance_layout,
     sampling_constants: OctreeVolume::sampling_constants,
     create,
 };
@@ -645,6 +647,7 @@ impl VoxelStructure for OctreeVolume {
             leaves: &self.leaves,
             leaf_store: &self.leaf_store,
             irradiance: &self.irradiance,
+            carry: &self.irradiance,
             leaf_irradiance: &self.leaf_irradiance,
             leaf_dispatch: (&self.args, 12),
         }
