@@ -167,6 +167,8 @@ impl GpuTimer {
         while p.pending > 0 {
             let Some(frame) = p.profiler.process_finished_frame(period) else {
                 if waiting.elapsed() > std::time::Duration::from_secs(30) {
+                    // Not again on every later read: those frames are given up.
+                    p.pending = 0;
                     return Err(Error::Gpu {
                         context: "timestamps".into(),
                         reason: "their readback did not complete within 30 s".into(),

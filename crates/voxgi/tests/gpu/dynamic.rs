@@ -263,40 +263,15 @@ fn a_clipmap_that_followed_the_camera_equals_one_made_there() {
 #[test]
 fn a_moved_clipmap_window_keeps_its_light_and_starts_the_rest_from_the_coarser() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
-    let c = ctx();
-    // Level 0's radiance (its window is the first of the stacked cubes) and window.
-    let finest = |r: &Renderer| -> (Vec<f32>, voxgi::voxel::Grid) {
-        let clipmap = r.structure::<voxgi::voxel::clipmap::Clipmap>().unwrap();
-        let v = clipmap.volume();
-        let bytes = readback::read_texture_3d(&c.device, &c.queue, &v.radiance, 0).unwrap();
-        let halves: &[u16] = bytemuck::cast_slice(&bytes);
-        let texels = (v.grid.resolution as usize).pow(3);
-        let light = halves[..4 * texels]
-            .iter()
-            .map(|&h| readback::f16_to_f32(h))
-            .collect();
-        (light, clipmap.levels()[0])
-    };
-    // A camera just above the floor, then a few of the finest window's steps along it: the
-    // window holds floor before and after, most of it in both places.
-    let moved = |slices: u32| {
-        let options = clipmap_options(1, slices);
-        let mut r = renderer(&scene, &options);
-        let mut p = params(&r);
-        p.camera.position = Vec3::new(0.2, 0.04, 0.3);
-        frame(&mut r, &p, SIZE, SIZE);
-        let before = finest(&r);
-        p.camera.position.x += 0.05;
-        frame(&mut r, &p, SIZE, SIZE);
-        (before, finest(&r))
-    };
-    let ((old, was), (carried, now)) = moved(4);
-    let (_, (full, _)) = moved(1);
+    let ((old, was), (carried, now)) = finest_moved_along_the_floor(&scene, 4);
+    let (_, (full, _)) = finest_moved_along_the_floor(&scene, 1);
     assert_ne!(was.origin, now.origin, "the finest window moved");
     // Voxels occupied in both places: each holds the light it held before (to the rounding of
     // the light's inputs: the leaves' centres and fragments are computed from the window's
-    // corner, which moved; stored as f16, 1e-3 apart), or gathered in its turn this frame
-    // (the full gather's light, to the bit).
+    // corner, which moved; stored as f16, 1e-3 apart: measured within that, allowed 1e-2,
+    // where a voxel carried from the coarser level was off by tens of percent), or gathered in
+    // its turn this frame (the full gather's light, to the bit: both gather the same direct
+    // light).
     let n = now.resolution as i32;
     let by = ((now.origin - was.origin) / now.voxel_size)
         .round()
@@ -316,7 +291,7 @@ fn a_moved_clipmap_window_keeps_its_light_and_starts_the_rest_from_the_coarser()
                 }
                 both += 1;
                 let same = (0..3).all(|ch| {
-                    (carried[a + ch] - old[b + ch]).abs() <= 1e-3 * old[b + ch].max(1e-3)
+                    (carried[a + ch] - old[b + ch]).abs() <= 1e-2 * old[b + ch].max(1e-3)
                 });
                 if same {
                     kept += 1;
@@ -367,27 +342,7 @@ fn a_moved_clipmap_window_keeps_its_light_and_starts_the_rest_from_the_coarser()
 #[test]
 fn leaves_by_a_clipmap_window_face_gather_as_inside_it() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
-    let c = ctx();
-    let finest = |r: &Renderer| -> (Vec<f32>, voxgi::voxel::Grid) {
-        let clipmap = r.structure::<voxgi::voxel::clipmap::Clipmap>().unwrap();
-        let v = clipmap.volume();
-        let bytes = readback::read_texture_3d(&c.device, &c.queue, &v.radiance, 0).unwrap();
-        let halves: &[u16] = bytemuck::cast_slice(&bytes);
-        let texels = (v.grid.resolution as usize).pow(3);
-        let light = halves[..4 * texels]
-            .iter()
-            .map(|&h| readback::f16_to_f32(h))
-            .collect();
-        (light, clipmap.levels()[0])
-    };
-    let mut r = renderer(&scene, &clipmap_options(1, 1));
-    let mut p = params(&r);
-    p.camera.position = Vec3::new(0.2, 0.04, 0.3);
-    frame(&mut r, &p, SIZE, SIZE);
-    let (old, was) = finest(&r);
-    p.camera.position.x += 0.05;
-    frame(&mut r, &p, SIZE, SIZE);
-    let (new, now) = finest(&r);
+    let ((old, was), (new, now)) = finest_moved_along_the_floor(&scene, 1);
     let n = now.resolution as i32;
     let by = ((now.origin - was.origin) / now.voxel_size)
         .round()
@@ -431,14 +386,44 @@ fn leaves_by_a_clipmap_window_face_gather_as_inside_it() {
         ratios.iter().filter(|r| r.0 < 4).count() >= 3,
         "few voxels near the faces: {ratios:?}"
     );
-    // Measured within 3.8 % at every distance (the cones' turns differ: the leaves' voxel
-    // coordinates, which turn them, are the window's own).
+    // Measured within 3.8 % at every distance, allowed 6 % (the cones' turns differ: the
+    // leaves' voxel coordinates, which turn them, are the window's own).
     for (d, count, ratio) in ratios {
         assert!(
-            (ratio - 1.0).abs() < 0.05,
+            (ratio - 1.0).abs() < 0.06,
             "{count} voxels {d} from a face gather {ratio} of what they did inside"
         );
     }
+}
+
+/// The finest level's light and window.
+type FinestLevel = (Vec<f32>, voxgi::voxel::Grid);
+
+/// The finest level (its window is the first of the stacked cubes) before and after the
+/// camera, just above the floor, moves a few of the finest window's steps along it (so the
+/// window holds floor before and after, most of it in both places), with `slices`.
+fn finest_moved_along_the_floor(scene: &Scene, slices: u32) -> (FinestLevel, FinestLevel) {
+    let c = ctx();
+    let finest = |r: &Renderer| -> FinestLevel {
+        let clipmap = r.structure::<voxgi::voxel::clipmap::Clipmap>().unwrap();
+        let v = clipmap.volume();
+        let bytes = readback::read_texture_3d(&c.device, &c.queue, &v.radiance, 0).unwrap();
+        let halves: &[u16] = bytemuck::cast_slice(&bytes);
+        let texels = (v.grid.resolution as usize).pow(3);
+        let light = halves[..4 * texels]
+            .iter()
+            .map(|&h| readback::f16_to_f32(h))
+            .collect();
+        (light, clipmap.levels()[0])
+    };
+    let mut r = renderer(scene, &clipmap_options(1, slices));
+    let mut p = params(&r);
+    p.camera.position = Vec3::new(0.2, 0.04, 0.3);
+    frame(&mut r, &p, SIZE, SIZE);
+    let before = finest(&r);
+    p.camera.position.x += 0.05;
+    frame(&mut r, &p, SIZE, SIZE);
+    (before, finest(&r))
 }
 
 /// A clipmap frame that moves one window voxelizes and builds that window alone: every other

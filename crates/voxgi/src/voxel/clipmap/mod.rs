@@ -292,8 +292,8 @@ pub struct Clipmap {
     /// A bit per level the build `plan` last asked for rebuilds alone (the others keep their
     /// leaves and light); 0 when it asked for none or for all of them.
     rebuilt_alone: u32,
-    /// The finest level `plan` last moved alone and how far (in its voxels, old minus new
-    /// corner): its window's occupancy is copied into `kept_occupancy` before its build, so
+    /// The finest level `plan` last moved alone and how far (in its voxels, the new corner
+    /// minus the old: a voxel's old index is its new one plus this): its window's occupancy is copied into `kept_occupancy` before its build, so
     /// its new leaves keep the light of the leaves that held their voxels (carry.wgsl).
     kept: Option<(u32, IVec3)>,
     /// One window's occupancy (`resolution`³ words).
