@@ -24,9 +24,10 @@
 //! volume's slots (voxels/dense/slots.wgsl), so the others keep their leaves, and their light
 //! (their bounces gather in `bounce_slices` turns); its own leaves where it overlaps its old
 //! place keep the light of the leaves that held their voxels (a copy of its occupancy is made
-//! before its build: voxels/clipmap/carry.wgsl), the others start from the coarser level's. A frame moves at most
-//! `RendererOptions::clipmap_budget` windows; the others wait at their old places, valid,
-//! until their turn (scrolling only the slabs newly inside a window is not built).
+//! before its build: voxels/clipmap/carry.wgsl), the others start from the coarser level's.
+//! A frame moves at most `RendererOptions::clipmap_budget` windows; the others wait at their
+//! old places, valid, until their turn (scrolling only the slabs newly inside a window is not
+//! built).
 
 mod nest;
 
@@ -173,12 +174,9 @@ fn create(
         resolution: res,
     };
     let previous_clipmap = previous.and_then(|p| p.as_any().downcast_ref::<Clipmap>());
-    let previous = previous.and_then(|p| {
-        let any = p.as_any();
-        any.downcast_ref::<Clipmap>()
-            .map(Clipmap::volume)
-            .or_else(|| any.downcast_ref::<DenseVolume>())
-    });
+    let previous = previous_clipmap
+        .map(Clipmap::volume)
+        .or_else(|| previous.and_then(|p| p.as_any().downcast_ref::<DenseVolume>()));
     // Every level holds about as many surface voxels as the scene's cube at this resolution.
     let leaves = (desc.leaves * count as u64).min((res as u64).pow(3) * count as u64);
     let inner = DenseVolume::create(device, base, count, desc, leaves, previous)?;
@@ -293,8 +291,9 @@ pub struct Clipmap {
     /// leaves and light); 0 when it asked for none or for all of them.
     rebuilt_alone: u32,
     /// The finest level `plan` last moved alone and how far (in its voxels, the new corner
-    /// minus the old: a voxel's old index is its new one plus this): its window's occupancy is copied into `kept_occupancy` before its build, so
-    /// its new leaves keep the light of the leaves that held their voxels (carry.wgsl).
+    /// minus the old: a voxel's old index is its new one plus this): its window's occupancy
+    /// is copied into `kept_occupancy` before its build, so its new leaves keep the light of
+    /// the leaves that held their voxels (carry.wgsl).
     kept: Option<(u32, IVec3)>,
     /// One window's occupancy (`resolution`³ words).
     kept_occupancy: wgpu::Buffer,
@@ -330,7 +329,7 @@ impl Clipmap {
         let kept_occupancy = kept_occupancy(device, &inner);
         let (sampling, leaves, carry) = Self::bind_groups(device, &inner, &clip, &kept_occupancy);
         let mut nest = Nest::new(device, &nest_pass, &inner);
-        nest.place(&levels, inner.grid.levels() - 1);
+        nest.place(&levels);
         Clipmap {
             nest,
             nest_pass,
@@ -357,7 +356,7 @@ impl Clipmap {
         (self.sampling, self.leaves, self.carry) =
             Self::bind_groups(device, &self.inner, &self.clip, &self.kept_occupancy);
         self.nest = Nest::new(device, &self.nest_pass, &self.inner);
-        self.place_nest();
+        self.nest.place(&self.levels);
     }
 
     /// The sampling group (the dense volume's with the levels), the leaves' group and the
@@ -467,18 +466,32 @@ impl Clipmap {
     /// coarser past that one's) is positive, and its weight against the next coarser (1 past
     /// the hand-over band).
     pub fn level_at(&self, p: Vec3, diameter: f32) -> (usize, f32) {
-        let reach = |k: usize| self.reach(p, diameter, MARGIN, k);
-        let weight = |k: usize, r: f32| (r / (BAND * self.levels[k].voxel_size)).clamp(0.0, 1.0);
+        let (k, r) = self.finest_reaching(p, diameter, MARGIN, |r| r > 0.0);
+        (k, (r / (BAND * self.levels[k].voxel_size)).clamp(0.0, 1.0))
+    }
+
+    /// The finest level whose reach (`room` voxels), each level's counted at most `BAND` of
+    /// the next coarser's voxels past that one's, is taken by `take` (the coarsest when none
+    /// is), with that reach.
+    fn finest_reaching(
+        &self,
+        p: Vec3,
+        diameter: f32,
+        room: f32,
+        take: impl Fn(f32) -> bool,
+    ) -> (usize, f32) {
         let last = self.levels.len() - 1;
-        let mut r = reach(last);
-        let (mut k, mut w) = (last, weight(last, r));
+        let mut r = self.reach(p, diameter, room, last);
+        let (mut k, mut kr) = (last, r);
         for j in (0..last).rev() {
-            r = reach(j).min(r - BAND * self.levels[j + 1].voxel_size);
-            if r > 0.0 {
-                (k, w) = (j, weight(j, r));
+            r = self
+                .reach(p, diameter, room, j)
+                .min(r - BAND * self.levels[j + 1].voxel_size);
+            if take(r) {
+                (k, kr) = (j, r);
             }
         }
-        (k, w)
+        (k, kr)
     }
 
     /// sample.wgsl's `level_reach`: how far past `room` voxels plus `diameter` level `k`'s
@@ -491,17 +504,7 @@ impl Clipmap {
     /// sample.wgsl's `level_holding`: the finest level whose reach (`room` voxels), carried as
     /// `level_at` carries it, is not negative.
     fn level_holding(&self, p: Vec3, diameter: f32, room: f32) -> usize {
-        let last = self.levels.len() - 1;
-        let (mut k, mut r) = (last, self.reach(p, diameter, room, last));
-        for j in (0..last).rev() {
-            r = self
-                .reach(p, diameter, room, j)
-                .min(r - BAND * self.levels[j + 1].voxel_size);
-            if r >= 0.0 {
-                k = j;
-            }
-        }
-        k
+        self.finest_reaching(p, diameter, room, |r| r >= 0.0).0
     }
 
     /// The CPU twin of shaders/voxels/clipmap/sample.wgsl's `sample_voxels` over `voxels`,
@@ -546,7 +549,7 @@ impl Clipmap {
                 g.origin = placed_origin(g, self.bounds, camera);
             }
             self.placed = true;
-            self.place_nest();
+            self.nest.place(&self.levels);
             return (all, true);
         }
         let moved = moves(&self.levels, self.bounds, camera, budget);
@@ -555,12 +558,8 @@ impl Clipmap {
                 g.origin = placed_origin(g, self.bounds, camera);
             }
         }
-        self.place_nest();
+        self.nest.place(&self.levels);
         (moved, false)
-    }
-
-    fn place_nest(&mut self) {
-        self.nest.place(&self.levels, self.inner.grid.levels() - 1);
     }
 
     /// Records the levels' placement into `clip` (and the nest's steps into its parameters)

@@ -272,8 +272,9 @@ impl Nest {
 
     /// Places the steps for windows `levels` (`nest_steps`); the next nest first restores
     /// what the old steps copied.
-    pub fn place(&mut self, levels: &[Grid], chain_levels: u32) {
-        let steps = nest_steps(levels, chain_levels);
+    pub fn place(&mut self, levels: &[Grid]) {
+        // A bind group per chain level.
+        let steps = nest_steps(levels, self.binds.len() as u32);
         if steps != self.steps {
             let mut old = std::mem::take(&mut self.steps);
             if self.restore.load(Ordering::Relaxed) {
