@@ -262,7 +262,7 @@ fn every_twin_has_the_wgsl_layout() {
         "FragmentGrid",
         [origin, resolution, voxel_size, inv_voxel_size, z_offset]
     );
-    twin!(m, GpuRegion, "FragmentRegion", [lo, hi]);
+    twin!(m, GpuRegion, "FragmentRegion", [lo, hi, kept_lo, kept_hi]);
     twin!(
         m,
         crate::voxel::clipmap::GpuClipLevels,

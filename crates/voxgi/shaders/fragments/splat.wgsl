@@ -80,7 +80,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let b = vec3<u32>(k & 1u, (k >> 1u) & 1u, (k >> 2u) & 1u);
         let o = select(o0, o1, b == vec3<u32>(1u));
         let cell = c0 + vec3<i32>(b);
-        if any(o == vec3<u32>(0u)) || any(cell < vec3<i32>(region.lo)) || any(cell > vec3<i32>(region.hi)) {
+        if any(o == vec3<u32>(0u)) || !region_holds(region, cell) {
             continue;
         }
         let volume = o.x * o.y * o.z;

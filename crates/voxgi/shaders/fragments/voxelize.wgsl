@@ -157,7 +157,8 @@ fn voxelize_entry(info: vec4<u32>, first: u32, stride: u32) {
     let v = (w + 2u) % 3u;
     let lo = max(vec3<i32>(floor(min(a, min(b, c)))), vec3<i32>(region.lo));
     let hi = min(vec3<i32>(floor(max(a, max(b, c)))), vec3<i32>(region.hi));
-    if any(hi < lo) {
+    // Nothing, or only voxels a moved window keeps.
+    if any(hi < lo) || (all(lo >= vec3<i32>(region.kept_lo)) && all(hi <= vec3<i32>(region.kept_hi))) {
         return;
     }
     let nu = u32(hi[u] - lo[u] + 1);
@@ -194,7 +195,7 @@ fn voxelize_entry(info: vec4<u32>, first: u32, stride: u32) {
             cell[v] = cv;
             cell[w] = cz;
             let center = vec3<f32>(cell) + 0.5;
-            if !tri_box_overlap(center, 0.5, a, b, c) {
+            if in_box(cell, region.kept_lo, region.kept_hi) || !tri_box_overlap(center, 0.5, a, b, c) {
                 continue;
             }
             // Attributes at the voxel centre's projection onto the triangle (barycentrics
@@ -229,7 +230,7 @@ fn voxelize_entry(info: vec4<u32>, first: u32, stride: u32) {
             emit(cell, diffuse, behind, n, emission, surface);
             var inner = cell;
             inner[w] -= select(-1, 1, n[w] > 0.0);
-            if inner[w] >= i32(region.lo[w]) && inner[w] <= i32(region.hi[w]) {
+            if region_holds(region, inner) {
                 // Inside the solid: no surface of its own, so shaded at its centre (a surface
                 // distance of 0 puts the shading point inside, where the light does not reach).
                 emit(inner, diffuse, 1.0, n, emission, 0.0);

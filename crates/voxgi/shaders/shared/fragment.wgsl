@@ -20,11 +20,24 @@ struct FragmentGrid {
     _pad: u32,
 }
 
-// The voxels a pass makes fragments in, bounds included (empty when hi < lo on an axis). Twin:
-// `GpuRegion` in src/fragments/grid.rs.
+// The voxels a pass makes fragments in, bounds included (empty when hi < lo on an axis), but
+// for those of the box kept_lo..kept_hi (none when kept_hi < kept_lo on an axis: the voxels a
+// moved clipmap window keeps from its old place). Twin: `GpuRegion` in src/fragments/grid.rs.
 struct FragmentRegion {
     lo: vec3<u32>,
     hi: vec3<u32>,
+    kept_lo: vec3<u32>,
+    kept_hi: vec3<u32>,
+}
+
+// Whether voxel `cell` lies in the box lo..hi, bounds included.
+fn in_box(cell: vec3<i32>, lo: vec3<u32>, hi: vec3<u32>) -> bool {
+    return all(cell >= vec3<i32>(lo)) && all(cell <= vec3<i32>(hi));
+}
+
+// Whether `r` makes fragments in voxel `cell`.
+fn region_holds(r: FragmentRegion, cell: vec3<i32>) -> bool {
+    return in_box(cell, r.lo, r.hi) && !in_box(cell, r.kept_lo, r.kept_hi);
 }
 
 struct Fragment {

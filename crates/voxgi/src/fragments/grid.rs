@@ -1,7 +1,7 @@
 //! The grid fragments lie on and structures are built over: a cube of `resolution`³ voxels.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{UVec3, Vec3};
+use glam::{IVec3, UVec3, Vec3};
 
 /// A cubic grid over the scene: `resolution` voxels per side from `origin`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,14 +45,21 @@ impl Grid {
 }
 
 /// A box of a grid's voxels, bounds included, where fragments are made: a pass that makes
-/// fragments makes none outside it. Empty when `hi` lies below `lo` on some axis.
+/// fragments makes none outside it, nor inside its `kept` box. Empty when `hi` lies below `lo`
+/// on some axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Region {
     /// The first voxel inside, per axis.
     pub lo: UVec3,
     /// The last voxel inside, per axis.
     pub hi: UVec3,
+    /// A box of voxels, bounds included, left out after all (none when its `.1` lies below
+    /// its `.0` on some axis): those a moved clipmap window keeps from its old place.
+    pub kept: (UVec3, UVec3),
 }
+
+/// No voxels left out of a region.
+const NONE_KEPT: (UVec3, UVec3) = (UVec3::ONE, UVec3::ZERO);
 
 impl Region {
     /// Every voxel of `grid`.
@@ -60,6 +67,26 @@ impl Region {
         Region {
             lo: UVec3::ZERO,
             hi: UVec3::splat(grid.resolution - 1),
+            kept: NONE_KEPT,
+        }
+    }
+
+    /// Every voxel of `grid` but those it keeps from where it lay before it moved by `moved`
+    /// voxels (its new corner minus the old; the voxels of both places, where a voxel's old
+    /// index is its new one plus `moved`).
+    pub fn all_but_kept(grid: &Grid, moved: IVec3) -> Self {
+        let r = grid.resolution as i32;
+        let (lo, hi) = (
+            (-moved).max(IVec3::ZERO),
+            (r - 1 - moved).min(IVec3::splat(r - 1)),
+        );
+        Region {
+            kept: if lo.cmple(hi).all() {
+                (lo.as_uvec3(), hi.as_uvec3())
+            } else {
+                NONE_KEPT
+            },
+            ..Region::all(grid)
         }
     }
 
@@ -67,6 +94,7 @@ impl Region {
     pub const EMPTY: Region = Region {
         lo: UVec3::ONE,
         hi: UVec3::ZERO,
+        kept: NONE_KEPT,
     };
 
     /// The voxels of `grid` that the world box `min..max` touches, grown by `margin` voxels
@@ -89,6 +117,7 @@ impl Region {
         Region {
             lo: lo.max(Vec3::ZERO).as_uvec3(),
             hi: hi.min(Vec3::splat(top)).as_uvec3(),
+            kept: NONE_KEPT,
         }
     }
 
@@ -104,6 +133,10 @@ impl Region {
             _pad0: 0,
             hi: self.hi.to_array(),
             _pad1: 0,
+            kept_lo: self.kept.0.to_array(),
+            _pad2: 0,
+            kept_hi: self.kept.1.to_array(),
+            _pad3: 0,
         }
     }
 }
@@ -120,6 +153,14 @@ pub struct GpuRegion {
     pub hi: [u32; 3],
     /// Padding; zero.
     pub _pad1: u32,
+    /// `Region::kept.0`.
+    pub kept_lo: [u32; 3],
+    /// Padding; zero.
+    pub _pad2: u32,
+    /// `Region::kept.1`.
+    pub kept_hi: [u32; 3],
+    /// Padding; zero.
+    pub _pad3: u32,
 }
 
 #[cfg(test)]
@@ -132,6 +173,20 @@ mod tests {
         assert!((g.extent() - 2.0 * 64.0 / 62.0).abs() < 1e-5);
         assert!((g.origin.x + g.voxel_size).abs() < 1e-5);
         assert_eq!(g.levels(), 7);
+    }
+
+    #[test]
+    fn a_moved_window_keeps_the_voxels_of_both_places() {
+        let g = Grid::around(Vec3::ZERO, Vec3::splat(1.0), 16);
+        // Moved 4 voxels up x and 2 down z: new x 0..=11 were old 4..=15, new z 2..=15 old 0..=13.
+        let r = Region::all_but_kept(&g, IVec3::new(4, 0, -2));
+        assert_eq!(r.kept, (UVec3::new(0, 0, 2), UVec3::new(11, 15, 15)));
+        assert_eq!((r.lo, r.hi), (Region::all(&g).lo, Region::all(&g).hi));
+        // Moved a whole window: nothing kept.
+        assert_eq!(
+            Region::all_but_kept(&g, IVec3::new(0, 16, 0)),
+            Region::all(&g)
+        );
     }
 
     #[test]

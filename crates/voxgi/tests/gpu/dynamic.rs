@@ -478,6 +478,109 @@ fn a_moved_clipmap_window_leaves_the_others_slots_alone() {
     }
 }
 
+/// A clipmap window that moves alone is voxelized only where it is new: the voxels it holds in
+/// both places keep their sums from before (that they equal a fresh clipmap's is
+/// `a_clipmap_that_followed_the_camera_equals_one_made_there`), so none of the frame's
+/// fragments lies among them, and the frame makes fewer fragments than the window's full
+/// voxelization does.
+#[test]
+fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
+    // Static geometry only: every fragment of the frame is the build's.
+    let scene = builtin::cornell_box();
+    let options = clipmap_options(1, 1);
+    let levels = |r: &Renderer| {
+        r.structure::<voxgi::voxel::clipmap::Clipmap>()
+            .expect("a clipmap")
+            .levels()
+            .to_vec()
+    };
+    // The window coordinates of `r`'s last fragments.
+    let cells = |r: &Renderer| -> Vec<[u32; 3]> {
+        let f = r.fragments();
+        let c = ctx();
+        let count = readback::read_buffer_copy(&c.device, &c.queue, &f.count).expect("count");
+        let count = bytemuck::cast_slice::<u8, u32>(&count)[0] as usize;
+        let words = readback::read_buffer_copy(&c.device, &c.queue, &f.buffer).expect("fragments");
+        let words: &[u32] = bytemuck::cast_slice(&words);
+        assert!(count * 5 <= words.len(), "the fragment buffer overflowed");
+        words
+            .chunks_exact(5)
+            .take(count)
+            .map(|w| [w[0] & 1023, (w[0] >> 10) & 1023, (w[0] >> 20) & 1023])
+            .collect()
+    };
+    let mut r = renderer(&scene, &options);
+    let mut p = params(&r);
+    // Just above the floor, then a few of the finest window's steps along it: most of the
+    // window's voxels lie in both places.
+    p.camera.position = Vec3::new(0.2, 0.04, 0.3);
+    frame(&mut r, &p, SIZE, SIZE);
+    let before = levels(&r);
+    p.camera.position.x += 0.05;
+    frame(&mut r, &p, SIZE, SIZE);
+    let after = levels(&r);
+    assert_eq!(
+        moved_windows(&before, &after),
+        vec![0],
+        "the finest moved alone"
+    );
+    let res = after[0].resolution;
+    let by = ((after[0].origin - before[0].origin) / after[0].voxel_size)
+        .round()
+        .as_ivec3();
+    let (lo, hi) = voxgi::voxel::Region::all_but_kept(&after[0], by).kept;
+    assert!(lo.cmple(hi).all(), "the move keeps voxels: {by}");
+    let moved = cells(&r);
+    assert!(!moved.is_empty(), "no fragments where the window is new");
+    for c in &moved {
+        assert!(c[2] < res, "a fragment of another window: {c:?}");
+        let inside = (0..3).all(|a| c[a] >= lo[a] && c[a] <= hi[a]);
+        assert!(
+            !inside,
+            "a fragment among the kept voxels {lo}..={hi}: {c:?}"
+        );
+    }
+    // A clipmap made where the camera is now voxelizes every window whole; its finest window
+    // lies where the moved one does (the coarser ones may lie elsewhere: the moved clipmap's
+    // waited within their steps).
+    let mut fresh = renderer(&scene, &options);
+    frame(&mut fresh, &p, SIZE, SIZE);
+    assert_eq!(
+        levels(&fresh)[0],
+        after[0],
+        "the fresh clipmap's finest window"
+    );
+    let whole = cells(&fresh).iter().filter(|c| c[2] < res).count();
+    // And both hold the same finest voxels, to the bit.
+    let c = ctx();
+    let finest = |r: &Renderer| -> Vec<Vec<u8>> {
+        let v = r
+            .structure::<voxgi::voxel::clipmap::Clipmap>()
+            .unwrap()
+            .volume();
+        [(&v.albedo, 4), (&v.normal, 4), (&v.emission, 8)]
+            .iter()
+            .map(|(t, bytes)| {
+                let all = readback::read_texture_3d(&c.device, &c.queue, t, 0).unwrap();
+                all[..(res as usize).pow(3) * bytes].to_vec()
+            })
+            .collect()
+    };
+    assert!(
+        finest(&r) == finest(&fresh),
+        "the moved window's voxels differ from a fresh clipmap's"
+    );
+    eprintln!(
+        "the moved window's fragments: {} of its {whole} (moved by {by})",
+        moved.len()
+    );
+    assert!(
+        moved.len() < whole,
+        "{} fragments for the new voxels, {whole} for the whole window",
+        moved.len()
+    );
+}
+
 /// The clipmap tests' options: five levels of automatic voxel size (the coarsest spans four
 /// times the box's cube, the finest a quarter of it), `budget` windows a frame, `slices`.
 fn clipmap_options(budget: u32, slices: u32) -> RendererOptions {

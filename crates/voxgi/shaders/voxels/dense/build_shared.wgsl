@@ -7,31 +7,37 @@
 @group(0) @binding(0) var<uniform> vol: Volume;
 // The fragments, as voxelize (or any other source) left them: the only input.
 @group(0) @binding(1) var<storage, read> fragments: array<Fragment>;
-@group(0) @binding(2) var<storage, read> fragment_count: array<u32>;
 // [0] slots asked for (occupied voxels, counted past the capacity) of every window, [1] the
-// most any window asked for (its part of the pool must hold them), [3] entries of `touched` of
+// most any window asked for (its part of the pool must hold them), [2] the fragments made
+// (counted past their buffer; copied from their count before each build and update, which
+// leaves a storage binding for `kept`), [3] entries of `touched` of
 // this update, [4] of the previous update, [5] fragments of the static geometry (those from
 // there on are the dynamic geometry's), [7] a bit per window the next build rebuilds (set by
 // the host; the others keep their slots); each window's own words (slots.wgsl).
-@group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>>;
+@group(0) @binding(2) var<storage, read_write> counters: array<atomic<u32>>;
 // Per voxel: 0 empty, 2 + slot once allocated, LOCKED while allocating (or past capacity).
-@group(0) @binding(4) var<storage, read_write> occupancy: array<atomic<u32>>;
+@group(0) @binding(3) var<storage, read_write> occupancy: array<atomic<u32>>;
 // Per slot: the voxel's linear index.
-@group(0) @binding(5) var<storage, read_write> slot_voxel: array<u32>;
+@group(0) @binding(4) var<storage, read_write> slot_voxel: array<u32>;
 // Per slot, ACCUM_STRIDE u32: the FRAGMENT_SUMS of shared/fragment.wgsl, then the largest
 // coverage.
-@group(0) @binding(6) var<storage, read_write> accum: array<atomic<u32>>;
-@group(0) @binding(7) var albedo_out: texture_storage_3d<rgba8unorm, write>;
-@group(0) @binding(8) var normal_out: texture_storage_3d<rgba8snorm, write>;
-@group(0) @binding(9) var emission_out: texture_storage_3d<rgba16float, write>;
-@group(0) @binding(10) var radiance_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(5) var<storage, read_write> accum: array<atomic<u32>>;
+@group(0) @binding(6) var albedo_out: texture_storage_3d<rgba8unorm, write>;
+@group(0) @binding(7) var normal_out: texture_storage_3d<rgba8snorm, write>;
+@group(0) @binding(8) var emission_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(9) var radiance_out: texture_storage_3d<rgba16float, write>;
 // Per slot, DYN_STRIDE u32: the ACCUM_STRIDE sums of the dynamic fragments, apart from the
 // static sums in `accum` so that undoing an update is zeroing them; then (static slots) 1
 // while the slot is listed as touched; then entry `slot` of the touched list: the slots the
 // dynamic fragments of this update fell into (static slots they share, and new slots above
 // the static ones), resolved now and restored by the next update. (Eight storage buffers per
 // stage is the minimum limit: the flag and the list share this one.)
-@group(0) @binding(11) var<storage, read_write> dyn_accum: array<atomic<u32>>;
+@group(0) @binding(10) var<storage, read_write> dyn_accum: array<atomic<u32>>;
+// A moved window's state from before its build (`DenseVolume::kept`): [0] the window plus one
+// (0: the build keeps none), [1..4] how far it moved (its new corner minus the old, in voxels,
+// i32: a voxel's old index is its new one plus this), from KEPT_OCCUPANCY its occupancy before
+// the build, then its part's static sums (ACCUM_STRIDE words a slot).
+@group(0) @binding(11) var<storage, read> kept: array<u32>;
 // The voxels written since the last filter, listed for the filter (changed.wgsl).
 //!include voxels/changed.wgsl
 //!include voxels/slots.wgsl
@@ -70,7 +76,7 @@ fn write_args(offset: u32, count: u32) {
 
 // Fragments made and kept: the count runs past the buffer when it overflowed.
 fn stored_fragments() -> u32 {
-    return min(fragment_count[0], arrayLength(&fragments));
+    return min(atomicLoad(&counters[FRAGMENTS]), arrayLength(&fragments));
 }
 
 fn slot_limit() -> u32 {
@@ -78,6 +84,27 @@ fn slot_limit() -> u32 {
 }
 
 const REBUILD: u32 = 7u;
+const FRAGMENTS: u32 = 2u;
+const KEPT_OCCUPANCY: u32 = 64u;
+const NOT_KEPT: u32 = 0xffffffffu;
+
+fn kept_by() -> vec3<i32> {
+    return vec3<i32>(bitcast<i32>(kept[1]), bitcast<i32>(kept[2]), bitcast<i32>(kept[3]));
+}
+
+// Voxel `v`'s index at the kept window's old place when the build keeps it (it lies in both
+// places), NOT_KEPT otherwise.
+fn kept_index(v: u32) -> u32 {
+    let r = vol.resolution;
+    if kept[0] == 0u || window_of_voxel(v) != kept[0] - 1u {
+        return NOT_KEPT;
+    }
+    let old = vec3<i32>(voxel_coord(v % (r * r * r), r)) + kept_by();
+    if any(old < vec3<i32>(0)) || any(old >= vec3<i32>(i32(r))) {
+        return NOT_KEPT;
+    }
+    return voxel_index(vec3<u32>(old), r);
+}
 
 // The window voxel `v` (a linear index through the stacked cubes) lies in.
 fn window_of_voxel(v: u32) -> u32 {

@@ -6,6 +6,8 @@
 // levels a clipmap moves this frame; every other window keeps its slots and sums):
 //   begin           remember each rebuilt window's slot count, reset it; the clear's dispatch
 //   clear_previous  zero the voxels the rebuilt windows filled (cheaper than clearing N^3)
+//   keep            a moved window's voxels that lay in it before: their slots again, with
+//                   their static sums (the fragments are only the other voxels')
 //   prepare_fragments / prepare_slots  indirect dispatch sizes from the counters
 //   allocate        one slot per occupied voxel, in its window's part of the pool
 //   accumulate      integer sums per slot
@@ -41,7 +43,7 @@ fn begin() {
 @compute @workgroup_size(1)
 fn prepare_fragments() {
     // The build's fragments are the static geometry's: updates take those past them.
-    atomicStore(&counters[5], fragment_count[0]);
+    atomicStore(&counters[5], atomicLoad(&counters[FRAGMENTS]));
     write_args(3u, stored_fragments());
 }
 
@@ -75,13 +77,57 @@ fn clear_previous(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
 }
 
 @compute @workgroup_size(64)
+fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    if kept[0] == 0u {
+        return;
+    }
+    let w = kept[0] - 1u;
+    let r = vol.resolution;
+    let by = kept_by();
+    // The box of both places, in the window's new voxels (the host dispatches its size).
+    let lo = max(-by, vec3<i32>(0));
+    let n = vec3<u32>(max(vec3<i32>(i32(r)) - abs(by), vec3<i32>(0)));
+    let i = flat(gid, nwg);
+    if i >= n.x * n.y * n.z {
+        return;
+    }
+    let c = vec3<u32>(lo) + vec3<u32>(i % n.x, (i / n.x) % n.y, i / (n.x * n.y));
+    let v = voxel_index(c + vec3<u32>(0u, 0u, w * r), r);
+    let o = kept[KEPT_OCCUPANCY + kept_index(v)];
+    // Empty, or locked past the capacity.
+    if o < 2u || o == LOCKED {
+        return;
+    }
+    let part = window_slots(vol.windows);
+    let t = o - 2u - w * part;
+    // The static geometry's slots (the last update's were freed before the build; `begin`
+    // kept their count).
+    if t >= min(atomicLoad(&counters[window_word(w, W_PREVIOUS)]), part) {
+        return;
+    }
+    // Voxels beyond the capacity stay locked, as `allocate` leaves them.
+    atomicStore(&occupancy[v], LOCKED);
+    let s = take_slot(v);
+    if s >= slot_limit() {
+        return;
+    }
+    slot_voxel[s] = v;
+    atomicStore(&occupancy[v], s + 2u);
+    let sums = KEPT_OCCUPANCY + r * r * r + t * ACCUM_STRIDE;
+    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+        atomicStore(&accum[s * ACCUM_STRIDE + k], kept[sums + k]);
+    }
+}
+
+@compute @workgroup_size(64)
 fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat(gid, nwg);
     if i >= stored_fragments() {
         return;
     }
     let v = voxel_index(unpack_coord(fragments[i].coord), vol.resolution);
-    if !rebuilding(window_of_voxel(v)) {
+    // A kept voxel has its sums (a fragment there would count twice).
+    if !rebuilding(window_of_voxel(v)) || kept_index(v) != NOT_KEPT {
         return;
     }
     // The first fragment of a voxel takes it; the weak exchange may fail spuriously, so retry
@@ -113,7 +159,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let f = fragments[i];
     let v = voxel_index(unpack_coord(f.coord), vol.resolution);
     let o = atomicLoad(&occupancy[v]);
-    if o < 2u || o == LOCKED || !rebuilding(window_of_voxel(v)) {
+    if o < 2u || o == LOCKED || !rebuilding(window_of_voxel(v)) || kept_index(v) != NOT_KEPT {
         return;
     }
     add_fragment(o - 2u, f, false);

@@ -291,15 +291,14 @@ pub struct Clipmap {
     /// leaves and light); 0 when it asked for none or for all of them.
     rebuilt_alone: u32,
     /// The finest level `plan` last moved alone and how far (in its voxels, the new corner
-    /// minus the old: a voxel's old index is its new one plus this): its window's occupancy
-    /// is copied into `kept_occupancy` before its build, so its new leaves keep the light of
-    /// the leaves that held their voxels (carry.wgsl).
+    /// minus the old: a voxel's old index is its new one plus this): its build keeps the
+    /// voxels of both places (only the others are voxelized: `Region::all_but_kept`), and its
+    /// window's occupancy from before, so that its new leaves keep the light of the leaves
+    /// that held their voxels (carry.wgsl).
     kept: Option<(u32, IVec3)>,
-    /// One window's occupancy (`resolution`³ words).
-    kept_occupancy: wgpu::Buffer,
     sampling: wgpu::BindGroup,
     leaves: wgpu::BindGroup,
-    /// What its new leaves' light starts from: the occupancy and `kept_occupancy`.
+    /// What its new leaves' light starts from: the occupancy and the kept one.
     carry: wgpu::BindGroup,
     /// The coarser levels filtered from the finer ones where they overlap, after each filter.
     nest: Nest,
@@ -326,8 +325,7 @@ impl Clipmap {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let kept_occupancy = kept_occupancy(device, &inner);
-        let (sampling, leaves, carry) = Self::bind_groups(device, &inner, &clip, &kept_occupancy);
+        let (sampling, leaves, carry) = Self::bind_groups(device, &inner, &clip);
         let mut nest = Nest::new(device, &nest_pass, &inner);
         nest.place(&levels);
         Clipmap {
@@ -343,7 +341,6 @@ impl Clipmap {
             placed: false,
             rebuilt_alone: 0,
             kept: None,
-            kept_occupancy,
             sampling,
             leaves,
             carry,
@@ -352,9 +349,8 @@ impl Clipmap {
 
     /// The bind groups over a volume made again (its pools resized).
     fn rebind(&mut self, device: &wgpu::Device) {
-        self.kept_occupancy = kept_occupancy(device, &self.inner);
         (self.sampling, self.leaves, self.carry) =
-            Self::bind_groups(device, &self.inner, &self.clip, &self.kept_occupancy);
+            Self::bind_groups(device, &self.inner, &self.clip);
         self.nest = Nest::new(device, &self.nest_pass, &self.inner);
         self.nest.place(&self.levels);
     }
@@ -365,7 +361,6 @@ impl Clipmap {
         device: &wgpu::Device,
         inner: &DenseVolume,
         clip: &wgpu::Buffer,
-        kept_occupancy: &wgpu::Buffer,
     ) -> (wgpu::BindGroup, wgpu::BindGroup, wgpu::BindGroup) {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -411,7 +406,7 @@ impl Clipmap {
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
-                    resource: kept_occupancy.as_entire_binding(),
+                    resource: inner.kept_occupancy(),
                 },
             ],
         });
@@ -632,16 +627,6 @@ fn clip_levels(
     l
 }
 
-/// A buffer for one window's occupancy (`Clipmap::kept`).
-fn kept_occupancy(device: &wgpu::Device, inner: &DenseVolume) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("clipmap kept occupancy"),
-        size: (inner.grid.resolution as u64).pow(3) * 4,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
-}
-
 impl VoxelStructure for Clipmap {
     /// Follows the camera within the frame's budget (`follow`): the windows that move are
     /// voxelized and lit again, alone (the others keep their leaves and light), with the
@@ -673,12 +658,10 @@ impl VoxelStructure for Clipmap {
                 .levels
                 .iter()
                 .enumerate()
-                .map(|(k, g)| {
-                    if moved & (1 << k) != 0 {
-                        Region::all(g)
-                    } else {
-                        Region::EMPTY
-                    }
+                .map(|(k, g)| match self.kept {
+                    Some((kept, by)) if kept as usize == k => Region::all_but_kept(g, by),
+                    _ if moved & (1 << k) != 0 => Region::all(g),
+                    _ => Region::EMPTY,
                 })
                 .collect();
             self.rebuilt_alone = if everything { 0 } else { moved };
@@ -744,18 +727,9 @@ impl VoxelStructure for Clipmap {
             0 => self.inner.every_window(),
             some => some,
         };
-        if let (Some((k, _)), true) = (self.kept, self.rebuilt_alone != 0) {
-            let size = self.kept_occupancy.size();
-            encoder.copy_buffer_to_buffer(
-                &self.inner.occupancy,
-                k as u64 * size,
-                &self.kept_occupancy,
-                0,
-                size,
-            );
-        }
+        let kept = self.kept.filter(|_| self.rebuilt_alone != 0);
         self.inner
-            .build_windows(device, encoder, fragments, rebuild, timer);
+            .build_windows(device, encoder, fragments, rebuild, kept, timer);
     }
 
     fn record_update(
@@ -812,7 +786,6 @@ impl VoxelStructure for Clipmap {
     fn memory(&self) -> Vec<(&'static str, u64)> {
         let mut m = self.inner.memory();
         m.push(("clipmap nest", self.nest.memory()));
-        m.push(("clipmap kept occupancy", self.kept_occupancy.size()));
         m
     }
 

@@ -28,6 +28,7 @@ use crate::voxel::{
 use crate::{Error, Result};
 use debug::DebugPass;
 use filter::FilterPass;
+use glam::IVec3;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
@@ -104,12 +105,21 @@ fn create(
 /// The counters' word of the windows a build rebuilds (`REBUILD` in build_shared.wgsl).
 const REBUILD_WORD: u64 = 7;
 
+/// The counters' word of the fragments made (`FRAGMENTS` in build_shared.wgsl).
+const FRAGMENTS_WORD: u64 = 2;
+
+/// Where a moved window's occupancy begins in `DenseVolume::kept`, in words (`KEPT_OCCUPANCY`
+/// in build_shared.wgsl): after the head's words, at an offset a storage binding may start at.
+const KEPT_OCCUPANCY_WORD: u64 = 64;
+
 /// The constants the Rust side shares with the build's WGSL, by their WGSL names (a test
 /// compares them).
 pub const SHARED_CONSTANTS: &[(&str, u64)] = &[
     ("ACCUM_STRIDE", ACCUM_STRIDE),
     ("DYN_STRIDE", DYN_STRIDE),
     ("REBUILD", REBUILD_WORD),
+    ("FRAGMENTS", FRAGMENTS_WORD),
+    ("KEPT_OCCUPANCY", KEPT_OCCUPANCY_WORD),
     ("WINDOW_WORDS", filter::WINDOW_WORDS),
     ("MAX_WINDOWS", filter::MAX_WINDOWS),
     ("WINDOW_STRIDE", filter::WINDOW_STRIDE),
@@ -177,7 +187,7 @@ pub struct DenseVolume {
     /// Occupied voxels each window's part of the slots holds (voxels/dense/slots.wgsl).
     pub window_slots: u32,
     /// `[0]` occupied voxels (slots asked for, past the capacity), `[1]` the most a window
-    /// asked for, `[3]` and `[4]` slots the dynamic geometry touched in this and the previous
+    /// asked for, `[2]` the fragments made (`FRAGMENTS_WORD`), `[3]` and `[4]` slots the dynamic geometry touched in this and the previous
     /// update (see dense_update.wgsl), `[6]` the voxels above the finest the last filter redid
     /// (one for all its directions; 0 when it filtered everything, after a build), `[7]` a bit
     /// per window the next build rebuilds, from `[8]` each level's count of voxels with a
@@ -194,6 +204,11 @@ pub struct DenseVolume {
     /// whether it is listed as touched, and an entry of the list of slots the last update
     /// touched. One slot for a scene without dynamic instances.
     dyn_accum: wgpu::Buffer,
+    /// A moved window's state from before its build, which the build keeps where the window
+    /// overlaps its old place (`build_windows`; build_shared.wgsl's `kept`): the window and
+    /// how far it moved, then from `KEPT_OCCUPANCY_WORD` its occupancy, then its part's static
+    /// sums. Only the head for a volume of one window.
+    kept: wgpu::Buffer,
     /// Whether the pools have room for dynamic geometry.
     pub dynamic: bool,
     /// Per slot: direct radiance (rgb) and opacity from inject, kept for the bounces (vec4 f32).
@@ -313,6 +328,8 @@ enum Run {
     One,
     /// Sized by the dispatch arguments at this byte offset.
     Indirect(u64),
+    /// A thread per item of this many, sized by the host.
+    Over(u32),
 }
 
 /// The dense volume's own pipelines (dense_build, filter, debug): made once per renderer and
@@ -341,6 +358,7 @@ struct UpdatePipelines {
 struct BuildPipelines {
     begin: wgpu::ComputePipeline,
     clear_previous: wgpu::ComputePipeline,
+    keep: wgpu::ComputePipeline,
     prepare_fragments: wgpu::ComputePipeline,
     allocate: wgpu::ComputePipeline,
     accumulate: wgpu::ComputePipeline,
@@ -451,6 +469,7 @@ impl DensePipelines {
         let build = BuildPipelines {
             begin: b("begin"),
             clear_previous: b("clear_previous"),
+            keep: b("keep"),
             prepare_fragments: b("prepare_fragments"),
             allocate: b("allocate"),
             accumulate: b("accumulate"),
@@ -562,6 +581,13 @@ impl DenseVolume {
             no,
         );
         let dyn_slots = if dynamic { slots } else { 1 };
+        let kept_words = KEPT_OCCUPANCY_WORD
+            + if windows > 1 {
+                (res as u64).pow(3) + window_slots as u64 * ACCUM_STRIDE
+            } else {
+                1
+            };
+        let kept = storage_buffer(device, "voxel kept window", kept_words * 4, no);
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
         let slot_irradiance = storage_buffer(device, "voxel leaf irradiance", slots * 16, no);
@@ -622,6 +648,7 @@ impl DenseVolume {
             slot_voxel,
             accum: storage_buffer(device, "voxel sums", slots * ACCUM_STRIDE * 4, no),
             dyn_accum: storage_buffer(device, "voxel dynamic sums", dyn_slots * DYN_STRIDE * 4, no),
+            kept,
             dynamic,
             slot_direct,
             slot_next,
@@ -668,6 +695,7 @@ impl DenseVolume {
                     + self.slot_irradiance.size(),
             ),
             ("voxel dynamic sums", self.dyn_accum.size()),
+            ("voxel kept window", self.kept.size()),
             ("voxel filter lists", self.counters.size()),
             ("voxel albedo", w * texture_bytes(res, 4, 1)),
             ("voxel normal", w * texture_bytes(res, 4, 1)),
@@ -794,23 +822,63 @@ impl DenseVolume {
         })
     }
 
+    /// Window `w`'s occupancy before its last build moved it, as `kept` holds it (the moved
+    /// window's light starts from its leaves there: voxels/clipmap/carry.wgsl).
+    pub(crate) fn kept_occupancy(&self) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.kept,
+            offset: KEPT_OCCUPANCY_WORD * 4,
+            size: wgpu::BufferSize::new((self.grid.resolution as u64).pow(3) * 4),
+        })
+    }
+
     /// Records a build from `fragments`: forget the previous build and clear what it filled,
     /// then allocate a slot per occupied voxel, sum its fragments and resolve the finest level.
     /// Records a build of the windows in `rebuild` (a bit each) from `fragments`: every other
     /// window keeps its slots, sums and textures (a clipmap rebuilding the levels that moved).
     /// The last update is taken out of every window first (the static build is what an update
-    /// merges into).
+    /// merges into). With `kept`, window `.0` of them moved by `.1` voxels (its new corner
+    /// minus the old) and keeps the static sums of the voxels it holds in both places: the
+    /// fragments are only those of the voxels newly inside (`Region::all_but_kept`).
     pub(crate) fn build_windows(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         fragments: &Fragments,
         rebuild: u32,
+        kept: Option<(u32, IVec3)>,
         timer: &mut GpuTimer,
     ) {
         let bind = self
             .fragment_bind
             .get(fragments, || self.build_bind_group(device, fragments));
+        copy_fragment_count(encoder, fragments, &self.counters);
+        // Every build says whether it keeps a window: the kernels skip its kept voxels.
+        let kept = kept.filter(|(w, _)| self.windows > 1 && rebuild & (1 << w) != 0);
+        let head: [i32; 4] = match kept {
+            Some((w, by)) => [w as i32 + 1, by.x, by.y, by.z],
+            None => [0; 4],
+        };
+        let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dense_build kept (staging)"),
+            contents: bytemuck::cast_slice(&head),
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.kept, 0, 16);
+        let voxels = (self.grid.resolution as u64).pow(3) * 4;
+        let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
+        // The occupancy with the last update's slots (their light is kept too), the sums
+        // without (below).
+        if let Some((w, _)) = kept {
+            let at = KEPT_OCCUPANCY_WORD * 4;
+            encoder.copy_buffer_to_buffer(
+                &self.occupancy,
+                w as u64 * voxels,
+                &self.kept,
+                at,
+                voxels,
+            );
+        }
         if self.dynamic {
             let u = &self.pipelines.update;
             let restore = [
@@ -819,6 +887,10 @@ impl DenseVolume {
                 (&u.free, Run::One),
             ];
             self.run_steps(encoder, "dense_build", &bind, &restore, timer);
+        }
+        if let Some((w, _)) = kept {
+            let at = KEPT_OCCUPANCY_WORD * 4 + voxels;
+            encoder.copy_buffer_to_buffer(&self.accum, w as u64 * sums, &self.kept, at, sums);
         }
         let mask = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("dense_build windows (staging)"),
@@ -840,11 +912,24 @@ impl DenseVolume {
             encoder.clear_buffer(&self.dyn_accum, 0, None);
         } else {
             // Each window's voxels and slots are one range of their buffers.
-            let voxels = (self.grid.resolution as u64).pow(3) * 4;
-            let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
             for w in (0..self.windows as u64).filter(|w| rebuild & (1 << w) != 0) {
                 encoder.clear_buffer(&self.occupancy, w * voxels, Some(voxels));
                 encoder.clear_buffer(&self.accum, w * sums, Some(sums));
+            }
+        }
+        if let Some((_, by)) = kept {
+            // A thread per voxel of both places.
+            let r = self.grid.resolution as i32;
+            let both = (IVec3::splat(r) - by.abs()).max(IVec3::ZERO);
+            let n = (both.x * both.y * both.z) as u32;
+            if n > 0 {
+                self.run_steps(
+                    encoder,
+                    "dense_build",
+                    &bind,
+                    &[(&b.keep, Run::Over(n))],
+                    timer,
+                );
             }
         }
         let steps = [
@@ -873,6 +958,7 @@ impl DenseVolume {
         let bind = self
             .fragment_bind
             .get(fragments, || self.build_bind_group(device, fragments));
+        copy_fragment_count(encoder, fragments, &self.counters);
         let u = &self.pipelines.update;
         let steps = [
             (&u.begin, Run::Prepare),
@@ -910,6 +996,10 @@ impl DenseVolume {
                     pass.dispatch_workgroups(1, 1, 1);
                 }
                 Run::One => pass.dispatch_workgroups(1, 1, 1),
+                Run::Over(n) => {
+                    let (x, y) = layout::groups_2d(*n, 64);
+                    pass.dispatch_workgroups(x, y, 1);
+                }
                 Run::Indirect(offset) => pass.dispatch_workgroups_indirect(&self.args, *offset),
             }
         }
@@ -929,7 +1019,6 @@ impl DenseVolume {
             entries: &layout::entries(vec![
                 self.volume.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
-                fragments.count.as_entire_binding(),
                 self.counters.as_entire_binding(),
                 self.occupancy.as_entire_binding(),
                 self.slot_voxel.as_entire_binding(),
@@ -939,9 +1028,16 @@ impl DenseVolume {
                 wgpu::BindingResource::TextureView(&e),
                 wgpu::BindingResource::TextureView(&r),
                 self.dyn_accum.as_entire_binding(),
+                self.kept.as_entire_binding(),
             ]),
         })
     }
+}
+
+/// Records the copy of the fragments' count into `counters`' `FRAGMENTS_WORD`, where the build
+/// and update steps read it.
+fn copy_fragment_count(encoder: &mut wgpu::CommandEncoder, f: &Fragments, counters: &wgpu::Buffer) {
+    encoder.copy_buffer_to_buffer(&f.count, 0, counters, FRAGMENTS_WORD * 4, 4);
 }
 
 fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
@@ -951,16 +1047,16 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         entries: &[
             layout::uniform(0, c, false),
             layout::storage(1, c, true),
-            layout::storage(2, c, true),
+            layout::storage(2, c, false),
             layout::storage(3, c, false),
             layout::storage(4, c, false),
             layout::storage(5, c, false),
-            layout::storage(6, c, false),
-            layout::storage_texture_3d(7, ALBEDO_FORMAT),
-            layout::storage_texture_3d(8, NORMAL_FORMAT),
-            layout::storage_texture_3d(9, EMISSION_FORMAT),
-            layout::storage_texture_3d(10, RADIANCE_FORMAT),
-            layout::storage(11, c, false),
+            layout::storage_texture_3d(6, ALBEDO_FORMAT),
+            layout::storage_texture_3d(7, NORMAL_FORMAT),
+            layout::storage_texture_3d(8, EMISSION_FORMAT),
+            layout::storage_texture_3d(9, RADIANCE_FORMAT),
+            layout::storage(10, c, false),
+            layout::storage(11, c, true),
         ],
     })
 }
@@ -990,7 +1086,7 @@ impl VoxelStructure for DenseVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        self.build_windows(device, encoder, fragments, self.every_window(), timer);
+        self.build_windows(device, encoder, fragments, self.every_window(), None, timer);
     }
 
     fn record_update(
