@@ -286,6 +286,12 @@ pub struct GpuScene {
     pub indices: wgpu::Buffer,
     /// One `GpuDraw` per drawn instance.
     pub draws: wgpu::Buffer,
+    /// Per draw, the world box its mesh fills where it is now: two `vec4<f32>`, the lowest
+    /// corner then the highest (w unused). Voxelize skips a draw's triangles outside the
+    /// region it voxelizes without reading them.
+    pub draw_bounds: wgpu::Buffer,
+    /// Per draw, its mesh's box in object space, for `draw_bounds` when it moves.
+    mesh_bounds: Vec<(Vec3, Vec3)>,
     /// Per draw, its model matrix in the previous frame (column-major mat4): the G-buffer's
     /// motion vectors. Brought up to date by `advance_motion`.
     pub prev_models: wgpu::Buffer,
@@ -355,6 +361,18 @@ fn mat(m: Mat4) -> [[f32; 4]; 4] {
 
 /// The draw of an instance with `transform` (its normal matrix the inverse transpose, or the
 /// identity when `transform` is singular).
+/// The world box of the object-space box `(lo, hi)` under `transform`: its lowest and highest
+/// corner as `draw_bounds` holds them.
+fn world_bounds(transform: Mat4, (lo, hi): (Vec3, Vec3)) -> [[f32; 4]; 2] {
+    let (mut a, mut b) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for k in 0..8 {
+        let corner = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+        let p = transform.transform_point3(corner);
+        (a, b) = (a.min(p), b.max(p));
+    }
+    [a.extend(0.0).to_array(), b.extend(0.0).to_array()]
+}
+
 fn gpu_draw(transform: Mat4, material: u32, light: Option<usize>) -> GpuDraw {
     let normal_matrix = transform.inverse().transpose();
     let normal_matrix = if normal_matrix.is_finite() {
@@ -485,6 +503,7 @@ impl GpuScene {
             ranges.push((first..indices.len() as u32, base as i32));
         }
         let mut draws = Vec::with_capacity(scene.instances.len());
+        let mut mesh_bounds = Vec::with_capacity(scene.instances.len());
         let mut calls = Vec::with_capacity(scene.instances.len());
         let mut instance_draw = Vec::with_capacity(scene.instances.len());
         for inst in &scene.instances {
@@ -508,6 +527,13 @@ impl GpuScene {
                 edges,
             });
             draws.push(gpu_draw(inst.transform, mesh.material as u32, inst.light));
+            mesh_bounds.push(
+                mesh.positions
+                    .iter()
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+                        (lo.min(p), hi.max(p))
+                    }),
+            );
         }
         let (textures, layer_of) = upload_textures(device, queue, scene, settings)?;
         let materials: Vec<GpuMaterial> = scene
@@ -579,6 +605,18 @@ impl GpuScene {
                 usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
             }),
             draws: storage("draws", bytemuck::cast_slice(&draws), 144),
+            draw_bounds: storage(
+                "draw bounds",
+                bytemuck::cast_slice(
+                    &draws
+                        .iter()
+                        .zip(&mesh_bounds)
+                        .map(|(d, &b)| world_bounds(Mat4::from_cols_array_2d(&d.model), b))
+                        .collect::<Vec<_>>(),
+                ),
+                32,
+            ),
+            mesh_bounds,
             prev_models: storage("previous models", bytemuck::cast_slice(&models), 64),
             prev_written: models.clone(),
             last_models: models,
@@ -724,6 +762,8 @@ impl GpuScene {
             draw as u64 * size_of::<GpuDraw>() as u64,
             bytemuck::bytes_of(d),
         );
+        let b = world_bounds(transform, self.mesh_bounds[draw as usize]);
+        queue.write_buffer(&self.draw_bounds, draw as u64 * 32, bytemuck::bytes_of(&b));
     }
 
     /// Called once per frame before the G-buffer: `prev_models` takes the models the last
@@ -753,7 +793,10 @@ impl GpuScene {
         vec![
             ("vertices", self.vertices.size()),
             ("indices", self.indices.size()),
-            ("draws", self.draws.size() + self.prev_models.size()),
+            (
+                "draws",
+                self.draws.size() + self.prev_models.size() + self.draw_bounds.size(),
+            ),
             ("materials", self.materials.size()),
             ("lights", self.lights.size()),
             ("points", self.points.size()),

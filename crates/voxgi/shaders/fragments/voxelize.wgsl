@@ -28,6 +28,8 @@
 @group(0) @binding(9) var<storage, read_write> fragment_count: array<atomic<u32>>;
 // Fragments are made in these voxels only.
 @group(0) @binding(10) var<uniform> region: FragmentRegion;
+// Per draw, the world box its mesh fills: lowest corner, highest corner (`GpuScene::draw_bounds`).
+@group(0) @binding(11) var<storage, read> draw_bounds: array<vec4<f32>>;
 
 // The dynamic geometry's pass: a fragment's voxel is filled only by the part of it that lies
 // behind the surface (inside the solid), and the voxel behind it, inside, is filled wholly.
@@ -108,8 +110,24 @@ fn main(
     voxelize_entry(triangles[t], lane, 64u);
 }
 
+// Whether draw `d`'s triangles may make fragments in the region: its box, in voxels and grown
+// by two (the host's rounding of its corners; the voxel behind a dynamic surface), meets the
+// region and does not lie inside its kept box. NaN corners (a degenerate transform) keep it.
+fn draw_in_region(d: u32) -> bool {
+    let lo = (draw_bounds[2u * d].xyz - grid.origin) * grid.inv_voxel_size - 2.0;
+    let hi = (draw_bounds[2u * d + 1u].xyz - grid.origin) * grid.inv_voxel_size + 2.0;
+    let outside = any(hi < vec3<f32>(region.lo)) || any(lo >= vec3<f32>(region.hi + 1u));
+    let kept = all(lo >= vec3<f32>(region.kept_lo)) && all(hi < vec3<f32>(region.kept_hi + 1u));
+    return !(outside || kept);
+}
+
 // Voxelizes table entry `info`: its columns from `first` on, every `stride`-th.
 fn voxelize_entry(info: vec4<u32>, first: u32, stride: u32) {
+    // Most of a large world's triangles lie outside a window, and all but a slab's outside
+    // the voxels a moved window does not keep: skipped before their vertices are read.
+    if !draw_in_region(info.x) {
+        return;
+    }
     let draw = draws[info.x];
     let m = materials[draw.material];
     let ia = indices[info.y] + info.z;

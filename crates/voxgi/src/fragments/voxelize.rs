@@ -40,6 +40,7 @@ impl VoxelizePass {
                 layout::storage(8, c, false),
                 layout::storage(9, c, false),
                 layout::uniform(10, c, false),
+                layout::storage(11, c, true),
             ],
         });
         let layouts = [Some(&layout)];
@@ -96,6 +97,7 @@ impl VoxelizePass {
                         Geometry::Static
                     },
                 ),
+                scene.draw_bounds.as_entire_binding(),
             ]),
         })
     }
