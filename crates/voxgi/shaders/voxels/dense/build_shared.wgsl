@@ -36,7 +36,7 @@
 // A moved window's state from before its build (`DenseVolume::kept`): [0] the window plus one
 // (0: the build keeps none), [1..4] how far it moved (its new corner minus the old, in voxels,
 // i32: a voxel's old index is its new one plus this), from KEPT_OCCUPANCY its occupancy before
-// the build, then its part's static sums (ACCUM_STRIDE words a slot).
+// the build, then its part's slots' voxels, then their static sums (ACCUM_STRIDE words a slot).
 @group(0) @binding(11) var<storage, read> kept: array<u32>;
 // The voxels written since the last filter, listed for the filter (changed.wgsl).
 //!include voxels/changed.wgsl

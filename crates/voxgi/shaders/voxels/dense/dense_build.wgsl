@@ -83,28 +83,20 @@ fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let w = kept[0] - 1u;
     let r = vol.resolution;
-    let by = kept_by();
-    // The box of both places, in the window's new voxels (the host dispatches its size).
-    let lo = max(-by, vec3<i32>(0));
-    let n = vec3<u32>(max(vec3<i32>(i32(r)) - abs(by), vec3<i32>(0)));
-    let i = flat(gid, nwg);
-    if i >= n.x * n.y * n.z {
-        return;
-    }
-    let c = vec3<u32>(lo) + vec3<u32>(i % n.x, (i / n.x) % n.y, i / (n.x * n.y));
-    let v = voxel_index(c + vec3<u32>(0u, 0u, w * r), r);
-    let o = kept[KEPT_OCCUPANCY + kept_index(v)];
-    // Empty, or locked past the capacity.
-    if o < 2u || o == LOCKED {
-        return;
-    }
     let part = window_slots(vol.windows);
-    let t = o - 2u - w * part;
-    // The static geometry's slots (the last update's were freed before the build; `begin`
-    // kept their count).
+    // A thread per static slot the window had (the last update's were freed before the build;
+    // `begin` kept their count), in their order: the leaves keep the order their fragments
+    // gave them, which the lighting passes' workgroups gather in.
+    let t = flat(gid, nwg);
     if t >= min(atomicLoad(&counters[window_word(w, W_PREVIOUS)]), part) {
         return;
     }
+    let old = voxel_coord(kept[KEPT_OCCUPANCY + r * r * r + t] - w * r * r * r, r);
+    let c = vec3<i32>(old) - kept_by();
+    if any(c < vec3<i32>(0)) || any(c >= vec3<i32>(i32(r))) {
+        return;
+    }
+    let v = voxel_index(vec3<u32>(c) + vec3<u32>(0u, 0u, w * r), r);
     // Voxels beyond the capacity stay locked, as `allocate` leaves them.
     atomicStore(&occupancy[v], LOCKED);
     let s = take_slot(v);
@@ -113,7 +105,7 @@ fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     slot_voxel[s] = v;
     atomicStore(&occupancy[v], s + 2u);
-    let sums = KEPT_OCCUPANCY + r * r * r + t * ACCUM_STRIDE;
+    let sums = KEPT_OCCUPANCY + r * r * r + part + t * ACCUM_STRIDE;
     for (var k = 0u; k < ACCUM_STRIDE; k++) {
         atomicStore(&accum[s * ACCUM_STRIDE + k], kept[sums + k]);
     }

@@ -206,8 +206,8 @@ pub struct DenseVolume {
     dyn_accum: wgpu::Buffer,
     /// A moved window's state from before its build, which the build keeps where the window
     /// overlaps its old place (`build_windows`; build_shared.wgsl's `kept`): the window and
-    /// how far it moved, then from `KEPT_OCCUPANCY_WORD` its occupancy, then its part's static
-    /// sums. Only the head for a volume of one window.
+    /// how far it moved, then from `KEPT_OCCUPANCY_WORD` its occupancy, then its part's slots'
+    /// voxels and static sums. Only the head for a volume of one window.
     kept: wgpu::Buffer,
     /// Whether the pools have room for dynamic geometry.
     pub dynamic: bool,
@@ -583,7 +583,7 @@ impl DenseVolume {
         let dyn_slots = if dynamic { slots } else { 1 };
         let kept_words = KEPT_OCCUPANCY_WORD
             + if windows > 1 {
-                (res as u64).pow(3) + window_slots as u64 * ACCUM_STRIDE
+                (res as u64).pow(3) + window_slots as u64 * (1 + ACCUM_STRIDE)
             } else {
                 1
             };
@@ -889,7 +889,11 @@ impl DenseVolume {
             self.run_steps(encoder, "dense_build", &bind, &restore, timer);
         }
         if let Some((w, _)) = kept {
+            let part = self.window_slots as u64 * 4;
             let at = KEPT_OCCUPANCY_WORD * 4 + voxels;
+            let slots = &self.slot_voxel;
+            encoder.copy_buffer_to_buffer(slots, w as u64 * part, &self.kept, at, part);
+            let at = at + part;
             encoder.copy_buffer_to_buffer(&self.accum, w as u64 * sums, &self.kept, at, sums);
         }
         let mask = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -917,20 +921,10 @@ impl DenseVolume {
                 encoder.clear_buffer(&self.accum, w * sums, Some(sums));
             }
         }
-        if let Some((_, by)) = kept {
-            // A thread per voxel of both places.
-            let r = self.grid.resolution as i32;
-            let both = (IVec3::splat(r) - by.abs()).max(IVec3::ZERO);
-            let n = (both.x * both.y * both.z) as u32;
-            if n > 0 {
-                self.run_steps(
-                    encoder,
-                    "dense_build",
-                    &bind,
-                    &[(&b.keep, Run::Over(n))],
-                    timer,
-                );
-            }
+        if kept.is_some() {
+            // A thread per slot of the window's part.
+            let keep = [(&b.keep, Run::Over(self.window_slots))];
+            self.run_steps(encoder, "dense_build", &bind, &keep, timer);
         }
         let steps = [
             (&b.prepare_fragments, Run::Prepare),
