@@ -359,8 +359,6 @@ fn mat(m: Mat4) -> [[f32; 4]; 4] {
     m.to_cols_array_2d()
 }
 
-/// The draw of an instance with `transform` (its normal matrix the inverse transpose, or the
-/// identity when `transform` is singular).
 /// The world box of the object-space box `(lo, hi)` under `transform`: its lowest and highest
 /// corner as `draw_bounds` holds them.
 fn world_bounds(transform: Mat4, (lo, hi): (Vec3, Vec3)) -> [[f32; 4]; 2] {
@@ -373,6 +371,8 @@ fn world_bounds(transform: Mat4, (lo, hi): (Vec3, Vec3)) -> [[f32; 4]; 2] {
     [a.extend(0.0).to_array(), b.extend(0.0).to_array()]
 }
 
+/// The draw of an instance with `transform` (its normal matrix the inverse transpose, or the
+/// identity when `transform` is singular).
 fn gpu_draw(transform: Mat4, material: u32, light: Option<usize>) -> GpuDraw {
     let normal_matrix = transform.inverse().transpose();
     let normal_matrix = if normal_matrix.is_finite() {

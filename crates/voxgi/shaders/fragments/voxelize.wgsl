@@ -112,7 +112,8 @@ fn main(
 
 // Whether draw `d`'s triangles may make fragments in the region: its box, in voxels and grown
 // by two (the host's rounding of its corners; the voxel behind a dynamic surface), meets the
-// region and does not lie inside its kept box. NaN corners (a degenerate transform) keep it.
+// region and does not lie inside its kept box. A box with NaN corners (a transform of NaNs)
+// fails every comparison and is kept.
 fn draw_in_region(d: u32) -> bool {
     let lo = (draw_bounds[2u * d].xyz - grid.origin) * grid.inv_voxel_size - 2.0;
     let hi = (draw_bounds[2u * d + 1u].xyz - grid.origin) * grid.inv_voxel_size + 2.0;

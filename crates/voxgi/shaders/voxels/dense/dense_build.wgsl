@@ -85,8 +85,9 @@ fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let r = vol.resolution;
     let part = window_slots(vol.windows);
     // A thread per static slot the window had (the last update's were freed before the build;
-    // `begin` kept their count), in their order: the leaves keep the order their fragments
-    // gave them, which the lighting passes' workgroups gather in.
+    // `begin` kept their count): the threads take slots about in the old slots' order, so the
+    // leaves keep about the order their fragments gave them, which the lighting passes'
+    // workgroups gather in (in voxel order the town's bounce ran slower).
     let t = flat(gid, nwg);
     if t >= min(atomicLoad(&counters[window_word(w, W_PREVIOUS)]), part) {
         return;

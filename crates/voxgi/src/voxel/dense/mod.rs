@@ -187,8 +187,8 @@ pub struct DenseVolume {
     /// Occupied voxels each window's part of the slots holds (voxels/dense/slots.wgsl).
     pub window_slots: u32,
     /// `[0]` occupied voxels (slots asked for, past the capacity), `[1]` the most a window
-    /// asked for, `[2]` the fragments made (`FRAGMENTS_WORD`), `[3]` and `[4]` slots the dynamic geometry touched in this and the previous
-    /// update (see dense_update.wgsl), `[6]` the voxels above the finest the last filter redid
+    /// asked for, `[2]` the fragments made (`FRAGMENTS_WORD`), `[3]` and `[4]` slots the
+    /// dynamic geometry touched in this and the previous update (see dense_update.wgsl), `[6]` the voxels above the finest the last filter redid
     /// (one for all its directions; 0 when it filtered everything, after a build), `[7]` a bit
     /// per window the next build rebuilds, from `[8]` each level's count of voxels with a
     /// changed child, from `[18]` each window's slot counts (`WINDOW_WORDS`), then the levels'
