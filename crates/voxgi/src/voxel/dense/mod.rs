@@ -188,8 +188,9 @@ pub struct DenseVolume {
     pub window_slots: u32,
     /// `[0]` occupied voxels (slots asked for, past the capacity), `[1]` the most a window
     /// asked for, `[2]` the fragments made (`FRAGMENTS_WORD`), `[3]` and `[4]` slots the
-    /// dynamic geometry touched in this and the previous update (see dense_update.wgsl), `[6]` the voxels above the finest the last filter redid
-    /// (one for all its directions; 0 when it filtered everything, after a build), `[7]` a bit
+    /// dynamic geometry touched in this and the previous update (see dense_update.wgsl), `[6]`
+    /// the voxels above the finest the last filter redid (one for all its directions; 0 when
+    /// it filtered everything, after a build), `[7]` a bit
     /// per window the next build rebuilds, from `[8]` each level's count of voxels with a
     /// changed child, from `[18]` each window's slot counts (`WINDOW_WORDS`), then the levels'
     /// bits and lists (voxels/dense/changed.wgsl).
@@ -822,8 +823,8 @@ impl DenseVolume {
         })
     }
 
-    /// Window `w`'s occupancy before its last build moved it, as `kept` holds it (the moved
-    /// window's light starts from its leaves there: voxels/clipmap/carry.wgsl).
+    /// The occupancy a moved window had before its last build, as `kept` holds it (its new
+    /// leaves' light starts from its leaves there: voxels/clipmap/carry.wgsl).
     pub(crate) fn kept_occupancy(&self) -> wgpu::BindingResource<'_> {
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
             buffer: &self.kept,
