@@ -177,7 +177,7 @@ fn voxelize_entry(info: vec4<u32>, first: u32, stride: u32) {
     let lo = max(vec3<i32>(floor(min(a, min(b, c)))), vec3<i32>(region.lo));
     let hi = min(vec3<i32>(floor(max(a, max(b, c)))), vec3<i32>(region.hi));
     // Nothing, or only voxels a moved window keeps.
-    if any(hi < lo) || (all(lo >= vec3<i32>(region.kept_lo)) && all(hi <= vec3<i32>(region.kept_hi))) {
+    if any(hi < lo) || (in_box(lo, region.kept_lo, region.kept_hi) && in_box(hi, region.kept_lo, region.kept_hi)) {
         return;
     }
     let nu = u32(hi[u] - lo[u] + 1);

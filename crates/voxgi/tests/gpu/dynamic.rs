@@ -197,12 +197,7 @@ fn a_clipmap_that_followed_the_camera_equals_one_made_there() {
     let (scene, _) = cornell_with_cube((0.40, 0.15));
     for (budget, slices) in [(1, 1), (0, 1), (1, 3)] {
         let options = clipmap_options(budget, slices);
-        let levels = |r: &Renderer| {
-            r.structure::<voxgi::voxel::clipmap::Clipmap>()
-                .expect("a clipmap")
-                .levels()
-                .to_vec()
-        };
+        let levels = clipmap_levels;
         let mut r = renderer(&scene, &options);
         let mut p = params(&r);
         frame(&mut r, &p, SIZE, SIZE);
@@ -417,13 +412,29 @@ fn finest_moved_along_the_floor(scene: &Scene, slices: u32) -> (FinestLevel, Fin
         (light, clipmap.levels()[0])
     };
     let mut r = renderer(scene, &clipmap_options(1, slices));
-    let mut p = params(&r);
+    let (before, after, _) = along_the_floor(&mut r, finest);
+    (before, after)
+}
+
+/// `look` at `r` after a frame with the camera just above the floor, and after one with it a
+/// few of the finest window's steps along it (so the window holds floor before and after,
+/// most of it in both places). Returns the second frame's parameters too.
+fn along_the_floor<T>(r: &mut Renderer, look: impl Fn(&Renderer) -> T) -> (T, T, FrameParams) {
+    let mut p = params(r);
     p.camera.position = Vec3::new(0.2, 0.04, 0.3);
-    frame(&mut r, &p, SIZE, SIZE);
-    let before = finest(&r);
+    frame(r, &p, SIZE, SIZE);
+    let before = look(r);
     p.camera.position.x += 0.05;
-    frame(&mut r, &p, SIZE, SIZE);
-    (before, finest(&r))
+    frame(r, &p, SIZE, SIZE);
+    (before, look(r), p)
+}
+
+/// The windows of `r`'s clipmap.
+fn clipmap_levels(r: &Renderer) -> Vec<voxgi::voxel::Grid> {
+    r.structure::<voxgi::voxel::clipmap::Clipmap>()
+        .expect("a clipmap")
+        .levels()
+        .to_vec()
 }
 
 /// A clipmap frame that moves one window voxelizes and builds that window alone: every other
@@ -488,12 +499,7 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
     // Static geometry only: every fragment of the frame is the build's.
     let scene = builtin::cornell_box();
     let options = clipmap_options(1, 1);
-    let levels = |r: &Renderer| {
-        r.structure::<voxgi::voxel::clipmap::Clipmap>()
-            .expect("a clipmap")
-            .levels()
-            .to_vec()
-    };
+    let levels = clipmap_levels;
     // The window coordinates of `r`'s last fragments.
     let cells = |r: &Renderer| -> Vec<[u32; 3]> {
         let f = r.fragments();
@@ -510,15 +516,7 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
             .collect()
     };
     let mut r = renderer(&scene, &options);
-    let mut p = params(&r);
-    // Just above the floor, then a few of the finest window's steps along it: most of the
-    // window's voxels lie in both places.
-    p.camera.position = Vec3::new(0.2, 0.04, 0.3);
-    frame(&mut r, &p, SIZE, SIZE);
-    let before = levels(&r);
-    p.camera.position.x += 0.05;
-    frame(&mut r, &p, SIZE, SIZE);
-    let after = levels(&r);
+    let (before, after, p) = along_the_floor(&mut r, levels);
     assert_eq!(
         moved_windows(&before, &after),
         vec![0],

@@ -86,24 +86,19 @@ fn slot_limit() -> u32 {
 const REBUILD: u32 = 7u;
 const FRAGMENTS: u32 = 2u;
 const KEPT_OCCUPANCY: u32 = 64u;
-const NOT_KEPT: u32 = 0xffffffffu;
 
 fn kept_by() -> vec3<i32> {
     return vec3<i32>(bitcast<i32>(kept[1]), bitcast<i32>(kept[2]), bitcast<i32>(kept[3]));
 }
 
-// Voxel `v`'s index at the kept window's old place when the build keeps it (it lies in both
-// places), NOT_KEPT otherwise.
-fn kept_index(v: u32) -> u32 {
+// Whether the build keeps voxel `v` (it lies in the kept window's old place too).
+fn kept_voxel(v: u32) -> bool {
     let r = vol.resolution;
     if kept[0] == 0u || window_of_voxel(v) != kept[0] - 1u {
-        return NOT_KEPT;
+        return false;
     }
     let old = vec3<i32>(voxel_coord(v % (r * r * r), r)) + kept_by();
-    if any(old < vec3<i32>(0)) || any(old >= vec3<i32>(i32(r))) {
-        return NOT_KEPT;
-    }
-    return voxel_index(vec3<u32>(old), r);
+    return all(old >= vec3<i32>(0)) && all(old < vec3<i32>(i32(r)));
 }
 
 // The window voxel `v` (a linear index through the stacked cubes) lies in.

@@ -120,7 +120,7 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     }
     let v = voxel_index(unpack_coord(fragments[i].coord), vol.resolution);
     // A kept voxel has its sums (a fragment there would count twice).
-    if !rebuilding(window_of_voxel(v)) || kept_index(v) != NOT_KEPT {
+    if !rebuilding(window_of_voxel(v)) || kept_voxel(v) {
         return;
     }
     // The first fragment of a voxel takes it; the weak exchange may fail spuriously, so retry
@@ -152,7 +152,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let f = fragments[i];
     let v = voxel_index(unpack_coord(f.coord), vol.resolution);
     let o = atomicLoad(&occupancy[v]);
-    if o < 2u || o == LOCKED || !rebuilding(window_of_voxel(v)) || kept_index(v) != NOT_KEPT {
+    if o < 2u || o == LOCKED || !rebuilding(window_of_voxel(v)) || kept_voxel(v) {
         return;
     }
     add_fragment(o - 2u, f, false);
