@@ -78,11 +78,12 @@ fn leaf_direct_light(i: u32) -> vec4<f32> {
 }
 
 // Whether leaf `i`'s direct light may differ from what the last injection left: when it is
-// new, when dynamic geometry moved through its voxel, or when a shadow lookup of
+// new (and did not keep its voxel's light through the build: `leaf_direct_kept`), when dynamic
+// geometry moved through its voxel, or when a shadow lookup of
 // `leaf_direct_light` reads a texel that changed (lights.wgsl's `irradiance_reads`, which
 // follows the lookups exactly). Everything else it reads is as it was.
 fn leaf_inputs_changed(i: u32) -> bool {
-    if params.all != 0u || leaf_is_new(i) {
+    if params.all != 0u || (leaf_is_new(i) && !leaf_direct_kept(i)) {
         return true;
     }
     let center = leaf_center(i);
@@ -137,7 +138,8 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if leaf_inputs_changed(s) {
         let k = atomicAdd(&todo[0], 1u);
         atomicStore(&todo[1u + k], s);
-    } else if STORE_RADIANCE && params.store_all != 0u {
+    } else if STORE_RADIANCE && (params.store_all != 0u || leaf_is_new(s)) {
+        // A new leaf's voxel holds nothing yet, even where it kept its light.
         store_leaf_radiance(s, leaf_direct[s]);
     }
 }

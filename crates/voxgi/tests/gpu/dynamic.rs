@@ -579,6 +579,69 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
     );
 }
 
+/// A moved clipmap window's voxels that it held in both places keep their direct light: the
+/// frame's injection lights only the leaves newly inside (the scene and its lights still), and
+/// the kept leaves' light is what a clipmap made where the camera is now computes.
+#[test]
+fn a_moved_clipmap_window_keeps_the_direct_light_of_the_voxels_it_held() {
+    let scene = builtin::cornell_box();
+    let options = clipmap_options(1, 1);
+    let c = ctx();
+    // The finest window's filled slots: per voxel, its direct light; and how many the last
+    // build kept (slots.wgsl's W_KEPT: word 18 + 3).
+    let finest = |r: &Renderer| -> (std::collections::HashMap<u32, [f32; 4]>, u32, u32) {
+        let v = r
+            .structure::<voxgi::voxel::clipmap::Clipmap>()
+            .unwrap()
+            .volume();
+        let read = |b: &wgpu::Buffer| readback::read_buffer_copy(&c.device, &c.queue, b).unwrap();
+        let (words, slots, light) = (read(&v.counters), read(&v.slot_voxel), read(&v.slot_direct));
+        let words: &[u32] = bytemuck::cast_slice(&words);
+        let slots: &[u32] = bytemuck::cast_slice(&slots);
+        let light: &[[f32; 4]] = bytemuck::cast_slice(&light);
+        let filled = words[18].min(v.window_slots) as usize;
+        let map = (0..filled).map(|s| (slots[s], light[s])).collect();
+        (map, filled as u32, words[18 + 3])
+    };
+    let mut r = renderer(&scene, &options);
+    let (before, after, p) = along_the_floor(&mut r, clipmap_levels);
+    assert_eq!(
+        moved_windows(&before, &after),
+        vec![0],
+        "the finest moved alone"
+    );
+    let relit = r.relit_leaves().unwrap();
+    let (moved, filled, kept) = finest(&r);
+    assert!(kept > 0 && kept < filled, "{kept} of {filled} leaves kept");
+    eprintln!("relit {relit} leaves; the moved window holds {filled}, {kept} of them kept");
+    // Nothing else changed: exactly the new leaves are lit.
+    assert_eq!(relit, (filled - kept) as u64, "the leaves lit anew");
+    let mut fresh = renderer(&scene, &options);
+    frame(&mut fresh, &p, SIZE, SIZE);
+    assert_eq!(
+        clipmap_levels(&fresh)[0],
+        after[0],
+        "the fresh clipmap's finest window"
+    );
+    let (made, _, none) = finest(&fresh);
+    assert_eq!(none, 0, "a fresh build keeps nothing");
+    assert_eq!(made.len(), moved.len(), "the leaves of both");
+    // Kept light was lit at the same world point from the old corner: the leaf's centre may
+    // round an ulp apart, and the soft shadow's weights move with it (5e-5 of the light when
+    // written); a leaf handed another voxel's light is off by far more than 1e-3.
+    let mut worst = 0.0f32;
+    for (v, a) in &moved {
+        let b = made
+            .get(v)
+            .unwrap_or_else(|| panic!("voxel {v} not in the fresh window"));
+        for k in 0..4 {
+            worst = worst.max((a[k] - b[k]).abs() / b[k].abs().max(1e-3));
+        }
+    }
+    eprintln!("the largest relative difference in direct light: {worst}");
+    assert!(worst < 1e-3, "kept direct light {worst} off a fresh one's");
+}
+
 /// The clipmap tests' options: five levels of automatic voxel size (the coarsest spans four
 /// times the box's cube, the finest a quarter of it), `budget` windows a frame, `slices`.
 fn clipmap_options(budget: u32, slices: u32) -> RendererOptions {

@@ -36,8 +36,10 @@
 // A moved window's state from before its build (`DenseVolume::kept`): [0] the window plus one
 // (0: the build keeps none), [1..4] how far it moved (its new corner minus the old, in voxels,
 // i32: a voxel's old index is its new one plus this), from KEPT_OCCUPANCY its occupancy before
-// the build, then its part's slots' voxels, then their static sums (ACCUM_STRIDE words a slot).
-@group(0) @binding(11) var<storage, read> kept: array<u32>;
+// the build, then its part's slots' voxels, then their static sums (ACCUM_STRIDE words a slot),
+// then their direct light (four words a slot), then the direct light `keep` hands on, by the
+// slot the voxel holds now (the host copies it into the leaves' after the step).
+@group(0) @binding(11) var<storage, read_write> kept: array<u32>;
 // The voxels written since the last filter, listed for the filter (changed.wgsl).
 //!include voxels/changed.wgsl
 //!include voxels/slots.wgsl

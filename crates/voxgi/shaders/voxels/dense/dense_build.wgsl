@@ -7,7 +7,8 @@
 //   begin           remember each rebuilt window's slot count, reset it; the clear's dispatch
 //   clear_previous  zero the voxels the rebuilt windows filled (cheaper than clearing N^3)
 //   keep            a moved window's voxels that lay in it before: their slots again, with
-//                   their static sums (the fragments are only the other voxels')
+//                   their static sums (the fragments are only the other voxels') and their
+//                   direct light
 //   prepare_fragments / prepare_slots  indirect dispatch sizes from the counters
 //   allocate        one slot per occupied voxel, in its window's part of the pool
 //   accumulate      integer sums per slot
@@ -42,6 +43,13 @@ fn begin() {
 
 @compute @workgroup_size(1)
 fn prepare_fragments() {
+    // Every slot a rebuilt window holds so far is one `keep` took (the first of its part).
+    let c = window_slots(vol.windows);
+    for (var w = 0u; w < vol.windows; w++) {
+        if rebuilding(w) {
+            atomicStore(&counters[window_word(w, W_KEPT)], min(atomicLoad(&counters[window_word(w, W_COUNT)]), c));
+        }
+    }
     // The build's fragments are the static geometry's: updates take those past them.
     atomicStore(&counters[5], atomicLoad(&counters[FRAGMENTS]));
     write_args(3u, stored_fragments());
@@ -109,6 +117,12 @@ fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let sums = KEPT_OCCUPANCY + r * r * r + part + t * ACCUM_STRIDE;
     for (var k = 0u; k < ACCUM_STRIDE; k++) {
         atomicStore(&accum[s * ACCUM_STRIDE + k], kept[sums + k]);
+    }
+    // Its direct light, unless the lights or what moved change it (inject decides).
+    let direct = KEPT_OCCUPANCY + r * r * r + part * (1u + ACCUM_STRIDE);
+    let handed = direct + 4u * part + 4u * (s - w * part);
+    for (var k = 0u; k < 4u; k++) {
+        kept[handed + k] = kept[direct + 4u * t + k];
     }
 }
 

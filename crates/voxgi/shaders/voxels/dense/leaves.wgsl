@@ -8,6 +8,9 @@
 //   fn leaf_is_new(i) -> bool                     made by the last update or a build of
 //                                                 part of the structure: its slot held
 //                                                 another leaf before (or none)
+//   fn leaf_direct_kept(i) -> bool                new, but its direct light is that of the
+//                                                 leaf that held its voxel before the build
+//                                                 (a moved window's voxels in both places)
 //   fn leaf_coord(i) -> vec3<u32>                 the leaf's finest-grid voxel
 //   fn leaf_center(i) -> vec3<f32>                its centre, metres
 //   fn leaf_size(i) -> f32                        its edge, metres
@@ -54,6 +57,13 @@ fn leaf_exists(i: u32) -> bool {
 // (`leaf_window_rebuilt` of voxels/<kind>/placement.wgsl).
 fn leaf_is_new(i: u32) -> bool {
     return !slot_static(i, leaf_grid.windows) || leaf_window_rebuilt(i / window_slots(leaf_grid.windows));
+}
+
+// The build's `keep` handed these slots their voxel's direct light from before the move.
+fn leaf_direct_kept(i: u32) -> bool {
+    let c = window_slots(leaf_grid.windows);
+    let w = i / c;
+    return leaf_window_rebuilt(w) && i - w * c < atomicLoad(&counters[window_word(w, W_KEPT)]);
 }
 
 fn leaf_coord(i: u32) -> vec3<u32> {

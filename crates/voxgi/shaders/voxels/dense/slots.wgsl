@@ -3,8 +3,10 @@
 // that a clipmap can rebuild one level while the others keep their slots and their light. Its
 // words in the volume's counters (`counters`, array<atomic<u32>>, and `slot_voxel`, declared
 // by the includer), from WINDOW_WORDS, per window: the slots it asked for (counted past C),
-// those before its last build (cleared by the next), and its static geometry's (below them the
-// build's, above them the last update's). `DenseVolume`'s counters layout is the twin.
+// those before its last build (cleared by the next), its static geometry's (below them the
+// build's, above them the last update's), and those its last build kept from before a move
+// (the first of its part: dense_build's `keep` takes them before any other). `DenseVolume`'s
+// counters layout is the twin.
 
 const WINDOW_WORDS: u32 = 18u;
 const MAX_WINDOWS: u32 = 8u;
@@ -12,6 +14,7 @@ const WINDOW_STRIDE: u32 = 4u;
 const W_COUNT: u32 = 0u;
 const W_PREVIOUS: u32 = 1u;
 const W_STATIC: u32 = 2u;
+const W_KEPT: u32 = 3u;
 
 fn window_word(w: u32, k: u32) -> u32 {
     return WINDOW_WORDS + w * WINDOW_STRIDE + k;

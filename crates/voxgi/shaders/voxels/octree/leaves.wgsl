@@ -29,6 +29,11 @@ fn leaf_is_new(i: u32) -> bool {
     return i >= leaf_nodes[STATIC_SLOTS];
 }
 
+// The octree keeps no leaf's light through a build.
+fn leaf_direct_kept(i: u32) -> bool {
+    return false;
+}
+
 fn leaf_coord(i: u32) -> vec3<u32> {
     return unpack_coord(leaf_slots[i * SLOT_STRIDE]);
 }

@@ -208,7 +208,8 @@ pub struct DenseVolume {
     /// A moved window's state from before its build, which the build keeps where the window
     /// overlaps its old place (`build_windows`; build_shared.wgsl's `kept`): the window and
     /// how far it moved, then from `KEPT_OCCUPANCY_WORD` its occupancy, then its part's slots'
-    /// voxels and static sums. Only the head for a volume of one window.
+    /// voxels, static sums and direct light, then the direct light the build's `keep` hands to
+    /// the slots that keep their voxel. Only the head for a volume of one window.
     kept: wgpu::Buffer,
     /// Whether the pools have room for dynamic geometry.
     pub dynamic: bool,
@@ -584,7 +585,7 @@ impl DenseVolume {
         let dyn_slots = if dynamic { slots } else { 1 };
         let kept_words = KEPT_OCCUPANCY_WORD
             + if windows > 1 {
-                (res as u64).pow(3) + window_slots as u64 * (1 + ACCUM_STRIDE)
+                (res as u64).pow(3) + window_slots as u64 * (1 + ACCUM_STRIDE + 2 * 4)
             } else {
                 1
             };
@@ -896,6 +897,10 @@ impl DenseVolume {
             encoder.copy_buffer_to_buffer(slots, w as u64 * part, &self.kept, at, part);
             let at = at + part;
             encoder.copy_buffer_to_buffer(&self.accum, w as u64 * sums, &self.kept, at, sums);
+            let at = at + sums;
+            let direct = part * 4;
+            let light = &self.slot_direct;
+            encoder.copy_buffer_to_buffer(light, w as u64 * direct, &self.kept, at, direct);
         }
         let mask = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("dense_build windows (staging)"),
@@ -922,10 +927,17 @@ impl DenseVolume {
                 encoder.clear_buffer(&self.accum, w * sums, Some(sums));
             }
         }
-        if kept.is_some() {
+        if let Some((w, _)) = kept {
             // A thread per slot of the window's part.
             let keep = [(&b.keep, Run::Over(self.window_slots))];
             self.run_steps(encoder, "dense_build", &bind, &keep, timer);
+            // The kept slots' direct light, by their new slots (the part's other slots are new
+            // leaves: inject lights them).
+            let direct = self.window_slots as u64 * 16;
+            let handed = KEPT_OCCUPANCY_WORD * 4 + voxels + sums + self.window_slots as u64 * 4;
+            let handed = handed + direct;
+            let light = &self.slot_direct;
+            encoder.copy_buffer_to_buffer(&self.kept, handed, light, w as u64 * direct, direct);
         }
         let steps = [
             (&b.prepare_fragments, Run::Prepare),
@@ -1051,7 +1063,7 @@ fn build_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             layout::storage_texture_3d(8, EMISSION_FORMAT),
             layout::storage_texture_3d(9, RADIANCE_FORMAT),
             layout::storage(10, c, false),
-            layout::storage(11, c, true),
+            layout::storage(11, c, false),
         ],
     })
 }
