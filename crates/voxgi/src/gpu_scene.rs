@@ -752,6 +752,16 @@ impl GpuScene {
         }
     }
 
+    /// Draw `draw`'s world box as `draw_bounds` holds it (lowest and highest corner).
+    pub fn draw_box(&self, draw: u32) -> (glam::Vec3, glam::Vec3) {
+        let model = Mat4::from_cols_array_2d(&self.gpu_draws[draw as usize].model);
+        let [lo, hi] = world_bounds(model, self.mesh_bounds[draw as usize]);
+        (
+            glam::Vec4::from(lo).truncate(),
+            glam::Vec4::from(hi).truncate(),
+        )
+    }
+
     /// Writes a new object-to-world transform for draw `draw`.
     pub fn set_transform(&mut self, queue: &wgpu::Queue, draw: u32, transform: Mat4) {
         let d = &mut self.gpu_draws[draw as usize];

@@ -3,7 +3,7 @@
 //! Padding fields (`_…`) are left out of the comparison by name; the offsets around them and
 //! the size still pin them. The octree's layout constants are checked against tree.wgsl's.
 
-use crate::fragments::{GpuFragmentGrid, GpuRegion};
+use crate::fragments::{GpuFragmentGrid, GpuRegion, TableSpan};
 use crate::frame::uniforms::GpuFrame;
 use crate::gpu::shader::compose;
 use crate::gpu_scene::{GpuDraw, GpuLight, GpuMaterial, GpuPoint, GpuVertex};
@@ -263,6 +263,12 @@ fn every_twin_has_the_wgsl_layout() {
         [origin, resolution, voxel_size, inv_voxel_size, z_offset]
     );
     twin!(m, GpuRegion, "FragmentRegion", [lo, hi, kept_lo, kept_hi]);
+    twin!(
+        m,
+        TableSpan,
+        "TableSpan",
+        [small_first, small_count, large_first, large_count]
+    );
     twin!(
         m,
         crate::voxel::clipmap::GpuClipLevels,

@@ -30,6 +30,16 @@
 @group(0) @binding(10) var<uniform> region: FragmentRegion;
 // Per draw, the world box its mesh fills: lowest corner, highest corner (`GpuScene::draw_bounds`).
 @group(0) @binding(11) var<storage, read> draw_bounds: array<vec4<f32>>;
+// The entries this dispatch pair runs (`TableSpan` in fragments/mod.rs, chosen by the dynamic
+// offset): the draws the host found near the region, so the rest of a large world's table
+// costs no thread at all.
+struct TableSpan {
+    small_first: u32,
+    small_count: u32,
+    large_first: u32,
+    large_count: u32,
+}
+@group(0) @binding(12) var<uniform> span: TableSpan;
 
 // The dynamic geometry's pass: a fragment's voxel is filled only by the part of it that lies
 // behind the surface (inside the solid), and the voxel behind it, inside, is filled wholly.
@@ -90,10 +100,10 @@ fn tri_box_overlap(center: vec3<f32>, h: f32, a: vec3<f32>, b: vec3<f32>, c: vec
 @compute @workgroup_size(64)
 fn small(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let t = gid.x + gid.y * nwg.x * 64u;
-    if t >= triangles[0].x {
+    if t >= span.small_count {
         return;
     }
-    voxelize_entry(triangles[1u + t], 0u, 1u);
+    voxelize_entry(triangles[1u + span.small_first + t], 0u, 1u);
 }
 
 // One triangle, or a share of its columns, per workgroup.
@@ -103,11 +113,11 @@ fn main(
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    let t = 1u + triangles[0].x + wg.x + wg.y * nwg.x;
-    if t >= arrayLength(&triangles) {
+    let i = wg.x + wg.y * nwg.x;
+    if i >= span.large_count {
         return;
     }
-    voxelize_entry(triangles[t], lane, 64u);
+    voxelize_entry(triangles[1u + triangles[0].x + span.large_first + i], lane, 64u);
 }
 
 // Whether draw `d`'s triangles may make fragments in the region: its box, in voxels and grown

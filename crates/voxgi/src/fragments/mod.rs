@@ -77,7 +77,14 @@ pub struct FragmentWindow {
     pub grid: wgpu::Buffer,
     /// Where they are made (`FragmentRegion`s, static at 0, dynamic at `REGION_STRIDE`).
     pub regions: wgpu::Buffer,
+    /// The triangle table's spans voxelize runs (`TableSpan`s, `REGION_STRIDE` apart): the
+    /// dynamic table's at 0, the static table's from `REGION_STRIDE` (`set_spans`).
+    pub spans: wgpu::Buffer,
 }
+
+/// The most spans of the static triangle table a window's voxelization runs (`table_spans`
+/// merges the nearest past this).
+pub const MAX_SPANS: usize = 63;
 
 /// Bytes between the two regions of `Fragments::regions` (the largest uniform offset
 /// alignment WebGPU allows a device to ask for).
@@ -111,6 +118,12 @@ impl Fragments {
                     label: Some("fragment regions"),
                     contents: &regions_bytes(Region::all(grid), Region::all(grid)),
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                }),
+                spans: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("voxelize spans"),
+                    size: (1 + MAX_SPANS as u64) * REGION_STRIDE,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
                 }),
             })
             .collect();
@@ -173,6 +186,41 @@ impl Fragments {
             buffer: &self.windows[window].regions,
             offset,
             size: wgpu::BufferSize::new(size_of::<GpuRegion>() as u64),
+        })
+    }
+
+    /// Writes the spans of `geometry`'s triangle table that voxelize runs on grid `window` in
+    /// the next recording (`TriangleTable::spans`; one for the dynamic table, at most
+    /// `MAX_SPANS` for the static one).
+    pub fn set_spans(
+        &self,
+        queue: &wgpu::Queue,
+        window: usize,
+        geometry: Geometry,
+        spans: &[TableSpan],
+    ) {
+        let (at, most) = match geometry {
+            Geometry::Dynamic => (0, 1),
+            Geometry::Static => (REGION_STRIDE, MAX_SPANS),
+        };
+        assert!(spans.len() <= most, "{} voxelize spans", spans.len());
+        let mut bytes = vec![0u8; spans.len() * REGION_STRIDE as usize];
+        for (chunk, s) in bytes.chunks_mut(REGION_STRIDE as usize).zip(spans) {
+            chunk[..16].copy_from_slice(bytemuck::bytes_of(s));
+        }
+        queue.write_buffer(&self.windows[window].spans, at, &bytes);
+    }
+
+    /// The spans a voxelize pass over `geometry`'s table on grid `window` binds (one
+    /// `TableSpan`, its dynamic offset choosing which).
+    pub fn spans(&self, window: usize, geometry: Geometry) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.windows[window].spans,
+            offset: match geometry {
+                Geometry::Static => REGION_STRIDE,
+                Geometry::Dynamic => 0,
+            },
+            size: wgpu::BufferSize::new(size_of::<TableSpan>() as u64),
         })
     }
 
@@ -297,6 +345,111 @@ pub struct TriangleTable {
     pub count: u32,
     /// The dynamic instances' triangles (their fragments carry coverage), or the static ones'.
     pub dynamic: bool,
+    /// Per draw of a static table, in the table's order: its world box and its entries (the
+    /// small ones' and the workgroups', each a range of their list). Empty for a dynamic one.
+    draws: Vec<DrawEntries>,
+}
+
+/// A static draw's world box and its entries in the triangle table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrawEntries {
+    /// Its world box's lowest corner.
+    pub lo: glam::Vec3,
+    /// Its world box's highest corner.
+    pub hi: glam::Vec3,
+    /// Its small entries: `[first, end)` of that list.
+    pub small: [u32; 2],
+    /// Its workgroup entries: `[first, end)` of that list.
+    pub large: [u32; 2],
+}
+
+/// What one dispatch pair of voxelize runs (`TableSpan` in shaders/fragments/voxelize.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct TableSpan {
+    /// The first small entry, within the small entries.
+    pub small_first: u32,
+    /// How many small entries.
+    pub small_count: u32,
+    /// The first workgroup entry, within the workgroup entries.
+    pub large_first: u32,
+    /// How many workgroup entries.
+    pub large_count: u32,
+}
+
+impl TriangleTable {
+    /// Every entry in one span.
+    pub fn whole(&self) -> TableSpan {
+        TableSpan {
+            small_first: 0,
+            small_count: self.small,
+            large_first: 0,
+            large_count: self.count,
+        }
+    }
+
+    /// The spans of a static table that voxelizing `region` of `grid` runs: the entries of
+    /// the draws whose box may reach it (`draw_spans`). A dynamic table's draws move: all of it.
+    pub fn spans(&self, grid: &Grid, region: &Region) -> Vec<TableSpan> {
+        if self.dynamic {
+            return vec![self.whole()];
+        }
+        draw_spans(&self.draws, grid, region, MAX_SPANS)
+    }
+}
+
+/// The spans of `draws`' entries whose draws' boxes may make fragments in `region` of `grid`,
+/// neighbours merged, at most `most` (the nearest merged across the draws between them, whose
+/// entries then run too: voxelize's own box test, `draw_in_region`, skips them). The box test
+/// is voxelize's with a voxel more of margin, so the host never leaves out a draw the GPU
+/// would voxelize.
+pub fn draw_spans(
+    draws: &[DrawEntries],
+    grid: &Grid,
+    region: &Region,
+    most: usize,
+) -> Vec<TableSpan> {
+    if region.is_empty() {
+        return Vec::new();
+    }
+    let reaches = |d: &DrawEntries| {
+        let lo = (d.lo - grid.origin) / grid.voxel_size - 3.0;
+        let hi = (d.hi - grid.origin) / grid.voxel_size + 3.0;
+        // NaN corners fail every comparison: such a draw is run.
+        let outside =
+            (0..3).any(|a| hi[a] < region.lo[a] as f32 || lo[a] >= (region.hi[a] + 1) as f32);
+        let (klo, khi) = region.kept;
+        let kept = (0..3).all(|a| lo[a] >= klo[a] as f32 && hi[a] < (khi[a] + 1) as f32);
+        !(outside || kept)
+    };
+    // Runs of draws, by their index in `draws`.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for (i, _) in draws.iter().enumerate().filter(|(_, d)| reaches(d)) {
+        match runs.last_mut() {
+            Some((_, end)) if *end == i => *end = i + 1,
+            _ => runs.push((i, i + 1)),
+        }
+    }
+    // Too many: merge across the smallest gaps (in draws) first.
+    while runs.len() > most.max(1) {
+        let k = (1..runs.len())
+            .min_by_key(|&k| runs[k].0 - runs[k - 1].1)
+            .expect("two runs or more");
+        runs[k - 1].1 = runs[k].1;
+        runs.remove(k);
+    }
+    runs.iter()
+        .map(|&(a, b)| {
+            let (first, last) = (&draws[a], &draws[b - 1]);
+            TableSpan {
+                small_first: first.small[0],
+                small_count: last.small[1] - first.small[0],
+                large_first: first.large[0],
+                large_count: last.large[1] - first.large[0],
+            }
+        })
+        .filter(|s| s.small_count + s.large_count > 0)
+        .collect()
 }
 
 /// Voxel columns one voxelize workgroup takes at most (512 per thread). A CPU driver
@@ -334,6 +487,7 @@ pub fn triangle_table(
     finest: f32,
 ) -> Result<TriangleTable> {
     let (mut small, mut t): (Vec<[u32; 4]>, Vec<[u32; 4]>) = (Vec::new(), Vec::new());
+    let mut draws = Vec::new();
     for call in scene.calls.iter().filter(|c| c.dynamic == dynamic) {
         // The visible surface of an area light is not voxelized, neither as an emitter (its
         // light reaches surfaces as the light's direct term, shaded per pixel and injected per
@@ -343,6 +497,7 @@ pub fn triangle_table(
         if call.light.is_some() {
             continue;
         }
+        let (small_at, large_at) = (small.len() as u32, t.len() as u32);
         for (first, &edge) in call.indices.clone().step_by(3).zip(&call.edges) {
             // A dynamic instance may be scaled up past its uploaded size: its triangles keep
             // the workgroups that share any number of columns.
@@ -354,6 +509,15 @@ pub fn triangle_table(
             for chunk in 0..n {
                 t.push([call.draw, first, call.base_vertex as u32, chunk | n << 16]);
             }
+        }
+        if !dynamic {
+            let (lo, hi) = scene.draw_box(call.draw);
+            draws.push(DrawEntries {
+                lo,
+                hi,
+                small: [small_at, small.len() as u32],
+                large: [large_at, t.len() as u32],
+            });
         }
     }
     let n = t.len() as u32;
@@ -387,6 +551,7 @@ pub fn triangle_table(
         small: s,
         count: n,
         dynamic,
+        draws,
     })
 }
 
@@ -400,4 +565,96 @@ pub fn allocate(device: &wgpu::Device, grids: &[Grid], wanted: u64) -> Result<Fr
     crate::gpu::checked(device, "voxel fragments", || {
         Fragments::new(device, grids, capacity)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{UVec3, Vec3};
+
+    /// Draws a metre wide along x, 0.5 m apart, each with one small and one large entry.
+    fn row(n: u32) -> Vec<DrawEntries> {
+        (0..n)
+            .map(|i| {
+                let x = i as f32 * 1.5;
+                DrawEntries {
+                    lo: Vec3::new(x, 0.0, 0.0),
+                    hi: Vec3::new(x + 1.0, 1.0, 1.0),
+                    small: [i, i + 1],
+                    large: [i, i + 1],
+                }
+            })
+            .collect()
+    }
+
+    fn grid() -> Grid {
+        Grid {
+            origin: Vec3::ZERO,
+            voxel_size: 0.1,
+            resolution: 256,
+        }
+    }
+
+    #[test]
+    fn spans_run_the_draws_near_the_region_and_merge_neighbours() {
+        let draws = row(10);
+        // x from 3.0 to 6.0 m: draws 2 and 3 meet it, draw 4 (from 6.0 m) only by the margin
+        // (voxelize's two voxels and the host's third), draw 1 (to 2.5 m) not even so.
+        let region = Region {
+            lo: UVec3::new(30, 0, 0),
+            hi: UVec3::new(59, 9, 9),
+            kept: (UVec3::ONE, UVec3::ZERO),
+        };
+        let spans = draw_spans(&draws, &grid(), &region, MAX_SPANS);
+        assert_eq!(
+            spans,
+            vec![TableSpan {
+                small_first: 2,
+                small_count: 3,
+                large_first: 2,
+                large_count: 3,
+            }]
+        );
+        // Draws whose box, grown, lies inside the kept box are left out, splitting the run:
+        // with voxels 0..=99 on x kept (up to 10 m, every y and z), draws 0 to 5 (the last
+        // ends at 8.5 m) are kept, 6 to 9 run (draw 6 ends at 10 m, its box grown past it).
+        let region = Region {
+            kept: (UVec3::new(0, 0, 0), UVec3::new(99, 255, 255)),
+            ..Region::all(&grid())
+        };
+        let mut lifted = draws.clone();
+        for d in &mut lifted {
+            (d.lo.y, d.hi.y, d.lo.z, d.hi.z) = (5.0, 6.0, 5.0, 6.0);
+        }
+        lifted[0].lo.x = 0.5;
+        let spans = draw_spans(&lifted, &grid(), &region, MAX_SPANS);
+        let runs: Vec<(u32, u32)> = spans
+            .iter()
+            .map(|s| (s.small_first, s.small_count))
+            .collect();
+        assert_eq!(runs, vec![(6, 4)]);
+        assert!(draw_spans(&draws, &grid(), &Region::EMPTY, MAX_SPANS).is_empty());
+    }
+
+    #[test]
+    fn too_many_spans_merge_across_the_smallest_gaps() {
+        let mut draws = row(9);
+        // Draws 0, 2, 4, 8 reach the region (the others moved far away): 4 runs.
+        for i in [1, 3, 5, 6, 7] {
+            draws[i].lo += Vec3::splat(100.0);
+            draws[i].hi += Vec3::splat(100.0);
+        }
+        let region = Region::all(&grid());
+        let spans = draw_spans(&draws, &grid(), &region, 2);
+        // The gaps after 0 and 2 are one draw, after 4 three: 0..=4 merge, 8 stays apart.
+        let runs: Vec<(u32, u32)> = spans
+            .iter()
+            .map(|s| (s.small_first, s.small_count))
+            .collect();
+        assert_eq!(runs, vec![(0, 5), (8, 1)]);
+        // A box of NaNs fails every comparison: run, as voxelize runs it.
+        draws[1].lo = Vec3::NAN;
+        let spans = draw_spans(&draws, &grid(), &region, MAX_SPANS);
+        assert_eq!(spans[0].small_count, 3, "{spans:?}");
+    }
 }

@@ -1,7 +1,7 @@
 //! voxelize: every mesh triangle into voxel fragments (conservative, exact overlap). It writes
 //! the fragments and their count, nothing else.
 
-use crate::fragments::{Fragments, Geometry, TriangleTable};
+use crate::fragments::{Fragments, Geometry, REGION_STRIDE, TableSpan, TriangleTable};
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
@@ -41,6 +41,7 @@ impl VoxelizePass {
                 layout::storage(9, c, false),
                 layout::uniform(10, c, false),
                 layout::storage(11, c, true),
+                layout::uniform(12, c, true),
             ],
         });
         let layouts = [Some(&layout)];
@@ -75,6 +76,11 @@ impl VoxelizePass {
         fragments: &Fragments,
         window: usize,
     ) -> wgpu::BindGroup {
+        let geometry = if triangles.dynamic {
+            Geometry::Dynamic
+        } else {
+            Geometry::Static
+        };
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("voxelize"),
             layout: &self.layout,
@@ -89,49 +95,51 @@ impl VoxelizePass {
                 triangles.buffer.as_entire_binding(),
                 fragments.buffer.as_entire_binding(),
                 fragments.count.as_entire_binding(),
-                fragments.region(
-                    window,
-                    if triangles.dynamic {
-                        Geometry::Dynamic
-                    } else {
-                        Geometry::Static
-                    },
-                ),
+                fragments.region(window, geometry),
                 scene.draw_bounds.as_entire_binding(),
+                fragments.spans(window, geometry),
             ]),
         })
     }
 
-    /// Records the pass over `triangles` (a thread per small triangle, a workgroup per other
-    /// table entry), appending to `fragments` and
-    /// its count; clear the count first (`Fragments::record_clear`). A dynamic table's fragments
-    /// carry coverage. Timed as "voxelize".
+    /// Records the pass over `spans` of `triangles` (a thread per small triangle, a workgroup
+    /// per other table entry), appending to `fragments` and its count; clear the count first
+    /// (`Fragments::record_clear`). `spans` are those `Fragments::set_spans` wrote for the
+    /// bind group's window, in order. A dynamic table's fragments carry coverage. Timed as
+    /// "voxelize".
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         triangles: &TriangleTable,
+        spans: &[TableSpan],
         bind: &wgpu::BindGroup,
         timer: &mut GpuTimer,
     ) {
+        if spans.is_empty() {
+            return;
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("voxelize"),
             timestamp_writes: timer.compute("voxelize"),
         });
-        pass.set_bind_group(0, bind, &[]);
-        // Only static tables hold small triangles (`triangle_table`).
-        if triangles.small > 0 {
-            pass.set_pipeline(&self.small);
-            let (x, y) = layout::groups_2d(triangles.small, 64);
-            pass.dispatch_workgroups(x, y, 1);
-        }
-        if triangles.count > 0 {
-            pass.set_pipeline(if triangles.dynamic {
-                &self.dynamic
-            } else {
-                &self.pipeline
-            });
-            let (x, y) = layout::groups_2d(triangles.count, 1);
-            pass.dispatch_workgroups(x, y, 1);
+        let large = if triangles.dynamic {
+            &self.dynamic
+        } else {
+            &self.pipeline
+        };
+        for (k, span) in spans.iter().enumerate() {
+            pass.set_bind_group(0, bind, &[k as u32 * REGION_STRIDE as u32]);
+            // Only static tables hold small triangles (`triangle_table`).
+            if span.small_count > 0 {
+                pass.set_pipeline(&self.small);
+                let (x, y) = layout::groups_2d(span.small_count, 64);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            if span.large_count > 0 {
+                pass.set_pipeline(large);
+                let (x, y) = layout::groups_2d(span.large_count, 1);
+                pass.dispatch_workgroups(x, y, 1);
+            }
         }
     }
 }

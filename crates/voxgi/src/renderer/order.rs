@@ -508,9 +508,13 @@ impl Renderer {
             // where the build has a region.
             let regions = work.build.as_deref().unwrap_or_default();
             let built = |k: usize| regions.get(k).is_some_and(|r| !r.is_empty());
-            for (_, b) in fb.iter().enumerate().filter(|(k, _)| built(*k)) {
-                p.voxelize
-                    .record(encoder, &self.static_triangles, &b.voxelize_static, timer);
+            for (k, b) in fb.iter().enumerate().filter(|(k, _)| built(*k)) {
+                // The table's entries of the draws near the region only.
+                let spans = self.static_triangles.spans(&grids[k], &regions[k]);
+                self.fragments
+                    .set_spans(&self.queue, k, Geometry::Static, &spans);
+                let (table, bind) = (&self.static_triangles, &b.voxelize_static);
+                p.voxelize.record(encoder, table, &spans, bind, timer);
                 p.splat.record(encoder, b.splat_static.as_ref(), timer);
             }
             self.fragments.record_mark(encoder);
@@ -521,9 +525,12 @@ impl Renderer {
         }
         if work.update.is_some() {
             self.fragments.record_truncate(encoder);
-            for b in fb.iter() {
-                p.voxelize
-                    .record(encoder, &self.dynamic_triangles, &b.voxelize_dynamic, timer);
+            let spans = [self.dynamic_triangles.whole()];
+            for (k, b) in fb.iter().enumerate() {
+                self.fragments
+                    .set_spans(&self.queue, k, Geometry::Dynamic, &spans);
+                let (table, bind) = (&self.dynamic_triangles, &b.voxelize_dynamic);
+                p.voxelize.record(encoder, table, &spans, bind, timer);
                 p.splat.record(encoder, b.splat_dynamic.as_ref(), timer);
             }
             self.volume

@@ -145,8 +145,12 @@ impl Sizing<'_> {
                 self.splat
                     .bind(self.device, self.scene, fragments, k, Geometry::Static)
             });
+            let spans = self
+                .triangles
+                .spans(&fragments.grids[k], &Region::all(&fragments.grids[k]));
+            fragments.set_spans(self.queue, k, Geometry::Static, &spans);
             self.voxelize
-                .record(&mut encoder, self.triangles, &voxelize, &mut timer);
+                .record(&mut encoder, self.triangles, &spans, &voxelize, &mut timer);
             self.splat.record(&mut encoder, splat.as_ref(), &mut timer);
         }
         fragments.record_mark(&mut encoder);

@@ -293,8 +293,9 @@ fn inside_a_finer_level_the_coarser_one_reads_its_mips() {
     }
 }
 
-/// Voxelize skips a draw whose box misses the window it voxelizes (voxelize.wgsl's
-/// `draw_in_region`), and no other: every level of a clipmap over cubes inside, astride and
+/// Voxelize skips a draw whose box misses the window it voxelizes (the host's spans of the
+/// table, `TriangleTable::spans`, and voxelize.wgsl's `draw_in_region`), and no other: every
+/// level of a clipmap over cubes inside, astride and
 /// outside its finest window holds the voxels the CPU voxelizer finds there for all of them.
 /// Not to the voxel: the GPU multiplies by the inverse voxel size where the CPU divides, so a
 /// face within rounding of a voxel face may land a layer apart (the cubes' faces lie off the
