@@ -82,8 +82,8 @@ pub struct FragmentWindow {
     pub spans: wgpu::Buffer,
 }
 
-/// The most spans of the static triangle table a window's voxelization runs (`table_spans`
-/// merges the nearest past this).
+/// The most spans of the static triangle table a window's voxelization runs (`draw_spans`
+/// merges across the narrowest gaps past this).
 pub const MAX_SPANS: usize = 63;
 
 /// Bytes between the two regions of `Fragments::regions` (the largest uniform offset
@@ -399,8 +399,8 @@ impl TriangleTable {
 }
 
 /// The spans of `draws`' entries whose draws' boxes may make fragments in `region` of `grid`,
-/// neighbours merged, at most `most` (the nearest merged across the draws between them, whose
-/// entries then run too: voxelize's own box test, `draw_in_region`, skips them). The box test
+/// neighbours merged, at most `most` (merged across the narrowest gaps, whose draws' entries
+/// then run too: voxelize's own box test, `draw_in_region`, skips them). The box test
 /// is voxelize's with a voxel more of margin, so the host never leaves out a draw the GPU
 /// would voxelize.
 pub fn draw_spans(
@@ -430,13 +430,28 @@ pub fn draw_spans(
             _ => runs.push((i, i + 1)),
         }
     }
-    // Too many: merge across the smallest gaps (in draws) first.
-    while runs.len() > most.max(1) {
-        let k = (1..runs.len())
-            .min_by_key(|&k| runs[k].0 - runs[k - 1].1)
-            .expect("two runs or more");
-        runs[k - 1].1 = runs[k].1;
-        runs.remove(k);
+    // Too many: keep apart only at the `most - 1` widest gaps, in table entries (what a gap
+    // merged over costs: its entries' threads, which voxelize's own box test returns).
+    let most = most.max(1);
+    if runs.len() > most {
+        let entries = |a: usize, b: usize| {
+            let (first, last) = (&draws[a], &draws[b - 1]);
+            (last.small[1] - first.small[0]) + (last.large[1] - first.large[0])
+        };
+        let mut gaps: Vec<(u32, usize)> = (1..runs.len())
+            .map(|k| (entries(runs[k - 1].1, runs[k].0), k))
+            .collect();
+        gaps.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+        let mut apart: Vec<usize> = gaps[..most - 1].iter().map(|g| g.1).collect();
+        apart.sort_unstable();
+        let mut merged = Vec::with_capacity(most);
+        let mut start = runs[0].0;
+        for &k in &apart {
+            merged.push((start, runs[k - 1].1));
+            start = runs[k].0;
+        }
+        merged.push((start, runs[runs.len() - 1].1));
+        runs = merged;
     }
     runs.iter()
         .map(|&(a, b)| {

@@ -290,6 +290,9 @@ pub(crate) const WINDOW_WORDS: u64 = 18;
 pub(crate) const MAX_WINDOWS: u64 = 8;
 /// Words per window (`WINDOW_STRIDE` there).
 pub(crate) const WINDOW_STRIDE: u64 = 4;
+/// A window's word counting the slots its last build kept from before a move (`W_KEPT`
+/// there), the last of its words.
+pub(crate) const W_KEPT: u64 = 3;
 /// The windows' words.
 const WINDOW_COUNTER_WORDS: u64 = MAX_WINDOWS * WINDOW_STRIDE;
 

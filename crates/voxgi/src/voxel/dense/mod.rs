@@ -123,10 +123,31 @@ pub const SHARED_CONSTANTS: &[(&str, u64)] = &[
     ("WINDOW_WORDS", filter::WINDOW_WORDS),
     ("MAX_WINDOWS", filter::MAX_WINDOWS),
     ("WINDOW_STRIDE", filter::WINDOW_STRIDE),
+    ("W_KEPT", filter::W_KEPT),
 ];
 
 /// Slot pools more than this many times the last build's count shrink.
 const SHRINK_BELOW: u64 = 4;
+
+/// Bytes of `DenseVolume::kept` per slot of a window's part: its voxel, its static sums and
+/// its direct light twice (as it was, and handed to its new slot).
+const KEPT_SLOT_BYTES: u64 = 4 * (1 + ACCUM_STRIDE + 2 * 4);
+
+/// The most occupied voxels `windows` cubes of `grid` can hold on this device: the per-slot
+/// buffers' limit, and for several windows the moved window's copy (`kept`: its occupancy and
+/// one window's part, bound whole).
+fn slot_limit(device: &wgpu::Device, grid: &Grid, windows: u32) -> u64 {
+    let most = crate::gpu::max_entries(device, SLOT_BYTES);
+    if windows < 2 {
+        return most;
+    }
+    let occupancy = KEPT_OCCUPANCY_WORD * 4 + (grid.resolution as u64).pow(3) * 4;
+    let room = device
+        .limits()
+        .max_storage_buffer_binding_size
+        .saturating_sub(occupancy);
+    most.min(room / KEPT_SLOT_BYTES * windows as u64)
+}
 
 /// Checks a slot capacity (occupied voxels) against the device's storage-buffer limit.
 fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
@@ -285,10 +306,7 @@ impl DenseVolume {
         previous: Option<&DenseVolume>,
     ) -> Result<DenseVolume> {
         check_volume_fits(device, &grid, windows)?;
-        let slots = slot_capacity(
-            device,
-            leaves.min(crate::gpu::max_entries(device, SLOT_BYTES)),
-        )?;
+        let slots = slot_capacity(device, leaves.min(slot_limit(device, &grid, windows)))?;
         let p = match previous {
             Some(v) => v.pipelines.clone(),
             None => checked(device, "pipeline creation", || DensePipelines::new(device))?,
@@ -585,7 +603,7 @@ impl DenseVolume {
         let dyn_slots = if dynamic { slots } else { 1 };
         let kept_words = KEPT_OCCUPANCY_WORD
             + if windows > 1 {
-                (res as u64).pow(3) + window_slots as u64 * (1 + ACCUM_STRIDE + 2 * 4)
+                (res as u64).pow(3) + window_slots as u64 * KEPT_SLOT_BYTES / 4
             } else {
                 1
             };
@@ -931,8 +949,9 @@ impl DenseVolume {
             // A thread per slot of the window's part.
             let keep = [(&b.keep, Run::Over(self.window_slots))];
             self.run_steps(encoder, "dense_build", &bind, &keep, timer);
-            // The kept slots' direct light, by their new slots (the part's other slots are new
-            // leaves: inject lights them).
+            // The kept slots' direct light, by their new slots. The part's other slots take
+            // stale light here, but they are new leaves: a frame with voxel work always injects,
+            // and inject lights every new leaf it was not handed.
             let direct = self.window_slots as u64 * 16;
             let handed = KEPT_OCCUPANCY_WORD * 4 + voxels + sums + self.window_slots as u64 * 4;
             let handed = handed + direct;
@@ -1124,7 +1143,7 @@ impl VoxelStructure for DenseVolume {
     }
 
     fn leaf_limit(&self, device: &wgpu::Device) -> u64 {
-        crate::gpu::max_entries(device, SLOT_BYTES)
+        slot_limit(device, &self.grid, self.windows)
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
