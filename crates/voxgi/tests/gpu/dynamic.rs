@@ -429,6 +429,46 @@ fn along_the_floor<T>(r: &mut Renderer, look: impl Fn(&Renderer) -> T) -> (T, T,
     (before, look(r), p)
 }
 
+/// A clipmap renderer of `scene` after `along_the_floor`, which moves its finest window alone:
+/// the renderer, its windows before and after, and the frame's parameters.
+fn move_the_finest_window(
+    scene: &Scene,
+    options: &RendererOptions,
+) -> (
+    Renderer,
+    Vec<voxgi::voxel::Grid>,
+    Vec<voxgi::voxel::Grid>,
+    FrameParams,
+) {
+    let mut r = renderer(scene, options);
+    let (before, after, p) = along_the_floor(&mut r, clipmap_levels);
+    assert_eq!(
+        moved_windows(&before, &after),
+        vec![0],
+        "the finest moved alone"
+    );
+    (r, before, after, p)
+}
+
+/// A clipmap renderer of `scene` made where `p` puts the camera, after a frame: it voxelizes
+/// every window whole; its finest window is `finest`, where the moved one lies (the coarser
+/// ones may lie elsewhere: a moved clipmap's wait within their steps).
+fn made_there(
+    scene: &Scene,
+    options: &RendererOptions,
+    p: &FrameParams,
+    finest: &voxgi::voxel::Grid,
+) -> Renderer {
+    let mut fresh = renderer(scene, options);
+    frame(&mut fresh, p, SIZE, SIZE);
+    assert_eq!(
+        &clipmap_levels(&fresh)[0],
+        finest,
+        "the fresh clipmap's finest window"
+    );
+    fresh
+}
+
 /// The windows of `r`'s clipmap.
 fn clipmap_levels(r: &Renderer) -> Vec<voxgi::voxel::Grid> {
     r.structure::<voxgi::voxel::clipmap::Clipmap>()
@@ -499,7 +539,6 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
     // Static geometry only: every fragment of the frame is the build's.
     let scene = builtin::cornell_box();
     let options = clipmap_options(1, 1);
-    let levels = clipmap_levels;
     // The window coordinates of `r`'s last fragments.
     let cells = |r: &Renderer| -> Vec<[u32; 3]> {
         let f = r.fragments();
@@ -515,13 +554,7 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
             .map(|w| [w[0] & 1023, (w[0] >> 10) & 1023, (w[0] >> 20) & 1023])
             .collect()
     };
-    let mut r = renderer(&scene, &options);
-    let (before, after, p) = along_the_floor(&mut r, levels);
-    assert_eq!(
-        moved_windows(&before, &after),
-        vec![0],
-        "the finest moved alone"
-    );
+    let (r, before, after, p) = move_the_finest_window(&scene, &options);
     let res = after[0].resolution;
     let by = ((after[0].origin - before[0].origin) / after[0].voxel_size)
         .round()
@@ -538,16 +571,8 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
             "a fragment among the kept voxels {lo}..={hi}: {c:?}"
         );
     }
-    // A clipmap made where the camera is now voxelizes every window whole; its finest window
-    // lies where the moved one does (the coarser ones may lie elsewhere: the moved clipmap's
-    // waited within their steps).
-    let mut fresh = renderer(&scene, &options);
-    frame(&mut fresh, &p, SIZE, SIZE);
-    assert_eq!(
-        levels(&fresh)[0],
-        after[0],
-        "the fresh clipmap's finest window"
-    );
+    // A clipmap made where the camera is now voxelizes every window whole.
+    let fresh = made_there(&scene, &options, &p, &after[0]);
     let whole = cells(&fresh).iter().filter(|c| c[2] < res).count();
     // And both hold the same finest voxels, to the bit.
     let c = ctx();
@@ -603,26 +628,14 @@ fn a_moved_clipmap_window_keeps_the_direct_light_of_the_voxels_it_held() {
         let map = (0..filled).map(|s| (slots[s], light[s])).collect();
         (map, filled as u32, words[18 + 3])
     };
-    let mut r = renderer(&scene, &options);
-    let (before, after, p) = along_the_floor(&mut r, clipmap_levels);
-    assert_eq!(
-        moved_windows(&before, &after),
-        vec![0],
-        "the finest moved alone"
-    );
+    let (r, _, after, p) = move_the_finest_window(&scene, &options);
     let relit = r.relit_leaves().unwrap();
     let (moved, filled, kept) = finest(&r);
     assert!(kept > 0 && kept < filled, "{kept} of {filled} leaves kept");
     eprintln!("relit {relit} leaves; the moved window holds {filled}, {kept} of them kept");
     // Nothing else changed: exactly the new leaves are lit.
     assert_eq!(relit, (filled - kept) as u64, "the leaves lit anew");
-    let mut fresh = renderer(&scene, &options);
-    frame(&mut fresh, &p, SIZE, SIZE);
-    assert_eq!(
-        clipmap_levels(&fresh)[0],
-        after[0],
-        "the fresh clipmap's finest window"
-    );
+    let fresh = made_there(&scene, &options, &p, &after[0]);
     let (made, _, none) = finest(&fresh);
     assert_eq!(none, 0, "a fresh build keeps nothing");
     assert_eq!(made.len(), moved.len(), "the leaves of both");
