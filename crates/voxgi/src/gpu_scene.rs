@@ -6,7 +6,7 @@
 use crate::{Error, RendererOptions, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use voxgi_scene::{AlphaMode, AreaShape, Light, LightKind, Scene, pointcloud};
+use voxgi_scene::{Aabb, AlphaMode, AreaShape, Light, LightKind, Scene, pointcloud};
 use wgpu::util::DeviceExt;
 
 /// Mirrors `Vertex` in shaders/shared/scene.wgsl.
@@ -291,7 +291,7 @@ pub struct GpuScene {
     /// region it voxelizes without reading them.
     pub draw_bounds: wgpu::Buffer,
     /// Per draw, its mesh's box in object space, for `draw_bounds` when it moves.
-    mesh_bounds: Vec<(Vec3, Vec3)>,
+    mesh_bounds: Vec<Aabb>,
     /// Per draw, its model matrix in the previous frame (column-major mat4): the G-buffer's
     /// motion vectors. Brought up to date by `advance_motion`.
     pub prev_models: wgpu::Buffer,
@@ -359,16 +359,11 @@ fn mat(m: Mat4) -> [[f32; 4]; 4] {
     m.to_cols_array_2d()
 }
 
-/// The world box of the object-space box `(lo, hi)` under `transform`: its lowest and highest
-/// corner as `draw_bounds` holds them.
-fn world_bounds(transform: Mat4, (lo, hi): (Vec3, Vec3)) -> [[f32; 4]; 2] {
-    let (mut a, mut b) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for k in 0..8 {
-        let corner = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
-        let p = transform.transform_point3(corner);
-        (a, b) = (a.min(p), b.max(p));
-    }
-    [a.extend(0.0).to_array(), b.extend(0.0).to_array()]
+/// The world box of the object-space box `b` under `transform`: its lowest and highest corner
+/// as `draw_bounds` holds them.
+fn world_bounds(transform: Mat4, b: Aabb) -> [[f32; 4]; 2] {
+    let w = b.transformed(transform);
+    [w.min.extend(0.0).to_array(), w.max.extend(0.0).to_array()]
 }
 
 /// The draw of an instance with `transform` (its normal matrix the inverse transpose, or the
@@ -527,13 +522,10 @@ impl GpuScene {
                 edges,
             });
             draws.push(gpu_draw(inst.transform, mesh.material as u32, inst.light));
-            mesh_bounds.push(
-                mesh.positions
-                    .iter()
-                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-                        (lo.min(p), hi.max(p))
-                    }),
-            );
+            mesh_bounds.push(mesh.positions.iter().fold(Aabb::EMPTY, |mut b, &p| {
+                b.grow(p);
+                b
+            }));
         }
         let (textures, layer_of) = upload_textures(device, queue, scene, settings)?;
         let materials: Vec<GpuMaterial> = scene
@@ -753,13 +745,9 @@ impl GpuScene {
     }
 
     /// Draw `draw`'s world box as `draw_bounds` holds it (lowest and highest corner).
-    pub fn draw_box(&self, draw: u32) -> (glam::Vec3, glam::Vec3) {
+    pub fn draw_box(&self, draw: u32) -> Aabb {
         let model = Mat4::from_cols_array_2d(&self.gpu_draws[draw as usize].model);
-        let [lo, hi] = world_bounds(model, self.mesh_bounds[draw as usize]);
-        (
-            glam::Vec4::from(lo).truncate(),
-            glam::Vec4::from(hi).truncate(),
-        )
+        self.mesh_bounds[draw as usize].transformed(model)
     }
 
     /// Writes a new object-to-world transform for draw `draw`.

@@ -82,6 +82,14 @@ pub struct FragmentWindow {
     pub spans: wgpu::Buffer,
 }
 
+/// Where `geometry`'s spans begin in `FragmentWindow::spans`.
+fn spans_offset(geometry: Geometry) -> u64 {
+    match geometry {
+        Geometry::Dynamic => 0,
+        Geometry::Static => REGION_STRIDE,
+    }
+}
+
 /// The most spans of the static triangle table a window's voxelization runs (`draw_spans`
 /// merges across the narrowest gaps past this).
 pub const MAX_SPANS: usize = 63;
@@ -199,15 +207,16 @@ impl Fragments {
         geometry: Geometry,
         spans: &[TableSpan],
     ) {
-        let (at, most) = match geometry {
-            Geometry::Dynamic => (0, 1),
-            Geometry::Static => (REGION_STRIDE, MAX_SPANS),
+        let most = match geometry {
+            Geometry::Dynamic => 1,
+            Geometry::Static => MAX_SPANS,
         };
         assert!(spans.len() <= most, "{} voxelize spans", spans.len());
         let mut bytes = vec![0u8; spans.len() * REGION_STRIDE as usize];
         for (chunk, s) in bytes.chunks_mut(REGION_STRIDE as usize).zip(spans) {
             chunk[..16].copy_from_slice(bytemuck::bytes_of(s));
         }
+        let at = spans_offset(geometry);
         queue.write_buffer(&self.windows[window].spans, at, &bytes);
     }
 
@@ -216,10 +225,7 @@ impl Fragments {
     pub fn spans(&self, window: usize, geometry: Geometry) -> wgpu::BindingResource<'_> {
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
             buffer: &self.windows[window].spans,
-            offset: match geometry {
-                Geometry::Static => REGION_STRIDE,
-                Geometry::Dynamic => 0,
-            },
+            offset: spans_offset(geometry),
             size: wgpu::BufferSize::new(size_of::<TableSpan>() as u64),
         })
     }
@@ -526,10 +532,10 @@ pub fn triangle_table(
             }
         }
         if !dynamic {
-            let (lo, hi) = scene.draw_box(call.draw);
+            let b = scene.draw_box(call.draw);
             draws.push(DrawEntries {
-                lo,
-                hi,
+                lo: b.min,
+                hi: b.max,
                 small: [small_at, small.len() as u32],
                 large: [large_at, t.len() as u32],
             });

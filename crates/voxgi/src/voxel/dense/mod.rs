@@ -133,6 +133,36 @@ const SHRINK_BELOW: u64 = 4;
 /// its direct light twice (as it was, and handed to its new slot).
 const KEPT_SLOT_BYTES: u64 = 4 * (1 + ACCUM_STRIDE + 2 * 4);
 
+/// Where the regions of `DenseVolume::kept` begin, in bytes (build_shared.wgsl's `kept`),
+/// for windows of `resolution`³ voxels and `window_slots` slots: after the head, the moved
+/// window's occupancy, then per slot of its part its voxel, its static sums, its direct light
+/// and the direct light `keep` hands to its new slot; `end` is the buffer's size.
+struct KeptLayout {
+    occupancy: u64,
+    slots: u64,
+    sums: u64,
+    direct: u64,
+    handed: u64,
+    end: u64,
+}
+
+fn kept_layout(resolution: u32, window_slots: u32) -> KeptLayout {
+    let part = window_slots as u64;
+    let occupancy = KEPT_OCCUPANCY_WORD * 4;
+    let slots = occupancy + (resolution as u64).pow(3) * 4;
+    let sums = slots + part * 4;
+    let direct = sums + part * ACCUM_STRIDE * 4;
+    let handed = direct + part * 16;
+    KeptLayout {
+        occupancy,
+        slots,
+        sums,
+        direct,
+        handed,
+        end: slots + part * KEPT_SLOT_BYTES,
+    }
+}
+
 /// The most occupied voxels `windows` cubes of `grid` can hold on this device: the per-slot
 /// buffers' limit, and for several windows the moved window's copy (`kept`: its occupancy and
 /// one window's part, bound whole).
@@ -141,11 +171,10 @@ fn slot_limit(device: &wgpu::Device, grid: &Grid, windows: u32) -> u64 {
     if windows < 2 {
         return most;
     }
-    let occupancy = KEPT_OCCUPANCY_WORD * 4 + (grid.resolution as u64).pow(3) * 4;
     let room = device
         .limits()
         .max_storage_buffer_binding_size
-        .saturating_sub(occupancy);
+        .saturating_sub(kept_layout(grid.resolution, 0).slots);
     most.min(room / KEPT_SLOT_BYTES * windows as u64)
 }
 
@@ -601,13 +630,13 @@ impl DenseVolume {
             no,
         );
         let dyn_slots = if dynamic { slots } else { 1 };
-        let kept_words = KEPT_OCCUPANCY_WORD
-            + if windows > 1 {
-                (res as u64).pow(3) + window_slots as u64 * KEPT_SLOT_BYTES / 4
-            } else {
-                1
-            };
-        let kept = storage_buffer(device, "voxel kept window", kept_words * 4, no);
+        // Only the head for one window.
+        let kept_bytes = if windows > 1 {
+            kept_layout(res, window_slots).end
+        } else {
+            KEPT_OCCUPANCY_WORD * 4 + 4
+        };
+        let kept = storage_buffer(device, "voxel kept window", kept_bytes, no);
         let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
         let slot_irradiance = storage_buffer(device, "voxel leaf irradiance", slots * 16, no);
@@ -847,7 +876,7 @@ impl DenseVolume {
     pub(crate) fn kept_occupancy(&self) -> wgpu::BindingResource<'_> {
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
             buffer: &self.kept,
-            offset: KEPT_OCCUPANCY_WORD * 4,
+            offset: kept_layout(self.grid.resolution, 0).occupancy,
             size: wgpu::BufferSize::new((self.grid.resolution as u64).pow(3) * 4),
         })
     }
@@ -887,17 +916,15 @@ impl DenseVolume {
         encoder.copy_buffer_to_buffer(&staging, 0, &self.kept, 0, 16);
         let voxels = (self.grid.resolution as u64).pow(3) * 4;
         let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
+        let at = kept_layout(self.grid.resolution, self.window_slots);
+        // Per slot of a window's part: its voxel, its direct light.
+        let (part, direct) = (self.window_slots as u64 * 4, self.window_slots as u64 * 16);
         // The occupancy with the last update's slots (their light is kept too), the sums
         // without (below).
         if let Some((w, _)) = kept {
-            let at = KEPT_OCCUPANCY_WORD * 4;
-            encoder.copy_buffer_to_buffer(
-                &self.occupancy,
-                w as u64 * voxels,
-                &self.kept,
-                at,
-                voxels,
-            );
+            let occupancy = &self.occupancy;
+            let w = w as u64;
+            encoder.copy_buffer_to_buffer(occupancy, w * voxels, &self.kept, at.occupancy, voxels);
         }
         if self.dynamic {
             let u = &self.pipelines.update;
@@ -909,16 +936,10 @@ impl DenseVolume {
             self.run_steps(encoder, "dense_build", &bind, &restore, timer);
         }
         if let Some((w, _)) = kept {
-            let part = self.window_slots as u64 * 4;
-            let at = KEPT_OCCUPANCY_WORD * 4 + voxels;
-            let slots = &self.slot_voxel;
-            encoder.copy_buffer_to_buffer(slots, w as u64 * part, &self.kept, at, part);
-            let at = at + part;
-            encoder.copy_buffer_to_buffer(&self.accum, w as u64 * sums, &self.kept, at, sums);
-            let at = at + sums;
-            let direct = part * 4;
-            let light = &self.slot_direct;
-            encoder.copy_buffer_to_buffer(light, w as u64 * direct, &self.kept, at, direct);
+            let (w, kept) = (w as u64, &self.kept);
+            encoder.copy_buffer_to_buffer(&self.slot_voxel, w * part, kept, at.slots, part);
+            encoder.copy_buffer_to_buffer(&self.accum, w * sums, kept, at.sums, sums);
+            encoder.copy_buffer_to_buffer(&self.slot_direct, w * direct, kept, at.direct, direct);
         }
         let mask = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("dense_build windows (staging)"),
@@ -952,11 +973,8 @@ impl DenseVolume {
             // The kept slots' direct light, by their new slots. The part's other slots take
             // stale light here, but they are new leaves: a frame with voxel work always injects,
             // and inject lights every new leaf it was not handed.
-            let direct = self.window_slots as u64 * 16;
-            let handed = KEPT_OCCUPANCY_WORD * 4 + voxels + sums + self.window_slots as u64 * 4;
-            let handed = handed + direct;
             let light = &self.slot_direct;
-            encoder.copy_buffer_to_buffer(&self.kept, handed, light, w as u64 * direct, direct);
+            encoder.copy_buffer_to_buffer(&self.kept, at.handed, light, w as u64 * direct, direct);
         }
         let steps = [
             (&b.prepare_fragments, Run::Prepare),
