@@ -647,12 +647,12 @@ impl Renderer {
             if pools != self.pools {
                 continue;
             }
-            let counts = VoxelCounts {
-                fragments: words[0] as u64,
-                occupied: words[1] as u64,
-            };
             let mut pools = [0u32; POOL_COUNTERS];
             pools.copy_from_slice(&words[1..1 + POOL_COUNTERS]);
+            let counts = VoxelCounts {
+                fragments: words[0] as u64,
+                occupied: self.volume.occupied(&pools),
+            };
             self.last_counts = Some(counts);
             let frags = self.fragments.capacity as u64;
             let grow_volume = self.volume.needs_growth(&pools);
@@ -702,13 +702,16 @@ impl Renderer {
     /// Voxel statistics of the last build, read back now. This waits for the GPU: it is for
     /// tools and tests, never called by a frame.
     pub fn voxel_counts(&self) -> Result<VoxelCounts> {
-        let read = |b: &wgpu::Buffer| -> Result<u64> {
+        let read = |b: &wgpu::Buffer| -> Result<[u32; POOL_COUNTERS]> {
             let bytes = readback::read_buffer_copy(&self.device, &self.queue, b)?;
-            Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[0] as u64)
+            let mut words = [0u32; POOL_COUNTERS];
+            let n = (bytes.len() / 4).min(POOL_COUNTERS);
+            words[..n].copy_from_slice(&bytemuck::cast_slice::<u8, u32>(&bytes)[..n]);
+            Ok(words)
         };
         Ok(VoxelCounts {
-            fragments: read(&self.fragments.count)?,
-            occupied: read(self.volume.pool_counter())?,
+            fragments: read(&self.fragments.count)?[0] as u64,
+            occupied: self.volume.occupied(&read(self.volume.pool_counter())?),
         })
     }
 

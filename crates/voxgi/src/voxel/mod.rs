@@ -143,6 +143,11 @@ pub trait VoxelStructure: wgpu::WasmNotSendSync {
     fn leaf_capacity(&self) -> u64;
     /// The most leaves its pools can hold on `device` (its storage-buffer limit).
     fn leaf_limit(&self, device: &wgpu::Device) -> u64;
+    /// The occupied finest voxels among what a build counted (`pool_counter`'s words): the
+    /// leaves, unless the structure holds some voxels twice.
+    fn occupied(&self, counted: &[u32; POOL_COUNTERS]) -> u64 {
+        counted[0] as u64
+    }
     /// Whether a build that counted `counted` (`pool_counter`'s words) overflowed a pool.
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool;
     /// Makes room for what a build counted; the contents are lost (the next build refills
@@ -356,8 +361,9 @@ pub struct Filtering {
     pub ndf: bool,
 }
 
-/// Words of `VoxelStructure::pool_counter` read back after each build.
-pub const POOL_COUNTERS: usize = 4;
+/// Words of `VoxelStructure::pool_counter` read back after each build (the octree's sixth: the
+/// slots of its static build, `octree::STATIC_COUNTED`).
+pub const POOL_COUNTERS: usize = 6;
 
 /// Mirrors `Volume` in shaders/shared/volume.wgsl.
 #[repr(C)]

@@ -61,6 +61,7 @@ fn params(r: &Renderer) -> FrameParams {
 /// sums). The octree's atlases are left out: bricks a previous build used and this one does
 /// not keep their texels, which nothing reads.
 fn volume_bytes(r: &Renderer) -> Vec<(&'static str, Vec<u8>)> {
+    const HIDDEN: u32 = u32::MAX;
     let c = ctx();
     if let Some(o) = r.structure::<voxgi::voxel::octree::OctreeVolume>() {
         let nodes = readback::read_buffer_copy(&c.device, &c.queue, &o.nodes).expect("nodes");
@@ -69,11 +70,12 @@ fn volume_bytes(r: &Renderer) -> Vec<(&'static str, Vec<u8>)> {
         let slots = readback::read_buffer_copy(&c.device, &c.queue, &o.slots).expect("slots");
         let slots: &[u32] = bytemuck::cast_slice(&slots);
         // Each leaf but for its parent's node index (word 1), which depends on the pools'
-        // sizes and so on the scene's estimate.
+        // sizes and so on the scene's estimate: whether it is hidden (a static leaf an
+        // update's slot stands in for) instead.
         let leaves: Vec<u32> = slots
             .chunks_exact(voxgi::voxel::octree::SLOT_WORDS as usize)
             .take(words[0] as usize)
-            .flat_map(|s| [&s[..1], &s[2..]].concat())
+            .flat_map(|s| [&s[..1], &[(s[1] == HIDDEN) as u32], &s[2..]].concat())
             .collect();
         return vec![
             ("nodes", format!("{walked:?}").into_bytes()),
@@ -184,6 +186,19 @@ fn sequence_of_moves(options: &RendererOptions) {
         }
         let what = &format!("{what} ({:?}, {} bounces)", options.voxels, options.bounces);
         assert_like_fresh(&mut r, &scene, options, what);
+        if let Some(o) = r.structure::<voxgi::voxel::octree::OctreeVolume>() {
+            // The cube stands on the floor: some of its voxels are the floor's too, and the
+            // update gives those slots of its own (the static ones hidden), which the next
+            // update's clear must give back for the sequence to end like a fresh octree.
+            let c = ctx();
+            let nodes = readback::read_buffer_copy(&c.device, &c.queue, &o.nodes).expect("nodes");
+            let stood_in =
+                bytemuck::cast_slice::<u8, u32>(&nodes)[voxgi::voxel::octree::STOOD_IN_COUNTED];
+            assert!(
+                stood_in > 0,
+                "{what}: no voxel shared by the cube and the floor"
+            );
+        }
     }
 }
 

@@ -22,9 +22,11 @@ struct Level {
 @group(0) @binding(7) var odd_out: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(8) var<uniform> level: Level;
 // The build's scratch: first, per workgroup of `count`, its marked nodes, then (after `scan`)
-// the marked nodes before it (`block_words()` of them); then per leaf slot ACCUM_STRIDE sums of
-// its fragments. A static scene's build makes it and drops it after; a dynamic scene keeps it
-// (its updates add to the static leaves' sums).
+// the marked nodes before it (`block_words()` of them); then per leaf slot from STATIC_SLOTS
+// on, ACCUM_STRIDE words: the sums of its fragments, and (in an update) 1 + the static slot
+// it stands in for. A build makes one for all its slots and drops it after; a dynamic scene
+// keeps one for the slots its updates may add (the last update's are read by the next one's
+// clear).
 @group(0) @binding(9) var<storage, read_write> scratch: array<atomic<u32>>;
 // The top grid (voxels/octree/tree.wgsl): per depth down to GRID_DEPTH, the node at each
 // position, 0 where none.
@@ -54,9 +56,23 @@ fn block_words() -> u32 {
     return tree.tiles / 8u + 2u;
 }
 
-// Where slot s's sums begin in the scratch.
+// Where slot s's sums begin in the scratch: a build's from slot 0 (STATIC_SLOTS is 0 while it
+// runs), an update's from the first slot after the static build's.
 fn sums_of(s: u32) -> u32 {
-    return block_words() + s * ACCUM_STRIDE;
+    return block_words() + (s - atomicLoad(&nodes[STATIC_SLOTS])) * ACCUM_STRIDE;
+}
+
+// Whether slot s (at least STATIC_SLOTS) has its sums in the scratch: a dynamic scene's scratch
+// holds the slots its pools leave for updates, which a static build larger than the one the
+// pools were sized for may leave fewer of.
+fn sums_fit(s: u32) -> bool {
+    return block_words() + (s - atomicLoad(&nodes[STATIC_SLOTS]) + 1u) * ACCUM_STRIDE <= arrayLength(&scratch);
+}
+
+// Whether leaf slot s is a static one whose voxel the running update's dynamic geometry shares
+// (`flag` hides it: a slot of the update takes the voxel, with the sums of both).
+fn shared_static(s: u32) -> bool {
+    return s < atomicLoad(&nodes[STATIC_SLOTS]) && atomicLoad(&slots[s * SLOT_STRIDE + 1u]) == HIDDEN;
 }
 
 fn stored_fragments() -> u32 {
@@ -181,7 +197,7 @@ fn class_capacity(c: u32) -> u32 {
 @compute @workgroup_size(1)
 fn mark() {
     let c = brick_class(tree.depth - 1u - level.t);
-    atomicStore(&nodes[4], atomicLoad(&nodes[1u + c]));
+    atomicStore(&nodes[ALLOC_START], atomicLoad(&nodes[1u + c]));
 }
 
 var<workgroup> ranks: array<u32, 64>;
@@ -212,7 +228,10 @@ fn marked(n: u32) -> bool {
         return false;
     }
     let c = child(n);
-    return select(c >= NEEDED, c == CONTENT, level.t == tree.depth);
+    if level.t == tree.depth {
+        return c == CONTENT || (c != 0u && c < NEEDED && shared_static(c - 1u));
+    }
+    return c >= NEEDED;
 }
 
 @compute @workgroup_size(64)
@@ -264,8 +283,8 @@ fn allocate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoca
     }
     let c = brick_class(tree.depth - 1u - level.t);
     // Counted past the capacity, so the host sees how many tiles the class needs.
-    atomicMax(&nodes[1u + c], atomicLoad(&nodes[4]) + r + 1u);
-    let k = atomicLoad(&nodes[4]) + r;
+    atomicMax(&nodes[1u + c], atomicLoad(&nodes[ALLOC_START]) + r + 1u);
+    let k = atomicLoad(&nodes[ALLOC_START]) + r;
     if k >= class_capacity(c) {
         atomicStore(&nodes[child_word(tree, n)], 0u);
         return;
@@ -374,15 +393,31 @@ fn allocate_slots(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_
         return;
     }
     atomicMax(&nodes[0], s + 1u);
-    if s >= tree.slots {
-        atomicStore(&nodes[child_word(tree, n)], 0u);
+    let info = tiles[(n / 8u) * TILE_WORDS] | ((n % 8u) << 29u);
+    // A voxel a static leaf holds (shared with the update's geometry), or 0.
+    let held = atomicLoad(&nodes[child_word(tree, n)]);
+    let stands_in = select(0u, held, held != CONTENT);
+    if s >= tree.slots || !sums_fit(s) {
+        // No room: a shared voxel keeps its static leaf (shown again), a new one stays empty.
+        atomicStore(&nodes[child_word(tree, n)], stands_in);
+        if stands_in != 0u {
+            atomicStore(&slots[(stands_in - 1u) * SLOT_STRIDE + 1u], info);
+        }
+        // Within the pool but past the scratch: the slot stays unlit and the next clear skips it.
+        if s < tree.slots {
+            atomicStore(&slots[s * SLOT_STRIDE + 1u], HIDDEN);
+        }
         return;
     }
     atomicStore(&nodes[child_word(tree, n)], s + 1u);
     atomicStore(&slots[s * SLOT_STRIDE], pack_coord(node_coord(n)));
-    atomicStore(&slots[s * SLOT_STRIDE + 1u], tiles[(n / 8u) * TILE_WORDS] | ((n % 8u) << 29u));
-    for (var k = 0u; k < ACCUM_STRIDE; k++) {
+    atomicStore(&slots[s * SLOT_STRIDE + 1u], info);
+    for (var k = 0u; k < FRAGMENT_SUMS + 1u; k++) {
         atomicStore(&scratch[sums_of(s) + k], 0u);
+    }
+    atomicStore(&scratch[sums_of(s) + STANDS_IN], stands_in);
+    if stands_in != 0u {
+        atomicAdd(&nodes[STOOD_IN], 1u);
     }
 }
 
@@ -398,8 +433,13 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     if node == NONE {
         return;
     }
-    let v = child(node);
-    if v == 0u || v >= NEEDED {
+    add_fragment(f, child(node));
+}
+
+// Adds fragment f into the sums of the leaf whose child word is v, if it has sums: every slot
+// in a build, the update's own slots in an update (a static leaf's attributes are its build's).
+fn add_fragment(f: Fragment, v: u32) {
+    if v == 0u || v >= NEEDED || v - 1u < atomicLoad(&nodes[STATIC_SLOTS]) {
         return;
     }
     let base = sums_of(v - 1u);
@@ -417,13 +457,13 @@ fn prepare_slots() {
 
 @compute @workgroup_size(64)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    // A build resolves every slot; an update the slots of its box's voxels (the new ones, and
-    // the static ones its fragments may have added to).
+    // A build resolves every slot; an update its own slots, by the voxels of its box.
     var s = flat(gid, nwg);
     if atomicLoad(&nodes[UPDATING]) != 0u {
         let n = node_for_thread(s, tree.depth);
         let v = select(0u, child(n), n != NONE);
-        s = select(NONE, v - 1u, v != 0u && v < NEEDED);
+        let own = v != 0u && v < NEEDED && v - 1u >= atomicLoad(&nodes[STATIC_SLOTS]);
+        s = select(NONE, v - 1u, own);
     }
     if s >= min(atomicLoad(&nodes[0]), tree.slots) {
         return;
@@ -471,7 +511,7 @@ fn store_value(m: u32, o: u32, lvl: u32, block: u32, v: vec4<f32>) {
 // (RANGES in a build, DYN_RANGES in an update); returns how many.
 fn record_new_tiles(ranges: u32) -> u32 {
     let c = brick_class(tree.depth - 1u - level.t);
-    let start = atomicLoad(&nodes[4]);
+    let start = atomicLoad(&nodes[ALLOC_START]);
     let end = min(atomicLoad(&nodes[1u + c]), class_capacity(c));
     let count = select(0u, end - start, end > start);
     let u = level.t + 1u;

@@ -20,8 +20,9 @@ fn leaf_slot(t: u32) -> u32 {
     return select(NO_LEAF, t, leaf_exists(t));
 }
 
+// A static leaf whose voxel an update's slot holds (with its dynamic geometry) is hidden.
 fn leaf_exists(i: u32) -> bool {
-    return i < min(leaf_nodes[0], leaf_tree.slots);
+    return i < min(leaf_nodes[0], leaf_tree.slots) && leaf_slots[i * SLOT_STRIDE + 1u] != HIDDEN;
 }
 
 // An update hands out the slots after the static build's anew (octree_update.wgsl).

@@ -27,7 +27,7 @@
 
 @compute @workgroup_size(1)
 fn begin() {
-    for (var i = 0u; i < 4u; i++) {
+    for (var i = 0u; i <= STOOD_IN; i++) {
         atomicStore(&nodes[i], 0u);
     }
     // Depth 0 is the root tile: tile 0, whose node 0 is the root.

@@ -4,9 +4,13 @@
 // an update starts by dropping the last one's). In the order the host runs them:
 //   begin_clear, clear_leaves, clear_nodes
 //            zero the texels the last update's leaves and nodes wrote into the static bricks
-//            (their own bricks go with them); the host then copies the static build's nodes,
-//            leaves and top grid back over the last update's (the static tiles' records
-//            are never written)
+//            (their own bricks go with them); the leaves' voxels get their static child words
+//            back (none, or the static leaf a slot stood in for, shown again)
+//   restore  per depth, what the last update wrote into static records: the child pointer of
+//            a static node it gave a tile, the -axis neighbour of a static node beside one of
+//            its nodes, its nodes' top-grid entries (the host then copies the static build's
+//            header of counters back). No copy of the static nodes or leaves is kept: an update
+//            writes into them only these words, whose static values are known (0, or the slot)
 //   begin_update, bounds
 //            the ranges and dispatch sizes of this update, and the box of its fragments
 // then per depth t as octree_build, but from the dynamic fragments only:
@@ -16,13 +20,17 @@
 //            the marked nodes, static or dynamic, take tiles after the static ones, ranked by
 //            their position in the box (the marks lie in it), so the cost follows what moved
 //   repair   a static node whose negative neighbour is one of the new nodes points to it
-// and at depth D: the new voxels take slots after the static ones, the fragments' sums are
-// added (into a static leaf's, when they share its voxel), and the box's leaves are resolved.
+// and at depth D: the new voxels take slots after the static ones, and so do the voxels a
+// static leaf holds that the dynamic fragments reach (the static leaf is hidden, not changed);
+// the dynamic fragments' sums are added, then the static fragments' in those shared voxels
+// (accumulate_static: the integer sums do not depend on the order, so the shared leaf is a
+// build's to the bit), and the update's leaves are resolved.
 
 //!include voxels/build_shared.wgsl
 
 const ARGS_NEW: u32 = 39u;
 const ARGS_CLEAR: u32 = 72u;
+const ARGS_STATIC: u32 = 75u;
 
 @compute @workgroup_size(1)
 fn begin_clear() {
@@ -43,8 +51,23 @@ fn clear_leaves(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let info = atomicLoad(&slots[s * SLOT_STRIDE + 1u]);
-    store_value(info & 0x1fffffffu, info >> 29u, 0u, 0u, vec4<f32>(0.0));
-    flag_node(info & 0x1fffffffu);
+    // A slot counted past the room for its sums was never given its voxel.
+    if !sums_fit(s) || info == HIDDEN {
+        return;
+    }
+    let parent = info & 0x1fffffffu;
+    store_value(parent, info >> 29u, 0u, 0u, vec4<f32>(0.0));
+    flag_node(parent);
+    // The voxel's static child word: none, or the static leaf this slot stood in for (its
+    // parent is the same node). The node may lie in a tile of the last update: no matter.
+    let tile = child(parent);
+    let stands_in = atomicLoad(&scratch[sums_of(s) + STANDS_IN]);
+    if tile != 0u && tile < NEEDED {
+        atomicStore(&nodes[child_word(tree, tile * 8u + (info >> 29u))], stands_in);
+    }
+    if stands_in != 0u {
+        atomicStore(&slots[(stands_in - 1u) * SLOT_STRIDE + 1u], info);
+    }
 }
 
 // The last update's nodes of depth level.t: each zeroes its value, every direction, in its
@@ -67,6 +90,42 @@ fn clear_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     // m may be a static node that keeps no children now: its value is to be redone.
     flag_node(m);
+}
+
+// The last update's nodes of depth level.t (after clear_nodes of every depth, which reach the
+// bricks through the child pointers this resets): each one's parent had no children in the
+// static build (else it would not have taken a new tile); a static node on its positive side
+// had no -axis neighbour there (the position was empty); the top grid had no node there.
+@compute @workgroup_size(64)
+fn restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let u = level.t;
+    let i = flat(gid, nwg);
+    if i >= atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]) * 8u {
+        return;
+    }
+    let n = atomicLoad(&nodes[DYN_RANGES + 2u * u]) * 8u + i;
+    atomicStore(&nodes[child_word(tree, tiles[(n / 8u) * TILE_WORDS])], 0u);
+    let c = node_coord(n);
+    if u <= grid_depth(tree) {
+        grid[grid_index(c, u)] = 0u;
+    }
+    // `repair`'s writes (above the leaves, which keep no neighbours).
+    if u >= tree.depth {
+        return;
+    }
+    let side = 1u << u;
+    for (var a = 0u; a < 3u; a++) {
+        if (((n % 8u) >> a) & 1u) == 0u || c[a] + 1u >= side {
+            continue;
+        }
+        var p = c;
+        p[a] += 1u;
+        // Reached through static nodes only, whose child pointers nothing resets.
+        let m = node_at(p, u);
+        if m != NONE && atomicLoad(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a]) == n {
+            atomicStore(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a], 0u);
+        }
+    }
 }
 
 @compute @workgroup_size(1)
@@ -128,8 +187,13 @@ fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     if t == tree.depth {
-        // A voxel a static leaf holds already keeps its slot (the sums are added to it).
-        mark_node(n, CONTENT);
+        // A voxel a static leaf holds is hidden for one of the update's slots to take it.
+        let v = child(n);
+        if v != 0u && v < NEEDED && v - 1u < atomicLoad(&nodes[STATIC_SLOTS]) {
+            atomicStore(&slots[(v - 1u) * SLOT_STRIDE + 1u], HIDDEN);
+        } else {
+            mark_node(n, CONTENT);
+        }
         return;
     }
     // The node and its seven negative neighbours (their bricks hold its voxels as a border),
@@ -152,6 +216,34 @@ fn flag(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         if k == 0u || around[k] != 0u {
             mark_node(around[k], NEEDED);
         }
+    }
+}
+
+// The dispatch over the static fragments, when the update shares any voxel with a static leaf.
+@compute @workgroup_size(1)
+fn prepare_static() {
+    let any_shared = atomicLoad(&nodes[STOOD_IN]) > 0u;
+    write_args(ARGS_STATIC, select(0u, min(atomicLoad(&nodes[FIRST_FRAGMENT]), stored_fragments()), any_shared));
+}
+
+// The static fragments in the voxels the update shares with static leaves (a slot of the
+// update stands in for each): their sums join the dynamic ones (add_fragment leaves the
+// static leaves' alone). Fragments outside the update's box return before descending.
+@compute @workgroup_size(64)
+fn accumulate_static(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat(gid, nwg);
+    if i >= min(atomicLoad(&nodes[FIRST_FRAGMENT]), stored_fragments()) {
+        return;
+    }
+    let f = fragments[i];
+    let c = unpack_coord(f.coord);
+    let b = update_box(tree.depth);
+    if any(c < b.lo) || any(c >= b.lo + b.size) {
+        return;
+    }
+    let node = descend(c, tree.depth);
+    if node != NONE {
+        add_fragment(f, child(node));
     }
 }
 

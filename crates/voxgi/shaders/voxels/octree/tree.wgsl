@@ -75,13 +75,16 @@ struct Octree {
 // The node buffer starts with a header of counters, so that every pass reaching the nodes
 // reaches them too (one storage binding fewer: inject's stage holds the minimum eight): [0]
 // leaf slots, [1..4] tiles of classes V, E and O (all counted past the capacity: the host
-// reads these four back to grow the pools), [4] where the tiles of the depth being allocated
-// start in their class, [STATIC_SLOTS] the static build's slots, [FIRST_FRAGMENT] the first
-// fragment the running build or update reads, [UPDATING] 1 during an update; from [RANGES],
-// per depth t, the first tile and the number of tiles of the static build, from
-// [DYN_RANGES] those of the last update (after the static ones in each class); from [BOX] the
-// box of the update's fragments.
+// reads these back to grow the pools), [STOOD_IN] the static leaves the last update's slots
+// stand in for (hidden: the host counts the occupied voxels without them), [STATIC_SLOTS] the
+// static build's slots (read back too: updates keep sums only for the slots after them),
+// [FIRST_FRAGMENT] the first fragment the running build or update reads, [UPDATING] 1 during
+// an update; from [RANGES], per depth t, the first tile and the number of tiles of the static
+// build, from [DYN_RANGES] those of the last update (after the static ones in each class);
+// from [BOX] the box of the update's fragments; [ALLOC_START] where the tiles of the depth
+// being allocated start in their class.
 const NODE_HEADER: u32 = 64u;
+const STOOD_IN: u32 = 4u;
 const STATIC_SLOTS: u32 = 5u;
 const FIRST_FRAGMENT: u32 = 6u;
 const UPDATING: u32 = 7u;
@@ -90,6 +93,7 @@ const DYN_RANGES: u32 = 32u;
 // [BOX..BOX + 3] and [BOX + 3..BOX + 6]: the smallest and largest finest-voxel coordinates of
 // an update's fragments (octree_update.wgsl's `bounds`).
 const BOX: u32 = 54u;
+const ALLOC_START: u32 = 60u;
 const NODE_STRIDE: u32 = 4u;
 // Node 2 of the root tile stands above the root: its child pointer names the brick of level D,
 // the whole volume as one voxel (the dense volume's top mip), filtered from the root's brick.
@@ -134,9 +138,13 @@ const NONE: u32 = 0xffffffffu;
 // Per leaf slot, u32: packed coordinate, parent node | octant << 29, albedo (rgba8unorm),
 // normal (rgba8snorm), emission and the surface's distance (2 x f16 each).
 const SLOT_STRIDE: u32 = 6u;
-// Per leaf slot, the build's sums of its fragments (voxels/octree/build_shared.wgsl's
-// `scratch`, which only builds and updates bind).
-const ACCUM_STRIDE: u32 = 13u;
+// Per leaf slot, the build's sums of its fragments and the static slot an update's slot stands
+// in for (voxels/octree/build_shared.wgsl's `scratch`, which only builds and updates bind).
+const ACCUM_STRIDE: u32 = 14u;
+const STANDS_IN: u32 = 13u;
+// Word 1 of a static leaf slot while an update's slot stands in for it: no pass lights it, and
+// the next update's clear gives it back its parent.
+const HIDDEN: u32 = 0xffffffffu;
 
 fn octant_of(c: vec3<u32>, shift: u32) -> u32 {
     let b = (c >> vec3<u32>(shift)) & vec3<u32>(1u);

@@ -2,7 +2,7 @@
 //! root, and the dynamic geometry merged into the static build.
 
 use super::*;
-use tree::{ARGS_CLEAR, ARGS_NEW};
+use tree::{ARGS_CLEAR, ARGS_NEW, ARGS_STATIC};
 
 impl OctreeVolume {
     pub(super) fn build_bind_group(
@@ -44,18 +44,11 @@ impl OctreeVolume {
         fragments: &Fragments,
         timer: &mut GpuTimer,
     ) {
-        // A dynamic scene keeps its scratch for the updates; a static scene's lives for this
-        // build (wgpu keeps it until the GPU is done with it).
-        let bind = match &self.updates {
-            Some(u) => self.fragment_bind.get(fragments, || {
-                self.build_bind_group(device, fragments, &u.scratch)
-            }),
-            None => {
-                let bytes = scratch_bytes(self.layout.tiles as u64, self.pools.slots as u64);
-                let scratch = storage_buffer(device, "octree build sums", bytes);
-                self.build_bind_group(device, fragments, &scratch)
-            }
-        };
+        // The build's sums live for this build (wgpu keeps them until the GPU is done with
+        // them); a dynamic scene keeps sums only for the slots its updates add.
+        let bytes = scratch_bytes(self.layout.tiles as u64, self.pools.slots as u64);
+        let scratch = storage_buffer(device, "octree build sums", bytes);
+        let bind = self.build_bind_group(device, fragments, &scratch);
         let args = &self.args_bind;
         let b = &self.pipelines.build;
         let depth = self.depth();
@@ -87,17 +80,8 @@ impl OctreeVolume {
         encoder.clear_buffer(&self.top_grid, 0, None);
         self.run_steps(encoder, "octree_build", &bind, args, &steps, timer);
         if let Some(u) = &self.updates {
-            for (live, copy) in self.base_buffers(&u.scratch).iter().zip(&u.snapshot) {
-                encoder.copy_buffer_to_buffer(live, 0, copy, 0, live.size());
-            }
+            encoder.copy_buffer_to_buffer(&self.nodes, 0, &u.header, 0, u.header.size());
         }
-    }
-
-    /// The buffers an update starts from the static build's copy of, with the dynamic
-    /// scene's `scratch`. Not the tiles: an update writes only the records of its own tiles,
-    /// after the static ones.
-    fn base_buffers<'a>(&'a self, scratch: &'a wgpu::Buffer) -> [&'a wgpu::Buffer; 4] {
-        [&self.nodes, &self.slots, &self.top_grid, scratch]
     }
 
     /// Records `steps` in one compute pass timed as `label`: each dispatch reads what the one
@@ -130,10 +114,10 @@ impl OctreeVolume {
     }
 
     /// Records an update by the dynamic fragments (those after the static build's): the last
-    /// update's texels in the static bricks are zeroed, the static build's nodes, leaves and
-    /// top grid come back from their copy, and the dynamic fragments are merged in depth by
-    /// depth (octree_update.wgsl). Without a copy (a scene with no dynamic instances) it is a
-    /// build.
+    /// update's texels in the static bricks are zeroed and its writes into the static nodes
+    /// and leaves undone, the static build's header comes back from its copy, and the dynamic
+    /// fragments are merged in depth by depth (octree_update.wgsl). A scene with no dynamic
+    /// instances builds instead.
     pub(super) fn update(
         &self,
         device: &wgpu::Device,
@@ -160,10 +144,12 @@ impl OctreeVolume {
         for t in 1..=depth {
             clear.push((&u.clear_nodes, t, over_new(t)));
         }
-        self.run_steps(encoder, "octree_update", &bind, args, &clear, timer);
-        for (live, copy) in self.base_buffers(&base.scratch).iter().zip(&base.snapshot) {
-            encoder.copy_buffer_to_buffer(copy, 0, live, 0, live.size());
+        // After every depth's clear: those reach the bricks through the pointers this resets.
+        for t in 1..=depth {
+            clear.push((&u.restore, t, over_new(t)));
         }
+        self.run_steps(encoder, "octree_update", &bind, args, &clear, timer);
+        encoder.copy_buffer_to_buffer(&base.header, 0, &self.nodes, 0, base.header.size());
         let mut steps: Vec<(&wgpu::ComputePipeline, u32, Run)> = vec![
             (&u.begin_update, 0, Run::Prepare),
             (&u.bounds, 0, Run::Indirect(0)),
@@ -190,6 +176,8 @@ impl OctreeVolume {
             (&u.scan, depth, Run::One),
             (&u.allocate_slots, depth, over_nodes(depth)),
             (&u.accumulate, depth, Run::Indirect(0)),
+            (&u.prepare_static, depth, Run::Prepare),
+            (&u.accumulate_static, depth, Run::Indirect(ARGS_STATIC * 4)),
             (&u.prepare_slots, depth, Run::Prepare),
             // Over the box's voxels (prepare_depth's size), not every slot.
             (&u.resolve, depth, over_nodes(depth)),

@@ -23,7 +23,7 @@ mod pools;
 mod tree;
 
 pub use pipelines::OctreePipelines;
-pub use pools::OctreePools;
+pub use pools::{OctreePools, STATIC_COUNTED, STOOD_IN_COUNTED};
 #[cfg(test)]
 pub(crate) use tree::SHARED_CONSTANTS;
 pub use tree::{
@@ -386,10 +386,11 @@ impl OctreeVolume {
             filter_group(&even_atlas, &odd_atlas),
         ];
         let updates = dynamic.then(|| {
-            let scratch = storage_buffer(device, "octree build sums", scratch_bytes(tiles, slots));
-            let snapshot = [&nodes, &slot_buf, &top_grid, &scratch]
-                .map(|b| storage_buffer(device, "octree static snapshot", b.size()));
-            UpdateBase { scratch, snapshot }
+            let bytes = scratch_bytes(tiles, pools.update_slots() as u64);
+            UpdateBase {
+                scratch: storage_buffer(device, "octree update sums", bytes),
+                header: storage_buffer(device, "octree static header", NODE_HEADER * 4),
+            }
         });
         let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("octree_build args"),
@@ -522,16 +523,10 @@ impl OctreeVolume {
                     + self.leaf_irradiance.size(),
             ),
             (
-                "octree build sums (dynamic scenes)",
-                self.updates.as_ref().map_or(0, |u| u.scratch.size()),
-            ),
-            (
-                "octree static copy (dynamic scenes)",
+                "octree update sums (dynamic scenes)",
                 self.updates
-                    .iter()
-                    .flat_map(|u| &u.snapshot)
-                    .map(|b| b.size())
-                    .sum(),
+                    .as_ref()
+                    .map_or(0, |u| u.scratch.size() + u.header.size()),
             ),
             ("octree even atlas", texels(&self.even_atlas)),
             ("octree odd atlas", texels(&self.odd_atlas)),
@@ -553,7 +548,7 @@ impl VoxelStructure for OctreeVolume {
     }
 
     fn bind_fragments(&mut self, device: &wgpu::Device, fragments: &Fragments) {
-        // A static scene's scratch lives for one build: its bind group is made with it.
+        // The updates' bind group; a build makes its own, with sums for all its slots.
         if let Some(u) = &self.updates {
             let bind = self.build_bind_group(device, fragments, &u.scratch);
             self.fragment_bind.set(fragments, bind);
@@ -596,6 +591,11 @@ impl VoxelStructure for OctreeVolume {
         // The build's scratch holds the tiles' flags before the slots' sums.
         (max_binding(device) / 4).saturating_sub(scratch_bytes(self.layout.tiles as u64, 0) / 4)
             / ACCUM_WORDS
+    }
+
+    fn occupied(&self, counted: &[u32; POOL_COUNTERS]) -> u64 {
+        // The static leaves an update's slots stand in for are hidden.
+        counted[0].saturating_sub(counted[STOOD_IN_COUNTED]) as u64
     }
 
     fn needs_growth(&self, counted: &[u32; POOL_COUNTERS]) -> bool {
@@ -669,13 +669,15 @@ impl VoxelStructure for OctreeVolume {
 
 /// What a dynamic scene keeps for its updates.
 struct UpdateBase {
-    /// The build's scratch (`scratch` in build_shared.wgsl: the allocation's per-workgroup
-    /// counts, then per leaf slot the sums of its fragments): the updates add to the static
-    /// leaves' sums.
+    /// The updates' scratch (`scratch` in build_shared.wgsl: the allocation's per-workgroup
+    /// counts, then per slot an update may add its fragments' sums and the static slot it
+    /// stands in for, which the next update's clear reads): `OctreePools::update_slots` of
+    /// them, not the static build's.
     scratch: wgpu::Buffer,
-    /// The static build's copy of `OctreeVolume::base_buffers`, which every update starts
-    /// from.
-    snapshot: [wgpu::Buffer; 4],
+    /// The static build's header of counters (ranges, slots, the first dynamic fragment),
+    /// which every update starts from. The rest of what an update writes into the static
+    /// nodes and leaves its successor's clear undoes (octree_update.wgsl).
+    header: wgpu::Buffer,
 }
 
 /// Bytes of the build's scratch for `tiles` tiles and `slots` leaf slots (`block_words` and

@@ -20,6 +20,7 @@ pub(super) struct UpdatePipelines {
     pub(super) begin_clear: wgpu::ComputePipeline,
     pub(super) clear_leaves: wgpu::ComputePipeline,
     pub(super) clear_nodes: wgpu::ComputePipeline,
+    pub(super) restore: wgpu::ComputePipeline,
     pub(super) begin_update: wgpu::ComputePipeline,
     pub(super) bounds: wgpu::ComputePipeline,
     pub(super) prepare_depth: wgpu::ComputePipeline,
@@ -34,6 +35,8 @@ pub(super) struct UpdatePipelines {
     pub(super) repair: wgpu::ComputePipeline,
     pub(super) allocate_slots: wgpu::ComputePipeline,
     pub(super) accumulate: wgpu::ComputePipeline,
+    pub(super) prepare_static: wgpu::ComputePipeline,
+    pub(super) accumulate_static: wgpu::ComputePipeline,
     pub(super) prepare_slots: wgpu::ComputePipeline,
     pub(super) resolve: wgpu::ComputePipeline,
 }
@@ -124,6 +127,7 @@ impl OctreePipelines {
             begin_clear: u("begin_clear", true),
             clear_leaves: u("clear_leaves", false),
             clear_nodes: u("clear_nodes", false),
+            restore: u("restore", false),
             begin_update: u("begin_update", true),
             bounds: u("bounds", false),
             prepare_depth: u("prepare_depth", true),
@@ -138,6 +142,8 @@ impl OctreePipelines {
             repair: u("repair", false),
             allocate_slots: u("allocate_slots", false),
             accumulate: u("accumulate", false),
+            prepare_static: u("prepare_static", true),
+            accumulate_static: u("accumulate_static", false),
             prepare_slots: u("prepare_slots", true),
             resolve: u("resolve", false),
         };

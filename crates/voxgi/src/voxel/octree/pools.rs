@@ -15,6 +15,23 @@ pub struct OctreePools {
     pub even_tiles: u32,
     /// Tiles whose parents' bricks hold an odd level.
     pub odd_tiles: u32,
+    /// Of `slots`, those a dynamic scene's static build fills, as a build counted them (0
+    /// before one has): its updates' slots follow them, and only those keep their build sums
+    /// between frames (`update_slots`).
+    pub static_slots: u32,
+}
+
+/// The word of the octree's pool counters (`OctreeVolume::pool_counter`) that holds the static
+/// leaves the last update's slots stand in for (`STOOD_IN` in tree.wgsl).
+pub const STOOD_IN_COUNTED: usize = 4;
+/// The word of the pool counters that holds the static build's slots (`STATIC_SLOTS`).
+pub const STATIC_COUNTED: usize = 5;
+
+/// The static build's slots in `counted`, the pool counters (none where they stop before).
+fn static_counted(counted: &[u32]) -> u32 {
+    counted
+        .get(STATIC_COUNTED)
+        .map_or(0, |&n| n.min(counted[0]))
 }
 
 impl OctreePools {
@@ -28,7 +45,14 @@ impl OctreePools {
             leaf_tiles: c(leaves / 2),
             even_tiles: c(leaves / 16),
             odd_tiles: c(leaves / 8),
+            static_slots: 0,
         }
+    }
+
+    /// The slots a dynamic scene's updates may add after the static build's: the room its
+    /// update scratch keeps their sums for.
+    pub fn update_slots(&self) -> u32 {
+        self.slots - self.static_slots.min(self.slots)
     }
 
     /// These pools, shrunk where a buffer would exceed `max_binding` bytes: a first guess
@@ -72,6 +96,7 @@ impl OctreePools {
             leaf_tiles: need(counted[1]),
             even_tiles: need(counted[2]),
             odd_tiles: need(counted[3]),
+            static_slots: if room { static_counted(counted) } else { 0 },
         }
     }
 
@@ -81,13 +106,20 @@ impl OctreePools {
     /// Pools more than twice what the build needed (the first guess comes from an upper bound
     /// on the fragments) shrink to the counts, and an eighth with `room` (`fitting`): the
     /// octree's point is its memory.
+    /// With `room`, the slots the last update added must fit the update scratch too, and a
+    /// scratch sized before the static build counted itself (for every slot) shrinks to the
+    /// slots updates may add.
     pub fn resized_for(&self, counted: &[u32], room: bool) -> Option<Self> {
         let have = [self.slots, self.leaf_tiles, self.even_tiles, self.odd_tiles];
-        if counted.iter().zip(have).all(|(&n, h)| n <= h) {
+        let added = counted[0] - if room { static_counted(counted) } else { 0 };
+        if counted.iter().zip(have).all(|(&n, h)| n <= h) && added <= self.update_slots() {
             let fit = Self::fitting(counted, room);
             // Below a few MiB a shrink is not worth a rebuild.
             let oversized = self.bytes() > 2 * fit.bytes() && self.bytes() > 8 << 20;
-            return oversized.then_some(fit);
+            let scratch = self.update_slots() as u64 * ACCUM_WORDS * 4;
+            let scratch_oversized =
+                room && self.update_slots() > 2 * fit.update_slots() && scratch > 8 << 20;
+            return (oversized || scratch_oversized).then_some(fit);
         }
         let grow = |n: u32, h: u32| -> u32 {
             let half = h.saturating_add(h / 2);
@@ -98,6 +130,7 @@ impl OctreePools {
             leaf_tiles: grow(counted[1], self.leaf_tiles),
             even_tiles: grow(counted[2], self.even_tiles),
             odd_tiles: grow(counted[3], self.odd_tiles),
+            static_slots: if room { static_counted(counted) } else { 0 },
         })
     }
 }
@@ -113,6 +146,7 @@ mod tests {
             leaf_tiles: 100,
             even_tiles: 10,
             odd_tiles: 10,
+            static_slots: 0,
         };
         assert_eq!(p.resized_for(&[1000, 100, 10, 10], true), None);
         let g = p.resized_for(&[5000, 100, 10, 11], true).unwrap();
@@ -161,5 +195,30 @@ mod tests {
             counted
         );
         assert_eq!(exact.resized_for(&counted, false), None);
+    }
+
+    /// A dynamic scene keeps build sums for the slots its updates add, not for the static
+    /// build's: the pool counters' word 5 says how many those are.
+    #[test]
+    fn a_dynamic_scenes_update_scratch_follows_the_slots_updates_add() {
+        let guess = OctreePools::for_leaves(500_000);
+        // The counting build before the first frame: static geometry only.
+        let built = [400_000, 150_000, 6_000, 25_000, 0, 400_000];
+        // The guess is within twice the counts, but its scratch was sized for every slot.
+        let fit = guess
+            .resized_for(&built, true)
+            .expect("the scratch shrinks");
+        assert_eq!((fit.slots, fit.static_slots), (450_000, 400_000));
+        assert_eq!(fit.update_slots(), 50_000);
+        assert_eq!(fit.resized_for(&built, true), None);
+        // An update that adds 40,000 slots fits; one that adds 60,000 grows the pool by half.
+        let updated = [440_000, 150_000, 6_000, 25_000, 0, 400_000];
+        assert_eq!(fit.resized_for(&updated, true), None);
+        let over = [460_000, 150_000, 6_000, 25_000, 0, 400_000];
+        let grown = fit.resized_for(&over, true).expect("grows");
+        assert_eq!((grown.slots, grown.update_slots()), (675_000, 275_000));
+        // A static scene keeps no update scratch: its counters' word 5 does not count.
+        let exact = guess.resized_for(&built, false);
+        assert!(exact.is_none_or(|p| p.static_slots == 0), "{exact:?}");
     }
 }

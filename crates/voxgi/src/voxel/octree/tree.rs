@@ -10,18 +10,20 @@ pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const NODE_WORDS: u64 = 4;
 /// u32 per leaf slot (`SLOT_STRIDE` in tree.wgsl): what the leaf is.
 pub const SLOT_WORDS: u64 = 6;
-/// u32 per leaf slot of the build's sums (`ACCUM_STRIDE` in tree.wgsl), in the scratch buffer
-/// only builds and updates bind.
-pub const ACCUM_WORDS: u64 = 13;
+/// u32 per leaf slot of the build's sums and the static slot an update's slot stands in for
+/// (`ACCUM_STRIDE` in tree.wgsl), in the scratch buffer only builds and updates bind.
+pub const ACCUM_WORDS: u64 = 14;
 /// Bytes per leaf slot across the slot, direct-light and bounce buffers.
 pub const SLOT_BYTES: u64 = SLOT_WORDS * 4 + 32;
 /// Words of counters before the nodes in the node buffer (`NODE_HEADER` in tree.wgsl).
 pub(super) const NODE_HEADER: u64 = 64;
 /// Dispatch sizes (u32): fragments, leaves, the nodes of each depth, the new nodes of each
-/// depth, the last update's leaves (`ARGS_NEW`, `ARGS_CLEAR` in octree_update.wgsl).
-pub(super) const ARGS_WORDS: u64 = 75;
+/// depth, the last update's leaves, the static fragments (`ARGS_NEW`, `ARGS_CLEAR`,
+/// `ARGS_STATIC` in octree_update.wgsl).
+pub(super) const ARGS_WORDS: u64 = 78;
 pub(super) const ARGS_NEW: u64 = 39;
 pub(super) const ARGS_CLEAR: u64 = 72;
+pub(super) const ARGS_STATIC: u64 = 75;
 /// u32 per tile in the tile buffer (`TILE_WORDS` in tree.wgsl).
 pub(super) const TILE_WORDS: u64 = 2;
 /// Deepest depth of the top grid (`GRID_DEPTH` in tree.wgsl).
@@ -47,6 +49,9 @@ pub(crate) const SHARED_CONSTANTS: &[(&str, u64)] = &[
     ("GRID_DEPTH", GRID_DEPTH as u64),
     ("ARGS_NEW", ARGS_NEW),
     ("ARGS_CLEAR", ARGS_CLEAR),
+    ("ARGS_STATIC", ARGS_STATIC),
+    ("STOOD_IN", super::STOOD_IN_COUNTED as u64),
+    ("STATIC_SLOTS", super::STATIC_COUNTED as u64),
     ("FLAG_SHIFT", FLAG_SHIFT as u64),
 ];
 
