@@ -228,22 +228,24 @@ fn prepare_static() {
 
 // The static fragments in the voxels the update shares with static leaves (a slot of the
 // update stands in for each): their sums join the dynamic ones (add_fragment leaves the
-// static leaves' alone). Fragments outside the update's box return before descending.
+// static leaves' alone). A thread per static fragment: those outside the update's box return
+// after reading their coordinate, but the pass still grows with the static fragments, not
+// with what moved (on lavapipe it is most of the update's cost at Sponza 256³).
 @compute @workgroup_size(64)
 fn accumulate_static(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat(gid, nwg);
-    if i >= min(atomicLoad(&nodes[FIRST_FRAGMENT]), stored_fragments()) {
+    // (write_args sizes an empty dispatch at one workgroup.)
+    if i >= min(atomicLoad(&nodes[FIRST_FRAGMENT]), stored_fragments()) || atomicLoad(&nodes[STOOD_IN]) == 0u {
         return;
     }
-    let f = fragments[i];
-    let c = unpack_coord(f.coord);
+    let c = unpack_coord(fragments[i].coord);
     let b = update_box(tree.depth);
     if any(c < b.lo) || any(c >= b.lo + b.size) {
         return;
     }
     let node = descend(c, tree.depth);
     if node != NONE {
-        add_fragment(f, child(node));
+        add_fragment(fragments[i], child(node));
     }
 }
 
