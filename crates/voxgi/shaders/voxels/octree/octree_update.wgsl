@@ -234,8 +234,9 @@ fn prepare_static() {
 @compute @workgroup_size(64)
 fn accumulate_static(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat(gid, nwg);
-    // (write_args sizes an empty dispatch at one workgroup.)
-    if i >= min(atomicLoad(&nodes[FIRST_FRAGMENT]), stored_fragments()) || atomicLoad(&nodes[STOOD_IN]) == 0u {
+    // Without a shared voxel the dispatch is one workgroup (write_args' least), whose
+    // fragments add to nothing: add_fragment finds only static leaves.
+    if i >= min(atomicLoad(&nodes[FIRST_FRAGMENT]), stored_fragments()) {
         return;
     }
     let c = unpack_coord(fragments[i].coord);
