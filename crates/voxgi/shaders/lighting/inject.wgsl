@@ -87,7 +87,9 @@ fn leaf_inputs_changed(i: u32) -> bool {
         return true;
     }
     let center = leaf_center(i);
-    let margin = vec3<f32>(leaf_size(i));
+    // A mesh's fragments lie in the voxels its surface crosses (centres within 0.87 of a voxel
+    // of it), a point's up to a voxel behind it (centres within 1.5 voxels of the point).
+    let margin = vec3<f32>(1.5 * leaf_size(i));
     if all(center >= params.moved_min.xyz - margin) && all(center <= params.moved_max.xyz + margin) {
         return true;
     }

@@ -149,6 +149,54 @@ fn a_sequence_of_moves_renders_like_a_fresh_renderer() {
     }
 }
 
+/// Two dynamic cubes in opposite corners of the Cornell box, one on the floor and one under the
+/// ceiling: the box an octree update spans then holds more voxel positions than its scratch
+/// keeps per-workgroup counts for, and its dispatches run over the nodes instead (`over_box` in
+/// build_shared.wgsl). Moved and moved back, the octree still ends like a fresh one.
+#[test]
+fn scattered_dynamic_geometry_updates_like_a_fresh_octree() {
+    let options = RendererOptions {
+        voxels: voxgi::VoxelKind::OCTREE,
+        // At 64³ the walls' tiles still leave room for the box's counts.
+        voxel_resolution: 128,
+        ..options()
+    };
+    let hanging = |x: f32| {
+        Mat4::from_translation(Vec3::new(x, 0.46, 0.48)) * Mat4::from_scale(Vec3::splat(0.12))
+    };
+    let (mut scene, low) = cornell_with_cube((0.08, 0.08));
+    let high = scene.instances.len();
+    scene.append(builtin::cube([0.8, 0.8, 0.3]), hanging(0.48), true);
+    let mut r = renderer(&scene, &options);
+    let p = params(&r);
+    frame(&mut r, &p, SIZE, SIZE);
+    {
+        // The cubes' fragments span the box from one's lower corner to the other's upper.
+        let o = r
+            .structure::<voxgi::voxel::octree::OctreeVolume>()
+            .expect("an octree");
+        let size = o.grid.voxel_size;
+        let lo = (Vec3::new(0.02, 0.001, 0.02) - o.grid.origin) / size;
+        let hi = (Vec3::new(0.54, 0.52, 0.54) - o.grid.origin) / size;
+        let positions = (hi - lo).floor().max(Vec3::ZERO).element_product() as u64;
+        let counted = 8 * o.layout.tiles as u64 + 128;
+        assert!(
+            positions > counted,
+            "the box's {positions} positions fit the {counted} the scratch counts for"
+        );
+    }
+    for (what, a, b) in [
+        ("moved", cube_at((0.10, 0.12)), hanging(0.44)),
+        ("moved back", cube_at((0.08, 0.08)), hanging(0.48)),
+    ] {
+        r.set_instance_transform(low, a).expect("dynamic");
+        r.set_instance_transform(high, b).expect("dynamic");
+        scene.instances[low].transform = a;
+        scene.instances[high].transform = b;
+        assert_like_fresh(&mut r, &scene, &options, what);
+    }
+}
+
 /// The index of the Cornell box's ceiling light in `scene`.
 fn ceiling_light(scene: &Scene) -> usize {
     scene

@@ -83,7 +83,7 @@ fn an_impossible_resolution_is_refused_before_the_first_frame() {
 fn a_scene_counted_before_its_first_frame_renders_as_a_full_rebuild() {
     let ctx = ctx();
     let binding = ctx.device.limits().max_storage_buffer_binding_size;
-    // Past the dense volume's 60 and the octree's build sums' 52 bytes per leaf
+    // Past the dense volume's 60 and the octree's build sums' 56 bytes per leaf
     // (`ACCUM_WORDS`), as 8 fragments a point.
     let per_leaf = 60.min(voxgi::voxel::octree::ACCUM_WORDS * 4);
     let n = (binding / per_leaf / 8 + 1) as usize;

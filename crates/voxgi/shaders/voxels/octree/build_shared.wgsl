@@ -161,11 +161,23 @@ fn update_box(t: u32) -> Box {
     return Box(l, (hi >> shift) - l + 1u);
 }
 
-// Threads of the dispatches over the nodes of depth t: every node in a build; in an update, a
-// thread per position of its box (so the update's cost follows what moved, not the static
-// octree, and its ranks follow the positions: the same layout every run).
-fn threads_at(t: u32) -> u32 {
+// Whether the dispatches over the nodes of depth t run over the positions of the update's box:
+// in an update, unless the box holds more positions than the scratch keeps per-workgroup
+// counts for (`block_words`, a count per 64 of the pool's nodes: scattered or long dynamic
+// geometry), where they run over the depth's nodes as a build's do.
+fn over_box(t: u32) -> bool {
     if atomicLoad(&nodes[UPDATING]) == 0u {
+        return false;
+    }
+    let b = update_box(t);
+    return (b.size.x * b.size.y * b.size.z + 63u) / 64u <= block_words();
+}
+
+// Threads of the dispatches over the nodes of depth t: every node, or in an update a thread per
+// position of its box (so the update's cost follows what moved, not the static octree, and its
+// ranks follow the positions: the same layout every run).
+fn threads_at(t: u32) -> u32 {
+    if !over_box(t) {
         return nodes_at(t);
     }
     let b = update_box(t);
@@ -174,7 +186,7 @@ fn threads_at(t: u32) -> u32 {
 
 // The node thread `i` of such a dispatch takes, or NONE.
 fn node_for_thread(i: u32, t: u32) -> u32 {
-    if atomicLoad(&nodes[UPDATING]) == 0u {
+    if !over_box(t) {
         return node_of_depth(i, t);
     }
     let b = update_box(t);

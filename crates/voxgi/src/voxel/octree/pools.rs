@@ -106,9 +106,9 @@ impl OctreePools {
     /// Pools more than twice what the build needed (the first guess comes from an upper bound
     /// on the fragments) shrink to the counts, and an eighth with `room` (`fitting`): the
     /// octree's point is its memory.
-    /// With `room`, the slots the last update added must fit the update scratch too, and a
-    /// scratch sized before the static build counted itself (for every slot) shrinks to the
-    /// slots updates may add.
+    /// With `room`, the slots the last update added must fit the update scratch too, and the
+    /// first guess's scratch (sized for every slot, before a build counted the static ones)
+    /// shrinks to the slots updates may add.
     pub fn resized_for(&self, counted: &[u32], room: bool) -> Option<Self> {
         let have = [self.slots, self.leaf_tiles, self.even_tiles, self.odd_tiles];
         let added = counted[0] - if room { static_counted(counted) } else { 0 };
@@ -116,9 +116,13 @@ impl OctreePools {
             let fit = Self::fitting(counted, room);
             // Below a few MiB a shrink is not worth a rebuild.
             let oversized = self.bytes() > 2 * fit.bytes() && self.bytes() > 8 << 20;
+            // Only the first guess's (made before a build counted its static slots): grown
+            // pools keep their room, or a growth would shrink again at once.
             let scratch = self.update_slots() as u64 * ACCUM_WORDS * 4;
-            let scratch_oversized =
-                room && self.update_slots() > 2 * fit.update_slots() && scratch > 8 << 20;
+            let scratch_oversized = room
+                && self.static_slots == 0
+                && self.update_slots() > 2 * fit.update_slots()
+                && scratch > 8 << 20;
             return (oversized || scratch_oversized).then_some(fit);
         }
         let grow = |n: u32, h: u32| -> u32 {
@@ -217,6 +221,8 @@ mod tests {
         let over = [460_000, 150_000, 6_000, 25_000, 0, 400_000];
         let grown = fit.resized_for(&over, true).expect("grows");
         assert_eq!((grown.slots, grown.update_slots()), (675_000, 275_000));
+        // And keeps that room: the same count does not shrink it again.
+        assert_eq!(grown.resized_for(&over, true), None);
         // A static scene keeps no update scratch: its counters' word 5 does not count.
         let exact = guess.resized_for(&built, false);
         assert!(exact.is_none_or(|p| p.static_slots == 0), "{exact:?}");
