@@ -78,11 +78,10 @@ fn clear_leaves(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
 @compute @workgroup_size(64)
 fn clear_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let u = level.t;
-    let i = flat(gid, nwg);
-    if i >= atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]) * 8u {
+    let c = last_update_node(flat(gid, nwg), u);
+    if c == NONE {
         return;
     }
-    let c = atomicLoad(&nodes[DYN_RANGES + 2u * u]) * 8u + i;
     let m = tiles[(c / 8u) * TILE_WORDS];
     let k = tree.depth - u;
     for (var d = 0u; d < tree.dirs * u32(k > 0u); d++) {
@@ -99,11 +98,10 @@ fn clear_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 @compute @workgroup_size(64)
 fn restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let u = level.t;
-    let i = flat(gid, nwg);
-    if i >= atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]) * 8u {
+    let n = last_update_node(flat(gid, nwg), u);
+    if n == NONE {
         return;
     }
-    let n = atomicLoad(&nodes[DYN_RANGES + 2u * u]) * 8u + i;
     atomicStore(&nodes[child_word(tree, tiles[(n / 8u) * TILE_WORDS])], 0u);
     let c = node_coord(n);
     if u <= grid_depth(tree) {
@@ -113,19 +111,33 @@ fn restore(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if u >= tree.depth {
         return;
     }
-    let side = 1u << u;
     for (var a = 0u; a < 3u; a++) {
-        if (((n % 8u) >> a) & 1u) == 0u || c[a] + 1u >= side {
-            continue;
-        }
-        var p = c;
-        p[a] += 1u;
-        // Reached through static nodes only, whose child pointers nothing resets.
-        let m = node_at(p, u);
+        // A static one is reached through static nodes only, whose child pointers stay.
+        let m = beside_new(n, c, u, a);
         if m != NONE && atomicLoad(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a]) == n {
             atomicStore(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a], 0u);
         }
     }
+}
+
+// Node `i` of the last update's tiles of depth u (which the next update's clear reads before
+// the header comes back), or NONE.
+fn last_update_node(i: u32, u: u32) -> u32 {
+    if i >= atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]) * 8u {
+        return NONE;
+    }
+    return atomicLoad(&nodes[DYN_RANGES + 2u * u]) * 8u + i;
+}
+
+// The node on new node n's positive side along axis a (n at coordinate c of depth u), or NONE:
+// where n comes first in its tile along the axis, the next node is its sibling (new too).
+fn beside_new(n: u32, c: vec3<u32>, u: u32, a: u32) -> u32 {
+    if (((n % 8u) >> a) & 1u) == 0u || c[a] + 1u >= (1u << u) {
+        return NONE;
+    }
+    var p = c;
+    p[a] += 1u;
+    return node_at(p, u);
 }
 
 @compute @workgroup_size(1)
@@ -267,17 +279,10 @@ fn repair(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
         return;
     }
     let c = node_coord(n);
-    let side = 1u << u;
     let dyn_start = atomicLoad(&nodes[DYN_RANGES + 2u * u]);
     let dyn_end = dyn_start + atomicLoad(&nodes[DYN_RANGES + 2u * u + 1u]);
     for (var a = 0u; a < 3u; a++) {
-        // Where n comes first in its tile along the axis, the next node is its sibling (new too).
-        if (((n % 8u) >> a) & 1u) == 0u || c[a] + 1u >= side {
-            continue;
-        }
-        var p = c;
-        p[a] += 1u;
-        let m = node_at(p, u);
+        let m = beside_new(n, c, u, a);
         if m != NONE && (m / 8u < dyn_start || m / 8u >= dyn_end) {
             atomicStore(&nodes[NODE_HEADER + m * NODE_STRIDE + 1u + a], n);
         }
