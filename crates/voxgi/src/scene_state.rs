@@ -141,10 +141,7 @@ impl SceneState {
             .point_clouds
             .iter()
             .map(|pc| {
-                let mut local = Aabb::EMPTY;
-                for &p in &pc.positions {
-                    local.grow(p);
-                }
+                let local = cloud_extent(pc);
                 CloudState {
                     dynamic: pc.dynamic,
                     light: pc.light,
@@ -238,5 +235,47 @@ impl SceneState {
             lights,
             frames: self.player.frames_at(t)?,
         })
+    }
+}
+
+/// Where cloud `pc`'s samples reach in its own space: its points, grown by the largest disc
+/// radius (its surfels in the shadow maps) or region edge (its voxel fragments lie up to one
+/// edge behind a point), so that a moved cloud's box holds all it changed.
+pub fn cloud_extent(pc: &PointCloud) -> Aabb {
+    let mut b = Aabb::EMPTY;
+    for &p in &pc.positions {
+        b.grow(p);
+    }
+    let reach = pc
+        .radii
+        .iter()
+        .chain(&pc.regions)
+        .fold(0.0f32, |m, &r| if r.is_finite() { m.max(r) } else { m });
+    if b.min.x <= b.max.x {
+        b.min -= glam::Vec3::splat(reach);
+        b.max += glam::Vec3::splat(reach);
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_clouds_extent_holds_its_largest_disc_and_region() {
+        let pc = PointCloud {
+            positions: vec![glam::Vec3::ZERO, glam::Vec3::new(1.0, 0.0, 0.0)],
+            radii: vec![0.05, 0.2],
+            regions: vec![0.1, 0.1],
+            ..Default::default()
+        };
+        let b = cloud_extent(&pc);
+        assert_eq!(b.min, glam::Vec3::splat(-0.2));
+        assert_eq!(b.max, glam::Vec3::new(1.2, 0.2, 0.2));
+        assert!(
+            cloud_extent(&PointCloud::default()).min.x > 0.0,
+            "empty stays empty"
+        );
     }
 }

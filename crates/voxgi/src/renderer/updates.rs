@@ -208,10 +208,7 @@ impl Renderer {
         pc.light = old.light;
         pc.name = old.name.clone();
         let (transform, old_local) = (c.transform, c.local);
-        let mut local = Aabb::EMPTY;
-        for &p in &pc.positions {
-            local.grow(p);
-        }
+        let local = crate::scene_state::cloud_extent(&pc);
         let park = super::parking(&super::grid(&self.facts, &self.options));
         let room = self.scene.cloud_ranges[cloud].len();
         self.scene
