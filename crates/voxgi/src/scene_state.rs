@@ -251,7 +251,7 @@ pub fn cloud_extent(pc: &PointCloud) -> Aabb {
         .iter()
         .chain(&pc.regions)
         .fold(0.0f32, |m, &r| if r.is_finite() { m.max(r) } else { m });
-    if b.min.x <= b.max.x {
+    if !b.is_empty() {
         b.min -= glam::Vec3::splat(reach);
         b.max += glam::Vec3::splat(reach);
     }
