@@ -36,12 +36,11 @@ impl Neighbours {
         }
         let grid = CellGrid::new(positions);
         let tree = std::sync::OnceLock::new();
-        let order = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-        // Rings outwards, then the tree: into `found`, `stride` of them, nearest first.
-        let search = |i: u32, found: &mut Vec<(f32, u32)>| {
+        // Rings outwards from ring `first` (`found` holds the points of those inside it), then
+        // the tree: into `found`, `stride` of them, nearest first.
+        let search = |i: u32, first: i64, found: &mut Vec<u64>| {
             let q = positions[i as usize];
-            found.clear();
-            if grid.nearest(positions, q, stride, found) {
+            if grid.nearest(positions, q, stride, first, found) {
                 return;
             }
             found.clear();
@@ -58,16 +57,14 @@ impl Neighbours {
                 )
                 .iter()
                 .map(|n| {
-                    (
-                        positions[n.item as usize].distance_squared(q),
-                        n.item as u32,
-                    )
+                    let j = n.item as u32;
+                    rank(positions[j as usize].distance_squared(q), j)
                 }),
             );
             // A query finds `stride` points (all lie within infinity); the padding only keeps
             // the layout should it not.
-            found.resize(stride, (f32::INFINITY, i));
-            found.sort_unstable_by(order);
+            found.resize(stride, rank(f32::INFINITY, i));
+            found.sort_unstable();
         };
         // Cell by cell, in the grid's order (neighbouring cells read the same cells).
         let sorted = par_chunks(grid.runs.len(), |cells, out: &mut Vec<u32>| {
@@ -95,21 +92,30 @@ impl Neighbours {
                     let mut done = false;
                     if shared {
                         found.clear();
-                        found.extend(candidates.iter().map(|&(p, j)| (p.distance_squared(q), j)));
-                        let (_, kth, _) = found.select_nth_unstable_by(stride - 1, order);
+                        found.extend(
+                            candidates
+                                .iter()
+                                .map(|&(p, j)| rank(p.distance_squared(q), j)),
+                        );
+                        let (_, &mut kth, _) = found.select_nth_unstable(stride - 1);
                         // No point outside the 27 cells is nearer than this (a little less,
                         // for rounding).
                         let reach = (grid.h + grid.inside(q, c)) * (1.0 - 1e-5);
-                        if kth.0 < reach * reach {
+                        if distance_of(kth) < reach * reach {
                             found.truncate(stride);
-                            found.sort_unstable_by(order);
+                            found.sort_unstable();
                             done = true;
                         }
                     }
                     if !done {
-                        search(i, &mut found);
+                        // The 27 cells are rings 0 and 1: the search goes on from ring 2 with
+                        // their points (still all in `found`).
+                        if !shared {
+                            found.clear();
+                        }
+                        search(i, if shared { 2 } else { 0 }, &mut found);
                     }
-                    out.extend(found.iter().map(|n| n.1));
+                    out.extend(found.iter().map(|&n| n as u32));
                 }
             }
         });
@@ -139,6 +145,19 @@ impl Neighbours {
             out.extend(range.map(|i| f(i, self.of(i, k))))
         })
     }
+}
+
+/// A neighbour `j` at squared distance `d2` as one number that orders neighbours nearest first,
+/// ties by index: the distance's bits above the index (a non-negative float's bits order as
+/// the float does), so that selecting and sorting compare integers, not pairs.
+fn rank(d2: f32, j: u32) -> u64 {
+    debug_assert!(d2 >= 0.0, "a squared distance");
+    ((d2.to_bits() as u64) << 32) | j as u64
+}
+
+/// The squared distance a `rank` holds.
+fn distance_of(rank: u64) -> f32 {
+    f32::from_bits((rank >> 32) as u32)
 }
 
 /// Points sorted into cubic cells of side `h` (a few points each where the points are), found
@@ -262,18 +281,20 @@ impl CellGrid {
     }
 
     /// The `count` nearest points to `q` (itself among them), nearest first, ties by index,
-    /// into `found`; false when they were not found within `MAX_RINGS` rings.
+    /// into `found`, which holds the points of the rings inside ring `first` (searched
+    /// already: none of them held the answer); false when they were not found within
+    /// `MAX_RINGS` rings.
     fn nearest(
         &self,
         positions: &[Vec3],
         q: Vec3,
         count: usize,
-        found: &mut Vec<(f32, u32)>,
+        first: i64,
+        found: &mut Vec<u64>,
     ) -> bool {
         let c = Self::cell_of(self.lo, self.h, q);
-        let order = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
         let inside = self.inside(q, c);
-        for r in 0..=MAX_RINGS as i64 {
+        for r in first..=MAX_RINGS as i64 {
             for dz in -r..=r {
                 for dy in -r..=r {
                     // Only the ring's shell: the inner cells were searched already.
@@ -287,7 +308,7 @@ impl CellGrid {
                         found.extend(
                             self.cell([c[0] + dx, c[1] + dy, c[2] + dz])
                                 .iter()
-                                .map(|&j| (positions[j as usize].distance_squared(q), j)),
+                                .map(|&j| rank(positions[j as usize].distance_squared(q), j)),
                         );
                         dx += step;
                     }
@@ -298,13 +319,13 @@ impl CellGrid {
                 return false;
             }
             if found.len() >= count {
-                let (_, kth, _) = found.select_nth_unstable_by(count - 1, order);
+                let (_, &mut kth, _) = found.select_nth_unstable(count - 1);
                 // No point in an unsearched cell is nearer than this (a little less, for
                 // rounding).
                 let reach = (r as f32 * self.h + inside) * (1.0 - 1e-5);
-                if kth.0 < reach * reach {
+                if distance_of(kth) < reach * reach {
                     found.truncate(count);
-                    found.sort_unstable_by(order);
+                    found.sort_unstable();
                     return true;
                 }
             }

@@ -165,6 +165,11 @@ impl PointsAhead {
         self.timing
     }
 
+    /// The points' `pointcloud::SPREAD_NEIGHBOURS` nearest neighbours.
+    pub fn neighbours(&self) -> &Neighbours {
+        &self.neighbours
+    }
+
     /// Turns the estimated normals as `prepare_cloud` would for the cloud placed by
     /// `transform` (`camera`: the scene's default camera's position), and returns the
     /// points, their neighbours and the estimation's times (the orientation's among the
