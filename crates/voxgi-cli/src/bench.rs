@@ -336,12 +336,13 @@ fn sequence_summary(frames: &[voxgi::SequenceFrame]) -> serde_json::Value {
     let normals = median(&|f| ms(f.prepared.normals));
     let regions = median(&|f| ms(f.prepared.regions));
     let radii = median(&|f| ms(f.prepared.radii));
+    let spread = median(&|f| ms(f.prepared.spread));
     let set = median(&|f| ms(f.set));
     println!(
         "point sequences: {} new frames of {points:.0} points (medians, CPU): waiting for the \
          file {waited:.1} ms; set_points {set:.1} ms; estimated ahead (on the reading thread): \
          neighbours {neighbours:.0}, normals {normals:.0}, regions {regions:.0}, radii \
-         {radii:.0}",
+         {radii:.0}, spread {spread:.0}",
         frames.len()
     );
     serde_json::json!({
@@ -353,6 +354,7 @@ fn sequence_summary(frames: &[voxgi::SequenceFrame]) -> serde_json::Value {
         "normals_ms": normals,
         "regions_ms": regions,
         "radii_ms": radii,
+        "spread_ms": spread,
     })
 }
 

@@ -1,5 +1,5 @@
 //! Times the attribute estimation a point sequence runs on every frame (`PointsAhead::new`:
-//! the neighbour search, normals, regions and radii) on a random subset of a point file's
+//! the neighbour search, normals, regions, radii and the surface spread) on a random subset of a point file's
 //! points (a mesh's vertices), several runs, and prints the median of each step and a checksum of the neighbours
 //! found (the same on any machine and build that finds the same neighbours).
 //!
@@ -65,7 +65,7 @@ fn run() -> Result<(), String> {
         positions.swap(i, j);
     }
     positions.truncate(n);
-    let mut steps: [Vec<Duration>; 5] = Default::default();
+    let mut steps: [Vec<Duration>; 6] = Default::default();
     let mut checksum = 0u64;
     for _ in 0..runs {
         let cloud = PointCloud {
@@ -81,6 +81,7 @@ fn run() -> Result<(), String> {
             timing.normals,
             timing.regions,
             timing.radii,
+            timing.spread,
             total,
         ]) {
             s.push(d);
@@ -98,9 +99,16 @@ fn run() -> Result<(), String> {
     };
     let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
     println!("{n} points, {runs} runs, {threads} threads; median ms:");
-    for (name, s) in ["neighbours", "normals", "regions", "radii", "total"]
-        .iter()
-        .zip(steps.iter_mut())
+    for (name, s) in [
+        "neighbours",
+        "normals",
+        "regions",
+        "radii",
+        "spread",
+        "total",
+    ]
+    .iter()
+    .zip(steps.iter_mut())
     {
         println!("  {name:<11} {:9.2}", median(s));
     }

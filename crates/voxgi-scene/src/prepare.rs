@@ -29,6 +29,9 @@ pub struct PointPreparation {
     pub regions: Duration,
     /// Disc radii (8 neighbours).
     pub radii: Duration,
+    /// The surface spread (`pointcloud::surface_spread`, 24 neighbours), where estimated
+    /// ahead (`PointsAhead`); at upload the renderer computes it as it writes the surfels.
+    pub spread: Duration,
 }
 
 /// Fills in normals (k = 16), regions of influence and disc radii (k = 8) of point clouds that
@@ -111,9 +114,12 @@ pub fn prepare_cloud_with(pc: &mut PointCloud, camera: Vec3, nb: &Neighbours) ->
 pub struct PointsAhead {
     /// The points, their missing attributes filled; estimated normals with either sign.
     points: PointCloud,
-    /// Their `pointcloud::SPREAD_NEIGHBOURS` nearest neighbours (the surface spread reads
-    /// them).
+    /// Their `pointcloud::SPREAD_NEIGHBOURS` nearest neighbours.
     neighbours: Neighbours,
+    /// Their surface spread (`pointcloud::surface_spread`, in the cloud's units), which does
+    /// not depend on which way the normals face; empty without normals, `None` where a
+    /// normal is still to be made (a degenerate neighbourhood's, which faces the viewpoint).
+    spread: Option<Vec<f32>>,
     /// What the estimation took.
     timing: PointPreparation,
     /// The normals were estimated and still face either way.
@@ -138,9 +144,15 @@ impl PointsAhead {
             PointPreparation::default()
         };
         timing.neighbours = found;
+        let t = Instant::now();
+        let spread = (!points.normals.contains(&Vec3::ZERO)).then(|| {
+            pointcloud::surface_spread_from(&points, &neighbours, pointcloud::SPREAD_NEIGHBOURS)
+        });
+        timing.spread = t.elapsed();
         PointsAhead {
             points,
             neighbours,
+            spread,
             timing,
             unoriented,
         }
@@ -172,20 +184,30 @@ impl PointsAhead {
 
     /// Turns the estimated normals as `prepare_cloud` would for the cloud placed by
     /// `transform` (`camera`: the scene's default camera's position), and returns the
-    /// points, their neighbours and the estimation's times (the orientation's among the
+    /// points, their surface spread and the estimation's times (the orientation's among the
     /// normals').
     pub fn finish(
         mut self,
         transform: Mat4,
         camera: Vec3,
-    ) -> (PointCloud, Neighbours, PointPreparation) {
+    ) -> (PointCloud, Vec<f32>, PointPreparation) {
         self.points.transform = transform;
         if self.unoriented {
             let t = Instant::now();
             orient(&mut self.points, camera);
             self.timing.normals += t.elapsed();
         }
-        (self.points, self.neighbours, self.timing)
+        let spread = self.spread.unwrap_or_else(|| {
+            let t = Instant::now();
+            let spread = pointcloud::surface_spread_from(
+                &self.points,
+                &self.neighbours,
+                pointcloud::SPREAD_NEIGHBOURS,
+            );
+            self.timing.spread += t.elapsed();
+            spread
+        });
+        (self.points, spread, self.timing)
     }
 }
 
@@ -261,8 +283,8 @@ mod tests {
         }
     }
 
-    /// Estimating ahead and finishing later gives what the whole estimation gives, to the bit,
-    /// whichever way the normals turn: to the camera (the cloud's origin inside its bounds)
+    /// Estimating ahead and finishing later gives what the whole estimation gives (the surface
+    /// spread too), to the bit, whichever way the normals turn: to the camera (the cloud's origin inside its bounds)
     /// or to its origin (outside), under a transform that turns the cloud about.
     #[test]
     fn estimating_ahead_equals_estimating_at_once() {
@@ -274,8 +296,9 @@ mod tests {
             whole.transform = transform;
             let nb = Neighbours::find(&whole.positions, pointcloud::SPREAD_NEIGHBOURS);
             prepare_cloud_with(&mut whole, camera, &nb);
-            let (ahead, ahead_nb, timing) =
-                PointsAhead::new(sheet(offset)).finish(transform, camera);
+            let ahead = PointsAhead::new(sheet(offset));
+            let ahead_nb = ahead.neighbours().clone();
+            let (ahead, spread, timing) = ahead.finish(transform, camera);
             assert_eq!(timing.points, whole.positions.len());
             assert_eq!(ahead.transform, transform);
             assert_eq!(ahead.normals, whole.normals, "offset {offset}");
@@ -283,6 +306,10 @@ mod tests {
             assert_eq!(ahead.regions, whole.regions);
             let n = whole.positions.len();
             assert!((0..n).all(|i| ahead_nb.of(i, 24) == nb.of(i, 24)));
+            // The spread ahead, from normals facing either way, is the oriented normals'.
+            let want = pointcloud::surface_spread_from(&whole, &nb, pointcloud::SPREAD_NEIGHBOURS);
+            assert_eq!(spread.len(), n);
+            assert_eq!(spread, want, "offset {offset}");
             // Every normal faces the viewpoint: the camera while the origin lies inside the
             // cloud's bounds, else the origin.
             let view = if offset.x < 0.0 {

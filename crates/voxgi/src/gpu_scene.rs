@@ -685,15 +685,14 @@ impl GpuScene {
         queue: &wgpu::Queue,
         cloud: usize,
         pc: &voxgi_scene::PointCloud,
-        neighbours: &pointcloud::Neighbours,
+        spread: Vec<f32>,
         park: Vec3,
     ) {
         let Some(range) = self.cloud_ranges.get(cloud).cloned() else {
             return;
         };
         let n = pc.positions.len().min(range.len());
-        self.local_spread[cloud] =
-            pointcloud::surface_spread_from(pc, neighbours, pointcloud::SPREAD_NEIGHBOURS);
+        self.local_spread[cloud] = spread;
         self.set_cloud(queue, cloud, pc, pc.transform);
         self.park_spare(queue, cloud, n, park);
     }

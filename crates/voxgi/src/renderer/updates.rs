@@ -183,7 +183,8 @@ impl Renderer {
 
     /// `set_points` for points whose attributes were estimated ahead
     /// (`voxgi_scene::prepare::PointsAhead::new`, which may run on any thread while frames
-    /// render): here only the normals are turned to face the viewer, and the surfels written.
+    /// render, the surface spread too): here only the normals are turned to face the viewer,
+    /// and the surfels written.
     pub fn set_points_ahead(
         &mut self,
         cloud: usize,
@@ -202,8 +203,7 @@ impl Renderer {
         old: &voxgi_scene::PointCloud,
     ) -> Result<voxgi_scene::prepare::PointPreparation> {
         let c = &self.state.clouds[cloud];
-        let (mut pc, neighbours, prepared) =
-            ahead.finish(c.transform, self.default_camera.position);
+        let (mut pc, spread, prepared) = ahead.finish(c.transform, self.default_camera.position);
         pc.dynamic = true;
         pc.light = old.light;
         pc.name = old.name.clone();
@@ -212,7 +212,7 @@ impl Renderer {
         let park = super::parking(&super::grid(&self.facts, &self.options));
         let room = self.scene.cloud_ranges[cloud].len();
         self.scene
-            .set_cloud_points(&self.queue, cloud, &pc, &neighbours, park);
+            .set_cloud_points(&self.queue, cloud, &pc, spread, park);
         let zero = vec![[0.0f32; 4]; room];
         self.scene.set_cloud_motion(&self.queue, cloud, &zero);
         let geometry = pc.light.is_none();
