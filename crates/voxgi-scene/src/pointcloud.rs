@@ -518,20 +518,21 @@ pub fn estimate_regions_from(pc: &mut PointCloud, nb: &Neighbours, k: usize) {
     let positions = &pc.positions;
     pc.regions = nb.map(k.max(1), |i, nb| {
         let p = positions[i];
-        let others: Vec<Vec3> = nb
-            .iter()
-            .map(|&j| positions[j as usize] - p)
-            .filter(|d| *d != Vec3::ZERO)
-            .collect();
-        if others.is_empty() {
+        // One pass over the neighbours at another place: how many, the nearest by the
+        // maximum norm, the farthest.
+        let (mut others, mut chebyshev, mut dk) = (0usize, f32::INFINITY, 0.0f32);
+        for &j in nb {
+            let d = positions[j as usize] - p;
+            if d != Vec3::ZERO {
+                others += 1;
+                chebyshev = chebyshev.min(d.abs().max_element());
+                dk = dk.max(d.length());
+            }
+        }
+        if others == 0 {
             return 0.0;
         }
-        let chebyshev = others
-            .iter()
-            .map(|d| d.abs().max_element())
-            .fold(f32::INFINITY, f32::min);
-        let dk = others.iter().map(|d| d.length()).fold(0.0f32, f32::max);
-        let density = (std::f32::consts::PI / (others.len() + 1) as f32).sqrt() * dk;
+        let density = (std::f32::consts::PI / (others + 1) as f32).sqrt() * dk;
         chebyshev.max(density)
     });
 }
