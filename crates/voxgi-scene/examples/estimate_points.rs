@@ -1,7 +1,8 @@
 //! Times the attribute estimation a point sequence runs on every frame (`PointsAhead::new`:
-//! the neighbour search, normals, regions, radii and the surface spread) on a random subset of a point file's
-//! points (a mesh's vertices), several runs, and prints the median of each step and a checksum of the neighbours
-//! found (the same on any machine and build that finds the same neighbours).
+//! the neighbour search, normals, regions, radii and the surface spread) on a random subset
+//! of a point file's points (or a mesh's vertices), several runs, and prints the median of
+//! each step and a checksum of the neighbours found (equal wherever the same neighbours are
+//! found).
 //!
 //!   cargo run --release -p voxgi-scene --example estimate_points -- \
 //!       ../shared/scenes/pointcloud_pcl_office1/office1_xyzrgb.ply --points 100000
