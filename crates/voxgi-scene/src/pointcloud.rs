@@ -28,7 +28,8 @@ impl Neighbours {
     /// a uniform grid (a few points each) share one candidate list, their cell and its 26
     /// neighbours, which holds the answer unless a point lies near its cell's face in a sparse
     /// spot; those search ring by ring outwards, and a query that runs out after a few rings
-    /// (a point far from the rest) asks a k-d tree.
+    /// (a point far from the rest) asks a k-d tree. The positions are finite (the loaders and
+    /// `Renderer::set_points` check it); a point that is not lies farther than every other.
     pub fn find(positions: &[Vec3], k: usize) -> Self {
         let stride = (k + 1).min(positions.len());
         if stride == 0 {
@@ -120,9 +121,9 @@ impl Neighbours {
             }
         });
         let mut idx = vec![0u32; sorted.len()];
-        for (rank, &i) in grid.sorted.iter().enumerate() {
+        for (at, &i) in grid.sorted.iter().enumerate() {
             let i = i as usize;
-            idx[i * stride..][..stride].copy_from_slice(&sorted[rank * stride..][..stride]);
+            idx[i * stride..][..stride].copy_from_slice(&sorted[at * stride..][..stride]);
         }
         Self { stride, idx }
     }
@@ -149,9 +150,10 @@ impl Neighbours {
 
 /// A neighbour `j` at squared distance `d2` as one number that orders neighbours nearest first,
 /// ties by index: the distance's bits above the index (a non-negative float's bits order as
-/// the float does), so that selecting and sorting compare integers, not pairs.
+/// the float does), so that selecting and sorting compare integers, not pairs. (A squared
+/// distance is never -0.0; one from a position that is not finite, infinite or NaN of either
+/// sign, orders after every finite one.)
 fn rank(d2: f32, j: u32) -> u64 {
-    debug_assert!(d2 >= 0.0, "a squared distance");
     ((d2.to_bits() as u64) << 32) | j as u64
 }
 
@@ -828,11 +830,18 @@ mod tests {
                 Vec3::new(x, (x * 3.0).sin() * 0.3, z)
             })
             .collect();
-        for (cloud, k) in [
-            (&pts[..], 24),
-            (&pts[..], 8),
-            (&pts[..5], 24),
-            (&surface[..], 24),
+        // A lattice with some points twice: distances tie everywhere (exact in binary).
+        let mut lattice: Vec<Vec3> = (0..300)
+            .map(|i| Vec3::new((i % 10) as f32, (i / 10 % 10) as f32, (i / 100) as f32) * 0.25)
+            .collect();
+        lattice.extend_from_within(40..60);
+        for (cloud, k, exact) in [
+            (&pts[..], 24, false),
+            (&pts[..], 8, false),
+            (&pts[..5], 24, false),
+            (&surface[..], 24, false),
+            (&lattice[..], 24, true),
+            (&lattice[..], 8, true),
         ] {
             let nb = Neighbours::find(cloud, k);
             assert_eq!(nb.k(), k.min(cloud.len() - 1));
@@ -849,13 +858,19 @@ mod tests {
                         .iter()
                         .map(|a| a.1)
                         .collect();
-                    // The same distances (ties among equal distances may pick other points).
+                    // The same distances (ties among equal distances may pick other points
+                    // where the k-d tree answers: the far cluster's points).
                     let d = |v: &[u32]| {
                         v.iter()
                             .map(|&j| cloud[j as usize].distance_squared(p))
                             .collect::<Vec<f32>>()
                     };
                     assert_eq!(d(got), d(&want), "point {i}, k {kk}");
+                    // Ties by index, where the grid answers (a lattice: no query reaches
+                    // the tree).
+                    if exact {
+                        assert_eq!(got, &want[..], "point {i}, k {kk}");
+                    }
                 }
             }
         }

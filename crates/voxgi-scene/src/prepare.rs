@@ -29,8 +29,9 @@ pub struct PointPreparation {
     pub regions: Duration,
     /// Disc radii (8 neighbours).
     pub radii: Duration,
-    /// The surface spread (`pointcloud::surface_spread`, 24 neighbours), where estimated
-    /// ahead (`PointsAhead`); at upload the renderer computes it as it writes the surfels.
+    /// The surface spread (`pointcloud::surface_spread`, 24 neighbours) of `PointsAhead`,
+    /// ahead or, where a degenerate neighbourhood's normal waited for the viewpoint, in
+    /// `finish`; at upload the renderer computes it as it writes the surfels.
     pub spread: Duration,
 }
 
@@ -145,7 +146,10 @@ impl PointsAhead {
         };
         timing.neighbours = found;
         let t = Instant::now();
-        let spread = (!points.normals.contains(&Vec3::ZERO)).then(|| {
+        // A degenerate neighbourhood's estimate is zero until `finish` turns it to the
+        // viewpoint; a file's normals stay as they are.
+        let waits = unoriented && points.normals.contains(&Vec3::ZERO);
+        let spread = (!waits).then(|| {
             pointcloud::surface_spread_from(&points, &neighbours, pointcloud::SPREAD_NEIGHBOURS)
         });
         timing.spread = t.elapsed();
@@ -284,24 +288,38 @@ mod tests {
     }
 
     /// Estimating ahead and finishing later gives what the whole estimation gives (the surface
-    /// spread too), to the bit, whichever way the normals turn: to the camera (the cloud's origin inside its bounds)
-    /// or to its origin (outside), under a transform that turns the cloud about.
+    /// spread too), to the bit, whichever way the normals turn: to the camera (the cloud's
+    /// origin inside its bounds) or to its origin (outside), under a transform that turns the
+    /// cloud about; with the sheet's row of collinear points (degenerate neighbourhoods, whose
+    /// spread waits for the viewpoint) and without it (the spread computed ahead).
     #[test]
     fn estimating_ahead_equals_estimating_at_once() {
         let transform =
             Mat4::from_rotation_x(2.5) * Mat4::from_translation(Vec3::new(0.3, 1.0, -2.0));
         let camera = Vec3::new(0.5, 4.0, 3.0);
-        for offset in [Vec3::new(-1.0, -0.1, -0.7), Vec3::new(2.0, 1.0, 1.0)] {
-            let mut whole = sheet(offset);
+        let offsets = [Vec3::new(-1.0, -0.1, -0.7), Vec3::new(2.0, 1.0, 1.0)];
+        for (offset, row) in offsets.into_iter().flat_map(|o| [(o, true), (o, false)]) {
+            // The sheet's 40 × 30 points, and its row of 20 after them or not.
+            let cloud = || {
+                let mut pc = sheet(offset);
+                pc.positions.truncate(if row { 1220 } else { 1200 });
+                pc
+            };
+            let mut whole = cloud();
             whole.transform = transform;
             let nb = Neighbours::find(&whole.positions, pointcloud::SPREAD_NEIGHBOURS);
             prepare_cloud_with(&mut whole, camera, &nb);
-            let ahead = PointsAhead::new(sheet(offset));
+            let ahead = PointsAhead::new(cloud());
+            assert_eq!(
+                ahead.spread.is_none(),
+                row,
+                "the spread waits for the row's normals"
+            );
             let ahead_nb = ahead.neighbours().clone();
             let (ahead, spread, timing) = ahead.finish(transform, camera);
             assert_eq!(timing.points, whole.positions.len());
             assert_eq!(ahead.transform, transform);
-            assert_eq!(ahead.normals, whole.normals, "offset {offset}");
+            assert_eq!(ahead.normals, whole.normals, "offset {offset}, row {row}");
             assert_eq!(ahead.radii, whole.radii);
             assert_eq!(ahead.regions, whole.regions);
             let n = whole.positions.len();
@@ -309,7 +327,7 @@ mod tests {
             // The spread ahead, from normals facing either way, is the oriented normals'.
             let want = pointcloud::surface_spread_from(&whole, &nb, pointcloud::SPREAD_NEIGHBOURS);
             assert_eq!(spread.len(), n);
-            assert_eq!(spread, want, "offset {offset}");
+            assert_eq!(spread, want, "offset {offset}, row {row}");
             // Every normal faces the viewpoint: the camera while the origin lies inside the
             // cloud's bounds, else the origin.
             let view = if offset.x < 0.0 {

@@ -678,8 +678,8 @@ impl GpuScene {
 
     /// Gives dynamic cloud `cloud` new points (`pc`, placed by its transform, at most as many
     /// as its range holds): they are written from its range's start, with their surface
-    /// spread computed anew; the slots left over get points that nothing draws or splats (no
-    /// disc, at `park`: a place outside the voxels).
+    /// spread `spread` (in the cloud's units, `PointsAhead::finish`); the slots left over get
+    /// points that nothing draws or splats (no disc, at `park`: a place outside the voxels).
     pub fn set_cloud_points(
         &mut self,
         queue: &wgpu::Queue,

@@ -183,7 +183,8 @@ impl Renderer {
 
     /// `set_points` for points whose attributes were estimated ahead
     /// (`voxgi_scene::prepare::PointsAhead::new`, which may run on any thread while frames
-    /// render, the surface spread too): here only the normals are turned to face the viewer,
+    /// render, the surface spread too): here only the normals are turned to face the viewer
+    /// (and the spread computed where a degenerate neighbourhood's normal waited for that),
     /// and the surfels written.
     pub fn set_points_ahead(
         &mut self,
@@ -491,8 +492,8 @@ pub struct SequenceFrame {
     /// The attribute estimation: on the thread that read the file ahead, or while the caller
     /// waited (`waited`, a frame not read ahead: the first, or after a jump in time).
     pub prepared: voxgi_scene::prepare::PointPreparation,
-    /// `set_points_ahead` on the caller's thread: the normals' orientation, the surface
-    /// spread, the surfels and their upload (and the estimation when the frame was not read
-    /// ahead).
+    /// `set_points_ahead` on the caller's thread: the normals' orientation, the surfels and
+    /// their upload (and the surface spread where a degenerate neighbourhood's normal waited
+    /// for the viewpoint, and the whole estimation when the frame was not read ahead).
     pub set: web_time::Duration,
 }
