@@ -336,30 +336,38 @@ impl CellGrid {
     }
 }
 
-/// Splits `0..n` into one chunk per core (`available_parallelism`, 1 where it is unknown) and
-/// concatenates what `f` writes for each chunk, in order.
+/// Splits `0..n` into chunks, several per core (`available_parallelism`, 1 where it is
+/// unknown), which the cores take in turn as they finish, and concatenates what `f` writes
+/// for each chunk, in order. Equal shares per core left one core idle while the other
+/// searched the sparse parts of a scan, where queries go ring by ring.
 fn par_chunks<T: Send>(n: usize, f: impl Fn(std::ops::Range<usize>, &mut Vec<T>) + Sync) -> Vec<T> {
     let threads = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
         .min(16);
-    let chunk = n.div_ceil(threads).max(1);
-    // One chunk (one core, or a platform without threads: the browser's main thread) runs
-    // here rather than on a thread of its own.
-    if chunk >= n {
+    // One core, or a platform without threads (the browser's main thread): all here.
+    if threads == 1 || n < 2 {
         let mut out = Vec::new();
         f(0..n, &mut out);
         return out;
     }
-    std::thread::scope(|s| {
-        let handles: Vec<_> = (0..n)
-            .step_by(chunk)
-            .map(|start| {
-                let f = &f;
+    let chunk = n.div_ceil(8 * threads).max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut done: Vec<(usize, Vec<T>)> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                let (f, next) = (&f, &next);
                 s.spawn(move || {
-                    let mut out = Vec::new();
-                    f(start..(start + chunk).min(n), &mut out);
-                    out
+                    let mut done = Vec::new();
+                    loop {
+                        let start = next.fetch_add(chunk, std::sync::atomic::Ordering::Relaxed);
+                        if start >= n {
+                            return done;
+                        }
+                        let mut out = Vec::new();
+                        f(start..(start + chunk).min(n), &mut out);
+                        done.push((start, out));
+                    }
                 })
             })
             .collect();
@@ -367,7 +375,9 @@ fn par_chunks<T: Send>(n: usize, f: impl Fn(std::ops::Range<usize>, &mut Vec<T>)
             .into_iter()
             .flat_map(|h| h.join().expect("neighbour worker panicked"))
             .collect()
-    })
+    });
+    done.sort_unstable_by_key(|(start, _)| *start);
+    done.into_iter().flat_map(|(_, out)| out).collect()
 }
 
 /// Estimates unit normals where the cloud has none: the direction of least variance of each
