@@ -363,7 +363,7 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
     x.xdotool(&["mousemove", "--window", &window, "500", "200"]);
     x.xdotool(&["key", "Tab"]);
     x.xdotool(&["key", "g"]);
-    viewer.finish();
+    let log = viewer.finish();
     let img = image::open(&png).expect("the screenshot").to_rgb8();
     // The panel hidden and the camera where it was: left of the box (the image spans the
     // window) the background is black; the panel there would be grey with text, and a
@@ -373,13 +373,12 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
         margin.iter().all(|&c| c < 8.0),
         "left margin {margin:?}: the panel or the zoomed-in box is there"
     );
-    // G reached the viewer: the path tracer's few samples a pixel are noisy (the split view's
-    // test measured 10.7 on the green wall against cone tracing's 2.5).
-    let wall = ((0.66, 0.72), (0.4, 0.6));
-    let rough = roughness(&img, wall.0, wall.1);
+    // G reached the viewer, which says so. (The path tracer's noise told it before, but how
+    // many samples it has after the screenshot's 40 frames follows the machine's load: one
+    // run read 0.83 on the green wall, as smooth as cone tracing.)
     assert!(
-        rough > 5.0,
-        "the green wall's roughness {rough}: not path traced"
+        log.contains("display: PathTraced"),
+        "G did not switch to the path tracer:\n{log}"
     );
 }
 

@@ -244,6 +244,9 @@ impl Viewer {
             self.toasts
                 .info("paused: the path tracer shows a still scene");
         }
+        if display != self.ground.display {
+            log::info!("display: {display:?}");
+        }
         self.ground.display = display;
     }
 
