@@ -373,9 +373,9 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
         margin.iter().all(|&c| c < 8.0),
         "left margin {margin:?}: the panel or the zoomed-in box is there"
     );
-    // G reached the viewer, which says so. (The path tracer's noise told it before, but how
-    // many samples it has after the screenshot's 40 frames follows the machine's load: one
-    // run read 0.83 on the green wall, as smooth as cone tracing.)
+    // G reached the viewer, which says so. (The path tracer's noise told it before, but the
+    // samples it has by the screenshot's 40th frame follow a time budget, so the machine's
+    // speed and load: in one run it was as smooth as cone tracing.)
     assert!(
         log.contains("display: PathTraced"),
         "G did not switch to the path tracer:\n{log}"
