@@ -317,6 +317,9 @@ pub struct GpuScene {
     pub point_regions: wgpu::Buffer,
     /// Number of points in `points`.
     pub point_count: u32,
+    /// Some material has a metallic part: the shadow maps keep the surfaces' specular
+    /// materials for the injection (`lighting/shadow.wgsl`).
+    pub metals: bool,
     /// The first `geometry_points` of `points` are geometry: voxelized and shadowing every
     /// light. The rest show area lights.
     pub geometry_points: u32,
@@ -627,6 +630,7 @@ impl GpuScene {
                 },
             ),
             point_count: points.len() as u32,
+            metals: scene.materials.iter().any(|m| m.metallic > 0.0),
             geometry_points: geometry as u32,
             static_points: static_geometry as u32,
             cloud_ranges: clouds

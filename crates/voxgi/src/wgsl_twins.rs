@@ -282,7 +282,7 @@ fn every_twin_has_the_wgsl_layout() {
         m,
         GpuInjectParams,
         "InjectParams",
-        [light_count, all, store_all, moved_min, moved_max,]
+        [light_count, all, store_all, materials, moved_min, moved_max]
     );
     twin!(m, GpuMomentRect, "MomentRect", [min, max, layer, far]);
     twin!(

@@ -1,8 +1,10 @@
 // inject: direct light from every light (with the shadow maps) and emission into the
-// structure's leaves: Lambertian outgoing radiance albedo/pi * E + Le, premultiplied by opacity.
+// structure's leaves: Lambertian outgoing radiance albedo/pi * E + Le, premultiplied by opacity,
+// and beside it what a metal reflects of the lights specularly (shared/specular_lobe.wgsl).
 
 //!include shared/scene.wgsl
 //!include shared/lights.wgsl
+//!include shared/specular_lobe.wgsl
 //!include voxels/leaf_store.wgsl
 
 struct InjectParams {
@@ -13,7 +15,8 @@ struct InjectParams {
     // 1: every leaf's radiance is stored (bounces overwrote it since the last injection); 0:
     // only those recomputed, the others still hold what the last injection stored.
     store_all: u32,
-    _pad: u32,
+    // 1: the shadow maps hold the surfaces' specular materials (a scene with metals).
+    materials: u32,
     // Where dynamic geometry moved since the last injection (world space; min > max: nowhere).
     moved_min: vec4<f32>,
     moved_max: vec4<f32>,
@@ -53,28 +56,105 @@ fn to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
     return normalize(l.position - p);
 }
 
-// Radiance leaving leaf `i`, with albedo a, averaged normal (xyz) and normal agreement (w).
-fn leaf_direct_light(i: u32) -> vec4<f32> {
+// A leaf's direct light: its radiance (rgb, premultiplied by opacity, and opacity) and its
+// specular lobe (`pack_lobe`).
+struct Direct {
+    light: vec4<f32>,
+    lobe: vec4<f32>,
+}
+
+// Light leaving leaf `i`, with albedo a, averaged normal (xyz) and normal agreement (w).
+fn leaf_direct_light(i: u32) -> Direct {
     let albedo = leaf_albedo(i);
     let nw = leaf_normal(i);
     let emission = leaf_emission(i);
     let center = leaf_center(i);
     var e = vec3<f32>(0.0);
+    var spec = Specular();
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
         for (var l = 0u; l < params.light_count; l++) {
-            e += light_irradiance(lights[l], shading_point(i, lights[l]), n, 1.5);
+            let p = shading_point(i, lights[l]);
+            let el = light_irradiance(lights[l], p, n, 1.5);
+            e += el;
+            reflect_light(&spec, lights[l], p, n, el);
         }
     } else {
         // Opposite faces share this voxel (a thin two-sided wall): one isotropic value cannot
-        // keep the sides apart, so both get half the light of a surface facing it.
+        // keep the sides apart, so both get half the light of a surface facing it (and no
+        // lobe: it would leave from both sides).
         for (var k = 0u; k < params.light_count; k++) {
             let l = lights[k];
             e += 0.5 * light_irradiance(l, shading_point(i, l), to_light(l, center), 1.5);
         }
     }
     let radiance = albedo.rgb / PI * e + emission;
-    return vec4<f32>(radiance * albedo.a, albedo.a);
+    return Direct(vec4<f32>(radiance * albedo.a, albedo.a), spec_lobe(spec));
+}
+
+// The lights' specular reflections summed: exitance, the reflected directions weighted by
+// their luminance, and their luminance-weighted solid angles.
+struct Specular {
+    m: vec3<f32>,
+    dir: vec3<f32>,
+    weight: f32,
+    solid_angle: f32,
+}
+
+// Adds what the surface at p (normal n) reflects of `light`, whose irradiance there is `e`:
+// the material the light's shadow map sees at p (a lit surface is what it sees), its Fresnel
+// term at the light's angle, about the mirror direction, as wide as GGX's reflected lobe
+// (4 pi alpha^2 cos: the half-vector lobe's pi alpha^2, widened by the reflection's Jacobian)
+// and the light's own solid angle together. Lights without shadow maps reflect nothing here.
+fn reflect_light(spec: ptr<function, Specular>, light: Light, p: vec3<f32>, n: vec3<f32>, e: vec3<f32>) {
+    if params.materials == 0u || light.shadow_count == 0u || all(e <= vec3<f32>(0.0)) {
+        return;
+    }
+    let view = shadow_views[shadow_view_index(light, p)];
+    let mat = shadow_material(view, vec2<i32>(floor(shadow_uv(view, p).xy * view.resolution)));
+    if all(mat.rgb <= vec3<f32>(0.0)) {
+        return;
+    }
+    let l = to_light(light, p);
+    let c = max(dot(n, l), 0.0);
+    let m = e * lobe_albedo(mat.rgb, mat.a, c);
+    let w = dot(m, vec3<f32>(0.2126, 0.7152, 0.0722));
+    let alpha = mat.a * mat.a;
+    var source = 0.0;
+    if is_area_light(light) {
+        let to = light.position - p;
+        let d2 = max(dot(to, to), 1e-8);
+        source = light.area * abs(dot(light.direction, to)) / (d2 * sqrt(d2));
+    }
+    (*spec).m += m;
+    (*spec).dir += w * reflect(-l, n);
+    (*spec).weight += w;
+    (*spec).solid_angle += w * (4.0 * PI * alpha * alpha * c + source);
+}
+
+// The share of the light from direction cosine `c` the GGX lobe of F0 `f0` and `roughness`
+// reflects at all (its directional albedo; by reciprocity the same seen from there), in
+// Karis's analytic fit (Unreal's mobile EnvBRDFApprox): the screen's glossy light reads a
+// table of voxgi's own BRDF (brdf.rs) instead, which inject does not bind; the fit is within
+// a few per cent of it but for roughness 0.2-0.5, where it is 10-18 % low (docs/QUALITY.md).
+fn lobe_albedo(f0: vec3<f32>, roughness: f32, c: f32) -> vec3<f32> {
+    let r = roughness * vec4<f32>(-1.0, -0.0275, -0.572, 0.022) + vec4<f32>(1.0, 0.0425, 1.04, -0.04);
+    let a004 = min(r.x * r.x, exp2(-9.28 * c)) * r.x + r.y;
+    let ab = vec2<f32>(-1.04, 1.04) * a004 + r.zw;
+    return f0 * ab.x + ab.y;
+}
+
+// The lobe of the summed reflections: the directions' disagreement widens it (a half-length
+// mean direction adds a hemisphere's worth).
+fn spec_lobe(spec: Specular) -> vec4<f32> {
+    if spec.weight <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let len = length(spec.dir);
+    let agreement = len / spec.weight;
+    let solid_angle = spec.solid_angle / spec.weight + 2.0 * PI * (1.0 - agreement);
+    let dir = select(vec3<f32>(0.0, 1.0, 0.0), spec.dir / len, len > 0.0);
+    return pack_lobe(spec.m, dir, solid_angle / (2.0 * PI));
 }
 
 // Whether leaf `i`'s direct light may differ from what the last injection left: when it is
@@ -104,11 +184,23 @@ fn leaf_inputs_changed(i: u32) -> bool {
         if nw.w > 0.3 {
             n = normalize(nw.xyz);
         }
-        if irradiance_reads(light, shadow_view_index(light, p), p, n, 1.5) {
+        let v = shadow_view_index(light, p);
+        if irradiance_reads(light, v, p, n, 1.5) || material_read(v, p) {
             return true;
         }
     }
     return false;
+}
+
+// Whether `reflect_light` reads a changed texel of view `v`'s materials at p (the texel p lies
+// in, which the distance lookups need not read).
+fn material_read(v: u32, p: vec3<f32>) -> bool {
+    let dirt = view_dirt[v];
+    if params.materials == 0u || dirt.x >= dirt.z {
+        return false;
+    }
+    let view = shadow_views[v];
+    return texel_dirty(view, vec2<i32>(floor(shadow_uv(view, p).xy * view.resolution)), dirt);
 }
 
 // How near view `view` can see what moved: texels change only where moved geometry was or is
@@ -142,7 +234,7 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         atomicStore(&todo[1u + k], s);
     } else if STORE_RADIANCE && (params.store_all != 0u || leaf_is_new(s)) {
         // A new leaf's voxel holds nothing yet, even where it kept its light.
-        store_leaf_radiance(s, leaf_direct[s]);
+        store_leaf_radiance(s, leaf_direct[2u * s]);
     }
 }
 
@@ -163,9 +255,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let s = atomicLoad(&todo[1u + i]);
     let r = leaf_direct_light(s);
-    leaf_direct[s] = r;
+    leaf_direct[2u * s] = r.light;
+    leaf_direct[2u * s + 1u] = r.lobe;
     if STORE_RADIANCE {
-        store_leaf_radiance(s, r);
+        store_leaf_radiance(s, r.light);
     }
 }
 

@@ -1,5 +1,7 @@
 // shadow: renders one shadow view (a layer of the shadow atlas) as occluder distances, from the
-// mesh instances and from point-cloud surfels.
+// mesh instances and from point-cloud surfels, and beside each distance the specular material of
+// the surface seen there (`material_code`): inject reads it to put what a lit metal reflects
+// into its leaf. An atlas of one channel (a scene without metals) keeps the distance only.
 
 //!include shared/scene.wgsl
 //!include shared/surfel.wgsl
@@ -10,10 +12,25 @@
 @group(0) @binding(3) var<storage, read> points: array<Point>;
 // Per point: how far its neighbours stray from its tangent plane (metres).
 @group(0) @binding(4) var<storage, read> point_spread: array<f32>;
+@group(0) @binding(5) var<storage, read> materials: array<Material>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
+    @location(1) @interpolate(flat) material: u32,
+}
+
+// A metal's F0 and roughness as one integer below 2^24 + 1 (exact in f32): 0 for a surface
+// without a metallic part, whose specular light the voxels leave out (a dielectric's 4 %),
+// else 1 + six bits each of F0's rgb and of the roughness. Decoded by lights.wgsl's
+// `shadow_material`.
+fn material_code(m: Material) -> f32 {
+    if m.metallic <= 0.0 {
+        return 0.0;
+    }
+    let f0 = mix(vec3<f32>(0.04 * m.specular), m.base_color.rgb, m.metallic);
+    let q = vec4<u32>(round(clamp(vec4<f32>(f0, m.roughness), vec4<f32>(0.0), vec4<f32>(1.0)) * 63.0));
+    return f32(1u + (q.x | (q.y << 6u) | (q.z << 12u) | (q.w << 18u)));
 }
 
 @vertex
@@ -22,6 +39,7 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) di: u32) -> 
     var out: VsOut;
     out.clip = view.view_proj * world;
     out.world = world.xyz;
+    out.material = draws[di].material;
     return out;
 }
 
@@ -71,12 +89,13 @@ fn vs_points(@builtin(vertex_index) vi: u32) -> PointOut {
     return out;
 }
 
+// Points carry no metal: a distance without a material.
 @fragment
-fn fs_points(in: PointOut) -> @location(0) f32 {
+fn fs_points(in: PointOut) -> @location(0) vec2<f32> {
     if dot(in.disc, in.disc) > 1.0 {
         discard;
     }
-    return occluder_distance(in.world);
+    return vec2<f32>(occluder_distance(in.world), 0.0);
 }
 
 // The occluder distance this view stores for a surface point.
@@ -91,8 +110,8 @@ fn occluder_distance(world: vec3<f32>) -> f32 {
 }
 
 @fragment
-fn fs_main(in: VsOut) -> @location(0) f32 {
-    return occluder_distance(in.world);
+fn fs_main(in: VsOut) -> @location(0) vec2<f32> {
+    return vec2<f32>(occluder_distance(in.world), material_code(materials[in.material]));
 }
 
 // With static maps (`StaticMaps`, a scene with dynamic geometry and four times as many static
@@ -102,25 +121,25 @@ fn fs_main(in: VsOut) -> @location(0) f32 {
 // themselves), as one pass over both would.
 @group(1) @binding(0) var static_maps: texture_2d_array<f32>;
 
-fn over_static(clip: vec4<f32>, d: f32) -> f32 {
+fn over_static(clip: vec4<f32>, d: f32, material: f32) -> vec2<f32> {
     let s = textureLoad(static_maps, vec2<i32>(clip.xy), i32(view.layer), 0).r;
     if d >= s {
         discard;
     }
-    return d;
+    return vec2<f32>(d, material);
 }
 
 @fragment
-fn fs_main_over(in: VsOut) -> @location(0) f32 {
-    return over_static(in.clip, occluder_distance(in.world));
+fn fs_main_over(in: VsOut) -> @location(0) vec2<f32> {
+    return over_static(in.clip, occluder_distance(in.world), material_code(materials[in.material]));
 }
 
 @fragment
-fn fs_points_over(in: PointOut) -> @location(0) f32 {
+fn fs_points_over(in: PointOut) -> @location(0) vec2<f32> {
     if dot(in.disc, in.disc) > 1.0 {
         discard;
     }
-    return over_static(in.clip, occluder_distance(in.world));
+    return over_static(in.clip, occluder_distance(in.world), 0.0);
 }
 
 // Resetting a rectangle of a view before re-rendering only that part (the scissor limits the
@@ -132,6 +151,6 @@ fn vs_clear(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
 }
 
 @fragment
-fn fs_clear() -> @location(0) f32 {
-    return 3.0e38;
+fn fs_clear() -> @location(0) vec2<f32> {
+    return vec2<f32>(3.0e38, 0.0);
 }

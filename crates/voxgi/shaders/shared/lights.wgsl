@@ -64,6 +64,20 @@ fn shadow_texel(view: ShadowView, t: vec2<i32>) -> f32 {
     return textureLoad(shadow_maps, c, i32(view.layer), 0).r;
 }
 
+// The specular material of the surface texel `t` of `view` sees (lighting/shadow.wgsl's
+// `material_code`: 0 for none, and always in an atlas of distances alone): F0 (rgb) and
+// roughness (a), or all zero.
+fn shadow_material(view: ShadowView, t: vec2<i32>) -> vec4<f32> {
+    let r = i32(view.resolution);
+    let c = clamp(t, vec2<i32>(0), vec2<i32>(r - 1)) + vec2<i32>(view.offset);
+    let code = u32(textureLoad(shadow_maps, c, i32(view.layer), 0).g);
+    if code == 0u {
+        return vec4<f32>(0.0);
+    }
+    let q = code - 1u;
+    return vec4<f32>(vec4<u32>(q & 63u, (q >> 6u) & 63u, (q >> 12u) & 63u, q >> 18u)) / 63.0;
+}
+
 // The distance a planar receiver (through p, normal n) would have at shadow-map position uv:
 // comparing occluders against this instead of p's own distance stops wide filters from letting
 // a tilted surface shadow itself (receiver-plane depth bias, exact for planes).

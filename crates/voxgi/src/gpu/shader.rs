@@ -50,6 +50,7 @@ const SOURCES: &[(&str, &str)] = wgsl![
     "shared/surfel.wgsl",
     "shared/interleave.wgsl",
     "shared/upsample.wgsl",
+    "shared/specular_lobe.wgsl",
     "lighting/shadow.wgsl",
     "lighting/moments.wgsl",
     "screen/gbuffer.wgsl",

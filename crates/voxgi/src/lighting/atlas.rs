@@ -54,6 +54,9 @@ pub(crate) const SHADOW_PERSPECTIVE: u32 = 1;
 pub(crate) const UNIFORM_STRIDE: u64 = 256;
 /// Format of the atlas's distance maps: the nearest occluder's distance per texel, metres.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Format of the atlas of a scene with metals: the distance, and the specular material of the
+/// surface seen there (lighting/shadow.wgsl's `material_code`).
+pub const MATERIAL_ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 /// Format of the prefiltered moments (lighting/moments.wgsl): f32, since the variance is a
 /// difference of two close squares.
 pub const MOMENTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -64,7 +67,8 @@ pub struct ShadowAtlas {
     pub views: Vec<GpuShadowView>,
     /// Which light each view belongs to.
     pub view_light: Vec<usize>,
-    /// The atlas texture: one square `ATLAS_FORMAT` layer per view (at least one).
+    /// The atlas texture: one square `ATLAS_FORMAT` (or `MATERIAL_ATLAS_FORMAT`) layer per view
+    /// (at least one).
     pub texture: wgpu::Texture,
     /// `texture` as a 2D-array view, for the lighting passes.
     pub array_view: wgpu::TextureView,
@@ -470,12 +474,19 @@ fn check_atlas(
     casts: &[bool],
     res: u32,
     moments: bool,
+    materials: bool,
     limits: &wgpu::Limits,
 ) -> Result<()> {
     let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
-    // The distance maps (R32Float), and with VSM/ESM filtering their moments (Rgba32Float),
-    // a texture of the same layers of its own.
-    let texel = if moments { 16 } else { 4 };
+    // The distance maps (R32Float, Rg32Float with materials), and with VSM/ESM filtering their
+    // moments (Rgba32Float), a texture of the same layers of its own.
+    let texel = if moments {
+        16
+    } else if materials {
+        8
+    } else {
+        4
+    };
     let bytes = res as u64 * res as u64 * layers as u64 * texel;
     let lights = casts.iter().filter(|&&c| c).count();
     let cause = if layers > limits.max_texture_array_layers {
@@ -503,7 +514,9 @@ fn check_atlas(
 impl ShadowAtlas {
     /// Makes the atlas for `views` (owned by the lights in `view_light`), each map `res` texels
     /// square, with its depth buffer and view buffers, and with `moments` the prefiltered
-    /// moments of every map.
+    /// moments of every map, and with `materials` the surfaces' specular materials beside the
+    /// distances (`MATERIAL_ATLAS_FORMAT`).
+    #[allow(clippy::too_many_arguments)] // the atlas's shape, one argument each
     pub fn new(
         device: &wgpu::Device,
         views: Vec<GpuShadowView>,
@@ -512,7 +525,13 @@ impl ShadowAtlas {
         moments: bool,
         samples: bool,
         dynamic: bool,
+        materials: bool,
     ) -> Self {
+        let format = if materials {
+            MATERIAL_ATLAS_FORMAT
+        } else {
+            ATLAS_FORMAT
+        };
         let layers = views.iter().map(|v| v.layer + 1).max().unwrap_or(1);
         // Sample views are the quarter-size ones, after all the others (`plan_views`).
         let first_sample = views
@@ -550,7 +569,7 @@ impl ShadowAtlas {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: ATLAS_FORMAT,
+                format,
                 usage: usage
                     | wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING,
@@ -745,15 +764,19 @@ impl ShadowAtlas {
         ]
     }
 
-    /// GPU memory of the atlas in bytes, counted as 8 bytes per texel of every layer (the R32F
-    /// distance plus a Depth32 depth; the depth texture has one layer, so this is an upper bound),
-    /// plus the moments and the static geometry's maps.
+    /// GPU memory of the atlas in bytes, counted as the distance (and material) texel plus
+    /// 4 bytes of Depth32 depth per texel of every layer (the depth texture has one layer, so
+    /// this is an upper bound), plus the moments and the static geometry's maps.
     pub fn bytes(&self) -> u64 {
         let texels = |t: &wgpu::Texture| {
             t.width() as u64 * t.height() as u64 * t.depth_or_array_layers() as u64
         };
-        let statics = self.statics.as_ref().map_or(0, |s| texels(&s.texture) * 4);
-        texels(&self.texture) * 8 + texels(&self.moments) * 16 + statics
+        let texel = self.texture.format().block_copy_size(None).unwrap_or(4) as u64;
+        let statics = self
+            .statics
+            .as_ref()
+            .map_or(0, |s| texels(&s.texture) * texel);
+        texels(&self.texture) * (texel + 4) + texels(&self.moments) * 16 + statics
     }
 }
 
@@ -773,7 +796,7 @@ pub fn plan_atlas(
     let samples = options.temporal;
     let (views, owners) = plan_views(&mut scene.gpu_lights, casts, center, radius, res, samples);
     let moments = options.shadow_filter == ShadowFilter::VsmEsm;
-    check_atlas(&views, casts, res, moments, &device.limits())?;
+    check_atlas(&views, casts, res, moments, scene.metals, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
         ShadowAtlas::new(
@@ -784,6 +807,7 @@ pub fn plan_atlas(
             moments,
             samples,
             keep_static_maps(scene),
+            scene.metals,
         )
     })
 }

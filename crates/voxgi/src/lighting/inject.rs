@@ -3,7 +3,7 @@
 use crate::gpu::layout;
 use crate::gpu::timer::GpuTimer;
 use crate::gpu_scene::GpuScene;
-use crate::lighting::atlas::{ShadowAtlas, ViewDirt};
+use crate::lighting::atlas::{MATERIAL_ATLAS_FORMAT, ShadowAtlas, ViewDirt};
 use crate::options::ShadowFilter;
 use crate::voxel::{VoxelKind, VoxelStructure};
 use wgpu::util::DeviceExt;
@@ -41,7 +41,8 @@ pub(crate) struct GpuInjectParams {
     pub(crate) light_count: u32,
     pub(crate) all: u32,
     pub(crate) store_all: u32,
-    pub(crate) _pad: u32,
+    /// 1: the shadow maps hold the surfaces' specular materials (`MATERIAL_ATLAS_FORMAT`).
+    pub(crate) materials: u32,
     pub(crate) moved_min: [f32; 4],
     pub(crate) moved_max: [f32; 4],
 }
@@ -156,7 +157,7 @@ impl InjectPass {
             light_count: self.light_count,
             all: all as u32,
             store_all: store_all as u32,
-            _pad: 0,
+            materials: (atlas.texture.format() == MATERIAL_ATLAS_FORMAT) as u32,
             moved_min: lo,
             moved_max: hi,
         };

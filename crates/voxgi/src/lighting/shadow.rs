@@ -6,12 +6,27 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::gpu_scene::GpuScene;
 use crate::lighting::atlas::{
-    ATLAS_FORMAT, GpuShadowView, ShadowAtlas, UNIFORM_STRIDE, ViewDirt, behind_emitter,
+    ATLAS_FORMAT, GpuShadowView, MATERIAL_ATLAS_FORMAT, ShadowAtlas, UNIFORM_STRIDE, ViewDirt,
+    behind_emitter,
 };
 
 /// The shadow render pass (shaders/shadow.wgsl): the mesh and surfel pipelines writing distance
-/// maps into the shadow atlas, and their bind group layout.
+/// maps into the shadow atlas (and, in an atlas of two channels, the surfaces' specular
+/// materials beside them), and their bind group layout.
 pub struct ShadowPass {
+    /// For a one-channel atlas (distances).
+    distance: Pipelines,
+    /// For a two-channel atlas (distances and materials): made by the first `bind` to one.
+    with_materials: std::sync::OnceLock<Pipelines>,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    over_layout: wgpu::PipelineLayout,
+    layout: wgpu::BindGroupLayout,
+    statics_layout: wgpu::BindGroupLayout,
+}
+
+/// The pass's pipelines for one atlas format.
+struct Pipelines {
     pipeline: wgpu::RenderPipeline,
     /// Point-cloud surfels: 6 vertices per point, no index buffer.
     points: wgpu::RenderPipeline,
@@ -20,8 +35,73 @@ pub struct ShadowPass {
     /// Meshes and surfels drawn over the static geometry's maps (`StaticMaps`).
     pipeline_over: wgpu::RenderPipeline,
     points_over: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
-    statics_layout: wgpu::BindGroupLayout,
+}
+
+impl Pipelines {
+    fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        pipeline_layout: &wgpu::PipelineLayout,
+        over_layout: &wgpu::PipelineLayout,
+        format: wgpu::TextureFormat,
+    ) -> Self {
+        let make_with = |pipeline_layout: &wgpu::PipelineLayout,
+                         label: &str,
+                         vs: &str,
+                         fs: &str,
+                         depth: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: wgpu::TextureFormat::Depth32Float,
+                    depth_write_enabled: Some(depth),
+                    depth_compare: Some(if depth {
+                        wgpu::CompareFunction::Less
+                    } else {
+                        wgpu::CompareFunction::Always
+                    }),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let make = |label: &str, vs: &str, fs: &str, depth: bool| {
+            make_with(pipeline_layout, label, vs, fs, depth)
+        };
+        Pipelines {
+            pipeline: make("shadow", "vs_main", "fs_main", true),
+            points: make("shadow points", "vs_points", "fs_points", true),
+            clear: make("shadow clear", "vs_clear", "fs_clear", false),
+            pipeline_over: make_with(over_layout, "shadow", "vs_main", "fs_main_over", true),
+            points_over: make_with(
+                over_layout,
+                "shadow points",
+                "vs_points",
+                "fs_points_over",
+                true,
+            ),
+        }
+    }
 }
 
 /// The shadow pass's bind groups for one atlas (`ShadowPass::bind`).
@@ -32,7 +112,8 @@ pub struct ShadowBind {
 }
 
 impl ShadowPass {
-    /// Compiles both pipelines (no culling) and creates their bind group layout.
+    /// Compiles the pipelines for a one-channel atlas (no culling) and creates their bind
+    /// group layout.
     pub fn new(device: &wgpu::Device) -> Self {
         let vs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -43,6 +124,7 @@ impl ShadowPass {
                 layout::storage(2, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(3, wgpu::ShaderStages::VERTEX, true),
                 layout::storage(4, wgpu::ShaderStages::VERTEX, true),
+                layout::storage(5, wgpu::ShaderStages::FRAGMENT, true),
             ],
         });
         let statics_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -65,69 +147,44 @@ impl ShadowPass {
             bind_group_layouts: &[Some(&layout), Some(&statics_layout)],
             immediate_size: 0,
         });
-        let make_with = |pipeline_layout: &wgpu::PipelineLayout,
-                         label: &str,
-                         vs: &str,
-                         fs: &str,
-                         depth: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: wgpu::TextureFormat::Depth32Float,
-                    depth_write_enabled: Some(depth),
-                    depth_compare: Some(if depth {
-                        wgpu::CompareFunction::Less
-                    } else {
-                        wgpu::CompareFunction::Always
-                    }),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(ATLAS_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let make = |label: &str, vs: &str, fs: &str, depth: bool| {
-            make_with(&pipeline_layout, label, vs, fs, depth)
-        };
         ShadowPass {
-            pipeline: make("shadow", "vs_main", "fs_main", true),
-            points: make("shadow points", "vs_points", "fs_points", true),
-            clear: make("shadow clear", "vs_clear", "fs_clear", false),
-            pipeline_over: make_with(&over_layout, "shadow", "vs_main", "fs_main_over", true),
-            points_over: make_with(
+            distance: Pipelines::new(
+                device,
+                &module,
+                &pipeline_layout,
                 &over_layout,
-                "shadow points",
-                "vs_points",
-                "fs_points_over",
-                true,
+                ATLAS_FORMAT,
             ),
+            with_materials: std::sync::OnceLock::new(),
+            module,
+            pipeline_layout,
+            over_layout,
             layout,
             statics_layout,
         }
     }
 
+    /// The pipelines for an atlas of `format`.
+    fn pipelines(&self, format: wgpu::TextureFormat) -> &Pipelines {
+        match self.with_materials.get() {
+            Some(p) if format == MATERIAL_ATLAS_FORMAT => p,
+            _ => &self.distance,
+        }
+    }
     /// The pass's bind groups over `atlas`'s views and static maps and `scene`'s geometry
     /// (made once per atlas).
     pub fn bind(&self, device: &wgpu::Device, atlas: &ShadowAtlas, scene: &GpuScene) -> ShadowBind {
+        if atlas.texture.format() == MATERIAL_ATLAS_FORMAT {
+            self.with_materials.get_or_init(|| {
+                Pipelines::new(
+                    device,
+                    &self.module,
+                    &self.pipeline_layout,
+                    &self.over_layout,
+                    MATERIAL_ATLAS_FORMAT,
+                )
+            });
+        }
         let statics = atlas.statics.as_ref().map(|s| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shadow statics"),
@@ -148,6 +205,7 @@ impl ShadowPass {
                 scene.draws.as_entire_binding(),
                 scene.points.as_entire_binding(),
                 scene.point_spread.as_entire_binding(),
+                scene.materials.as_entire_binding(),
             ]),
         });
         ShadowBind { scene, statics }
@@ -172,6 +230,7 @@ impl ShadowPass {
         bind: &ShadowBind,
         timer: &mut GpuTimer,
     ) {
+        let pipelines = self.pipelines(atlas.texture.format());
         for i in 0..atlas.views.len() {
             let view = atlas.views[i];
             let mut dirt = views.get(i).copied().unwrap_or(ViewDirt::All);
@@ -194,7 +253,7 @@ impl ShadowPass {
                 let target = &maps.layer_views[layer];
                 let mut pass = begin(encoder, target, true, &atlas.depth_view, label, timer);
                 pass.set_bind_group(0, &bind.scene, &offset);
-                self.draw(&mut pass, scene, owner, Draws::Static, false);
+                self.draw(&mut pass, pipelines, scene, owner, Draws::Static, false);
                 dirt = ViewDirt::All;
             }
             let Some((x, y, w, h)) = dirt.scissor(res) else {
@@ -224,7 +283,7 @@ impl ShadowPass {
             pass.set_bind_group(0, &bind.scene, &offset);
             pass.set_bind_group(1, statics_bind, &[]);
             pass.set_scissor_rect(x, y, w, h);
-            self.draw(&mut pass, scene, owner, Draws::Dynamic, true);
+            self.draw(&mut pass, pipelines, scene, owner, Draws::Dynamic, true);
             drop(pass);
             if let Some(maps) = &mut atlas.statics {
                 maps.fresh[i] = true;
@@ -245,6 +304,7 @@ impl ShadowPass {
         label: &'static str,
         timer: &mut GpuTimer,
     ) {
+        let pipelines = self.pipelines(atlas.texture.format());
         let view = &atlas.views[i];
         let res = view.resolution as u32;
         let Some((x, y, w, h)) = dirt.scissor(res) else {
@@ -262,10 +322,17 @@ impl ShadowPass {
         }
         if !whole {
             pass.set_scissor_rect(x + ox as u32, y + oy as u32, w, h);
-            pass.set_pipeline(&self.clear);
+            pass.set_pipeline(&pipelines.clear);
             pass.draw(0..3, 0..1);
         }
-        self.draw(&mut pass, scene, atlas.view_light[i], Draws::All, false);
+        self.draw(
+            &mut pass,
+            pipelines,
+            scene,
+            atlas.view_light[i],
+            Draws::All,
+            false,
+        );
     }
 
     /// Draws `which` of the scene's meshes and points for a view of light `owner` (never the
@@ -273,15 +340,16 @@ impl ShadowPass {
     fn draw(
         &self,
         pass: &mut wgpu::RenderPass,
+        pipelines: &Pipelines,
         scene: &GpuScene,
         owner: usize,
         which: Draws,
         over: bool,
     ) {
         let (meshes, points) = if over {
-            (&self.pipeline_over, &self.points_over)
+            (&pipelines.pipeline_over, &pipelines.points_over)
         } else {
-            (&self.pipeline, &self.points)
+            (&pipelines.pipeline, &pipelines.points)
         };
         pass.set_pipeline(meshes);
         pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);

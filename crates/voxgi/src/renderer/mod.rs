@@ -760,7 +760,8 @@ impl Renderer {
         self.timer.read(&self.device)
     }
 
-    /// The shadow maps: one R32Float layer per shadow view (the area lights' sample views share
+    /// The shadow maps: one R32Float layer (Rg32Float in a scene with metals: the distance and the
+    /// specular material) per shadow view (the area lights' sample views share
     /// layers, a quarter each), the occluder's distance
     /// from the light (for inspection; `gpu::readback::read_texture_3d` reads every layer).
     pub fn shadow_maps(&self) -> &wgpu::Texture {

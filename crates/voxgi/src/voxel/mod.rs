@@ -361,6 +361,11 @@ pub struct Filtering {
     pub ndf: bool,
 }
 
+/// Bytes a leaf slot's direct light takes in its structure's `leaf_direct` (voxels/<kind>/
+/// leaves.wgsl): its radiance and opacity, and its specular lobe (shared/specular_lobe.wgsl),
+/// two vec4 f32.
+pub const DIRECT_BYTES: u64 = 32;
+
 /// Words of `VoxelStructure::pool_counter` read back after each build (the octree's sixth: the
 /// slots of its static build, `octree::STATIC_COUNTED`).
 pub const POOL_COUNTERS: usize = 6;

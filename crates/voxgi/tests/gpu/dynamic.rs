@@ -677,7 +677,7 @@ fn a_moved_clipmap_window_keeps_the_direct_light_of_the_voxels_it_held() {
     let c = ctx();
     // The finest window's filled slots: per voxel, its direct light; and how many the last
     // build kept (slots.wgsl's W_KEPT: word 18 + 3).
-    let finest = |r: &Renderer| -> (std::collections::HashMap<u32, [f32; 4]>, u32, u32) {
+    let finest = |r: &Renderer| -> (std::collections::HashMap<u32, [f32; 8]>, u32, u32) {
         let v = r
             .structure::<voxgi::voxel::clipmap::Clipmap>()
             .unwrap()
@@ -686,7 +686,8 @@ fn a_moved_clipmap_window_keeps_the_direct_light_of_the_voxels_it_held() {
         let (words, slots, light) = (read(&v.counters), read(&v.slot_voxel), read(&v.slot_direct));
         let words: &[u32] = bytemuck::cast_slice(&words);
         let slots: &[u32] = bytemuck::cast_slice(&slots);
-        let light: &[[f32; 4]] = bytemuck::cast_slice(&light);
+        // Per slot, its light and its specular lobe (voxel::DIRECT_BYTES).
+        let light: &[[f32; 8]] = bytemuck::cast_slice(&light);
         let filled = words[18].min(v.window_slots) as usize;
         let map = (0..filled).map(|s| (slots[s], light[s])).collect();
         (map, filled as u32, words[18 + 3])

@@ -118,11 +118,12 @@ fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var k = 0u; k < ACCUM_STRIDE; k++) {
         atomicStore(&accum[s * ACCUM_STRIDE + k], kept[sums + k]);
     }
-    // Its direct light, unless the lights or what moved change it (inject decides).
+    // Its direct light and lobe (8 words), unless the lights or what moved change them
+    // (inject decides).
     let direct = KEPT_OCCUPANCY + r * r * r + part * (1u + ACCUM_STRIDE);
-    let handed = direct + 4u * part + 4u * (s - w * part);
-    for (var k = 0u; k < 4u; k++) {
-        kept[handed + k] = kept[direct + 4u * t + k];
+    let handed = direct + 8u * part + 8u * (s - w * part);
+    for (var k = 0u; k < 8u; k++) {
+        kept[handed + k] = kept[direct + 8u * t + k];
     }
 }
 

@@ -11,6 +11,7 @@
 // filter to the bit.
 
 //!include shared/volume.wgsl
+//!include shared/specular_lobe.wgsl
 //!include voxels/changed.wgsl
 
 struct FilterParams {
@@ -36,6 +37,10 @@ struct FilterParams {
 @group(0) @binding(2) var dst: texture_storage_3d<rgba16float, write>;
 // The finest level's normals and their agreement (read with `ndf`).
 @group(0) @binding(3) var normals: texture_3d<f32>;
+// Per finest voxel: 0 empty, 2 + its leaf's slot (build_shared.wgsl's `occupancy`).
+@group(0) @binding(4) var<storage, read> occupancy: array<u32>;
+// Per slot, two: its direct light and its specular lobe (leaves.wgsl's `leaf_direct`).
+@group(0) @binding(5) var<storage, read> leaf_direct: array<vec4<f32>>;
 // The volume's counters: the levels' bits and lists (changed.wgsl).
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
 
@@ -43,13 +48,38 @@ fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
     return from_depth(textureLoad(src, base + o, 0));
 }
 
-// A finest voxel as direction `block` counts it.
+// A finest voxel as direction `block` counts it: its Lambertian light (weighed by its normals
+// with `ndf`) and, on the first directional level, what its specular lobe sends that way.
 fn leaf_child(base: vec3<i32>, o: vec3<i32>, block: u32) -> vec4<f32> {
     var w = 1.0;
     if params.ndf != 0u {
         w = ndf_weight(textureLoad(normals, base + o, 0), block);
     }
-    return w * child(base, o);
+    let v = child(base, o);
+    var lobe = vec3<f32>(0.0);
+    if params.src_blocked == 0u && v.a > 0.0 {
+        lobe = leaf_lobe(base + o, block);
+    }
+    // Apart, so that a voxel without a lobe filters to the same bits as before lobes were.
+    if all(lobe == vec3<f32>(0.0)) {
+        return w * v;
+    }
+    return w * v + vec4<f32>(v.a * lobe, 0.0);
+}
+
+// The radiance finest voxel `c`'s specular lobe sends towards the cones of direction `block`.
+fn leaf_lobe(c: vec3<i32>, block: u32) -> vec3<f32> {
+    let r = params.dst_res * 2u;
+    let occupied = occupancy[u32(c.x) + r * (u32(c.y) + r * u32(c.z))];
+    if occupied < 2u || occupied == 0xffffffffu {
+        return vec3<f32>(0.0);
+    }
+    let packed = leaf_direct[2u * (occupied - 2u) + 1u];
+    if all(packed.rgb <= vec3<f32>(0.0)) {
+        return vec3<f32>(0.0);
+    }
+    let n = textureLoad(normals, c, 0).xyz;
+    return lobe_radiance(unpack_lobe(packed), n / max(length(n), 1e-4), block);
 }
 
 // Level `params.step + 1`'s voxel `gid` in direction block `block` from its eight children.

@@ -18,7 +18,9 @@
 //   fn leaf_albedo(i) / leaf_normal(i) / leaf_emission(i)   what the build resolved
 //   fn leaf_surface(i) -> f32                     how far its centre lies in front of its
 //                                                 surface along the normal, voxels
-//   leaf_direct[i], leaf_next[i]                  per-leaf light: direct (inject) and bounced
+//   leaf_direct[2i], leaf_next[i]                 per-leaf light: direct (inject) and bounced;
+//   leaf_direct[2i + 1]                           the direct light's specular lobe
+//                                                 (shared/specular_lobe.wgsl)
 //
 // and voxels/<kind>/leaf_store.wgsl's store_leaf_radiance(i, premultiplied). All at
 // @group(2) (the store at @group(3)); `DenseVolume::leaves_layout` is the twin. The clipmap
@@ -35,7 +37,7 @@
 // The slots each window holds (voxels/dense/slots.wgsl).
 // Read-write: the leaf stores list the voxels they write in it for the filter (changed.wgsl).
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>>;
-// Per leaf: direct radiance (rgb) and opacity, kept for the bounces.
+// Per leaf, two: direct radiance (rgb) and opacity, kept for the bounces; its specular lobe.
 @group(2) @binding(6) var<storage, read_write> leaf_direct: array<vec4<f32>>;
 // Per leaf: the last bounce's outgoing radiance and opacity.
 @group(2) @binding(7) var<storage, read_write> leaf_next: array<vec4<f32>>;

@@ -40,6 +40,9 @@ impl FilterPass {
                 layout::texture_3d_load(1, c),
                 layout::storage_texture_3d(2, RADIANCE_FORMAT),
                 layout::texture_3d_load(3, c),
+                // The occupancy and the leaves' direct light (their specular lobes).
+                layout::storage(4, c, true),
+                layout::storage(5, c, true),
                 // The volume's counters: the levels' bits and lists (changed.wgsl).
                 layout::storage(6, c, false),
             ],
@@ -109,8 +112,9 @@ impl FilterPass {
 
     /// The bind groups of every level's step for a volume on `grid` (`windows` cubes of it
     /// stacked along z) with these textures (the finest level's `radiance` and `normal`, the
-    /// `chains` above) and its lists of changed voxels (in `counters`), with their parameters:
-    /// made once per volume (they bind only its own resources).
+    /// `chains` above), its lists of changed voxels (in `counters`), and its `occupancy` and
+    /// slots' `direct` light, whose specular lobes the first level folds in, with their
+    /// parameters: made once per volume (they bind only its own resources).
     #[allow(clippy::too_many_arguments)]
     pub fn bind(
         &self,
@@ -119,7 +123,7 @@ impl FilterPass {
         windows: u32,
         filtering: Filtering,
         [radiance, chains, normal]: [&wgpu::Texture; 3],
-        counters: &wgpu::Buffer,
+        [counters, occupancy, direct]: [&wgpu::Buffer; 3],
     ) -> FilterBinds {
         let steps = Self::steps(grid, windows, filtering);
         let mut bytes = vec![0u8; steps.len() * STRIDE as usize];
@@ -178,6 +182,8 @@ impl FilterPass {
                     wgpu::BindingResource::TextureView(&src),
                     wgpu::BindingResource::TextureView(&dst),
                     wgpu::BindingResource::TextureView(&normals),
+                    occupancy.as_entire_binding(),
+                    direct.as_entire_binding(),
                 ]);
                 entries.push(wgpu::BindGroupEntry {
                     binding: 6,

@@ -23,7 +23,8 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::voxel::registry::{KindInfo, StructureDesc};
 use crate::voxel::{
-    DebugView, Filtering, FragmentBind, POOL_COUNTERS, StructureBindings, VoxelStructure,
+    DIRECT_BYTES, DebugView, Filtering, FragmentBind, POOL_COUNTERS, StructureBindings,
+    VoxelStructure,
 };
 use crate::{Error, Result};
 use debug::DebugPass;
@@ -130,8 +131,8 @@ pub const SHARED_CONSTANTS: &[(&str, u64)] = &[
 const SHRINK_BELOW: u64 = 4;
 
 /// Bytes of `DenseVolume::kept` per slot of a window's part: its voxel, its static sums and
-/// its direct light twice (as it was, and handed to its new slot).
-const KEPT_SLOT_BYTES: u64 = 4 * (1 + ACCUM_STRIDE + 2 * 4);
+/// its direct light and lobe twice (as they were, and handed to its new slot).
+const KEPT_SLOT_BYTES: u64 = 4 * (1 + ACCUM_STRIDE) + 2 * DIRECT_BYTES;
 
 /// Where the regions of `DenseVolume::kept` begin, in bytes (build_shared.wgsl's `kept`),
 /// for windows of `resolution`³ voxels and `window_slots` slots: after the head, the moved
@@ -152,7 +153,7 @@ fn kept_layout(resolution: u32, window_slots: u32) -> KeptLayout {
     let slots = occupancy + (resolution as u64).pow(3) * 4;
     let sums = slots + part * 4;
     let direct = sums + part * ACCUM_STRIDE * 4;
-    let handed = direct + part * 16;
+    let handed = direct + part * DIRECT_BYTES;
     KeptLayout {
         occupancy,
         slots,
@@ -263,7 +264,8 @@ pub struct DenseVolume {
     kept: wgpu::Buffer,
     /// Whether the pools have room for dynamic geometry.
     pub dynamic: bool,
-    /// Per slot: direct radiance (rgb) and opacity from inject, kept for the bounces (vec4 f32).
+    /// Per slot: direct radiance (rgb) and opacity from inject, kept for the bounces, and the
+    /// specular lobe beside it (two vec4 f32, `DIRECT_BYTES`).
     pub slot_direct: wgpu::Buffer,
     /// Per slot: the last bounce's outgoing radiance and opacity (vec4 f32).
     pub slot_next: wgpu::Buffer,
@@ -637,7 +639,7 @@ impl DenseVolume {
             KEPT_OCCUPANCY_WORD * 4 + 4
         };
         let kept = storage_buffer(device, "voxel kept window", kept_bytes, no);
-        let slot_direct = storage_buffer(device, "voxel direct light", slots * 16, no);
+        let slot_direct = storage_buffer(device, "voxel direct light", slots * DIRECT_BYTES, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
         let slot_irradiance = storage_buffer(device, "voxel leaf irradiance", slots * 16, no);
         let occupancy = storage_buffer(
@@ -682,7 +684,7 @@ impl DenseVolume {
             windows,
             filtering,
             [&radiance, &chains, &normal],
-            &counters,
+            [&counters, &occupancy, &slot_direct],
         );
         DenseVolume {
             grid,
@@ -918,7 +920,10 @@ impl DenseVolume {
         let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
         let at = kept_layout(self.grid.resolution, self.window_slots);
         // Per slot of a window's part: its voxel, its direct light.
-        let (part, direct) = (self.window_slots as u64 * 4, self.window_slots as u64 * 16);
+        let (part, direct) = (
+            self.window_slots as u64 * 4,
+            self.window_slots as u64 * DIRECT_BYTES,
+        );
         // The occupancy with the last update's slots (their light is kept too), the sums
         // without (below).
         if let Some((w, _)) = kept {

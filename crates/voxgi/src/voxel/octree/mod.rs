@@ -36,7 +36,8 @@ use tree::{
 
 use super::registry::{KindInfo, StructureDesc};
 use super::{
-    DebugView, Filtering, FragmentBind, Grid, POOL_COUNTERS, StructureBindings, VoxelStructure,
+    DIRECT_BYTES, DebugView, Filtering, FragmentBind, Grid, POOL_COUNTERS, StructureBindings,
+    VoxelStructure,
 };
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
@@ -286,7 +287,7 @@ impl OctreeVolume {
         let grid_words = ((1u64 << (3 * (g + 1))) - 1) / 7;
         let top_grid = storage_buffer(device, "octree top grid", grid_words * 4);
         let slot_buf = storage_buffer(device, "octree leaf slots", slots * SLOT_WORDS * 4);
-        let leaf_direct = storage_buffer(device, "octree direct light", slots * 16);
+        let leaf_direct = storage_buffer(device, "octree direct light", slots * DIRECT_BYTES);
         let leaf_next = storage_buffer(device, "octree bounce light", slots * 16);
         let leaf_irradiance = storage_buffer(device, "octree leaf irradiance", slots * 16);
         let args = device.create_buffer(&wgpu::BufferDescriptor {
