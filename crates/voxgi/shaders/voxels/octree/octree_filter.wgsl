@@ -13,6 +13,7 @@
 // changes nothing, so flagging more than changed costs time, never exactness.
 
 //!include shared/volume.wgsl
+//!include shared/specular_lobe.wgsl
 //!include voxels/tree.wgsl
 
 struct Level {
@@ -32,6 +33,8 @@ struct Level {
 @group(0) @binding(7) var flags: texture_storage_2d<r32uint, read_write>;
 // [0]: the nodes the filter redid since the host last cleared it.
 @group(0) @binding(8) var<storage, read_write> redone: array<atomic<u32>>;
+// Per leaf slot, two: its direct light and its specular lobe (leaves.wgsl's `leaf_direct`).
+@group(0) @binding(9) var<storage, read> leaf_direct: array<vec4<f32>>;
 
 fn child(n: u32) -> u32 {
     return nodes[NODE_HEADER + n * NODE_STRIDE];
@@ -46,17 +49,28 @@ fn source(base: vec3<u32>, o: vec3<u32>) -> vec4<f32> {
 }
 
 // Leaf voxel `o` of the leaf tile `below` (level 0) as direction d counts it: weighed by its
-// normals with `tree.ndf`, as the dense volume's filter weighs its finest voxels.
+// normals with `tree.ndf`, as the dense volume's filter weighs its finest voxels, and with what
+// its specular lobe sends that way (voxels/dense/filter.wgsl's `leaf_child`).
 fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
-    var w = 1.0;
+    let v = source(base, o);
     // `filtered` also runs (and is discarded) for nodes without a brick: below 0.
-    if tree.ndf != 0u && below != 0u {
-        let word = nodes[child_word(tree, below * 8u + o.x + 2u * o.y + 4u * o.z)];
-        let slot = min(max(word, 1u) - 1u, tree.slots - 1u);
-        let normal = unpack4x8snorm(slots[slot * SLOT_STRIDE + 3u]);
+    if below == 0u {
+        return v;
+    }
+    let word = nodes[child_word(tree, below * 8u + o.x + 2u * o.y + 4u * o.z)];
+    let slot = min(max(word, 1u) - 1u, tree.slots - 1u);
+    let normal = unpack4x8snorm(slots[slot * SLOT_STRIDE + 3u]);
+    var w = 1.0;
+    if tree.ndf != 0u {
         w = select(1.0, ndf_weight(normal, d), word != 0u);
     }
-    return w * source(base, o);
+    let packed = leaf_direct[2u * slot + 1u];
+    // Apart, so that a voxel without a lobe filters to the same bits as before lobes were.
+    if word == 0u || v.a <= 0.0 || all(packed.rgb <= vec3<f32>(0.0)) {
+        return w * v;
+    }
+    let n = normal.xyz / max(length(normal.xyz), 1e-4);
+    return w * v + vec4<f32>(v.a * lobe_radiance(unpack_lobe(packed), n, d), 0.0);
 }
 
 // The redone nodes of this workgroup, added to `redone` once (one global atomic per node

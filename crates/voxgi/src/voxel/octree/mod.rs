@@ -379,6 +379,7 @@ impl OctreeVolume {
                     slot_buf.as_entire_binding(),
                     wgpu::BindingResource::TextureView(&view(&filter_flags)),
                     filter_redone.as_entire_binding(),
+                    leaf_direct.as_entire_binding(),
                 ]),
             })
         };

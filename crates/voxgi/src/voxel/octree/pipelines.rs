@@ -168,6 +168,8 @@ impl OctreePipelines {
                     count: None,
                 },
                 layout::storage(8, c, false),
+                // The leaves' direct light: their specular lobes.
+                layout::storage(9, c, true),
             ],
         });
         let filter_module =
