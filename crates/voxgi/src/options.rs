@@ -301,6 +301,13 @@ pub struct RendererOptions {
     /// (Toksvig's length of the mean normal). Needs `anisotropic`. Default false: leaves count
     /// as isotropic, which is what the figures in docs/QUALITY.md were calibrated with.
     pub ndf_mips: bool,
+    /// Metals' specular reflections of the lights in the bounces: each lit metal leaf keeps a
+    /// lobe of what it reflects, which the first directional level folds into its six
+    /// directions (docs/QUALITY.md, "Specular light in the bounces"). Needs `anisotropic`.
+    /// Default false: six directions spread a narrow lobe over their cells, which lights a wall
+    /// facing a metal's reflection at half strength but also surfaces beside it that should see
+    /// none (the metal Cornell box's block fronts), so it is a choice per scene for now.
+    pub specular_bounces: bool,
     /// Directional blocks each cone sample of the per-pixel gather reads in an anisotropic
     /// volume: 3, every axis by its weight (the paper's filtering), or 2, the two axes of
     /// largest weight renormalised (faster; docs/QUALITY.md has the cost in accuracy).
@@ -390,6 +397,7 @@ impl Default for RendererOptions {
             voxel_size: None,
             anisotropic: true,
             ndf_mips: false,
+            specular_bounces: false,
             gather_axes: 3,
             cones: ConeSet::Six60,
             bounces: 2,

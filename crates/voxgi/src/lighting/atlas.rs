@@ -796,7 +796,9 @@ pub fn plan_atlas(
     let samples = options.temporal;
     let (views, owners) = plan_views(&mut scene.gpu_lights, casts, center, radius, res, samples);
     let moments = options.shadow_filter == ShadowFilter::VsmEsm;
-    check_atlas(&views, casts, res, moments, scene.metals, &device.limits())?;
+    // The surfaces' specular materials, for the leaves' lobes.
+    let materials = scene.metals && options.specular_bounces;
+    check_atlas(&views, casts, res, moments, materials, &device.limits())?;
     crate::gpu::checked(device, "shadow atlas", || {
         queue.write_buffer(&scene.lights, 0, bytemuck::cast_slice(&scene.gpu_lights));
         ShadowAtlas::new(
@@ -807,7 +809,7 @@ pub fn plan_atlas(
             moments,
             samples,
             keep_static_maps(scene),
-            scene.metals,
+            materials,
         )
     })
 }

@@ -406,6 +406,7 @@ impl Renderer {
             || old.anisotropic != new.anisotropic
             || old.ndf_mips != new.ndf_mips;
         let atlas = old.shadow_map_size != new.shadow_map_size
+            || (old.specular_bounces != new.specular_bounces && self.scene.metals)
             || old.cone_shadows != new.cone_shadows
             || old.shadow_filter != new.shadow_filter
             // Area lights' sample views come and go with temporal accumulation.

@@ -367,6 +367,13 @@ impl RendererOptions {
                 "ndf_mips weighs six directional values: it needs the anisotropic volume".into(),
             ));
         }
+        if self.specular_bounces && !self.anisotropic {
+            return Err(Error::Setting(
+                "specular_bounces folds the lobes into six directional values: it needs the \
+                 anisotropic volume"
+                    .into(),
+            ));
+        }
         if self.progressive && self.bounces != UNLIMITED_BOUNCES {
             return Err(Error::Setting(format!(
                 "progressive bounces converge to unlimited bounces: set bounces to unlimited \

@@ -158,6 +158,16 @@ pub static SETTINGS: &[Setting] = &[
         access: access!(options bool ndf_mips),
     },
     Setting {
+        key: "specular_bounces",
+        label: "metals' reflections in the bounces",
+        help: "Metals reflect the lights' light specularly into the voxels (a lobe per lit leaf, \
+               folded into the six directions): a wall facing a metal's reflection is lit, at \
+               about half strength and spread. Needs anisotropic voxels.",
+        domain: Domain::Bool,
+        changes: Changes::Voxels,
+        access: access!(options bool specular_bounces),
+    },
+    Setting {
         key: "bounces",
         label: "bounces",
         help: "Indirect bounces: 0 (direct light only) to 8, or unlimited (until the energy \
