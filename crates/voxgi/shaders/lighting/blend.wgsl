@@ -28,7 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if s == NO_LEAF {
         return;
     }
-    var goal = leaf_direct[2u * s];
+    var goal = leaf_direct[direct_index(s)];
     if blend.from_bounce != 0u {
         goal = leaf_next[s];
     }

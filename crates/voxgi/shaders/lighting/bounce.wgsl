@@ -121,7 +121,7 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let k = atomicAdd(&listing[0], 1u);
         gathered[list_start() + 1u + k] = s;
     } else {
-        leaf_next[s] = re_emit(leaf_direct[2u * s], leaf_albedo(s), kept(s));
+        leaf_next[s] = re_emit(leaf_direct[direct_index(s)], leaf_albedo(s), kept(s));
     }
 }
 
@@ -197,7 +197,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if slices.count > 1u {
         keep(s, e);
     }
-    leaf_next[s] = re_emit(leaf_direct[2u * s], albedo, e);
+    leaf_next[s] = re_emit(leaf_direct[direct_index(s)], albedo, e);
 }
 
 // A leaf's light after a bounce: its direct light and albedo/pi of irradiance `e`, premultiplied

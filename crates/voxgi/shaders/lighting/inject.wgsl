@@ -234,7 +234,7 @@ fn mark(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         atomicStore(&todo[1u + k], s);
     } else if STORE_RADIANCE && (params.store_all != 0u || leaf_is_new(s)) {
         // A new leaf's voxel holds nothing yet, even where it kept its light.
-        store_leaf_radiance(s, leaf_direct[2u * s]);
+        store_leaf_radiance(s, leaf_direct[direct_index(s)]);
     }
 }
 
@@ -255,8 +255,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let s = atomicLoad(&todo[1u + i]);
     let r = leaf_direct_light(s);
-    leaf_direct[2u * s] = r.light;
-    leaf_direct[2u * s + 1u] = r.lobe;
+    leaf_direct[direct_index(s)] = r.light;
+    if leaf_lobes() {
+        leaf_direct[2u * s + 1u] = r.lobe;
+    }
     if STORE_RADIANCE {
         store_leaf_radiance(s, r.light);
     }

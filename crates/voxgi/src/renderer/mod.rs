@@ -184,6 +184,7 @@ impl SceneFacts {
             filtering: Filtering {
                 anisotropic: options.anisotropic,
                 ndf: options.ndf_mips,
+                lobes: options.specular_bounces,
             },
             leaves: options
                 .voxel_capacity
@@ -404,7 +405,8 @@ impl Renderer {
             || old.clipmap_levels != new.clipmap_levels
             || old.voxel_size != new.voxel_size
             || old.anisotropic != new.anisotropic
-            || old.ndf_mips != new.ndf_mips;
+            || old.ndf_mips != new.ndf_mips
+            || old.specular_bounces != new.specular_bounces;
         let atlas = old.shadow_map_size != new.shadow_map_size
             || (old.specular_bounces != new.specular_bounces && self.scene.metals)
             || old.cone_shadows != new.cone_shadows

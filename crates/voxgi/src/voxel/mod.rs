@@ -359,12 +359,19 @@ pub struct Filtering {
     /// The first directional level weighs each leaf per direction by its normal distribution
     /// (`RendererOptions::ndf_mips`; `cpu::ndf_weight`). Only with `anisotropic`.
     pub ndf: bool,
+    /// Each leaf keeps a specular lobe beside its direct light, which the first directional
+    /// level folds in (`RendererOptions::specular_bounces`). Only with `anisotropic`.
+    pub lobes: bool,
 }
 
-/// Bytes a leaf slot's direct light takes in its structure's `leaf_direct` (voxels/<kind>/
-/// leaves.wgsl): its radiance and opacity, and its specular lobe (shared/specular_lobe.wgsl),
-/// two vec4 f32.
-pub const DIRECT_BYTES: u64 = 32;
+impl Filtering {
+    /// Bytes a leaf slot's direct light takes in its structure's `leaf_direct` (voxels/<kind>/
+    /// leaves.wgsl): its radiance and opacity (a vec4 f32), and with `lobes` its specular lobe
+    /// after it (shared/specular_lobe.wgsl).
+    pub fn direct_bytes(self) -> u64 {
+        if self.lobes { 32 } else { 16 }
+    }
+}
 
 /// Words of `VoxelStructure::pool_counter` read back after each build (the octree's sixth: the
 /// slots of its static build, `octree::STATIC_COUNTED`).

@@ -206,8 +206,28 @@ fn ceiling_light(scene: &Scene) -> usize {
         .expect("the Cornell box's light")
 }
 
+/// The same with the leaves' specular lobes over a metal floor (`specular_bounces`), in every
+/// structure: the lobes move with the direct light and the fold with the filter.
+#[test]
+fn a_sequence_of_moves_with_specular_lobes_renders_like_a_fresh_renderer() {
+    for &voxels in voxgi::VoxelKind::ALL {
+        sequence_of_moves(&RendererOptions {
+            voxels,
+            bounces: 1,
+            specular_bounces: true,
+            ..options()
+        });
+    }
+}
+
 fn sequence_of_moves(options: &RendererOptions) {
     let (mut scene, cube) = cornell_with_cube((0.40, 0.15));
+    if options.specular_bounces {
+        let floor = scene.materials.iter_mut().find(|m| m.name == "floor");
+        let floor = floor.expect("floor material");
+        floor.metallic = 1.0;
+        floor.roughness = 0.3;
+    }
     let light = ceiling_light(&scene);
     let mut r = renderer(&scene, options);
     let p = params(&r);
@@ -672,12 +692,25 @@ fn a_moved_clipmap_window_voxelizes_only_its_new_voxels() {
 /// the kept leaves' light is what a clipmap made where the camera is now computes.
 #[test]
 fn a_moved_clipmap_window_keeps_the_direct_light_of_the_voxels_it_held() {
-    let scene = builtin::cornell_box();
-    let options = clipmap_options(1, 1);
+    keeps_the_direct_light(&builtin::cornell_box(), &clipmap_options(1, 1));
+}
+
+/// The same with the leaves' specular lobes (`specular_bounces`), which move with the direct
+/// light: the Cornell box with a metal floor, whose lit leaves have lobes.
+#[test]
+fn a_moved_clipmap_window_keeps_the_specular_lobes_of_the_voxels_it_held() {
+    let options = RendererOptions {
+        specular_bounces: true,
+        ..clipmap_options(1, 1)
+    };
+    keeps_the_direct_light(&crate::reference::metal_floor_cornell(0.3), &options);
+}
+
+fn keeps_the_direct_light(scene: &Scene, options: &RendererOptions) {
     let c = ctx();
-    // The finest window's filled slots: per voxel, its direct light; and how many the last
-    // build kept (slots.wgsl's W_KEPT: word 18 + 3).
-    let finest = |r: &Renderer| -> (std::collections::HashMap<u32, [f32; 8]>, u32, u32) {
+    // The finest window's filled slots: per voxel, its direct light (and lobe); and how many
+    // the last build kept (slots.wgsl's W_KEPT: word 18 + 3).
+    let finest = |r: &Renderer| -> (std::collections::HashMap<u32, Vec<f32>>, u32, u32) {
         let v = r
             .structure::<voxgi::voxel::clipmap::Clipmap>()
             .unwrap()
@@ -686,37 +719,46 @@ fn a_moved_clipmap_window_keeps_the_direct_light_of_the_voxels_it_held() {
         let (words, slots, light) = (read(&v.counters), read(&v.slot_voxel), read(&v.slot_direct));
         let words: &[u32] = bytemuck::cast_slice(&words);
         let slots: &[u32] = bytemuck::cast_slice(&slots);
-        // Per slot, its light and its specular lobe (voxel::DIRECT_BYTES).
-        let light: &[[f32; 8]] = bytemuck::cast_slice(&light);
+        let light: &[f32] = bytemuck::cast_slice(&light);
+        // Per slot: 4 floats, 8 with a lobe (`Filtering::direct_bytes`).
+        let per = light.len() / slots.len();
         let filled = words[18].min(v.window_slots) as usize;
-        let map = (0..filled).map(|s| (slots[s], light[s])).collect();
+        let map = (0..filled)
+            .map(|s| (slots[s], light[s * per..(s + 1) * per].to_vec()))
+            .collect();
         (map, filled as u32, words[18 + 3])
     };
-    let (r, _, after, p) = move_the_finest_window(&scene, &options);
+    let (r, _, after, p) = move_the_finest_window(scene, options);
     let relit = r.relit_leaves().unwrap();
     let (moved, filled, kept) = finest(&r);
     assert!(kept > 0 && kept < filled, "{kept} of {filled} leaves kept");
     eprintln!("relit {relit} leaves; the moved window holds {filled}, {kept} of them kept");
     // Nothing else changed: exactly the new leaves are lit.
     assert_eq!(relit, (filled - kept) as u64, "the leaves lit anew");
-    let fresh = made_there(&scene, &options, &p, &after[0]);
+    let fresh = made_there(scene, options, &p, &after[0]);
     let (made, _, none) = finest(&fresh);
     assert_eq!(none, 0, "a fresh build keeps nothing");
     assert_eq!(made.len(), moved.len(), "the leaves of both");
     // Kept light was lit at the same world point from the old corner: the leaf's centre may
     // round an ulp apart, and the soft shadow's weights move with it (5e-5 of the light when
-    // written); a leaf handed another voxel's light is off by far more than 1e-3.
+    // written); a leaf handed another voxel's light is off by far more than 1e-3. Of a lobe,
+    // its exitance (rgb) is compared; its packed direction and width (w) may round a step apart.
     let mut worst = 0.0f32;
+    let mut lobes = 0;
     for (v, a) in &moved {
         let b = made
             .get(v)
             .unwrap_or_else(|| panic!("voxel {v} not in the fresh window"));
-        for k in 0..4 {
+        for k in (0..a.len()).filter(|&k| k != 7) {
             worst = worst.max((a[k] - b[k]).abs() / b[k].abs().max(1e-3));
         }
+        lobes += (a.len() > 4 && a[4] > 0.0) as u32;
     }
-    eprintln!("the largest relative difference in direct light: {worst}");
+    eprintln!("the largest relative difference in direct light: {worst}; {lobes} lobes");
     assert!(worst < 1e-3, "kept direct light {worst} off a fresh one's");
+    if options.specular_bounces {
+        assert!(lobes > 0, "no leaf of the moved window has a lobe");
+    }
 }
 
 /// The clipmap tests' options: five levels of automatic voxel size (the coarsest spans four

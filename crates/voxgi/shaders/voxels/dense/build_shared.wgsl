@@ -35,7 +35,8 @@
 @group(0) @binding(10) var<storage, read_write> dyn_accum: array<atomic<u32>>;
 // A moved window's state from before its build (`DenseVolume::kept`): [0] the window plus one
 // (0: the build keeps none), [1..4] how far it moved (its new corner minus the old, in voxels,
-// i32: a voxel's old index is its new one plus this), from KEPT_OCCUPANCY its occupancy before
+// i32: a voxel's old index is its new one plus this), [4] the words of a slot's direct light
+// (4, or 8 with its specular lobe), from KEPT_OCCUPANCY its occupancy before
 // the build, then its part's slots' voxels, then their static sums (ACCUM_STRIDE words a slot),
 // then their direct light (four words a slot), then the direct light `keep` hands on, by the
 // slot the voxel holds now (the host copies it into the leaves' after the step).

@@ -118,12 +118,13 @@ fn keep(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var k = 0u; k < ACCUM_STRIDE; k++) {
         atomicStore(&accum[s * ACCUM_STRIDE + k], kept[sums + k]);
     }
-    // Its direct light and lobe (8 words), unless the lights or what moved change them
-    // (inject decides).
+    // Its direct light (and lobe: `kept[4]` words a slot), unless the lights or what moved
+    // change them (inject decides).
+    let words = kept[4];
     let direct = KEPT_OCCUPANCY + r * r * r + part * (1u + ACCUM_STRIDE);
-    let handed = direct + 8u * part + 8u * (s - w * part);
-    for (var k = 0u; k < 8u; k++) {
-        kept[handed + k] = kept[direct + 8u * t + k];
+    let handed = direct + words * part + words * (s - w * part);
+    for (var k = 0u; k < words; k++) {
+        kept[handed + k] = kept[direct + words * t + k];
     }
 }
 

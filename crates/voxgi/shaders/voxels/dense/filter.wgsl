@@ -28,7 +28,9 @@ struct FilterParams {
     step: u32,
     // Cubes stacked along z in every level and block (`Volume::windows`).
     windows: u32,
-    _pad1: u32,
+    // 1: the slots keep specular lobes (`leaf_direct` two vec4 a slot), folded in at the
+    // first level.
+    lobes: u32,
     _pad2: u32,
 }
 
@@ -39,7 +41,8 @@ struct FilterParams {
 @group(0) @binding(3) var normals: texture_3d<f32>;
 // Per finest voxel: 0 empty, 2 + its leaf's slot (build_shared.wgsl's `occupancy`).
 @group(0) @binding(4) var<storage, read> occupancy: array<u32>;
-// Per slot, two: its direct light and its specular lobe (leaves.wgsl's `leaf_direct`).
+// Per slot: its direct light, and with `lobes` its specular lobe after it (leaves.wgsl's
+// `leaf_direct`).
 @group(0) @binding(5) var<storage, read> leaf_direct: array<vec4<f32>>;
 // The volume's counters: the levels' bits and lists (changed.wgsl).
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
@@ -57,7 +60,7 @@ fn leaf_child(base: vec3<i32>, o: vec3<i32>, block: u32) -> vec4<f32> {
     }
     let v = child(base, o);
     var lobe = vec3<f32>(0.0);
-    if params.src_blocked == 0u && v.a > 0.0 {
+    if params.src_blocked == 0u && params.lobes != 0u && v.a > 0.0 {
         lobe = leaf_lobe(base + o, block);
     }
     // Apart, so that a voxel without a lobe filters to the same bits as before lobes were.

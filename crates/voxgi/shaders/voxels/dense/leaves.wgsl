@@ -18,9 +18,9 @@
 //   fn leaf_albedo(i) / leaf_normal(i) / leaf_emission(i)   what the build resolved
 //   fn leaf_surface(i) -> f32                     how far its centre lies in front of its
 //                                                 surface along the normal, voxels
-//   leaf_direct[2i], leaf_next[i]                 per-leaf light: direct (inject) and bounced;
-//   leaf_direct[2i + 1]                           the direct light's specular lobe
-//                                                 (shared/specular_lobe.wgsl)
+//   leaf_direct[direct_index(i)], leaf_next[i]    per-leaf light: direct (inject) and bounced
+//   fn leaf_lobes() -> bool                       leaf_direct[2i + 1] holds the direct light's
+//                                                 specular lobe (shared/specular_lobe.wgsl)
 //
 // and voxels/<kind>/leaf_store.wgsl's store_leaf_radiance(i, premultiplied). All at
 // @group(2) (the store at @group(3)); `DenseVolume::leaves_layout` is the twin. The clipmap
@@ -37,7 +37,8 @@
 // The slots each window holds (voxels/dense/slots.wgsl).
 // Read-write: the leaf stores list the voxels they write in it for the filter (changed.wgsl).
 @group(2) @binding(5) var<storage, read_write> counters: array<atomic<u32>>;
-// Per leaf, two: direct radiance (rgb) and opacity, kept for the bounces; its specular lobe.
+// Per leaf: direct radiance (rgb) and opacity, kept for the bounces; with lobes
+// (`Filtering::lobes`, the buffer twice as long) its specular lobe after each.
 @group(2) @binding(6) var<storage, read_write> leaf_direct: array<vec4<f32>>;
 // Per leaf: the last bounce's outgoing radiance and opacity.
 @group(2) @binding(7) var<storage, read_write> leaf_next: array<vec4<f32>>;
@@ -45,6 +46,15 @@
 //!include voxels/slots.wgsl
 
 const NO_LEAF: u32 = 0xffffffffu;
+
+fn leaf_lobes() -> bool {
+    return arrayLength(&leaf_direct) >= 2u * arrayLength(&slot_voxel);
+}
+
+// Where leaf i's direct light lies in `leaf_direct`.
+fn direct_index(i: u32) -> u32 {
+    return select(i, 2u * i, leaf_lobes());
+}
 
 fn leaf_slot(t: u32) -> u32 {
     return filled_slot(t, leaf_grid.windows);

@@ -16,6 +16,16 @@
 
 const NO_LEAF: u32 = 0xffffffffu;
 
+// Whether `leaf_direct` keeps a specular lobe after each leaf's direct light (twice as long).
+fn leaf_lobes() -> bool {
+    return arrayLength(&leaf_direct) >= 2u * (arrayLength(&leaf_slots) / SLOT_STRIDE);
+}
+
+// Where leaf i's direct light lies in `leaf_direct`.
+fn direct_index(i: u32) -> u32 {
+    return select(i, 2u * i, leaf_lobes());
+}
+
 fn leaf_slot(t: u32) -> u32 {
     return select(NO_LEAF, t, leaf_exists(t));
 }

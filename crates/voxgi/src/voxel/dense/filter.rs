@@ -102,7 +102,7 @@ impl FilterPass {
                         ndf as u32,
                         level - 1,
                         windows,
-                        0,
+                        (filtering.lobes && src.is_none()) as u32,
                         0,
                     ],
                 }

@@ -23,8 +23,7 @@ use crate::gpu::timer::GpuTimer;
 use crate::gpu::{layout, shader};
 use crate::voxel::registry::{KindInfo, StructureDesc};
 use crate::voxel::{
-    DIRECT_BYTES, DebugView, Filtering, FragmentBind, POOL_COUNTERS, StructureBindings,
-    VoxelStructure,
+    DebugView, Filtering, FragmentBind, POOL_COUNTERS, StructureBindings, VoxelStructure,
 };
 use crate::{Error, Result};
 use debug::DebugPass;
@@ -131,8 +130,11 @@ pub const SHARED_CONSTANTS: &[(&str, u64)] = &[
 const SHRINK_BELOW: u64 = 4;
 
 /// Bytes of `DenseVolume::kept` per slot of a window's part: its voxel, its static sums and
-/// its direct light and lobe twice (as they were, and handed to its new slot).
-const KEPT_SLOT_BYTES: u64 = 4 * (1 + ACCUM_STRIDE) + 2 * DIRECT_BYTES;
+/// its direct light (`direct` bytes: with its lobe, if any) twice (as it was, and handed to
+/// its new slot).
+fn kept_slot_bytes(direct: u64) -> u64 {
+    4 * (1 + ACCUM_STRIDE) + 2 * direct
+}
 
 /// Where the regions of `DenseVolume::kept` begin, in bytes (build_shared.wgsl's `kept`),
 /// for windows of `resolution`³ voxels and `window_slots` slots: after the head, the moved
@@ -147,20 +149,20 @@ struct KeptLayout {
     end: u64,
 }
 
-fn kept_layout(resolution: u32, window_slots: u32) -> KeptLayout {
+fn kept_layout(resolution: u32, window_slots: u32, direct_bytes: u64) -> KeptLayout {
     let part = window_slots as u64;
     let occupancy = KEPT_OCCUPANCY_WORD * 4;
     let slots = occupancy + (resolution as u64).pow(3) * 4;
     let sums = slots + part * 4;
     let direct = sums + part * ACCUM_STRIDE * 4;
-    let handed = direct + part * DIRECT_BYTES;
+    let handed = direct + part * direct_bytes;
     KeptLayout {
         occupancy,
         slots,
         sums,
         direct,
         handed,
-        end: slots + part * KEPT_SLOT_BYTES,
+        end: slots + part * kept_slot_bytes(direct_bytes),
     }
 }
 
@@ -175,8 +177,9 @@ fn slot_limit(device: &wgpu::Device, grid: &Grid, windows: u32) -> u64 {
     let room = device
         .limits()
         .max_storage_buffer_binding_size
-        .saturating_sub(kept_layout(grid.resolution, 0).slots);
-    most.min(room / KEPT_SLOT_BYTES * windows as u64)
+        .saturating_sub(kept_layout(grid.resolution, 0, 0).slots);
+    // (With lobes: the larger.)
+    most.min(room / kept_slot_bytes(32) * windows as u64)
 }
 
 /// Checks a slot capacity (occupied voxels) against the device's storage-buffer limit.
@@ -231,6 +234,8 @@ pub struct DenseVolume {
     pub anisotropic: bool,
     /// The first chain level weighs the finest voxels by their normals (`Filtering::ndf`).
     pub ndf: bool,
+    /// The slots keep specular lobes beside their direct light (`Filtering::lobes`).
+    pub lobes: bool,
     /// The volume's placement as a `GpuVolume` uniform.
     pub volume: wgpu::Buffer,
     /// Occupied voxels the slot buffers hold: `windows` parts of `window_slots`.
@@ -265,7 +270,7 @@ pub struct DenseVolume {
     /// Whether the pools have room for dynamic geometry.
     pub dynamic: bool,
     /// Per slot: direct radiance (rgb) and opacity from inject, kept for the bounces, and the
-    /// specular lobe beside it (two vec4 f32, `DIRECT_BYTES`).
+    /// specular lobe beside it with `lobes` (one or two vec4 f32, `Filtering::direct_bytes`).
     pub slot_direct: wgpu::Buffer,
     /// Per slot: the last bounce's outgoing radiance and opacity (vec4 f32).
     pub slot_next: wgpu::Buffer,
@@ -315,6 +320,7 @@ impl DenseVolume {
                 Filtering {
                     anisotropic: self.anisotropic,
                     ndf: self.ndf,
+                    lobes: self.lobes,
                 },
                 slots,
                 self.dynamic,
@@ -634,12 +640,13 @@ impl DenseVolume {
         let dyn_slots = if dynamic { slots } else { 1 };
         // Only the head for one window.
         let kept_bytes = if windows > 1 {
-            kept_layout(res, window_slots).end
+            kept_layout(res, window_slots, filtering.direct_bytes()).end
         } else {
             KEPT_OCCUPANCY_WORD * 4 + 4
         };
         let kept = storage_buffer(device, "voxel kept window", kept_bytes, no);
-        let slot_direct = storage_buffer(device, "voxel direct light", slots * DIRECT_BYTES, no);
+        let direct_bytes = filtering.direct_bytes();
+        let slot_direct = storage_buffer(device, "voxel direct light", slots * direct_bytes, no);
         let slot_next = storage_buffer(device, "voxel bounce light", slots * 16, no);
         let slot_irradiance = storage_buffer(device, "voxel leaf irradiance", slots * 16, no);
         let occupancy = storage_buffer(
@@ -691,6 +698,7 @@ impl DenseVolume {
             windows,
             anisotropic,
             ndf: filtering.ndf,
+            lobes: filtering.lobes,
             volume,
             slot_capacity: slots as u32,
             window_slots,
@@ -878,7 +886,7 @@ impl DenseVolume {
     pub(crate) fn kept_occupancy(&self) -> wgpu::BindingResource<'_> {
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
             buffer: &self.kept,
-            offset: kept_layout(self.grid.resolution, 0).occupancy,
+            offset: kept_layout(self.grid.resolution, 0, 0).occupancy,
             size: wgpu::BufferSize::new((self.grid.resolution as u64).pow(3) * 4),
         })
     }
@@ -906,23 +914,26 @@ impl DenseVolume {
         copy_fragment_count(encoder, fragments, &self.counters);
         // Every build says whether it keeps a window: the kernels skip its kept voxels.
         let kept = kept.filter(|(w, _)| self.windows > 1 && rebuild & (1 << w) != 0);
-        let head: [i32; 4] = match kept {
-            Some((w, by)) => [w as i32 + 1, by.x, by.y, by.z],
-            None => [0; 4],
+        // Word 4: the words of a slot's direct light (build_shared.wgsl's `kept`).
+        let words = (self.slot_direct.size() / self.slot_capacity.max(1) as u64 / 4) as i32;
+        let head: [i32; 8] = match kept {
+            Some((w, by)) => [w as i32 + 1, by.x, by.y, by.z, words, 0, 0, 0],
+            None => [0, 0, 0, 0, words, 0, 0, 0],
         };
         let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("dense_build kept (staging)"),
             contents: bytemuck::cast_slice(&head),
             usage: wgpu::BufferUsages::COPY_SRC,
         });
-        encoder.copy_buffer_to_buffer(&staging, 0, &self.kept, 0, 16);
+        encoder.copy_buffer_to_buffer(&staging, 0, &self.kept, 0, 32);
         let voxels = (self.grid.resolution as u64).pow(3) * 4;
         let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
-        let at = kept_layout(self.grid.resolution, self.window_slots);
+        let direct_bytes = self.slot_direct.size() / self.slot_capacity.max(1) as u64;
+        let at = kept_layout(self.grid.resolution, self.window_slots, direct_bytes);
         // Per slot of a window's part: its voxel, its direct light.
         let (part, direct) = (
             self.window_slots as u64 * 4,
-            self.window_slots as u64 * DIRECT_BYTES,
+            self.window_slots as u64 * direct_bytes,
         );
         // The occupancy with the last update's slots (their light is kept too), the sums
         // without (below).

@@ -36,8 +36,7 @@ use tree::{
 
 use super::registry::{KindInfo, StructureDesc};
 use super::{
-    DIRECT_BYTES, DebugView, Filtering, FragmentBind, Grid, POOL_COUNTERS, StructureBindings,
-    VoxelStructure,
+    DebugView, Filtering, FragmentBind, Grid, POOL_COUNTERS, StructureBindings, VoxelStructure,
 };
 use crate::fragments::Fragments;
 use crate::frame::targets::FrameTargets;
@@ -126,6 +125,8 @@ pub struct OctreeVolume {
     pub grid: Grid,
     /// Six directional values per voxel above the finest level (true) or one.
     pub anisotropic: bool,
+    /// The slots keep specular lobes beside their direct light (`Filtering::lobes`).
+    pub lobes: bool,
     /// The pools' sizes.
     pub pools: OctreePools,
     /// The `GpuOctree` uniform.
@@ -287,7 +288,11 @@ impl OctreeVolume {
         let grid_words = ((1u64 << (3 * (g + 1))) - 1) / 7;
         let top_grid = storage_buffer(device, "octree top grid", grid_words * 4);
         let slot_buf = storage_buffer(device, "octree leaf slots", slots * SLOT_WORDS * 4);
-        let leaf_direct = storage_buffer(device, "octree direct light", slots * DIRECT_BYTES);
+        let leaf_direct = storage_buffer(
+            device,
+            "octree direct light",
+            slots * filtering.direct_bytes(),
+        );
         let leaf_next = storage_buffer(device, "octree bounce light", slots * 16);
         let leaf_irradiance = storage_buffer(device, "octree leaf irradiance", slots * 16);
         let args = device.create_buffer(&wgpu::BufferDescriptor {
@@ -402,6 +407,7 @@ impl OctreeVolume {
         Ok(OctreeVolume {
             grid,
             anisotropic,
+            lobes: filtering.lobes,
             pools,
             tree,
             layout,
@@ -619,6 +625,7 @@ impl VoxelStructure for OctreeVolume {
                     Filtering {
                         anisotropic: self.anisotropic,
                         ndf: self.layout.ndf != 0,
+                        lobes: self.lobes,
                     },
                     pools,
                     self.updates.is_some(),
