@@ -135,8 +135,8 @@ fn reflect_light(spec: ptr<function, Specular>, light: Light, p: vec3<f32>, n: v
 // The share of the light from direction cosine `c` the GGX lobe of F0 `f0` and `roughness`
 // reflects at all (its directional albedo; by reciprocity the same seen from there), in
 // Karis's analytic fit (Unreal's mobile EnvBRDFApprox): the screen's glossy light reads a
-// table of voxgi's own BRDF (brdf.rs) instead, which inject does not bind; the fit is within
-// a few per cent of it but for roughness 0.2-0.5, where it is 10-18 % low (docs/QUALITY.md).
+// table of voxgi's own BRDF (brdf.rs) instead, which inject does not bind (docs/QUALITY.md,
+// "Glossy reflections", compares the two).
 fn lobe_albedo(f0: vec3<f32>, roughness: f32, c: f32) -> vec3<f32> {
     let r = roughness * vec4<f32>(-1.0, -0.0275, -0.572, 0.022) + vec4<f32>(1.0, 0.0425, 1.04, -0.04);
     let a004 = min(r.x * r.x, exp2(-9.28 * c)) * r.x + r.y;
@@ -144,8 +144,8 @@ fn lobe_albedo(f0: vec3<f32>, roughness: f32, c: f32) -> vec3<f32> {
     return f0 * ab.x + ab.y;
 }
 
-// The lobe of the summed reflections: the directions' disagreement widens it (a half-length
-// mean direction adds a hemisphere's worth).
+// The lobe of the summed reflections: the directions' disagreement widens it (directions that
+// cancel out add a hemisphere's worth).
 fn spec_lobe(spec: Specular) -> vec4<f32> {
     if spec.weight <= 0.0 {
         return vec4<f32>(0.0);

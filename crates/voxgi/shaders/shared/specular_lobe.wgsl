@@ -1,11 +1,11 @@
-// What a leaf reflects specularly of the lights: its lobe. inject writes it beside the leaf's
-// direct light (leaf_direct[2i + 1]); the first directional mip level folds it into the six
+// What a leaf reflects specularly of the lights: its lobe (`specular_bounces`). inject writes it
+// beside the leaf's direct light (leaf_direct[2i + 1]); the first directional mip level folds it into the six
 // directions (voxels/<kind>/ filters), so a cone that looks at a lit metal from where its
 // reflection goes sees the light it reflects. The finest level stays isotropic: cones that read
 // it (the nearest samples of narrow cones) see no lobe.
 //
 // A lobe is one vec4: the specular radiant exitance M (rgb, W/m^2: the lights' irradiance
-// times Fresnel), and in w an integer below 2^24 (exact in f32): the lobe's mean direction
+// times the lobe's directional albedo), and in w an integer below 2^24 (exact in f32): the lobe's mean direction
 // octahedrally in nine bits a coordinate, and in six bits how widely it spreads (`t`, 0: a
 // mirror's beam, 1: as wide as a Lambertian surface's light).
 

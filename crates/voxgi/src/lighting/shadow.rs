@@ -164,11 +164,14 @@ impl ShadowPass {
         }
     }
 
-    /// The pipelines for an atlas of `format`.
+    /// The pipelines for an atlas of `format` (`bind` made those of a two-channel atlas).
     fn pipelines(&self, format: wgpu::TextureFormat) -> &Pipelines {
-        match self.with_materials.get() {
-            Some(p) if format == MATERIAL_ATLAS_FORMAT => p,
-            _ => &self.distance,
+        if format == MATERIAL_ATLAS_FORMAT {
+            self.with_materials
+                .get()
+                .expect("ShadowPass::bind comes before record for an atlas")
+        } else {
+            &self.distance
         }
     }
     /// The pass's bind groups over `atlas`'s views and static maps and `scene`'s geometry

@@ -205,3 +205,32 @@ fn frame_params_change_the_picture_without_rebuilding() {
     }
     assert!(frame(&mut r, &params, SIZE, SIZE).ldr == first.ldr);
 }
+
+/// `specular_bounces` switched on and off on a renderer of a scene with a metal (the Cornell
+/// box's floor): the shadow maps gain and lose their material channel and the leaves their
+/// lobes, and each state renders like a fresh renderer with those options, to the bit.
+#[test]
+fn specular_bounces_switch_like_a_fresh_renderer() {
+    let scene = crate::reference::metal_floor_cornell(0.3);
+    let on = RendererOptions {
+        specular_bounces: true,
+        ..base()
+    };
+    let mut r = renderer(&scene, &base());
+    let params = FrameParams::new(r.default_camera().clone());
+    let off_image = frame(&mut r, &params, SIZE, SIZE);
+    r.set_options(&on).expect("specular bounces on");
+    let on_image = frame(&mut r, &params, SIZE, SIZE);
+    let fresh = frame(&mut renderer(&scene, &on), &params, SIZE, SIZE);
+    assert!(
+        on_image.hdr == fresh.hdr,
+        "switched on: not a fresh renderer's image"
+    );
+    assert!(on_image.hdr != off_image.hdr, "the lobes changed nothing");
+    r.set_options(&base()).expect("specular bounces off");
+    let again = frame(&mut r, &params, SIZE, SIZE);
+    assert!(
+        again.hdr == off_image.hdr,
+        "switched off: not the first image"
+    );
+}

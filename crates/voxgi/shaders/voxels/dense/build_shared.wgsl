@@ -38,7 +38,7 @@
 // i32: a voxel's old index is its new one plus this), [4] the words of a slot's direct light
 // (4, or 8 with its specular lobe), from KEPT_OCCUPANCY its occupancy before
 // the build, then its part's slots' voxels, then their static sums (ACCUM_STRIDE words a slot),
-// then their direct light (four words a slot), then the direct light `keep` hands on, by the
+// then their direct light ([4] words a slot), then the direct light `keep` hands on, by the
 // slot the voxel holds now (the host copies it into the leaves' after the step).
 @group(0) @binding(11) var<storage, read_write> kept: array<u32>;
 // The voxels written since the last filter, listed for the filter (changed.wgsl).
