@@ -302,6 +302,7 @@ fn every_twin_has_the_wgsl_layout() {
             tiles,
             slots,
             ndf,
+            lobes,
             leaf_atlas,
             even_atlas,
             odd_atlas,

@@ -365,11 +365,18 @@ pub struct Filtering {
 }
 
 impl Filtering {
+    /// The most bytes a slot's direct light takes (`direct_bytes` with lobes).
+    pub const MOST_DIRECT_BYTES: u64 = 32;
+
     /// Bytes a leaf slot's direct light takes in its structure's `leaf_direct` (voxels/<kind>/
     /// leaves.wgsl): its radiance and opacity (a vec4 f32), and with `lobes` its specular lobe
     /// after it (shared/specular_lobe.wgsl).
     pub fn direct_bytes(self) -> u64 {
-        if self.lobes { 32 } else { 16 }
+        if self.lobes {
+            Self::MOST_DIRECT_BYTES
+        } else {
+            16
+        }
     }
 }
 

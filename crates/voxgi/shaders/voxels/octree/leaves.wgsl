@@ -16,9 +16,9 @@
 
 const NO_LEAF: u32 = 0xffffffffu;
 
-// Whether `leaf_direct` keeps a specular lobe after each leaf's direct light (twice as long).
+// Whether `leaf_direct` keeps a specular lobe after each leaf's direct light.
 fn leaf_lobes() -> bool {
-    return arrayLength(&leaf_direct) >= 2u * (arrayLength(&leaf_slots) / SLOT_STRIDE);
+    return leaf_tree.lobes != 0u;
 }
 
 // Where leaf i's direct light lies in `leaf_direct`.

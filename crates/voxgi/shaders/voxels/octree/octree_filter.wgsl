@@ -33,8 +33,8 @@ struct Level {
 @group(0) @binding(7) var flags: texture_storage_2d<r32uint, read_write>;
 // [0]: the nodes the filter redid since the host last cleared it.
 @group(0) @binding(8) var<storage, read_write> redone: array<atomic<u32>>;
-// Per leaf slot: its direct light, and when twice as long its specular lobe after it
-// (leaves.wgsl's `leaf_direct`).
+// Per leaf slot: its direct light, and with `tree.lobes` its specular lobe after it (leaves.wgsl's
+// `leaf_direct`).
 @group(0) @binding(9) var<storage, read> leaf_direct: array<vec4<f32>>;
 
 fn child(n: u32) -> u32 {
@@ -65,9 +65,8 @@ fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
     if tree.ndf != 0u {
         w = select(1.0, ndf_weight(normal, d), word != 0u);
     }
-    let lobes = arrayLength(&leaf_direct) >= 2u * (arrayLength(&slots) / SLOT_STRIDE);
     // Apart, so that a voxel without a lobe filters to the same bits as without lobes.
-    if !lobes || word == 0u || v.a <= 0.0 {
+    if tree.lobes == 0u || word == 0u || v.a <= 0.0 {
         return w * v;
     }
     let packed = leaf_direct[2u * slot + 1u];

@@ -65,8 +65,9 @@ struct Octree {
     slots: u32,
     // 1: the first directional level weighs the leaves by their normals (`ndf_weight`).
     ndf: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: `leaf_direct` keeps a specular lobe after each leaf's direct light (`Filtering::lobes`).
+    lobes: u32,
+    _pad: u32,
     leaf_atlas: AtlasShape,
     even_atlas: AtlasShape,
     odd_atlas: AtlasShape,

@@ -178,8 +178,7 @@ fn slot_limit(device: &wgpu::Device, grid: &Grid, windows: u32) -> u64 {
         .limits()
         .max_storage_buffer_binding_size
         .saturating_sub(kept_layout(grid.resolution, 0, 0).slots);
-    // (With lobes: the larger.)
-    most.min(room / kept_slot_bytes(32) * windows as u64)
+    most.min(room / kept_slot_bytes(Filtering::MOST_DIRECT_BYTES) * windows as u64)
 }
 
 /// Checks a slot capacity (occupied voxels) against the device's storage-buffer limit.
@@ -308,6 +307,15 @@ pub struct DenseVolume {
 }
 
 impl DenseVolume {
+    /// How the volume filters (what it was made with).
+    fn filtering(&self) -> Filtering {
+        Filtering {
+            anisotropic: self.anisotropic,
+            ndf: self.ndf,
+            lobes: self.lobes,
+        }
+    }
+
     /// The volume made again with `slots` slots (the contents are lost: the next build
     /// refills them).
     fn resize(&mut self, device: &wgpu::Device, slots: u32) -> crate::Result<()> {
@@ -317,11 +325,7 @@ impl DenseVolume {
                 &self.pipelines,
                 self.grid,
                 self.windows,
-                Filtering {
-                    anisotropic: self.anisotropic,
-                    ndf: self.ndf,
-                    lobes: self.lobes,
-                },
+                self.filtering(),
                 slots,
                 self.dynamic,
             )
@@ -915,7 +919,8 @@ impl DenseVolume {
         // Every build says whether it keeps a window: the kernels skip its kept voxels.
         let kept = kept.filter(|(w, _)| self.windows > 1 && rebuild & (1 << w) != 0);
         // Word 4: the words of a slot's direct light (build_shared.wgsl's `kept`).
-        let words = (self.slot_direct.size() / self.slot_capacity.max(1) as u64 / 4) as i32;
+        let direct_bytes = self.filtering().direct_bytes();
+        let words = (direct_bytes / 4) as i32;
         let head: [i32; 8] = match kept {
             Some((w, by)) => [w as i32 + 1, by.x, by.y, by.z, words, 0, 0, 0],
             None => [0, 0, 0, 0, words, 0, 0, 0],
@@ -928,7 +933,6 @@ impl DenseVolume {
         encoder.copy_buffer_to_buffer(&staging, 0, &self.kept, 0, 32);
         let voxels = (self.grid.resolution as u64).pow(3) * 4;
         let sums = self.window_slots as u64 * ACCUM_STRIDE * 4;
-        let direct_bytes = self.slot_direct.size() / self.slot_capacity.max(1) as u64;
         let at = kept_layout(self.grid.resolution, self.window_slots, direct_bytes);
         // Per slot of a window's part: its voxel, its direct light.
         let (part, direct) = (

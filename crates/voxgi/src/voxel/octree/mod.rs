@@ -125,8 +125,6 @@ pub struct OctreeVolume {
     pub grid: Grid,
     /// Six directional values per voxel above the finest level (true) or one.
     pub anisotropic: bool,
-    /// The slots keep specular lobes beside their direct light (`Filtering::lobes`).
-    pub lobes: bool,
     /// The pools' sizes.
     pub pools: OctreePools,
     /// The `GpuOctree` uniform.
@@ -261,7 +259,8 @@ impl OctreeVolume {
             tiles: tiles as u32,
             slots: pools.slots,
             ndf: (filtering.ndf && filtering.anisotropic) as u32,
-            _pad: [0; 2],
+            lobes: filtering.lobes as u32,
+            _pad: 0,
             leaf_atlas: leaf_shape,
             even_atlas: even_shape,
             odd_atlas: odd_shape,
@@ -407,7 +406,6 @@ impl OctreeVolume {
         Ok(OctreeVolume {
             grid,
             anisotropic,
-            lobes: filtering.lobes,
             pools,
             tree,
             layout,
@@ -625,7 +623,7 @@ impl VoxelStructure for OctreeVolume {
                     Filtering {
                         anisotropic: self.anisotropic,
                         ndf: self.layout.ndf != 0,
-                        lobes: self.lobes,
+                        lobes: self.layout.lobes != 0,
                     },
                     pools,
                     self.updates.is_some(),

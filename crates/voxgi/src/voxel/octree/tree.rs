@@ -83,8 +83,11 @@ pub struct GpuOctree {
     pub slots: u32,
     /// 1: the first directional level weighs the leaves by their normals (`Filtering::ndf`).
     pub ndf: u32,
+    /// 1: the leaves keep specular lobes after their direct light, which the first directional
+    /// level folds in (`Filtering::lobes`).
+    pub lobes: u32,
     /// Padding; zero.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
     /// The even atlas's region of level 0.
     pub leaf_atlas: GpuAtlasShape,
     /// The even atlas's region of levels 2, 4, …
