@@ -50,6 +50,7 @@ fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
 fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32, vs: f32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
     var t = vs;
+    cone_tan_half = tan_half;
     // Two loops: samples widen monotonically along a cone that leaves its surface, and once
     // they are WIDE_SAMPLE voxels across they no longer read the finest level (a quarter of the
     // fetches per step; 8 % of the gather on lavapipe).

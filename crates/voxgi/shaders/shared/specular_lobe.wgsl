@@ -57,3 +57,74 @@ fn lobe_radiance(lobe: Lobe, n: vec3<f32>, block: u32) -> vec3<f32> {
     // (Floored: a narrow lobe grazing the surface still leaves by a block across it.)
     return lobe.m * mix(narrow, wide, lobe.t) / max(gathers, 0.1);
 }
+
+// --- The lobe chain (the dense volume): two more blocks in every chain level keep the lobes'
+// moments, averaged like the isotropic chain, and a cone evaluates them towards itself, so a
+// narrow lobe keeps its direction at every level instead of spreading over the six blocks.
+//
+// Block 6: the coverage-weighted exitance and the coverage (a M, a); block 7: the
+// luminance-weighted direction, each leaf's as long as its lobe's mean cosine (a |M| rbar d,
+// a |M|). Means of these are the merged lobe's: the exitance per covered area M = rgb / a, and
+// a von Mises-Fisher lobe whose mean cosine is the summed direction's length over its weight
+// (Toksvig's and Banerjee's estimates): lobes that disagree merge into a wider one.
+
+// A leaf's lobe splits by its spread t: the share t leaves as a Lambertian surface's light does
+// (folded into the six directions, `lobe_radiance` with t = 1), the share 1 - t keeps its
+// direction in the chain as a vMF of concentration 1 / t (its solid angle, 2 pi t, kept; t is
+// stored in 63 steps, the narrowest counts as half a step). The chain holds radiance per covered
+// area: a surface seen at angle theta covers 1 / cos theta of the area it fills across the
+// cone, so the narrow share's exitance is divided by the cosine between its direction and the
+// normal (at most tenfold: a lobe grazing its surface).
+fn lobe_kappa(t: f32) -> f32 {
+    return 1.0 / max(t, 0.5 / 63.0);
+}
+
+fn narrow_share(lobe: Lobe, n: vec3<f32>) -> Lobe {
+    let c = max(dot(n, lobe.dir), 0.1);
+    return Lobe(lobe.m * (1.0 - lobe.t) / c, lobe.dir, lobe.t);
+}
+
+fn wide_share(lobe: Lobe) -> Lobe {
+    return Lobe(lobe.m * lobe.t, lobe.dir, 1.0);
+}
+
+// The two moment blocks of one leaf of opacity `a` (block 6 or 7).
+fn lobe_moments(lobe: Lobe, a: f32, block: u32) -> vec4<f32> {
+    let w = a * dot(lobe.m, vec3<f32>(0.2126, 0.7152, 0.0722));
+    if block == 6u {
+        return vec4<f32>(a * lobe.m, a);
+    }
+    let k = lobe_kappa(lobe.t);
+    // The vMF's mean cosine, coth k - 1/k (1 - 1/k within f32 for k > 9).
+    let rbar = select(1.0 / tanh(k) - 1.0 / k, 1.0 - 1.0 / k, k > 9.0);
+    return vec4<f32>(w * rbar * lobe.dir, w);
+}
+
+// A cone of half-angle tangent `tan_half` as a vMF: its solid angle, 2 pi (1 - cos), is the
+// lobe's 2 pi / kappa.
+fn cone_kappa(tan_half: f32) -> f32 {
+    let c = inverseSqrt(1.0 + tan_half * tan_half);
+    return (1.0 + c) / max(tan_half * tan_half * c * c, 1e-8);
+}
+
+// The radiance the merged lobe of moments `m` (block 6) and `v` (block 7) sends towards `out`
+// as a cone of concentration `cone` sees it: the lobe convolved with the cone (two vMFs'
+// concentrations combine as k1 k2 / (k1 + k2)), times the exitance per covered area. A
+// lobe's radiance M D(out) meets a Lambertian surface's M / pi where it looks along the normal.
+// The caller passes a cone narrower than the one traced (windows.wgsl): a sample already
+// merges the lobes of every point its footprint covers, whose disagreement widens the merged
+// lobe, and the cone's whole aperture counted again on top spread the light a metal floor
+// reflects onto a wall over directions that miss it (docs/QUALITY.md, "Specular light in the
+// bounces").
+fn lobe_light(m: vec4<f32>, v: vec4<f32>, out: vec3<f32>, cone: f32) -> vec3<f32> {
+    if m.a <= 1e-6 || v.w <= 1e-8 {
+        return vec3<f32>(0.0);
+    }
+    let len = length(v.xyz);
+    let rbar = min(len / v.w, 0.999);
+    let lobe = rbar * (3.0 - rbar * rbar) / (1.0 - rbar * rbar);
+    let k = max(lobe * cone / (lobe + cone), 1e-3);
+    let axis = v.xyz / max(len, 1e-8);
+    let d = k / (6.28318531 * (1.0 - exp(-2.0 * k))) * exp(k * (dot(axis, out) - 1.0));
+    return max(m.rgb, vec3<f32>(0.0)) / m.a * d;
+}

@@ -10,12 +10,18 @@ struct Volume {
     voxel_size: f32,
     // Mip levels including the finest.
     levels: u32,
-    // 1: six directional values per voxel above the finest level, 0: one.
+    // 1: six directional values per voxel above the finest level, 0: one; 2: six and the
+    // specular lobes' two (voxels/dense/windows.wgsl).
     anisotropic: u32,
     // Cubes of `resolution` voxels stacked along z in every texture and buffer (1; a clipmap's
     // levels are its windows).
     windows: u32,
 }
+
+// The half-angle tangent of the cone being traced (shared/cone.wgsl sets it): samples that
+// hold specular lobes see them as wide as the cone does. Other samples are read as by a
+// diffuse cone's.
+var<private> cone_tan_half: f32 = 0.57735;
 
 const MAX_CONES: u32 = 16u;
 

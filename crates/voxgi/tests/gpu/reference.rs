@@ -846,12 +846,12 @@ fn wall_lit_by_a_metal(roughness: f32) -> (f32, f32) {
 #[test]
 fn a_metal_floor_lights_the_wall_its_reflection_reaches() {
     // (roughness, the least and the most the cones may reach of the path tracer's light)
-    // Measured on lavapipe: 0.47 at roughness 0.25 and 1.52 at 1 (without the leaves' lobes
-    // the wall is black: 0). The six directions of the first mip level cannot hold a narrow
-    // lobe: its light leaves over the cells about its direction, and the part that misses the
-    // wall is lost; a lobe as wide as a Lambertian surface's leaves as one does, where rough
-    // GGX sends less to the grazing upper wall (docs/QUALITY.md, "Specular light in the
-    // bounces"). The bounds keep each near its measure and fail a lobe lost (0), its light
+    // Measured on lavapipe: 0.44 at roughness 0.25 and 1.52 at 1 (without the leaves' lobes
+    // the wall is black: 0; with the lobes folded into the six directions, 0.47 and 1.52).
+    // A coarse sample merges the lobes of all the floor it covers into one wider lobe, so a
+    // cone that meets the floor beside the point whose reflection reaches it reads too little;
+    // a lobe as wide as a Lambertian surface's leaves as one does, where rough GGX sends less
+    // to the grazing upper wall (docs/QUALITY.md, "Specular light in the bounces"). The bounds keep each near its measure and fail a lobe lost (0), its light
     // counted twice (0.94, 3.0), or a rough lobe without its directional albedo (2.5).
     for (roughness, lo, hi) in [(0.25, 0.35, 0.75), (1.0, 1.1, 2.0)] {
         let (cones, paths) = wall_lit_by_a_metal(roughness);

@@ -28,8 +28,9 @@ struct FilterParams {
     step: u32,
     // Cubes stacked along z in every level and block (`Volume::windows`).
     windows: u32,
-    // 1: the slots keep specular lobes (`leaf_direct` two vec4 a slot), folded in at the
-    // first level.
+    // The slots' specular lobes (`leaf_direct` two vec4 a slot): 0 none, 1 folded into the six
+    // directions at the first level (the clipmap: its windows leave no room for more blocks),
+    // 2 kept in two more blocks of every level (specular_lobe.wgsl, "The lobe chain").
     lobes: u32,
     _pad2: u32,
 }
@@ -70,19 +71,56 @@ fn leaf_child(base: vec3<i32>, o: vec3<i32>, block: u32) -> vec4<f32> {
     return w * v + vec4<f32>(v.a * lobe, 0.0);
 }
 
-// The radiance finest voxel `c`'s specular lobe sends towards the cones of direction `block`.
-fn leaf_lobe(c: vec3<i32>, block: u32) -> vec3<f32> {
+// Finest voxel `c`'s specular lobe, packed (zero without one).
+fn leaf_packed_lobe(c: vec3<i32>) -> vec4<f32> {
     let r = params.dst_res * 2u;
     let occupied = occupancy[u32(c.x) + r * (u32(c.y) + r * u32(c.z))];
     if occupied < 2u || occupied == 0xffffffffu {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
-    let packed = leaf_direct[2u * (occupied - 2u) + 1u];
+    return leaf_direct[2u * (occupied - 2u) + 1u];
+}
+
+// The radiance finest voxel `c`'s specular lobe sends towards the cones of direction `block`.
+fn leaf_lobe(c: vec3<i32>, block: u32) -> vec3<f32> {
+    let packed = leaf_packed_lobe(c);
     if all(packed.rgb <= vec3<f32>(0.0)) {
         return vec3<f32>(0.0);
     }
     let n = textureLoad(normals, c, 0).xyz;
-    return lobe_radiance(unpack_lobe(packed), n / max(length(n), 1e-4), block);
+    // With the chain only the lobe's wide share is folded in.
+    var lobe = unpack_lobe(packed);
+    if params.lobes == 2u {
+        lobe = wide_share(lobe);
+    }
+    return lobe_radiance(lobe, n / max(length(n), 1e-4), block);
+}
+
+// Lobe block `block` (6 or 7) of the voxel `id` whose children start at `base`: the mean of
+// its eight children's moments, the leaves' own on the first level.
+fn filter_lobes(base: vec3<i32>, id: vec3<u32>, block: u32) {
+    var sum = vec4<f32>(0.0);
+    for (var i = 0; i < 8; i++) {
+        let o = vec3<i32>(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+        if params.src_blocked != 0u {
+            sum += textureLoad(src, base + o, 0);
+            continue;
+        }
+        let a = child(base, o).a;
+        if a <= 0.0 {
+            continue;
+        }
+        let packed = leaf_packed_lobe(base + o);
+        if any(packed.rgb > vec3<f32>(0.0)) {
+            let n = textureLoad(normals, base + o, 0).xyz;
+            let lobe = narrow_share(unpack_lobe(packed), n / max(length(n), 1e-4));
+            sum += lobe_moments(lobe, a, block);
+        } else if block == 6u {
+            // Covered without a lobe: it dilutes the exitance per covered area.
+            sum.a += a;
+        }
+    }
+    textureStore(dst, id, sum * 0.125);
 }
 
 // Level `params.step + 1`'s voxel `gid` in direction block `block` from its eight children.
@@ -92,6 +130,10 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
     let id = vec3<u32>(gid.xy, block * depth + gid.z);
     var base = vec3<i32>(gid) * 2;
     base.z += i32(block * 2u * depth * params.src_blocked);
+    if block >= 6u {
+        filter_lobes(base, id, block);
+        return;
+    }
     if params.mode == 0u {
         var sum = vec4<f32>(0.0);
         for (var i = 0; i < 8; i++) {
@@ -120,7 +162,7 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
 }
 
 fn blocks() -> u32 {
-    return select(1u, 6u, params.mode == 1u);
+    return select(1u, 6u, params.mode == 1u) + select(0u, 2u, params.lobes == 2u);
 }
 
 // Every voxel of the level (after a build); the bits and counts are cleared after

@@ -6,12 +6,14 @@
 // The resources: the volume's placement `vol`, `radiance0` (finest level, isotropic),
 // `chains` (the directional mip chains, one level above the finest, as blocks stacked along
 // z: +X, -X, +Y, -Y, +Z, -Z, each block the windows stacked; in isotropic mode one block)
-// and `voxel_sampler` (trilinear, clamp to edge).
+// and `voxel_sampler` (trilinear, clamp to edge). With `vol.anisotropic` 2 two more blocks
+// follow the six: the specular lobes' moments (shared/specular_lobe.wgsl, "The lobe chain").
 //
 // No branch: CPU drivers run every side of a branch that differs between SIMD lanes, and
 // even a branch no lane takes costs more on lavapipe than the fetch it would skip.
 
 //!include shared/volume.wgsl
+//!include shared/specular_lobe.wgsl
 
 @group(1) @binding(0) var<uniform> vol: Volume;
 @group(1) @binding(1) var radiance0: texture_3d<f32>;
@@ -30,7 +32,27 @@ fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
     let fine = textureSampleLevel(radiance0, voxel_sampler, vec3<f32>(uvw.xy, z), 0.0);
     let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir, win);
     // Only between the finest level and the first coarse one is the finest level read.
-    return mix(fine, coarse, min(lod, 1.0));
+    let s = mix(fine, coarse, min(lod, 1.0));
+    if vol.anisotropic != 2u {
+        return s;
+    }
+    // The finest level has no lobes: they fade in as the chain does.
+    return with_lobes(s, uvw, max(lod - 1.0, 0.0), dir, win, min(lod, 1.0));
+}
+
+// Sample `s` (optical depth, seen along `dir`) with the light the lobes of chain level `cl`
+// send back along the cone, times `weight`: radiance per covered area, as opaque as the sample
+// is along dir (L sigma gains L_lobe sigma).
+fn with_lobes(s: vec4<f32>, uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32, weight: f32) -> vec4<f32> {
+    let upper = min(floor(cl) + 1.0, f32(vol.levels - 2u));
+    let texels = max(f32(vol.resolution / 2u) * exp2(-upper), 1.0);
+    let z = clamp(uvw.z, 0.5 / texels, 1.0 - 0.5 / texels);
+    let blocks = 8.0 * f32(vol.windows);
+    let first = 6.0 * f32(vol.windows) + f32(win);
+    let m = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first) / blocks), cl);
+    let v = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first + f32(vol.windows)) / blocks), cl);
+    let light = lobe_light(m, v, -dir, cone_kappa(0.25 * cone_tan_half));
+    return vec4<f32>(s.rgb + weight * light * s.a, s.a);
 }
 
 // True when the pipeline serves an isotropic volume: each sample then makes one fetch, not
@@ -61,7 +83,7 @@ fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
         vec3<f32>(select(1.0, 0.0, dir.x >= 0.0), select(3.0, 2.0, dir.y >= 0.0), select(5.0, 4.0, dir.z >= 0.0)),
         aniso,
     );
-    let blocks = select(1.0, 6.0, aniso) * windows;
+    let blocks = (select(1.0, 6.0, aniso) + select(0.0, 2.0, vol.anisotropic == 2u)) * windows;
     // Each direction's block holds every window: block b, window w at b * windows + w.
     let first = block * windows + window;
     // Weighted by the squared direction cosines (they sum to 1).

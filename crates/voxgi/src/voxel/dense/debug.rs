@@ -65,8 +65,8 @@ impl DebugPass {
     ) {
         let mode = view.id();
         let level = level.min(vol.grid.levels() - 1);
-        // In isotropic mode the one block serves every direction.
-        let block = direction.min(vol.chain_blocks() - 1);
+        // In isotropic mode the one block serves every direction; the lobe blocks are none.
+        let block = direction.min(vol.chain_blocks().min(6) - 1);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("debug params"),
             contents: bytemuck::cast_slice(&[mode, level, block, window]),

@@ -102,7 +102,11 @@ impl FilterPass {
                         ndf as u32,
                         level - 1,
                         windows,
-                        (filtering.lobes && src.is_none()) as u32,
+                        if super::lobe_chain(filtering, windows) {
+                            2
+                        } else {
+                            (filtering.lobes && src.is_none()) as u32
+                        },
                         0,
                     ],
                 }
@@ -196,7 +200,8 @@ impl FilterPass {
                 })
             })
             .collect();
-        let blocks = super::chain_blocks(filtering.anisotropic);
+        let blocks =
+            super::chain_blocks(filtering.anisotropic, super::lobe_chain(filtering, windows));
         let whole = steps
             .iter()
             .map(|s| {

@@ -188,7 +188,12 @@ fn slot_capacity(device: &wgpu::Device, wanted: u64) -> Result<u32> {
 
 /// Checks that the per-voxel buffers and textures of `windows` cubes of `grid` fit the
 /// device's limits.
-fn check_volume_fits(device: &wgpu::Device, grid: &Grid, windows: u32) -> Result<()> {
+fn check_volume_fits(
+    device: &wgpu::Device,
+    grid: &Grid,
+    windows: u32,
+    filtering: Filtering,
+) -> Result<()> {
     let l = device.limits();
     let occupancy = (grid.resolution as u64).pow(3) * windows as u64 * 4;
     if occupancy > l.max_storage_buffer_binding_size {
@@ -209,8 +214,9 @@ fn check_volume_fits(device: &wgpu::Device, grid: &Grid, windows: u32) -> Result
                 .exp2() as u32,
         )));
     }
-    // The deepest texture: the directional mips' six blocks of every window, along z.
-    let depth = (grid.resolution * windows).max(grid.resolution / 2 * 6 * windows);
+    // The deepest texture: the directional mips' blocks of every window, along z.
+    let blocks = chain_blocks(filtering.anisotropic, lobe_chain(filtering, windows));
+    let depth = (grid.resolution * windows).max(grid.resolution / 2 * blocks * windows);
     if grid.resolution > l.max_texture_dimension_3d || depth > l.max_texture_dimension_3d {
         return Err(Error::TooLarge(format!(
             "{} stacked {}³ voxel textures ({depth} texels deep) exceed this GPU's 3D texture \
@@ -346,7 +352,7 @@ impl DenseVolume {
         leaves: u64,
         previous: Option<&DenseVolume>,
     ) -> Result<DenseVolume> {
-        check_volume_fits(device, &grid, windows)?;
+        check_volume_fits(device, &grid, windows, desc.filtering)?;
         let slots = slot_capacity(device, leaves.min(slot_limit(device, &grid, windows)))?;
         let p = match previous {
             Some(v) => v.pipelines.clone(),
@@ -455,8 +461,21 @@ fn texture_3d_blocks(
     })
 }
 
-fn chain_blocks(anisotropic: bool) -> u32 {
-    if anisotropic { 6 } else { 1 }
+/// Blocks of the chains: six directions (or one isotropic), and the lobe chain's two.
+fn chain_blocks(anisotropic: bool, lobes: bool) -> u32 {
+    match (anisotropic, lobes) {
+        (false, _) => 1,
+        (true, false) => 6,
+        (true, true) => 8,
+    }
+}
+
+/// Whether a volume of `windows` windows keeps its leaves' specular lobes in two more chain
+/// blocks (shared/specular_lobe.wgsl, "The lobe chain"). A clipmap's windows, stacked along z,
+/// leave no room for two more blocks within the 3D texture limit at its usual sizes: it folds
+/// the lobes into the six directions at the first level instead.
+pub(crate) fn lobe_chain(filtering: Filtering, windows: u32) -> bool {
+    filtering.anisotropic && filtering.lobes && windows == 1
 }
 
 fn storage_buffer(
@@ -591,14 +610,18 @@ impl DenseVolume {
             resolution: res,
             voxel_size: grid.voxel_size,
             levels,
-            anisotropic: anisotropic as u32,
+            anisotropic: if lobe_chain(filtering, windows) {
+                2
+            } else {
+                anisotropic as u32
+            },
             windows,
         };
         let chains = texture_3d_blocks(
             device,
             "voxel radiance mips",
             res / 2,
-            chain_blocks(anisotropic) * windows,
+            chain_blocks(anisotropic, lobe_chain(filtering, windows)) * windows,
             levels - 1,
             RADIANCE_FORMAT,
         );
@@ -738,9 +761,10 @@ impl DenseVolume {
         }
     }
 
-    /// Blocks (directions) of `chains`: six, or one in isotropic mode.
+    /// Blocks of `chains`: six directions, or one in isotropic mode, and with the lobe chain
+    /// the lobes' two.
     pub fn chain_blocks(&self) -> u32 {
-        chain_blocks(self.anisotropic)
+        chain_blocks(self.anisotropic, lobe_chain(self.filtering(), self.windows))
     }
 
     fn memory_report(&self) -> Vec<(&'static str, u64)> {
@@ -765,7 +789,9 @@ impl DenseVolume {
             ("voxel emission", w * texture_bytes(res, 8, 1)),
             ("voxel radiance", w * texture_bytes(res, 8, 1)),
             (
-                if self.anisotropic {
+                if self.chain_blocks() == 8 {
+                    "voxel radiance mips (6 directions, 2 lobe blocks)"
+                } else if self.anisotropic {
                     "voxel radiance mips (6 directions)"
                 } else {
                     "voxel radiance mips"
