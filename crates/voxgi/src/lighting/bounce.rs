@@ -140,13 +140,15 @@ pub struct BouncePass {
 }
 
 impl BouncePass {
-    /// Compiles the pipelines for structure `kind`; `anisotropic` must match the structure's
-    /// mode (the gather samples all three axes of an anisotropic one); `irradiance`: also the
-    /// gather that keeps the leaves' irradiance (`BounceSteps::irradiance`).
+    /// Compiles the pipelines for structure `kind`; `anisotropic` and `lobes` must match the
+    /// structure's mode (the gather samples all three axes of an anisotropic one, and the lobe
+    /// chain of a dense volume with specular lobes); `irradiance`: also the gather that keeps
+    /// the leaves' irradiance (`BounceSteps::irradiance`).
     pub fn new(
         device: &wgpu::Device,
         kind: VoxelKind,
         anisotropic: bool,
+        lobes: bool,
         irradiance: bool,
     ) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
@@ -171,7 +173,6 @@ impl BouncePass {
         let leaves = kind.leaves_layout(device);
         let store = kind.leaf_store_layout(device);
         let carry = kind.carry_layout(device);
-        let [iso, axes] = kind.sampling_constants(anisotropic, 3);
         let mark = |entry| {
             voxel_pipeline_entry(
                 device,
@@ -184,13 +185,15 @@ impl BouncePass {
             )
         };
         let gather = |irradiance: bool| {
+            let mut constants = kind.sampling_constants(anisotropic, lobes, 3);
+            constants.push(("IRRADIANCE", f64::from(u8::from(irradiance))));
             voxel_pipeline(
                 device,
                 "bounce",
                 "lighting/bounce.wgsl",
                 kind.shaders(),
                 &[Some(&globals), Some(&voxels), Some(&leaves)],
-                &[iso, axes, ("IRRADIANCE", f64::from(u8::from(irradiance)))],
+                &constants,
             )
         };
         BouncePass {

@@ -290,7 +290,13 @@ impl Renderer {
                 atlas.views.len(),
                 options.shadow_filter,
             ),
-            bounce: BouncePass::new(device, options.voxels, options.anisotropic, leaves(options)),
+            bounce: BouncePass::new(
+                device,
+                options.voxels,
+                options.anisotropic,
+                options.specular_bounces,
+                leaves(options),
+            ),
             blend: BlendPass::new(device, options.voxels),
             gbuffer: GbufferPass::new(device),
             gather: GatherPass::new(device, options, facts.glossy),
@@ -480,8 +486,19 @@ impl Renderer {
             checked(device, "pipeline creation", || {
                 (
                     gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
-                    (kind || old.anisotropic != new.anisotropic || indirect)
-                        .then(|| BouncePass::new(device, new.voxels, new.anisotropic, leaves(new))),
+                    (kind
+                        || old.anisotropic != new.anisotropic
+                        || old.specular_bounces != new.specular_bounces
+                        || indirect)
+                        .then(|| {
+                            BouncePass::new(
+                                device,
+                                new.voxels,
+                                new.anisotropic,
+                                new.specular_bounces,
+                                leaves(new),
+                            )
+                        }),
                     (old.cone_shadows != new.cone_shadows || filter)
                         .then(|| composite_pass(device, &self.scene, &self.facts, new)),
                     (kind || filter).then(|| {

@@ -46,14 +46,16 @@ impl GatherPass {
             entries: &entries,
         });
         let kind = settings.voxels;
-        let [iso, axes] = kind.sampling_constants(settings.anisotropic, settings.gather_axes);
         let leaves = settings.indirect == IndirectShading::Leaves;
-        let constants = [
-            iso,
-            axes,
+        let mut constants = kind.sampling_constants(
+            settings.anisotropic,
+            settings.specular_bounces,
+            settings.gather_axes,
+        );
+        constants.extend([
             ("GLOSSY", f64::from(u8::from(glossy))),
             ("LEAVES", f64::from(u8::from(leaves))),
-        ];
+        ]);
         let voxels = kind.sampling_layout(device);
         let irradiance = kind.irradiance_layout(device);
         GatherPass {

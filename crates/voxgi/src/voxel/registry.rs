@@ -57,8 +57,9 @@ pub struct KindInfo {
     /// The layout of `@group(3)` of the bounce's `stash` and `mark`, what its carry.wgsl reads
     /// (where a new leaf's light may start from).
     pub carry_layout: fn(&wgpu::Device) -> wgpu::BindGroupLayout,
-    /// Values for the `override` constants of its sample.wgsl: (anisotropic, gather axes).
-    pub sampling_constants: fn(bool, u32) -> [(&'static str, f64); 2],
+    /// Values for the `override` constants of its sample.wgsl: (anisotropic, specular lobes,
+    /// gather axes).
+    pub sampling_constants: fn(bool, bool, u32) -> Vec<(&'static str, f64)>,
     /// Makes one. `previous`, the structure it replaces (of any kind), lends its pipelines
     /// when it is of this kind. Errors name what does not fit the device.
     pub create: CreateFn,
@@ -119,8 +120,13 @@ impl VoxelKind {
     }
 
     /// Values for the `override` constants of the structure's sample.wgsl.
-    pub fn sampling_constants(self, anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
-        (self.0.sampling_constants)(anisotropic, axes)
+    pub fn sampling_constants(
+        self,
+        anisotropic: bool,
+        lobes: bool,
+        axes: u32,
+    ) -> Vec<(&'static str, f64)> {
+        (self.0.sampling_constants)(anisotropic, lobes, axes)
     }
 
     /// Its WGSL files, for the shader composer.

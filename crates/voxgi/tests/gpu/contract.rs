@@ -329,7 +329,7 @@ pub fn run_probes(r: &voxgi::Renderer, probes: &[[f32; 8]]) -> Vec<Vec4> {
         bind_group_layouts: &[Some(&own), Some(&voxels)],
         immediate_size: 0,
     });
-    let constants = kind.sampling_constants(anisotropic, 3);
+    let constants = kind.sampling_constants(anisotropic, false, 3);
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("probe"),
         layout: Some(&layout),

@@ -33,7 +33,7 @@ fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
     let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir, win);
     // Only between the finest level and the first coarse one is the finest level read.
     let s = mix(fine, coarse, min(lod, 1.0));
-    if vol.anisotropic != 2u {
+    if !LOBE_CHAIN {
         return s;
     }
     // The finest level has no lobes: they fade in as the chain does.
@@ -54,6 +54,12 @@ fn with_lobes(s: vec4<f32>, uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32, w
     let light = lobe_light(m, v, -dir, cone_kappa(0.25 * cone_tan_half));
     return vec4<f32>(s.rgb + weight * light * s.a, s.a);
 }
+
+// True when the pipeline serves a volume with the lobe chain (`vol.anisotropic` 2): samples
+// add the lobes' light. A constant, not the uniform, so that the other pipelines carry no
+// branch (a third more gather time on lavapipe); the blocks are counted from the uniform, so
+// a pipeline without it still reads the six directions right.
+override LOBE_CHAIN: bool = false;
 
 // True when the pipeline serves an isotropic volume: each sample then makes one fetch, not
 // three equal ones (half the gather's time on lavapipe). Left false, the mode is read from

@@ -790,7 +790,7 @@ impl DenseVolume {
             ("voxel radiance", w * texture_bytes(res, 8, 1)),
             (
                 if self.chain_blocks() == 8 {
-                    "voxel radiance mips (6 directions, 2 lobe blocks)"
+                    "voxel radiance mips (6 dirs, 2 lobes)"
                 } else if self.anisotropic {
                     "voxel radiance mips (6 directions)"
                 } else {
@@ -802,11 +802,16 @@ impl DenseVolume {
     }
 
     /// Values for voxels/dense/sample.wgsl's `override` constants, for the pipelines that sample a
-    /// volume of this mode.
-    pub fn sampling_constants(anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
-        [
+    /// volume of this mode: `lobes`, whether it keeps the lobe chain.
+    pub fn sampling_constants(
+        anisotropic: bool,
+        lobes: bool,
+        axes: u32,
+    ) -> Vec<(&'static str, f64)> {
+        vec![
             ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
             ("SAMPLE_AXES", f64::from(axes)),
+            ("LOBE_CHAIN", if anisotropic && lobes { 1.0 } else { 0.0 }),
         ]
     }
 

@@ -439,9 +439,14 @@ impl OctreeVolume {
         self.layout.depth
     }
 
-    /// Values for voxels/octree/sample.wgsl's `override` constants.
-    pub fn sampling_constants(anisotropic: bool, axes: u32) -> [(&'static str, f64); 2] {
-        [
+    /// Values for voxels/octree/sample.wgsl's `override` constants. The octree folds its lobes
+    /// into the six directions: `_lobes` changes nothing in its sampling.
+    pub fn sampling_constants(
+        anisotropic: bool,
+        _lobes: bool,
+        axes: u32,
+    ) -> Vec<(&'static str, f64)> {
+        vec![
             ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
             ("SAMPLE_AXES", f64::from(axes)),
         ]
