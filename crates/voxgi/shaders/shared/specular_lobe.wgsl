@@ -111,11 +111,6 @@ fn cone_kappa(tan_half: f32) -> f32 {
 // as a cone of concentration `cone` sees it: the lobe convolved with the cone (two vMFs'
 // concentrations combine as k1 k2 / (k1 + k2)), times the exitance per covered area. A
 // lobe's radiance M D(out) meets a Lambertian surface's M / pi where it looks along the normal.
-// The caller passes a cone narrower than the one traced (windows.wgsl): a sample already
-// merges the lobes of every point its footprint covers, whose disagreement widens the merged
-// lobe, and the cone's whole aperture counted again on top spread the light a metal floor
-// reflects onto a wall over directions that miss it (docs/QUALITY.md, "Specular light in the
-// bounces").
 fn lobe_light(m: vec4<f32>, v: vec4<f32>, out: vec3<f32>, cone: f32) -> vec3<f32> {
     if m.a <= 1e-6 || v.w <= 1e-8 {
         return vec3<f32>(0.0);
@@ -127,4 +122,14 @@ fn lobe_light(m: vec4<f32>, v: vec4<f32>, out: vec3<f32>, cone: f32) -> vec3<f32
     let axis = v.xyz / max(len, 1e-8);
     let d = k / (6.28318531 * (1.0 - exp(-2.0 * k))) * exp(k * (dot(axis, out) - 1.0));
     return max(m.rgb, vec3<f32>(0.0)) / m.a * d;
+}
+
+// What a sample of the lobe chain with moments `m` and `v` sends back along a cone travelling
+// `dir`, as the cone being traced (`cone_tan_half`) sees it. The cone counts as a quarter of
+// its half-angle wide: a sample already merges the lobes of every point its footprint covers,
+// whose disagreement widens the merged lobe, and the cone's whole aperture counted again on
+// top spread the light a metal floor reflects onto a wall over directions that miss it
+// (docs/QUALITY.md, "Specular light in the bounces").
+fn chain_lobe_light(m: vec4<f32>, v: vec4<f32>, dir: vec3<f32>) -> vec3<f32> {
+    return lobe_light(m, v, -dir, cone_kappa(0.25 * cone_tan_half));
 }

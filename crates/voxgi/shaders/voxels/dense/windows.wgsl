@@ -51,8 +51,7 @@ fn with_lobes(s: vec4<f32>, uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32, w
     let first = 6.0 * f32(vol.windows) + f32(win);
     let m = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first) / blocks), cl);
     let v = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first + f32(vol.windows)) / blocks), cl);
-    let light = lobe_light(m, v, -dir, cone_kappa(0.25 * cone_tan_half));
-    return vec4<f32>(s.rgb + weight * light * s.a, s.a);
+    return vec4<f32>(s.rgb + weight * chain_lobe_light(m, v, dir) * s.a, s.a);
 }
 
 // True when the pipeline serves a volume with the lobe chain (`vol.anisotropic` 2): samples

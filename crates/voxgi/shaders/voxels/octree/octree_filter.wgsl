@@ -74,7 +74,39 @@ fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
         return w * v;
     }
     let n = normal.xyz / max(length(normal.xyz), 1e-4);
-    return w * v + vec4<f32>(v.a * lobe_radiance(unpack_lobe(packed), n, d), 0.0);
+    // The lobe's wide share; the rest goes up the lobe blocks (`lobe_filtered`).
+    return w * v + vec4<f32>(v.a * lobe_radiance(wide_share(unpack_lobe(packed)), n, d), 0.0);
+}
+
+// Lobe block d (6 or 7) at level k of the node whose children's brick is `below`: the mean of
+// its eight voxels' moments, the leaves' own at level 1 (shared/specular_lobe.wgsl, "The lobe
+// chain"; the dense volume's filter.wgsl `filter_lobes`).
+fn lobe_filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
+    let block = select(dir_block(tree, d), 0u, k == 1u);
+    let base = brick_texel(atlas_shape(tree, k - 1u), brick_index(tree, below, k - 1u), block);
+    var sum = vec4<f32>(0.0);
+    for (var j = 0u; j < 8u; j++) {
+        let o = octant_offset(j);
+        if k > 1u {
+            sum += textureLoad(src, base + o, 0);
+            continue;
+        }
+        let a = source(base, o).a;
+        let word = nodes[child_word(tree, below * 8u + j)];
+        if a <= 0.0 || word == 0u {
+            continue;
+        }
+        let slot = min(word - 1u, tree.slots - 1u);
+        let packed = leaf_direct[2u * slot + 1u];
+        if any(packed.rgb > vec3<f32>(0.0)) {
+            let normal = unpack4x8snorm(slots[slot * SLOT_STRIDE + 3u]).xyz;
+            let lobe = narrow_share(unpack_lobe(packed), normal / max(length(normal), 1e-4));
+            sum += lobe_moments(lobe, a, d);
+        } else if d == 6u {
+            sum.a += a;
+        }
+    }
+    return sum * 0.125;
 }
 
 // The redone nodes of this workgroup, added to `redone` once (one global atomic per node
@@ -140,6 +172,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
 // The value at level k, direction block d, of the node whose children's brick is `below`
 // (level k - 1): the dense volume's filter over its eight voxels, as stored optical depth.
 fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
+    if d >= 6u {
+        return lobe_filtered(below, k, d);
+    }
     // Level 0 is isotropic: every direction filters its one block.
     let block = select(dir_block(tree, d), 0u, k == 1u);
     let base = brick_texel(atlas_shape(tree, k - 1u), brick_index(tree, below, k - 1u), block);

@@ -12,6 +12,7 @@
 // Everything here reads @group(1) only; `OctreeVolume::sampling_layout` is its twin.
 
 //!include shared/volume.wgsl
+//!include shared/specular_lobe.wgsl
 //!include voxels/tree.wgsl
 
 @group(1) @binding(0) var<uniform> tree: Octree;
@@ -29,6 +30,10 @@ override ISOTROPIC_ONLY: bool = false;
 // Directional blocks a sample reads: 3, every axis by its weight, or 2, the two of largest
 // weight (as the dense volume's).
 override SAMPLE_AXES: u32 = 3u;
+// True when the pipeline serves an octree with specular lobes: its levels above the leaves
+// hold the lobes' moments in two more blocks, which samples add (as the dense volume's
+// `LOBE_CHAIN`; a constant so that other pipelines carry no branch).
+override LOBE_CHAIN: bool = false;
 
 fn voxels_voxel_size() -> f32 {
     return tree.voxel_size;
@@ -121,6 +126,13 @@ fn fetch_level(atlas: texture_3d<f32>, shape: AtlasShape, tile: u32, lvl: u32, l
             let y = textureSampleLevel(atlas, voxel_sampler, uy, 0.0);
             let z = textureSampleLevel(atlas, voxel_sampler, uz, 0.0);
             v = w.x * x + w.y * y + w.z * z;
+        }
+        if LOBE_CHAIN {
+            // Level 0 has no lobes (its one block is the leaves' light).
+            let m = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, 6.0 * block)) * inv, 0.0);
+            let l = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, 7.0 * block)) * inv, 0.0);
+            let light = select(vec3<f32>(0.0), chain_lobe_light(m, l, dir), lvl > 0u);
+            v = vec4<f32>(v.rgb + light * v.a, v.a);
         }
     }
     return select(vec4<f32>(0.0), v, tile != 0u);

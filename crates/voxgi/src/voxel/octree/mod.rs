@@ -191,7 +191,13 @@ impl OctreeVolume {
     ) -> crate::Result<Self> {
         let anisotropic = filtering.anisotropic;
         let depth = grid.resolution.ilog2();
-        let dirs: u32 = if anisotropic { 6 } else { 1 };
+        // Six directions, and the lobe chain's two blocks with specular lobes (octree_filter.wgsl's
+        // `lobe_filtered`).
+        let dirs: u32 = match (anisotropic, filtering.lobes) {
+            (false, _) => 1,
+            (true, false) => 6,
+            (true, true) => 8,
+        };
         // Tile 0 is the root's; then classes E, O and V (`child_word` in tree.wgsl).
         let base_e = 1u64;
         let base_o = base_e + pools.even_tiles as u64;
@@ -439,16 +445,17 @@ impl OctreeVolume {
         self.layout.depth
     }
 
-    /// Values for voxels/octree/sample.wgsl's `override` constants. The octree folds its lobes
-    /// into the six directions: `_lobes` changes nothing in its sampling.
+    /// Values for voxels/octree/sample.wgsl's `override` constants: `lobes`, whether it keeps
+    /// specular lobes (then in two more blocks of its levels above the leaves).
     pub fn sampling_constants(
         anisotropic: bool,
-        _lobes: bool,
+        lobes: bool,
         axes: u32,
     ) -> Vec<(&'static str, f64)> {
         vec![
             ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
             ("SAMPLE_AXES", f64::from(axes)),
+            ("LOBE_CHAIN", if anisotropic && lobes { 1.0 } else { 0.0 }),
         ]
     }
 
