@@ -1,8 +1,10 @@
 // What a leaf reflects specularly of the lights: its lobe (`specular_bounces`). inject writes it
-// beside the leaf's direct light (leaf_direct[2i + 1]); the first directional mip level folds it into the six
-// directions (voxels/<kind>/ filters), so a cone that looks at a lit metal from where its
-// reflection goes sees the light it reflects. The finest level stays isotropic: cones that read
-// it (the nearest samples of narrow cones) see no lobe.
+// beside the leaf's direct light (leaf_direct[2i + 1]); the levels above the finest keep it
+// (voxels/<kind>/ filters), so a cone that looks at a lit metal from where its reflection goes
+// sees the light it reflects: the dense volume and the octree in two more blocks ("The lobe
+// chain" below), the clipmap folded into its six directions at the first level
+// (`lobe_radiance`). The finest level stays isotropic: cones that read it (the nearest samples
+// of narrow cones) see no lobe.
 //
 // A lobe is one vec4: the specular radiant exitance M (rgb, W/m^2: the lights' irradiance
 // times the lobe's directional albedo), and in w an integer below 2^24 (exact in f32): the lobe's mean direction
@@ -125,11 +127,12 @@ fn lobe_light(m: vec4<f32>, v: vec4<f32>, out: vec3<f32>, cone: f32) -> vec3<f32
 }
 
 // What a sample of the lobe chain with moments `m` and `v` sends back along a cone travelling
-// `dir`, as the cone being traced (`cone_tan_half`) sees it. The cone counts as a quarter of
-// its half-angle wide: a sample already merges the lobes of every point its footprint covers,
+// `dir`, as the cone being traced (`cone_tan_half`) sees it. The cone counts as half its
+// half-angle wide: a sample already merges the lobes of every point its footprint covers,
 // whose disagreement widens the merged lobe, and the cone's whole aperture counted again on
-// top spread the light a metal floor reflects onto a wall over directions that miss it
+// top spread the light a metal floor reflects onto a wall over directions that miss it (a
+// third of it lost); narrower still, the reflection breaks into the texels' blocks
 // (docs/QUALITY.md, "Specular light in the bounces").
 fn chain_lobe_light(m: vec4<f32>, v: vec4<f32>, dir: vec3<f32>) -> vec3<f32> {
-    return lobe_light(m, v, -dir, cone_kappa(0.25 * cone_tan_half));
+    return lobe_light(m, v, -dir, cone_kappa(0.5 * cone_tan_half));
 }

@@ -161,9 +161,9 @@ pub static SETTINGS: &[Setting] = &[
         key: "specular_bounces",
         label: "metals' reflections in the bounces",
         help: "Metals reflect the lights' light specularly into the voxels (a lobe per lit leaf: \
-               the dense volume keeps its direction up the mip chain, the octree and the \
-               clipmap fold it into the six directions): a wall facing a metal's reflection is \
-               lit, at about half strength. Needs anisotropic voxels.",
+               the dense volume and the octree keep its direction up their levels, the \
+               clipmap folds it into the six directions): a wall facing a metal's reflection is \
+               lit, at under half strength. Needs anisotropic voxels.",
         domain: Domain::Bool,
         changes: Changes::Voxels,
         access: access!(options bool specular_bounces),

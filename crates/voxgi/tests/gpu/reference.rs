@@ -846,7 +846,7 @@ fn wall_lit_by_a_metal(roughness: f32) -> (f32, f32) {
 #[test]
 fn a_metal_floor_lights_the_wall_its_reflection_reaches() {
     // (roughness, the least and the most the cones may reach of the path tracer's light)
-    // Measured on lavapipe: 0.44 at roughness 0.25 and 1.52 at 1 (without the leaves' lobes
+    // Measured on lavapipe: 0.42 at roughness 0.25 and 1.52 at 1 (without the leaves' lobes
     // the wall is black: 0; with the lobes folded into the six directions, 0.47 and 1.52).
     // A coarse sample merges the lobes of all the floor it covers into one wider lobe, so a
     // cone that meets the floor beside the point whose reflection reaches it reads too little;
@@ -874,7 +874,7 @@ fn a_metal_floor_lights_the_wall_its_reflection_reaches() {
 fn a_metal_floors_reflection_leaves_the_surfaces_beside_it_dark() {
     // The front's light with the leaves' lobes over without them (a converged still, one
     // bounce, 64x64 at 64³), in the structures that keep the lobes up their levels. Measured
-    // on lavapipe: dense 1.06, octree 1.05. Folded into the six directions (the clipmap's way,
+    // on lavapipe: dense 1.06, octree 1.06. Folded into the six directions (the clipmap's way,
     // and every structure's before the lobe chain) a lobe about the vertical lit it 4.6 times
     // as bright (docs/QUALITY.md, "Specular light in the bounces", has the metal-floored box
     // against the path tracer). The bound fails a lobe that leaves sideways.
@@ -907,9 +907,9 @@ fn a_metal_floors_reflection_leaves_the_surfaces_beside_it_dark() {
 /// reads the same light from either.
 #[test]
 fn the_octree_keeps_the_specular_lobes_the_dense_volume_keeps() {
-    // Measured on lavapipe at 96x64, 64³: 0.4266 and 0.4245 of the path tracer (the two
+    // Measured on lavapipe at 96x64, 64³: 0.425 and 0.422 of the path tracer (the two
     // structures filter the same values; their samples interpolate bricks and mips
-    // differently, 0.5 % apart). 3 % catches a lobe block lost or read from the wrong level.
+    // differently, 0.6 % apart). 3 % catches a lobe block lost or read from the wrong level.
     let wall = |voxels| {
         let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../examples/metal-floor.toml");
