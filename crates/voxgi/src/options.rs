@@ -305,9 +305,10 @@ pub struct RendererOptions {
     /// lobe of what it reflects, which the dense volume and the octree keep up their levels in
     /// two more blocks (evaluated towards each cone) and the clipmap folds into its six
     /// directions at the first level (docs/QUALITY.md, "Specular light in the bounces"). Needs
-    /// `anisotropic`. Default false: both light a wall facing a metal's reflection at under
-    /// half strength, the fold also lights surfaces beside it that should see none (the metal
-    /// Cornell box's block fronts), and the lobe chain costs the gather and the bounces more.
+    /// `anisotropic`. In a scene without a metal it keeps nothing and costs nothing. Default
+    /// false: both ways light a wall facing a metal's reflection at under half strength, the
+    /// fold also lights surfaces beside it that should see none (the metal Cornell box's block
+    /// fronts), and the lobe chain costs the gather and the bounces more.
     pub specular_bounces: bool,
     /// Directional blocks each cone sample of the per-pixel gather reads in an anisotropic
     /// volume: 3, every axis by its weight (the paper's filtering), or 2, the two axes of

@@ -120,11 +120,8 @@ pub fn trace_diffuse_cones(
         });
         let kind = options.voxels;
         let sampling = kind.sampling_layout(device);
-        let constants = kind.sampling_constants(
-            options.anisotropic,
-            options.specular_bounces,
-            options.gather_axes,
-        );
+        let constants =
+            kind.sampling_constants(options.anisotropic, renderer.lobes(), options.gather_axes);
         let pipeline = shader::voxel_pipeline(
             device,
             "cone_probe",

@@ -170,9 +170,17 @@ struct SceneFacts {
     casts: Vec<bool>,
     /// Whether any surface may have a specular lobe.
     glossy: bool,
+    /// Whether any material is metallic (`GpuScene::metals`).
+    metals: bool,
 }
 
 impl SceneFacts {
+    /// Whether the voxels keep specular lobes: `specular_bounces` and a metal to reflect (in a
+    /// scene without one the lobes would all be zero: no slot, block or sample pays for them).
+    fn lobes(&self, options: &RendererOptions) -> bool {
+        options.specular_bounces && self.metals
+    }
+
     /// The structure `options` ask for on `grid`. Its pools start with room for the options'
     /// voxel capacity, or a quarter of the fragment estimate (slots: at most one per voxel,
     /// usually far fewer than fragments, and the estimate is itself an upper bound); the first
@@ -184,7 +192,7 @@ impl SceneFacts {
             filtering: Filtering {
                 anisotropic: options.anisotropic,
                 ndf: options.ndf_mips,
-                lobes: options.specular_bounces,
+                lobes: self.lobes(options),
             },
             leaves: options
                 .voxel_capacity
@@ -256,6 +264,7 @@ impl Renderer {
                 .fold(0.0f32, f32::max),
             casts: scene.lights.iter().map(|l| l.cast_shadows).collect(),
             glossy: gather::has_glossy(scene, gpu_scene.point_count),
+            metals: gpu_scene.metals,
         };
         let across = (facts.bounds.max - facts.bounds.min).max_element();
         if let Some(w) = coarse_voxels(across, &grid(&facts, options), options.voxels) {
@@ -294,12 +303,12 @@ impl Renderer {
                 device,
                 options.voxels,
                 options.anisotropic,
-                options.specular_bounces,
+                facts.lobes(options),
                 leaves(options),
             ),
             blend: BlendPass::new(device, options.voxels),
             gbuffer: GbufferPass::new(device),
-            gather: GatherPass::new(device, options, facts.glossy),
+            gather: GatherPass::new(device, options, facts.glossy, facts.lobes(options)),
             upsample: UpsamplePass::new(device),
             composite: composite_pass(device, &gpu_scene, &facts, options),
             temporal: TemporalPass::new(device),
@@ -412,7 +421,7 @@ impl Renderer {
             || old.voxel_size != new.voxel_size
             || old.anisotropic != new.anisotropic
             || old.ndf_mips != new.ndf_mips
-            || old.specular_bounces != new.specular_bounces;
+            || self.facts.lobes(old) != self.facts.lobes(new);
         let atlas = old.shadow_map_size != new.shadow_map_size
             || (old.specular_bounces != new.specular_bounces && self.scene.metals)
             || old.cone_shadows != new.cone_shadows
@@ -485,17 +494,19 @@ impl Renderer {
         let (gather_new, bounce_new, composite_new, inject_new) =
             checked(device, "pipeline creation", || {
                 (
-                    gather.then(|| GatherPass::new(device, new, self.facts.glossy)),
+                    gather.then(|| {
+                        GatherPass::new(device, new, self.facts.glossy, self.facts.lobes(new))
+                    }),
                     (kind
                         || old.anisotropic != new.anisotropic
-                        || old.specular_bounces != new.specular_bounces
+                        || self.facts.lobes(old) != self.facts.lobes(new)
                         || indirect)
                         .then(|| {
                             BouncePass::new(
                                 device,
                                 new.voxels,
                                 new.anisotropic,
-                                new.specular_bounces,
+                                self.facts.lobes(new),
                                 leaves(new),
                             )
                         }),
@@ -629,6 +640,12 @@ impl Renderer {
     /// The scene's own camera, or a view of its bounds.
     pub fn default_camera(&self) -> &Camera {
         &self.default_camera
+    }
+
+    /// Whether the voxels keep specular lobes (`specular_bounces` in a scene with a metal):
+    /// what every pipeline that samples them is compiled for.
+    pub(crate) fn lobes(&self) -> bool {
+        self.facts.lobes(&self.options)
     }
 
     /// The options this renderer was made with.

@@ -31,8 +31,14 @@ pub struct GatherPass {
 }
 
 impl GatherPass {
-    /// `glossy`: whether any surface may have a specular lobe (`has_glossy`).
-    pub fn new(device: &wgpu::Device, settings: &RendererOptions, glossy: bool) -> Self {
+    /// `glossy`: whether any surface may have a specular lobe (`has_glossy`); `lobes`: whether
+    /// the voxels keep specular lobes.
+    pub fn new(
+        device: &wgpu::Device,
+        settings: &RendererOptions,
+        glossy: bool,
+        lobes: bool,
+    ) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let globals = crate::frame::globals::layout(device);
         let mut entries = FrameTargets::gbuffer_layout(0, c).to_vec();
@@ -47,11 +53,8 @@ impl GatherPass {
         });
         let kind = settings.voxels;
         let leaves = settings.indirect == IndirectShading::Leaves;
-        let mut constants = kind.sampling_constants(
-            settings.anisotropic,
-            settings.specular_bounces,
-            settings.gather_axes,
-        );
+        let mut constants =
+            kind.sampling_constants(settings.anisotropic, lobes, settings.gather_axes);
         constants.extend([
             ("GLOSSY", f64::from(u8::from(glossy))),
             ("LEAVES", f64::from(u8::from(leaves))),

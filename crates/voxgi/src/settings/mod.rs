@@ -369,7 +369,7 @@ impl RendererOptions {
         }
         if self.specular_bounces && !self.anisotropic {
             return Err(Error::Setting(
-                "specular_bounces folds the lobes into six directional values: it needs the \
+                "specular_bounces keeps the lobes beside six directional values: it needs the \
                  anisotropic volume"
                     .into(),
             ));

@@ -234,3 +234,25 @@ fn specular_bounces_switch_like_a_fresh_renderer() {
         "switched off: not the first image"
     );
 }
+
+/// In a scene without a metal there is nothing to reflect: `specular_bounces` keeps no lobes,
+/// makes no extra blocks and compiles no lobe samples, and the image is the one without it, to
+/// the bit, in every structure.
+#[test]
+fn specular_bounces_without_a_metal_change_nothing() {
+    let scene = voxgi::scene::builtin::cornell_box();
+    for &voxels in voxgi::VoxelKind::ALL {
+        let off = RendererOptions { voxels, ..base() };
+        let on = RendererOptions {
+            specular_bounces: true,
+            ..off.clone()
+        };
+        let mut plain = renderer(&scene, &off);
+        let params = FrameParams::new(plain.default_camera().clone());
+        let without = frame(&mut plain, &params, SIZE, SIZE);
+        let mut r = renderer(&scene, &on);
+        let with = frame(&mut r, &params, SIZE, SIZE);
+        assert!(with.hdr == without.hdr, "{voxels:?}: the image changed");
+        assert_eq!(r.memory(), plain.memory(), "{voxels:?}: the memory changed");
+    }
+}
