@@ -302,13 +302,12 @@ pub struct RendererOptions {
     /// as isotropic, which is what the figures in docs/QUALITY.md were calibrated with.
     pub ndf_mips: bool,
     /// Metals' specular reflections of the lights in the bounces: each lit metal leaf keeps a
-    /// lobe of what it reflects, which the dense volume and the octree keep up their levels in
-    /// two more blocks (evaluated towards each cone) and the clipmap folds into its six
-    /// directions at the first level (docs/QUALITY.md, "Specular light in the bounces"). Needs
-    /// `anisotropic`. In a scene without a metal it keeps nothing and costs nothing. Default
-    /// false: both ways light a wall facing a metal's reflection at under half strength, the
-    /// fold also lights surfaces beside it that should see none (the metal Cornell box's block
-    /// fronts), and the lobe chain costs the gather and the bounces more.
+    /// lobe of what it reflects, which every structure keeps up its levels in two more blocks
+    /// beside the six directions, evaluated towards each cone (docs/QUALITY.md, "Specular
+    /// light in the bounces"). Needs `anisotropic`. In a scene without a metal it keeps nothing
+    /// and costs nothing. Default false: a wall facing a metal's reflection is lit at under
+    /// half its strength, and the lobes cost a scene with metals half as much gather time
+    /// again.
     pub specular_bounces: bool,
     /// Directional blocks each cone sample of the per-pixel gather reads in an anisotropic
     /// volume: 3, every axis by its weight (the paper's filtering), or 2, the two axes of

@@ -1,10 +1,9 @@
 // What a leaf reflects specularly of the lights: its lobe (`specular_bounces`). inject writes it
 // beside the leaf's direct light (leaf_direct[2i + 1]); the levels above the finest keep it
-// (voxels/<kind>/ filters), so a cone that looks at a lit metal from where its reflection goes
-// sees the light it reflects: the dense volume and the octree in two more blocks ("The lobe
-// chain" below), the clipmap folded into its six directions at the first level
-// (`lobe_radiance`). The finest level stays isotropic: cones that read it (the nearest samples
-// of narrow cones) see no lobe.
+// (voxels/<kind>/ filters) in two more blocks ("The lobe chain" below), its wide share folded
+// into the six directions at the first level (`lobe_radiance`), so a cone that looks at a lit
+// metal from where its reflection goes sees the light it reflects. The finest level stays
+// isotropic: cones that read it (the nearest samples of narrow cones) see no lobe.
 //
 // A lobe is one vec4: the specular radiant exitance M (rgb, W/m^2: the lights' irradiance
 // times the lobe's directional albedo), and in w an integer below 2^24 (exact in f32): the lobe's mean direction
@@ -35,7 +34,9 @@ fn unpack_lobe(v: vec4<f32>) -> Lobe {
 }
 
 // The radiance a cone travelling along direction block `block` (+X, -X, +Y, -Y, +Z, -Z: the
-// chains' order) reads of a leaf with lobe `lobe` and normal `n`, opacity aside.
+// chains' order) reads of a leaf with lobe `lobe` and normal `n`, opacity aside, the lobe
+// folded into the six directions (the filters fold a lobe's wide share this way; folding the
+// whole lobe lit what lies beside a narrow one's reflection, docs/QUALITY.md).
 //
 // A cone travelling d weighs the blocks of d's signs by d's squared cosines, and sees the light
 // leaving towards -d. So a narrow lobe about R goes to the blocks of -R's signs, each with R's
@@ -60,7 +61,7 @@ fn lobe_radiance(lobe: Lobe, n: vec3<f32>, block: u32) -> vec3<f32> {
     return lobe.m * mix(narrow, wide, lobe.t) / max(gathers, 0.1);
 }
 
-// --- The lobe chain (the dense volume): two more blocks in every chain level keep the lobes'
+// --- The lobe chain: two more blocks in every level above the finest keep the lobes'
 // moments, averaged like the isotropic chain, and a cone evaluates them towards itself, so a
 // narrow lobe keeps its direction at every level instead of spreading over the six blocks.
 //

@@ -160,10 +160,9 @@ pub static SETTINGS: &[Setting] = &[
     Setting {
         key: "specular_bounces",
         label: "metals' reflections in the bounces",
-        help: "Metals reflect the lights' light specularly into the voxels (a lobe per lit leaf: \
-               the dense volume and the octree keep its direction up their levels, the \
-               clipmap folds it into the six directions): a wall facing a metal's reflection is \
-               lit, at under half strength. Needs anisotropic voxels.",
+        help: "Metals reflect the lights' light specularly into the voxels (a lobe per lit leaf, \
+               kept up the voxels' levels beside the six directions): a wall facing a metal's \
+               reflection is lit, at under half strength. Needs anisotropic voxels.",
         domain: Domain::Bool,
         changes: Changes::Voxels,
         access: access!(options bool specular_bounces),

@@ -28,9 +28,9 @@ struct FilterParams {
     step: u32,
     // Cubes stacked along z in every level and block (`Volume::windows`).
     windows: u32,
-    // The slots' specular lobes (`leaf_direct` two vec4 a slot): 0 none, 1 folded into the six
-    // directions at the first level (the clipmap: its windows leave no room for more blocks),
-    // 2 kept in two more blocks of every level (specular_lobe.wgsl, "The lobe chain").
+    // 1: the slots keep specular lobes (`leaf_direct` two vec4 a slot): every level keeps
+    // their moments in two more blocks (specular_lobe.wgsl, "The lobe chain"), and the first
+    // folds their wide share into the six directions.
     lobes: u32,
     _pad2: u32,
 }
@@ -88,12 +88,8 @@ fn leaf_lobe(c: vec3<i32>, block: u32) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let n = textureLoad(normals, c, 0).xyz;
-    // With the chain only the lobe's wide share is folded in.
-    var lobe = unpack_lobe(packed);
-    if params.lobes == 2u {
-        lobe = wide_share(lobe);
-    }
-    return lobe_radiance(lobe, n / max(length(n), 1e-4), block);
+    // Only the lobe's wide share: the rest goes up the lobe blocks (`filter_lobes`).
+    return lobe_radiance(wide_share(unpack_lobe(packed)), n / max(length(n), 1e-4), block);
 }
 
 // Lobe block `block` (6 or 7) of the voxel `id` whose children start at `base`: the mean of
@@ -162,7 +158,7 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
 }
 
 fn blocks() -> u32 {
-    return select(1u, 6u, params.mode == 1u) + select(0u, 2u, params.lobes == 2u);
+    return select(1u, 6u, params.mode == 1u) + select(0u, 2u, params.lobes != 0u);
 }
 
 // Every voxel of the level (after a build); the bits and counts are cleared after

@@ -121,19 +121,9 @@ pub const KIND: KindInfo = KindInfo {
     leaf_store_layout: DenseVolume::leaf_store_layout,
     irradiance_layout: DenseVolume::irradiance_layout,
     carry_layout: Clipmap::carry_layout,
-    sampling_constants: clipmap_sampling_constants,
+    sampling_constants: DenseVolume::sampling_constants,
     create,
 };
-
-/// The dense volume's constants without the lobe chain: a clipmap's stacked windows fold their
-/// lobes into the six directions (`dense::lobe_chain`).
-fn clipmap_sampling_constants(
-    anisotropic: bool,
-    _lobes: bool,
-    axes: u32,
-) -> Vec<(&'static str, f64)> {
-    DenseVolume::sampling_constants(anisotropic, false, axes)
-}
 
 /// A clipmap for `desc`: `desc.levels` windows of `desc.grid.resolution`³ voxels, the finest
 /// `desc.voxel_size` (default: the coarsest level spans `AUTO_SPAN` times `desc.grid`, the

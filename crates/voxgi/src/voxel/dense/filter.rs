@@ -102,11 +102,7 @@ impl FilterPass {
                         ndf as u32,
                         level - 1,
                         windows,
-                        if super::lobe_chain(filtering, windows) {
-                            2
-                        } else {
-                            (filtering.lobes && src.is_none()) as u32
-                        },
+                        (filtering.lobes && filtering.anisotropic) as u32,
                         0,
                     ],
                 }
@@ -200,8 +196,7 @@ impl FilterPass {
                 })
             })
             .collect();
-        let blocks =
-            super::chain_blocks(filtering.anisotropic, super::lobe_chain(filtering, windows));
+        let blocks = super::chain_blocks(filtering.anisotropic, filtering.lobes);
         let whole = steps
             .iter()
             .map(|s| {

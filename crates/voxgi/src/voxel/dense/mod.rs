@@ -215,12 +215,18 @@ fn check_volume_fits(
         )));
     }
     // The deepest texture: the directional mips' blocks of every window, along z.
-    let blocks = chain_blocks(filtering.anisotropic, lobe_chain(filtering, windows));
+    let blocks = chain_blocks(filtering.anisotropic, filtering.lobes);
     let depth = (grid.resolution * windows).max(grid.resolution / 2 * blocks * windows);
     if grid.resolution > l.max_texture_dimension_3d || depth > l.max_texture_dimension_3d {
+        let lobes = if filtering.lobes {
+            " (with specular_bounces' two lobe blocks a level; without them it would be \
+             three quarters as deep)"
+        } else {
+            ""
+        };
         return Err(Error::TooLarge(format!(
-            "{} stacked {}³ voxel textures ({depth} texels deep) exceed this GPU's 3D texture \
-             limit of {}",
+            "{} stacked {}³ voxel textures ({depth} texels deep{lobes}) exceed this GPU's 3D \
+             texture limit of {}",
             windows, grid.resolution, l.max_texture_dimension_3d
         )));
     }
@@ -470,14 +476,6 @@ fn chain_blocks(anisotropic: bool, lobes: bool) -> u32 {
     }
 }
 
-/// Whether a volume of `windows` windows keeps its leaves' specular lobes in two more chain
-/// blocks (shared/specular_lobe.wgsl, "The lobe chain"). A clipmap's windows, stacked along z,
-/// leave no room for two more blocks within the 3D texture limit at its usual sizes: it folds
-/// the lobes into the six directions at the first level instead.
-pub(crate) fn lobe_chain(filtering: Filtering, windows: u32) -> bool {
-    filtering.anisotropic && filtering.lobes && windows == 1
-}
-
 fn storage_buffer(
     device: &wgpu::Device,
     label: &str,
@@ -610,7 +608,7 @@ impl DenseVolume {
             resolution: res,
             voxel_size: grid.voxel_size,
             levels,
-            anisotropic: if lobe_chain(filtering, windows) {
+            anisotropic: if anisotropic && filtering.lobes {
                 2
             } else {
                 anisotropic as u32
@@ -621,7 +619,7 @@ impl DenseVolume {
             device,
             "voxel radiance mips",
             res / 2,
-            chain_blocks(anisotropic, lobe_chain(filtering, windows)) * windows,
+            chain_blocks(anisotropic, filtering.lobes) * windows,
             levels - 1,
             RADIANCE_FORMAT,
         );
@@ -764,7 +762,7 @@ impl DenseVolume {
     /// Blocks of `chains`: six directions, or one in isotropic mode, and with the lobe chain
     /// the lobes' two.
     pub fn chain_blocks(&self) -> u32 {
-        chain_blocks(self.anisotropic, lobe_chain(self.filtering(), self.windows))
+        chain_blocks(self.anisotropic, self.lobes)
     }
 
     fn memory_report(&self) -> Vec<(&'static str, u64)> {
