@@ -380,6 +380,18 @@ impl Filtering {
     }
 }
 
+/// Values for the `override` constants every structure's sample.wgsl declares, for the
+/// pipelines that sample a structure of this mode: `anisotropic` (ISOTROPIC_ONLY: one fetch a
+/// sample), `lobes` (LOBE_CHAIN: the samples add the specular lobes' light) and `axes`, the
+/// directional blocks a sample reads (SAMPLE_AXES).
+pub fn sampling_constants(anisotropic: bool, lobes: bool, axes: u32) -> Vec<(&'static str, f64)> {
+    vec![
+        ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
+        ("SAMPLE_AXES", f64::from(axes)),
+        ("LOBE_CHAIN", if anisotropic && lobes { 1.0 } else { 0.0 }),
+    ]
+}
+
 /// Words of `VoxelStructure::pool_counter` read back after each build (the octree's sixth: the
 /// slots of its static build, `octree::STATIC_COUNTED`).
 pub const POOL_COUNTERS: usize = 6;

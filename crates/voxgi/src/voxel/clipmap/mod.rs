@@ -121,7 +121,7 @@ pub const KIND: KindInfo = KindInfo {
     leaf_store_layout: DenseVolume::leaf_store_layout,
     irradiance_layout: DenseVolume::irradiance_layout,
     carry_layout: Clipmap::carry_layout,
-    sampling_constants: DenseVolume::sampling_constants,
+    sampling_constants: super::sampling_constants,
     create,
 };
 

@@ -87,7 +87,7 @@ pub const KIND: KindInfo = KindInfo {
     irradiance_layout: DenseVolume::irradiance_layout,
     // Its carry.wgsl reads nothing: any group fits.
     carry_layout: DenseVolume::irradiance_layout,
-    sampling_constants: DenseVolume::sampling_constants,
+    sampling_constants: super::sampling_constants,
     create,
 };
 
@@ -796,20 +796,6 @@ impl DenseVolume {
                 },
                 w * self.chain_blocks() as u64 * texture_bytes(res / 2, 8, aniso_mips),
             ),
-        ]
-    }
-
-    /// Values for voxels/dense/sample.wgsl's `override` constants, for the pipelines that sample a
-    /// volume of this mode: `lobes`, whether it keeps the lobe chain.
-    pub fn sampling_constants(
-        anisotropic: bool,
-        lobes: bool,
-        axes: u32,
-    ) -> Vec<(&'static str, f64)> {
-        vec![
-            ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
-            ("SAMPLE_AXES", f64::from(axes)),
-            ("LOBE_CHAIN", if anisotropic && lobes { 1.0 } else { 0.0 }),
         ]
     }
 

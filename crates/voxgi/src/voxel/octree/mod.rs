@@ -85,7 +85,7 @@ pub const KIND: KindInfo = KindInfo {
     irradiance_layout: OctreeVolume::irradiance_layout,
     // Its carry.wgsl reads nothing: any group fits.
     carry_layout: OctreeVolume::irradiance_layout,
-    sampling_constants: OctreeVolume::sampling_constants,
+    sampling_constants: super::sampling_constants,
     create,
 };
 
@@ -443,20 +443,6 @@ impl OctreeVolume {
     /// log2 of the finest resolution: the depth of the leaf voxels.
     pub fn depth(&self) -> u32 {
         self.layout.depth
-    }
-
-    /// Values for voxels/octree/sample.wgsl's `override` constants: `lobes`, whether it keeps
-    /// specular lobes (then in two more blocks of its levels above the leaves).
-    pub fn sampling_constants(
-        anisotropic: bool,
-        lobes: bool,
-        axes: u32,
-    ) -> Vec<(&'static str, f64)> {
-        vec![
-            ("ISOTROPIC_ONLY", if anisotropic { 0.0 } else { 1.0 }),
-            ("SAMPLE_AXES", f64::from(axes)),
-            ("LOBE_CHAIN", if anisotropic && lobes { 1.0 } else { 0.0 }),
-        ]
     }
 
     /// The layout of @group(1) for the octree, twin of shaders/voxels/octree/sample.wgsl: the
