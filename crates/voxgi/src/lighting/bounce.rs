@@ -142,7 +142,7 @@ pub struct BouncePass {
 impl BouncePass {
     /// Compiles the pipelines for structure `kind`; `anisotropic` and `lobes` must match the
     /// structure's mode (the gather samples all three axes of an anisotropic one, and the lobe
-    /// chain of a dense volume with specular lobes); `irradiance`: also the gather that keeps
+    /// blocks of one with specular lobes); `irradiance`: also the gather that keeps
     /// the leaves' irradiance (`BounceSteps::irradiance`).
     pub fn new(
         device: &wgpu::Device,

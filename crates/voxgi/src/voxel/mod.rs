@@ -359,8 +359,10 @@ pub struct Filtering {
     /// The first directional level weighs each leaf per direction by its normal distribution
     /// (`RendererOptions::ndf_mips`; `cpu::ndf_weight`). Only with `anisotropic`.
     pub ndf: bool,
-    /// Each leaf keeps a specular lobe beside its direct light, which the first directional
-    /// level folds in (`RendererOptions::specular_bounces`). Only with `anisotropic`.
+    /// Each leaf keeps a specular lobe beside its direct light, whose moments every level above
+    /// the finest keeps in two more directional blocks (shared/specular_lobe.wgsl, "The lobe
+    /// chain"; `RendererOptions::specular_bounces` in a scene with a metal). Only with
+    /// `anisotropic`.
     pub lobes: bool,
 }
 

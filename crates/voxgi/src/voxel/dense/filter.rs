@@ -113,7 +113,7 @@ impl FilterPass {
     /// The bind groups of every level's step for a volume on `grid` (`windows` cubes of it
     /// stacked along z) with these textures (the finest level's `radiance` and `normal`, the
     /// `chains` above), its lists of changed voxels (in `counters`), and its `occupancy` and
-    /// slots' `direct` light, whose specular lobes the first level folds in, with their
+    /// slots' `direct` light, whose specular lobes the first level takes in, with their
     /// parameters: made once per volume (they bind only its own resources).
     #[allow(clippy::too_many_arguments)]
     pub fn bind(

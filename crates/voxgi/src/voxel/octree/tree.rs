@@ -83,8 +83,8 @@ pub struct GpuOctree {
     pub slots: u32,
     /// 1: the first directional level weighs the leaves by their normals (`Filtering::ndf`).
     pub ndf: u32,
-    /// 1: the leaves keep specular lobes after their direct light, which the first directional
-    /// level folds in (`Filtering::lobes`).
+    /// 1: the leaves keep specular lobes after their direct light, and the levels above them
+    /// the lobes' moments in two more blocks (`Filtering::lobes`).
     pub lobes: u32,
     /// Padding; zero.
     pub _pad: u32,
