@@ -906,7 +906,7 @@ fn a_metal_floors_reflection_leaves_the_surfaces_beside_it_dark() {
 /// examples/metal-floor.toml reads the same light from each.
 #[test]
 fn every_structure_keeps_the_specular_lobes_the_dense_volume_keeps() {
-    // Measured on lavapipe at 96x64, 64³: 0.425, 0.422 and 0.425 of the path tracer (the
+    // Measured on lavapipe at 96x64, 64³: 0.425, 0.423 and 0.425 of the path tracer (the
     // structures filter the same values; their samples interpolate bricks, mips and windows
     // differently, under 1 % apart). 3 % catches a lobe block lost or read from the wrong
     // level.
