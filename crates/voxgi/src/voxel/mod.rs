@@ -367,6 +367,16 @@ pub struct Filtering {
 }
 
 impl Filtering {
+    /// Blocks each level above the finest holds per voxel: six directions (one isotropic), and
+    /// with `lobes` the lobe chain's two after them (shared/specular_lobe.wgsl).
+    pub fn blocks(self) -> u32 {
+        match (self.anisotropic, self.lobes) {
+            (false, _) => 1,
+            (true, false) => 6,
+            (true, true) => 8,
+        }
+    }
+
     /// The most bytes a slot's direct light takes (`direct_bytes` with lobes).
     pub const MOST_DIRECT_BYTES: u64 = 32;
 

@@ -196,7 +196,7 @@ impl FilterPass {
                 })
             })
             .collect();
-        let blocks = super::chain_blocks(filtering.anisotropic, filtering.lobes);
+        let blocks = filtering.blocks();
         let whole = steps
             .iter()
             .map(|s| {

@@ -215,7 +215,7 @@ fn check_volume_fits(
         )));
     }
     // The deepest texture: the directional mips' blocks of every window, along z.
-    let blocks = chain_blocks(filtering.anisotropic, filtering.lobes);
+    let blocks = filtering.blocks();
     let depth = (grid.resolution * windows).max(grid.resolution / 2 * blocks * windows);
     if grid.resolution > l.max_texture_dimension_3d || depth > l.max_texture_dimension_3d {
         let lobes = if filtering.lobes {
@@ -467,15 +467,6 @@ fn texture_3d_blocks(
     })
 }
 
-/// Blocks of the chains: six directions (or one isotropic), and the lobe chain's two.
-fn chain_blocks(anisotropic: bool, lobes: bool) -> u32 {
-    match (anisotropic, lobes) {
-        (false, _) => 1,
-        (true, false) => 6,
-        (true, true) => 8,
-    }
-}
-
 fn storage_buffer(
     device: &wgpu::Device,
     label: &str,
@@ -619,7 +610,7 @@ impl DenseVolume {
             device,
             "voxel radiance mips",
             res / 2,
-            chain_blocks(anisotropic, filtering.lobes) * windows,
+            filtering.blocks() * windows,
             levels - 1,
             RADIANCE_FORMAT,
         );
@@ -762,7 +753,7 @@ impl DenseVolume {
     /// Blocks of `chains`: six directions, or one in isotropic mode, and with the lobe chain
     /// the lobes' two.
     pub fn chain_blocks(&self) -> u32 {
-        chain_blocks(self.anisotropic, self.lobes)
+        self.filtering().blocks()
     }
 
     fn memory_report(&self) -> Vec<(&'static str, u64)> {
@@ -787,7 +778,7 @@ impl DenseVolume {
             ("voxel emission", w * texture_bytes(res, 8, 1)),
             ("voxel radiance", w * texture_bytes(res, 8, 1)),
             (
-                if self.chain_blocks() == 8 {
+                if self.lobes {
                     "voxel radiance mips (6 dirs, 2 lobes)"
                 } else if self.anisotropic {
                     "voxel radiance mips (6 directions)"

@@ -191,13 +191,9 @@ impl OctreeVolume {
     ) -> crate::Result<Self> {
         let anisotropic = filtering.anisotropic;
         let depth = grid.resolution.ilog2();
-        // Six directions, and the lobe chain's two blocks with specular lobes (octree_filter.wgsl's
+        // With specular lobes, the lobe chain's two blocks after the six (octree_filter.wgsl's
         // `lobe_filtered`).
-        let dirs: u32 = match (anisotropic, filtering.lobes) {
-            (false, _) => 1,
-            (true, false) => 6,
-            (true, true) => 8,
-        };
+        let dirs = filtering.blocks();
         // Tile 0 is the root's; then classes E, O and V (`child_word` in tree.wgsl).
         let base_e = 1u64;
         let base_o = base_e + pools.even_tiles as u64;
