@@ -91,10 +91,16 @@ fn wide_share(lobe: Lobe) -> Lobe {
     return Lobe(lobe.m * lobe.t, lobe.dir, 1.0);
 }
 
-// The two moment blocks of one leaf of opacity `a` (block 6 or 7).
+// The lobe chain's two blocks after the six directions' (block index in a level's texture):
+// the exitance moments (coverage-weighted exitance, coverage) and the direction moments
+// (luminance-weighted mean direction, luminance).
+const LOBE_EXITANCE: u32 = 6u;
+const LOBE_DIRECTION: u32 = 7u;
+
+// The two moment blocks of one leaf of opacity `a` (LOBE_EXITANCE or LOBE_DIRECTION).
 fn lobe_moments(lobe: Lobe, a: f32, block: u32) -> vec4<f32> {
     let w = a * dot(lobe.m, vec3<f32>(0.2126, 0.7152, 0.0722));
-    if block == 6u {
+    if block == LOBE_EXITANCE {
         return vec4<f32>(a * lobe.m, a);
     }
     let k = lobe_kappa(lobe.t);

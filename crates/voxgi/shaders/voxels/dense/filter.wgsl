@@ -92,7 +92,7 @@ fn leaf_lobe(c: vec3<i32>, block: u32) -> vec3<f32> {
     return lobe_radiance(wide_share(unpack_lobe(packed)), n / max(length(n), 1e-4), block);
 }
 
-// Lobe block `block` (6 or 7) of the voxel `id` whose children start at `base`: the mean of
+// Lobe block `block` (LOBE_EXITANCE or LOBE_DIRECTION) of the voxel `id` whose children start at `base`: the mean of
 // its eight children's moments, the leaves' own on the first level.
 fn filter_lobes(base: vec3<i32>, id: vec3<u32>, block: u32) {
     var sum = vec4<f32>(0.0);
@@ -111,7 +111,7 @@ fn filter_lobes(base: vec3<i32>, id: vec3<u32>, block: u32) {
             let n = textureLoad(normals, base + o, 0).xyz;
             let lobe = narrow_share(unpack_lobe(packed), n / max(length(n), 1e-4));
             sum += lobe_moments(lobe, a, block);
-        } else if block == 6u {
+        } else if block == LOBE_EXITANCE {
             // Covered without a lobe: it dilutes the exitance per covered area.
             sum.a += a;
         }
@@ -126,7 +126,7 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
     let id = vec3<u32>(gid.xy, block * depth + gid.z);
     var base = vec3<i32>(gid) * 2;
     base.z += i32(block * 2u * depth * params.src_blocked);
-    if block >= 6u {
+    if block >= LOBE_EXITANCE {
         filter_lobes(base, id, block);
         return;
     }

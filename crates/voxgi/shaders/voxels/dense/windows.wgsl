@@ -44,13 +44,10 @@ fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
 // send back along the cone, times `weight`: radiance per covered area, as opaque as the sample
 // is along dir (L sigma gains L_lobe sigma).
 fn with_lobes(s: vec4<f32>, uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32, weight: f32) -> vec4<f32> {
-    let upper = min(floor(cl) + 1.0, f32(vol.levels - 2u));
-    let texels = max(f32(vol.resolution / 2u) * exp2(-upper), 1.0);
-    let z = clamp(uvw.z, 0.5 / texels, 1.0 - 0.5 / texels);
-    let blocks = 8.0 * f32(vol.windows);
-    let first = 6.0 * f32(vol.windows) + f32(win);
-    let m = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first) / blocks), cl);
-    let v = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first + f32(vol.windows)) / blocks), cl);
+    let z = chain_z(uvw.z, cl);
+    let blocks = f32(LOBE_DIRECTION + 1u) * f32(vol.windows);
+    let m = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + f32(LOBE_EXITANCE * vol.windows + win)) / blocks), cl);
+    let v = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + f32(LOBE_DIRECTION * vol.windows + win)) / blocks), cl);
     return vec4<f32>(s.rgb + weight * chain_lobe_light(m, v, dir) * s.a, s.a);
 }
 
@@ -69,13 +66,17 @@ override ISOTROPIC_ONLY: bool = false;
 // or 2, the two of largest weight (a third fewer fetches).
 override SAMPLE_AXES: u32 = 3u;
 
-// The directional chains of window `w` at chain level `cl` (the volume's level cl + 1).
-fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32> {
-    // Keep z half a texel inside the window at the coarser of the two levels read, so the
-    // trilinear filter never blends a neighbouring window's or direction's block.
+// A window's z at chain level `cl`, kept half a texel inside it at the coarser of the two levels
+// read, so the trilinear filter never blends a neighbouring window's or block's texels.
+fn chain_z(z: f32, cl: f32) -> f32 {
     let upper = min(floor(cl) + 1.0, f32(vol.levels - 2u));
     let texels = max(f32(vol.resolution / 2u) * exp2(-upper), 1.0);
-    let z = clamp(uvw.z, 0.5 / texels, 1.0 - 0.5 / texels);
+    return clamp(z, 0.5 / texels, 1.0 - 0.5 / texels);
+}
+
+// The directional chains of window `w` at chain level `cl` (the volume's level cl + 1).
+fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32> {
+    let z = chain_z(uvw.z, cl);
     let window = f32(win);
     let windows = f32(vol.windows);
     if ISOTROPIC_ONLY {

@@ -102,7 +102,7 @@ fn lobe_filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
             let normal = unpack4x8snorm(slots[slot * SLOT_STRIDE + 3u]).xyz;
             let lobe = narrow_share(unpack_lobe(packed), normal / max(length(normal), 1e-4));
             sum += lobe_moments(lobe, a, d);
-        } else if d == 6u {
+        } else if d == LOBE_EXITANCE {
             sum.a += a;
         }
     }
@@ -172,7 +172,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
 // The value at level k, direction block d, of the node whose children's brick is `below`
 // (level k - 1): the dense volume's filter over its eight voxels, as stored optical depth.
 fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
-    if d >= 6u {
+    if d >= LOBE_EXITANCE {
         return lobe_filtered(below, k, d);
     }
     // Level 0 is isotropic: every direction filters its one block.

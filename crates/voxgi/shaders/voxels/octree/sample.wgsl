@@ -129,8 +129,8 @@ fn fetch_level(atlas: texture_3d<f32>, shape: AtlasShape, tile: u32, lvl: u32, l
         }
         if LOBE_CHAIN {
             // Level 0 has no lobes (its one block is the leaves' light).
-            let m = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, 6.0 * block)) * inv, 0.0);
-            let l = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, 7.0 * block)) * inv, 0.0);
+            let m = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, f32(LOBE_EXITANCE) * block)) * inv, 0.0);
+            let l = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, f32(LOBE_DIRECTION) * block)) * inv, 0.0);
             let light = select(vec3<f32>(0.0), chain_lobe_light(m, l, dir), lvl > 0u);
             v = vec4<f32>(v.rgb + light * v.a, v.a);
         }
