@@ -71,13 +71,16 @@ fn leaf_direct_light(i: u32) -> Direct {
     let center = leaf_center(i);
     var e = vec3<f32>(0.0);
     var spec = Specular();
+    var faces = true;
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
+        faces = false;
         for (var l = 0u; l < params.light_count; l++) {
             let p = shading_point(i, lights[l]);
             let el = light_irradiance(lights[l], p, n, 1.5);
             e += el;
             reflect_light(&spec, lights[l], p, n, el);
+            faces = faces || dot(n, to_light(lights[l], p)) > 0.0;
         }
     } else {
         // Opposite faces share this voxel (a thin two-sided wall): one isotropic value cannot
@@ -89,7 +92,7 @@ fn leaf_direct_light(i: u32) -> Direct {
         }
     }
     let radiance = albedo.rgb / PI * e + emission;
-    return Direct(vec4<f32>(radiance * albedo.a, albedo.a), spec_lobe(spec));
+    return Direct(vec4<f32>(radiance * albedo.a, albedo.a), spec_lobe(spec, faces));
 }
 
 // The lights' specular reflections summed: exitance, the reflected directions weighted by
@@ -146,9 +149,9 @@ fn lobe_albedo(f0: vec3<f32>, roughness: f32, c: f32) -> vec3<f32> {
 
 // The lobe of the summed reflections: the directions' disagreement widens it (directions that
 // cancel out add a hemisphere's worth).
-fn spec_lobe(spec: Specular) -> vec4<f32> {
+fn spec_lobe(spec: Specular, faces: bool) -> vec4<f32> {
     if spec.weight <= 0.0 {
-        return vec4<f32>(0.0);
+        return select(vec4<f32>(0.0), NO_LOBE_FACING, faces);
     }
     let len = length(spec.dir);
     let agreement = len / spec.weight;

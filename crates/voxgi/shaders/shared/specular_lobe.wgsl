@@ -97,6 +97,19 @@ fn wide_share(lobe: Lobe) -> Lobe {
 const LOBE_EXITANCE: u32 = 6u;
 const LOBE_DIRECTION: u32 = 7u;
 
+// A leaf without a lobe that faces a light (in a shadow, or not a metal): in the chain its
+// coverage dilutes the lobes beside it, whose exitance is per covered area. A leaf that faces
+// away from every light has no lobe either, but does not dilute: it is the far face of a lit
+// slab or wall, hidden behind the lit face from where that face's lobe sends its light (the two
+// faces of a floor thinner than two voxels share the chain's first level, and the far face
+// halved the metal floor's reflection, docs/QUALITY.md).
+const NO_LOBE_FACING: vec4<f32> = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+
+// Whether a leaf's packed lobe (or its absence) counts in the chain's coverage.
+fn lobe_covers(packed: vec4<f32>) -> bool {
+    return packed.w > 0.0;
+}
+
 // The two moment blocks of one leaf of opacity `a` (LOBE_EXITANCE or LOBE_DIRECTION).
 fn lobe_moments(lobe: Lobe, a: f32, block: u32) -> vec4<f32> {
     let w = a * dot(lobe.m, vec3<f32>(0.2126, 0.7152, 0.0722));

@@ -846,14 +846,15 @@ fn wall_lit_by_a_metal(roughness: f32) -> (f32, f32) {
 #[test]
 fn a_metal_floor_lights_the_wall_its_reflection_reaches() {
     // (roughness, the least and the most the cones may reach of the path tracer's light)
-    // Measured on lavapipe: 0.42 at roughness 0.25 and 1.52 at 1 (without the leaves' lobes
-    // the wall is black: 0; with the lobes folded into the six directions, 0.47 and 1.52).
-    // A coarse sample merges the lobes of all the floor it covers into one wider lobe, so a
-    // cone that meets the floor beside the point whose reflection reaches it reads too little;
-    // a lobe as wide as a Lambertian surface's leaves as one does, where rough GGX sends less
-    // to the grazing upper wall (docs/QUALITY.md, "Specular light in the bounces"). The bounds keep each near its measure and fail a lobe lost (0), its light
-    // counted twice (0.94, 3.0), or a rough lobe without its directional albedo (2.5).
-    for (roughness, lo, hi) in [(0.25, 0.35, 0.75), (1.0, 1.1, 2.0)] {
+    // Measured on lavapipe: 0.85 at roughness 0.25 and 1.52 at 1 (without the leaves' lobes
+    // the wall is black: 0). A coarse sample merges the lobes of all the floor it covers into
+    // one wider lobe, which spreads the reflection; a lobe as wide as a Lambertian surface's
+    // leaves as one does, where rough GGX sends less to the grazing upper wall (docs/QUALITY.md,
+    // "Specular light in the bounces"). The bounds keep each near its measure and fail a lobe
+    // lost (0), the floor's unlit underside diluting its lobes in the chain (0.42: the two
+    // faces of the 2 cm floor share the chain's first level), its light counted twice (1.7,
+    // 3.0), or a rough lobe without its directional albedo (2.5).
+    for (roughness, lo, hi) in [(0.25, 0.7, 1.1), (1.0, 1.1, 2.0)] {
         let (cones, paths) = wall_lit_by_a_metal(roughness);
         eprintln!(
             "wall lit by a metal of roughness {roughness}: cones {cones:.5}, path tracer \
@@ -906,7 +907,7 @@ fn a_metal_floors_reflection_leaves_the_surfaces_beside_it_dark() {
 /// examples/metal-floor.toml reads the same light from each.
 #[test]
 fn every_structure_keeps_the_specular_lobes_the_dense_volume_keeps() {
-    // Measured on lavapipe at 96x64, 64³: 0.425, 0.423 and 0.425 of the path tracer (the
+    // Measured on lavapipe at 96x64, 64³: 0.851, 0.847 and 0.851 of the path tracer (the
     // structures filter the same values; their samples interpolate bricks, mips and windows
     // differently, under 1 % apart). 3 % catches a lobe block lost or read from the wrong
     // level.

@@ -111,8 +111,8 @@ fn filter_lobes(base: vec3<i32>, id: vec3<u32>, block: u32) {
             let n = textureLoad(normals, base + o, 0).xyz;
             let lobe = narrow_share(unpack_lobe(packed), n / max(length(n), 1e-4));
             sum += lobe_moments(lobe, a, block);
-        } else if block == LOBE_EXITANCE {
-            // Covered without a lobe: it dilutes the exitance per covered area.
+        } else if block == LOBE_EXITANCE && lobe_covers(packed) {
+            // Covered without a lobe, facing a light: it dilutes the exitance per covered area.
             sum.a += a;
         }
     }

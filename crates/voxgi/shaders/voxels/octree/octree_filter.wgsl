@@ -102,7 +102,7 @@ fn lobe_filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
             let normal = unpack4x8snorm(slots[slot * SLOT_STRIDE + 3u]).xyz;
             let lobe = narrow_share(unpack_lobe(packed), normal / max(length(normal), 1e-4));
             sum += lobe_moments(lobe, a, d);
-        } else if d == LOBE_EXITANCE {
+        } else if d == LOBE_EXITANCE && lobe_covers(packed) {
             sum.a += a;
         }
     }
