@@ -222,8 +222,8 @@ pub(crate) fn ao_beside_a_wall(scene: &Scene, cam: &Camera, kind: impl Into<Vari
 }
 
 /// The mean of the white furnace's image (`builtin::closed_box(0.5, 1.0)` or a version of it),
-/// at 32³: the series is the same at any resolution, and four structures' and shadings' series
-/// at 64³ took a minute and a half of the test binary's time on a 2-core machine.
+/// at 32³: the series is the same at any resolution, and at 64³ the four tests that run it (for
+/// every structure) were among the test binary's slowest.
 fn furnace(scene: &Scene, kind: Variant, bounces: u32) -> f32 {
     let cam = scene.cameras[0].clone();
     let out = render(
