@@ -92,8 +92,8 @@ fn leaf_lobe(c: vec3<i32>, block: u32) -> vec3<f32> {
     return lobe_radiance(wide_share(unpack_lobe(packed)), n / max(length(n), 1e-4), block);
 }
 
-// Lobe block `block` (LOBE_EXITANCE or LOBE_DIRECTION) of the voxel `id` whose children start at `base`: the mean of
-// its eight children's moments, the leaves' own on the first level.
+// Lobe block `block` (LOBE_EXITANCE or LOBE_DIRECTION) of the voxel `id` whose children start
+// at `base`: the mean of its eight children's moments, the leaves' own on the first level.
 fn filter_lobes(base: vec3<i32>, id: vec3<u32>, block: u32) {
     var sum = vec4<f32>(0.0);
     for (var i = 0; i < 8; i++) {
