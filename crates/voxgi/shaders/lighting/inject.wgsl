@@ -71,18 +71,16 @@ fn leaf_direct_light(i: u32) -> Direct {
     let center = leaf_center(i);
     var e = vec3<f32>(0.0);
     var spec = Specular();
-    var faces = true;
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
-        faces = false;
         for (var l = 0u; l < params.light_count; l++) {
             let p = shading_point(i, lights[l]);
             let el = light_irradiance(lights[l], p, n, 1.5);
             e += el;
             reflect_light(&spec, lights[l], p, n, el);
-            faces = faces || dot(n, to_light(lights[l], p)) > 0.0;
         }
     } else {
+        spec.faces = true;
         // Opposite faces share this voxel (a thin two-sided wall): one isotropic value cannot
         // keep the sides apart, so both get half the light of a surface facing it (and no
         // lobe: it would leave from both sides).
@@ -92,16 +90,18 @@ fn leaf_direct_light(i: u32) -> Direct {
         }
     }
     let radiance = albedo.rgb / PI * e + emission;
-    return Direct(vec4<f32>(radiance * albedo.a, albedo.a), spec_lobe(spec, faces));
+    return Direct(vec4<f32>(radiance * albedo.a, albedo.a), spec_lobe(spec));
 }
 
 // The lights' specular reflections summed: exitance, the reflected directions weighted by
-// their luminance, and their luminance-weighted solid angles.
+// their luminance, and their luminance-weighted solid angles; and whether the surface faces a
+// light (`NO_LOBE_FACING`).
 struct Specular {
     m: vec3<f32>,
     dir: vec3<f32>,
     weight: f32,
     solid_angle: f32,
+    faces: bool,
 }
 
 // Adds what the surface at p (normal n) reflects of `light`, whose irradiance there is `e`:
@@ -110,7 +110,13 @@ struct Specular {
 // (4 pi alpha^2 cos: the half-vector lobe's pi alpha^2, widened by the reflection's Jacobian)
 // and the light's own solid angle together. Lights without shadow maps reflect nothing here.
 fn reflect_light(spec: ptr<function, Specular>, light: Light, p: vec3<f32>, n: vec3<f32>, e: vec3<f32>) {
-    if params.materials == 0u || light.shadow_count == 0u || all(e <= vec3<f32>(0.0)) {
+    if params.materials == 0u {
+        return;
+    }
+    let l = to_light(light, p);
+    let c = max(dot(n, l), 0.0);
+    (*spec).faces = (*spec).faces || c > 0.0;
+    if light.shadow_count == 0u || all(e <= vec3<f32>(0.0)) {
         return;
     }
     let view = shadow_views[shadow_view_index(light, p)];
@@ -118,8 +124,6 @@ fn reflect_light(spec: ptr<function, Specular>, light: Light, p: vec3<f32>, n: v
     if all(mat.rgb <= vec3<f32>(0.0)) {
         return;
     }
-    let l = to_light(light, p);
-    let c = max(dot(n, l), 0.0);
     let m = e * lobe_albedo(mat.rgb, mat.a, c);
     let w = dot(m, vec3<f32>(0.2126, 0.7152, 0.0722));
     let alpha = mat.a * mat.a;
@@ -149,9 +153,9 @@ fn lobe_albedo(f0: vec3<f32>, roughness: f32, c: f32) -> vec3<f32> {
 
 // The lobe of the summed reflections: the directions' disagreement widens it (directions that
 // cancel out add a hemisphere's worth).
-fn spec_lobe(spec: Specular, faces: bool) -> vec4<f32> {
+fn spec_lobe(spec: Specular) -> vec4<f32> {
     if spec.weight <= 0.0 {
-        return select(vec4<f32>(0.0), NO_LOBE_FACING, faces);
+        return select(vec4<f32>(0.0), NO_LOBE_FACING, spec.faces);
     }
     let len = length(spec.dir);
     let agreement = len / spec.weight;
