@@ -157,8 +157,9 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
     textureStore(dst, id, to_depth(sum * 0.25));
 }
 
+// Twin: `Filtering::blocks`. The lobe chain's blocks come after the six directions.
 fn blocks() -> u32 {
-    return select(1u, 6u, params.mode == 1u) + select(0u, 2u, params.lobes != 0u);
+    return select(select(1u, 6u, params.mode == 1u), LOBE_DIRECTION + 1u, params.lobes != 0u);
 }
 
 // Every voxel of the level (after a build); the bits and counts are cleared after

@@ -89,7 +89,8 @@ fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
         vec3<f32>(select(1.0, 0.0, dir.x >= 0.0), select(3.0, 2.0, dir.y >= 0.0), select(5.0, 4.0, dir.z >= 0.0)),
         aniso,
     );
-    let blocks = (select(1.0, 6.0, aniso) + select(0.0, 2.0, vol.anisotropic == 2u)) * windows;
+    // As `Filtering::blocks`: the lobe chain's blocks come after the six directions.
+    let blocks = f32(select(select(1u, 6u, aniso), LOBE_DIRECTION + 1u, vol.anisotropic == 2u)) * windows;
     // Each direction's block holds every window: block b, window w at b * windows + w.
     let first = block * windows + window;
     // Weighted by the squared direction cosines (they sum to 1).
