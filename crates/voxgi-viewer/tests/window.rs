@@ -526,21 +526,24 @@ fn the_panel_is_resized_by_its_edge() {
         "--screenshot",
         png.to_str().unwrap(),
         "--after-frames",
-        "30",
+        "60",
     ];
     let args = ["--builtin", "cornell-box", "--size", "640x360", "--with-ui"];
     let viewer = Running::start(&x, &dir, &[&args[..], &shot[..]].concat());
     let w = viewer.window.clone();
     // Just right of the edge (egui grabs a few points either side), then along, slowly: a
-    // frame of the CPU driver takes a few hundred milliseconds.
+    // frame of the CPU driver takes a few hundred milliseconds, more while other tests' viewers
+    // share its cores, and egui must see the pointer over the edge in one frame, pressed in a
+    // later one and moved in later ones still (one frame's events at once are a click). The
+    // screenshot waits for enough frames that the drag ends before it.
     x.xdotool(&["mousemove", "--window", &w, "258", "200"]);
-    std::thread::sleep(std::time::Duration::from_millis(800));
+    std::thread::sleep(std::time::Duration::from_millis(1500));
     x.xdotool(&["mousedown", "1"]);
-    for to in ["300", "350", "400"] {
-        std::thread::sleep(std::time::Duration::from_millis(500));
+    for to in ["270", "300", "330", "360", "380", "400"] {
+        std::thread::sleep(std::time::Duration::from_millis(600));
         x.xdotool(&["mousemove", "--window", &w, to, "200"]);
     }
-    std::thread::sleep(std::time::Duration::from_millis(800));
+    std::thread::sleep(std::time::Duration::from_millis(1500));
     x.xdotool(&["mouseup", "1"]);
     viewer.finish();
     let img = image::open(&png).expect("the screenshot").to_rgb8();
