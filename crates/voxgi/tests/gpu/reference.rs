@@ -876,8 +876,9 @@ fn a_metal_floors_reflection_leaves_the_surfaces_beside_it_dark() {
     // The front's light with the leaves' lobes over without them (a still of four frames, one
     // bounce, 64x64 at 64³; sixteen frames read the same ratio). Measured on lavapipe: 1.06 in
     // every structure. Folded into the six directions (every structure's way before the lobe
-    // chain) a lobe about the vertical lit it 4.6 times as bright (docs/QUALITY.md, "Specular light in the bounces", has the
-    // metal-floored box against the path tracer). The bound fails a lobe that leaves sideways.
+    // chain) a lobe about the vertical lit it 4.6 times as bright (docs/QUALITY.md, "Specular
+    // light in the bounces", has the metal-floored box against the path tracer). The bound
+    // fails a lobe that leaves sideways.
     let scene = metal_floor_cornell(0.3);
     let cam = scene.cameras[0].clone();
     let front = |o: &RenderOutput| region(o, 32, 45, 47, 59);
