@@ -15,7 +15,8 @@ struct ProbePoint {
 @group(0) @binding(0) var<uniform> cones: Cones;
 @group(0) @binding(1) var<storage, read> points: array<ProbePoint>;
 // Per point, 16 cone slots of two entries: the cone's direction and weight (diffuse_cone),
-// then what trace_cone gathers along it (premultiplied radiance, opacity).
+// then what trace_cone gathers along it (premultiplied radiance, opacity), the mean of its
+// four quarters.
 @group(0) @binding(2) var<storage, read_write> results: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
@@ -31,5 +32,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let vs = voxels_voxel_size_at(q.p.xyz);
     let origin = q.p.xyz + n * vs * cones.origin_offset;
     results[2u * id.x] = c;
-    results[2u * id.x + 1u] = trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance, vs);
+    // The mean of the four quarters the gather's cones trace over a block.
+    var r = vec4<f32>(0.0);
+    for (var part = 0u; part < 4u; part++) {
+        r += 0.25 * trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance, vs, part);
+    }
+    results[2u * id.x + 1u] = r;
 }

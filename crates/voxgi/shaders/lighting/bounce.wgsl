@@ -174,20 +174,23 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         dot(vec3<f32>(c), vec3<f32>(0.5698402910, 0.7548776662, 0.4142135624)),
     ));
     let turn = select(r3, records_turn, IRRADIANCE);
+    // The cones' quarters (shared/cone.wgsl, cone_quarter) by the records' layout too: the
+    // voxels of any 4x4 window trace each cone through each quarter equally often.
+    let rank = leaf_rank(c);
     // Cones start at the voxels they read there: at a clipmap window's open face the next
     // coarser level's, whose thicker voxels a cone clearing only the leaf's own would read its
     // own surface in (elsewhere, and in the other structures, the leaf's own).
     let vs = max(leaf_size(s), voxels_voxel_size_at(center));
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
-        let g = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, vs);
+        let g = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, vs, rank, 0u);
         e = g.irradiance;
         ao = g.ao;
     } else {
         // Two-sided voxel: half the light from each side.
         let n = vec3<f32>(0.0, 1.0, 0.0);
-        let up = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, vs);
-        let down = gather_diffuse(center, -n, turn, IRRADIANCE, ALL_CONES, vs);
+        let up = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, vs, rank, 0u);
+        let down = gather_diffuse(center, -n, turn, IRRADIANCE, ALL_CONES, vs, rank, 1u);
         e = 0.5 * (up.irradiance + down.irradiance);
         ao = 0.5 * (up.ao + down.ao);
     }

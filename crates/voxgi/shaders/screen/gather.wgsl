@@ -41,7 +41,7 @@ fn cone_visibility(light: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     // plane is 2d away, (dist - t) cos = 4 tan t.
     let cos_plane = max(abs(dot(dir, light.direction)), 0.1);
     let stop = dist * cos_plane / (cos_plane + 4.0 * tan_half) - vs;
-    return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0), vs).a;
+    return 1.0 - trace_cone(origin, n, dir, tan_half, max(stop, 0.0), vs, WHOLE_FOOTPRINT).a;
 }
 
 fn area_visibility(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
@@ -116,7 +116,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if LEAVES {
         g = leaf_gather(p, n);
     } else {
-        g = gather_diffuse(p, n, turn, frame.view_mode == VIEW_AO, cone_half(gid.xy), vs);
+        // The cones' quarters turn with the frame's index in the sample sequence.
+        let view_ao = frame.view_mode == VIEW_AO;
+        g = gather_diffuse(p, n, turn, view_ao, cone_half(gid.xy), vs, rank, frame.light_sample);
     }
     var indirect = brdf_diffuse(s) * g.irradiance;
     let f0 = f0_of(s);
@@ -150,7 +152,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // same means within 3 %, at 10-15 % more of the gather on Sponza).
         let tan_half = clamp(a, 0.01, 1.0);
         let origin = p + n * vs * cones.origin_offset;
-        let spec = trace_cone(origin, n, dir, tan_half, cones.max_distance, vs).rgb;
+        let spec = trace_cone(origin, n, dir, tan_half, cones.max_distance, vs, WHOLE_FOOTPRINT).rgb;
         // Weighted by the lobe's directional albedo, a table of the very BRDF the path tracer
         // integrates (Karis's analytic fit, used before, is 10-18 % low at roughness 0.2-0.5).
         let uv = vec2<f32>(max(dot(n, v), 1e-4), s.roughness);

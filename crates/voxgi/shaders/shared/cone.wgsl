@@ -43,41 +43,84 @@ fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
     return 1.0 - pow(1.0 - a, step / ds);
 }
 
+// Which part of its footprint a cone traces: one of four quarters (QUARTERS), or the whole.
+const WHOLE_FOOTPRINT: u32 = 4u;
+// A quarter's samples, as a fraction of the footprint's diameter: a disc of diameter 0.35
+// about a quarter's centre (a quarter diameter off the axis on both cross axes) covers the
+// quarter about as a whole-footprint sample covers the footprint.
+const QUARTER_WIDTH: f32 = 0.35;
+
 // Front-to-back accumulation of one cone. Returns premultiplied radiance (rgb) and opacity (a).
 // Each step is `step_factor` cone diameters long; a sample's opacity is corrected for the step
 // length d' against the voxel size d of its level: alpha' = 1 - (1 - alpha)^(d'/d), which in
 // optical depth is 1 - e^(-sigma d'/d).
-fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32, vs: f32) -> vec4<f32> {
+//
+// Compositing takes each sample's opacity as independent of the last, which holds for a
+// sample filled evenly (a medium), not for one a surface covers in part: the rays that a
+// block's back face stops behind the front face that covered the same part of an earlier
+// sample are stopped twice, and a cone beside an edge loses far more light than the rays
+// within it (at the Cornell box's back wall a normal's cone passed 0.23 where the path
+// tracer's rays escape 0.55: docs/QUALITY.md). A narrower sample is more nearly all or
+// nothing, so `part` < WHOLE_FOOTPRINT traces one quarter of the footprint with samples
+// QUARTER_WIDTH wide and as long: its transmittance follows the rays of that quarter, and
+// the mean of the four quarters (over the pixels of a block, the voxels about a leaf, the
+// frames) is the footprint's. Narrowing every sample instead lets light through a one-voxel
+// wall; the quarters' samples still overlap along the cone, so they do not.
+fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32, vs: f32, part: u32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
     var t = vs;
     cone_tan_half = tan_half;
+    var off = vec3<f32>(0.0);
+    var width = 1.0;
+    if part < WHOLE_FOOTPRINT {
+        let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(dir.y) > 0.9);
+        let u = normalize(cross(dir, up));
+        let v = cross(dir, u);
+        off = (u * (f32(part & 1u) - 0.5) + v * (f32(part >> 1u) - 0.5)) * 0.5;
+        width = QUARTER_WIDTH;
+    }
     // Two loops: samples widen monotonically along a cone that leaves its surface, and once
     // they are WIDE_SAMPLE voxels across they no longer read the finest level (a quarter of the
-    // fetches per step; 8 % of the gather on lavapipe).
-    for (var i = 0u; i < 512u; i++) {
-        let p = origin + dir * t;
+    // fetches per step).
+    for (var i = 0u; i < 1024u; i++) {
         let d = max(vs, 2.0 * tan_half * t);
-        let ds = cone_sample_size(origin, n, p, d, vs);
-        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || ds >= WIDE_SAMPLE * vs {
+        let ds = cone_sample_size(origin, n, origin + dir * t, d, vs);
+        let p = origin + dir * t + off * ds;
+        let w = max(ds * width, vs);
+        if t >= max_dist || acc.a >= 0.995 || outside_volume(p) || w >= WIDE_SAMPLE * vs {
             break;
         }
-        let step = cone_step(d, ds, vs);
-        acc = composite_sample(acc, sample_depth(p, ds, dir), step / ds);
+        let step = cone_step(d, w, vs);
+        acc = composite_sample(acc, sample_depth(p, w, dir), step / w);
         t += step;
     }
-    for (var i = 0u; i < 512u; i++) {
-        let p = origin + dir * t;
+    for (var i = 0u; i < 1024u; i++) {
+        let d = max(vs, 2.0 * tan_half * t);
+        let ds = cone_sample_size(origin, n, origin + dir * t, d, vs);
+        let p = origin + dir * t + off * ds;
         // The volume is convex: a cone that has left it meets nothing more.
         if t >= max_dist || acc.a >= 0.995 || outside_volume(p) {
             break;
         }
-        let d = max(vs, 2.0 * tan_half * t);
-        let ds = cone_sample_size(origin, n, p, d, vs);
-        let step = cone_step(d, ds, vs);
-        acc = composite_sample(acc, sample_depth_wide(p, ds, dir), step / ds);
+        let w = max(ds * width, vs);
+        let step = cone_step(d, w, vs);
+        acc = composite_sample(acc, sample_depth_wide(p, w, dir), step / w);
         t += step;
     }
     return acc;
+}
+
+// The quarter (trace_cone's `part`) that cone i traces at a point of interleaving rank
+// `rank` (0..15), turned by `shift` (frames): every cone meets each quarter equally often
+// over the sixteen ranks and within each half of them (the two parities trace the two halves
+// of the ring, shared/interleave.wgsl), and not always at the same place in its cell (ranks
+// 2m and 2m + 1 place it at azimuth m and zenith m's 3-bit reversal, the gather's Hammersley
+// set): bit 0 follows the azimuth's middle bit, bit 1 whether azimuth and zenith lie in the
+// same half of the cell.
+fn cone_quarter(rank: u32, i: u32, shift: u32) -> u32 {
+    let m = rank >> 1u;
+    let q = ((m >> 1u) & 1u) | ((((m & 1u) ^ (m >> 2u)) & 1u) << 1u);
+    return (q + i + shift) & 3u;
 }
 
 // Front-to-back compositing of a sample of optical depth (L sigma, sigma) per sample diameter
@@ -164,7 +207,9 @@ const ALL_CONES: u32 = 2u;
 // halves, and the reconstruction's 4x4 average sees every cone at eight turns spread over its
 // cell (the gather gives each parity a Hammersley set of its own), so the estimate keeps its
 // mean at about 60 % of the cost.
-fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32, vs: f32) -> Gathered {
+//
+// Each cone traces one quarter of its footprint (trace_cone), cone_quarter(rank, i, shift).
+fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32, vs: f32, rank: u32, shift: u32) -> Gathered {
     let frame = tangent_frame(n);
     let origin = p + n * vs * cones.origin_offset;
     var e = vec3<f32>(0.0);
@@ -190,7 +235,8 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, ha
         let w = c.w * w_scale;
         let d = c.xyz;
         if cones.indirect != 0u {
-            let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance, vs);
+            let part = cone_quarter(rank, i, shift);
+            let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance, vs, part);
             // Weights are fractions of the cosine-weighted hemisphere, whose integral is pi.
             e += PI * w * r.rgb;
         }

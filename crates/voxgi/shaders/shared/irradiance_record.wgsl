@@ -19,11 +19,16 @@ fn record_normal(r: vec4<u32>) -> vec4<f32> {
     return unpack4x8snorm(r.z);
 }
 
+// Leaf c's rank in the 4x4 windows of leaf_turn (and its cones' quarters, cone_quarter).
+fn leaf_rank(c: vec3<u32>) -> u32 {
+    return 4u * ((c.x + c.y) & 3u) + ((c.y + c.z) & 3u);
+}
+
 // The turn of leaf c's cone bundle (shared/cone.wgsl, diffuse_cone): one of the sixteen
 // points of a Hammersley set, each once in every 4x4 window of any axis-aligned plane
 // ((x + y, y + z) mod 4 is one-to-one on each), the layout shared/leaf_irradiance.wgsl's
 // window averages.
 fn leaf_turn(c: vec3<u32>) -> vec2<f32> {
-    let rank = 4u * ((c.x + c.y) & 3u) + ((c.y + c.z) & 3u);
+    let rank = leaf_rank(c);
     return (vec2<f32>(f32(rank), f32(reverseBits(rank) >> 28u)) + 0.5) / 16.0;
 }

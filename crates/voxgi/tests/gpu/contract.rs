@@ -229,7 +229,7 @@ fn sample_voxels(p: vec3<f32>, d: f32, dir: vec3<f32>) -> vec4<f32> {{ return ve
         + "@group(0) @binding(0) var<uniform> cones: Cones;
 @compute @workgroup_size(1)
 fn main() {
-    let g = gather_diffuse(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), vec2<f32>(0.0), true, ALL_CONES, 0.1);
+    let g = gather_diffuse(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), vec2<f32>(0.0), true, ALL_CONES, 0.1, 0u, 0u);
 }
 ";
     validate(&parse(&src));

@@ -559,9 +559,11 @@ fn emissive_points_light_what_is_near_them_as_a_quad_lamp_does() {
             eprintln!("lamp ({kind:?}), its top, {name}: {m:.4}");
             assert!(m < 0.1, "{kind:?}: the lamp's top ({name}) shows {m}");
         }
-        // Left in the voxels, the same points leave the near floor dark (measured 0.0000): the
-        // case the promotion exists for.
+        // Left in the voxels, the same points leave the near floor far darker than the truth
+        // (measured 0.099 with the dense volume and the octree, 0.338 with the clipmap, of
+        // the path tracer's 0.668): the case the promotion exists for. The bound, 0.6 of the
+        // truth, fails a promotion that did nothing (the promoted lamp is within 2 %).
         let voxels = floor_mean(&vct_voxels, &cam, near);
-        assert!(voxels < 0.5 * floor_mean(&pt, &cam, near), "{voxels}");
+        assert!(voxels < 0.6 * floor_mean(&pt, &cam, near), "{voxels}");
     }
 }

@@ -373,17 +373,19 @@ fn cornell_mean_indirect(change: impl FnOnce(&mut RendererOptions)) -> f32 {
 }
 
 #[test]
-fn isotropic_mode_keeps_about_half_the_indirect_light() {
+fn isotropic_mode_keeps_less_of_the_indirect_light() {
     let iso = cornell_mean_indirect(|s| s.anisotropic = false);
     let aniso = cornell_mean_indirect(|_| {});
     eprintln!("mean indirect: isotropic {iso}, anisotropic {aniso}");
-    // An isotropic voxel averages a wall's lit face with its unlit views, so cones see about
-    // half the light (measured 0.58, the same to 1e-4 with the one-fetch isotropic pipeline
-    // and the three-fetch run-time path it replaces). A fetch from the wrong block would read
-    // another direction's data or nothing: far outside 0.4..0.65.
+    // An isotropic voxel averages a wall's lit face with its unlit views at the levels above
+    // the finest, where one voxel holds one face. Cones whose samples span the whole footprint
+    // read those levels and saw 0.58 of the light; cones tracing one quarter of it
+    // (shared/cone.wgsl) read the finest levels more, and see 0.89 (measured; the isotropic
+    // light rose by half, the anisotropic fell 8 %). A fetch from the wrong block would read
+    // another direction's data or nothing: outside 0.8..0.96.
     let ratio = iso / aniso;
     assert!(
-        (0.4..0.65).contains(&ratio),
+        (0.8..0.96).contains(&ratio),
         "isotropic / anisotropic {ratio}"
     );
 }
@@ -574,22 +576,24 @@ fn half_resolution_gather_matches_full_and_keeps_edges() {
         "half vs full resolution indirect: mean ratio {ratio:.4}, relative RMS {rms:.4}, \
          on {edges} edge pixels {edge_rms:.4}; {half_edges} edge pixels at half resolution"
     );
-    // Measured at 64x64: ratio 1.033, RMS 0.19, edge RMS 0.30 (both resolutions reconstruct
-    // sixteen turns of the bundle from windows of different sizes, so they differ in noise),
-    // 605 edge pixels at full and 591 at half resolution. The ratio read 0.99 before each
-    // parity of the Bayer ranks drew its own Hammersley set of turns, and 1.028 over 8-frame
-    // stills, so it is not noise: the half-resolution gather gathers 3 % more, not yet
-    // explained. Without edge weights, light bleeds across silhouettes and blurs the jumps
-    // away: 293 and 244 edge pixels. Bounds: the mean within 5 %, the RMS within 0.25, the
-    // edges within 0.35, and at least 400 edge pixels each.
+    // Measured at 64x64: ratio 1.042, RMS 0.27, edge RMS 0.38 (both resolutions reconstruct
+    // sixteen turns of the bundle from windows of different sizes, so they differ in noise;
+    // with each cone tracing one quarter of its footprint, a quarter of the sixteen per
+    // quarter, more than the 0.19 and 0.30 of whole footprints), 635 edge pixels at full and
+    // 673 at half resolution. The ratio read 0.99 before each parity of the Bayer ranks drew
+    // its own Hammersley set of turns, and 1.028 over 8-frame stills, so it is not noise: the
+    // half-resolution gather gathers 3-4 % more, not yet explained. Without edge weights,
+    // light bleeds across silhouettes and blurs the jumps away: 293 and 244 edge pixels.
+    // Bounds: the mean within 6 %, the RMS within 0.33, the edges within 0.45, and at least
+    // 400 edge pixels each.
     assert!(
         edges >= 400 && half_edges >= 400,
         "edges blurred: {edges} edge pixels at full resolution, {half_edges} at half"
     );
-    assert!(rel(ratio, 1.0) < 0.05, "half/full mean ratio {ratio}");
-    assert!(rms < 0.25, "half vs full relative RMS {rms}");
+    assert!(rel(ratio, 1.0) < 0.06, "half/full mean ratio {ratio}");
+    assert!(rms < 0.33, "half vs full relative RMS {rms}");
     assert!(
-        edge_rms < 0.35,
+        edge_rms < 0.45,
         "half vs full on edges: relative RMS {edge_rms}"
     );
 }
