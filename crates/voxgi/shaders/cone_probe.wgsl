@@ -32,10 +32,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let vs = voxels_voxel_size_at(q.p.xyz);
     let origin = q.p.xyz + n * vs * cones.origin_offset;
     results[2u * id.x] = c;
-    // The mean of the four quarters the gather's cones trace over a block.
+    // The mean of the four quarters the gather's cones trace over a block, or the whole
+    // footprint.
     var r = vec4<f32>(0.0);
-    for (var part = 0u; part < 4u; part++) {
-        r += 0.25 * trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance, vs, part);
+    if cones.quarters != 0u {
+        for (var part = 0u; part < 4u; part++) {
+            r += 0.25 * trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance, vs, part);
+        }
+    } else {
+        r = trace_cone(origin, n, c.xyz, cones.diffuse_tan, cones.max_distance, vs, WHOLE_FOOTPRINT);
     }
     results[2u * id.x + 1u] = r;
 }

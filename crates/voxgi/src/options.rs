@@ -330,6 +330,11 @@ pub struct RendererOptions {
     pub ao_lambda: f32,
     /// Cone sample step as a fraction of the cone's diameter (0.05..=2). Default 0.5.
     pub step_factor: f32,
+    /// Each diffuse cone (per pixel and in the voxel bounces) traces one quarter of its
+    /// footprint, a different one from pixel to pixel, voxel to voxel and frame to frame:
+    /// nearer the path tracer wherever surfaces partly cover the cones (docs/QUALITY.md). False
+    /// traces the whole footprint, at about half the gather's cost. Default true.
+    pub cone_quarters: bool,
     /// Cone origin offset along the normal, in finest voxels (0..=8): keeps a cone from seeing
     /// its own surface's voxels. Default 1.5.
     pub origin_offset: f32,
@@ -406,6 +411,7 @@ impl Default for RendererOptions {
             ao_radius: None,
             ao_lambda: 0.0,
             step_factor: 0.5,
+            cone_quarters: true,
             origin_offset: 1.5,
             max_distance: None,
             half_resolution: false,

@@ -254,6 +254,7 @@ fn every_twin_has_the_wgsl_layout() {
             ao_radius,
             origin_offset,
             indirect,
+            quarters,
         ]
     );
     twin!(

@@ -208,7 +208,8 @@ const ALL_CONES: u32 = 2u;
 // cell (the gather gives each parity a Hammersley set of its own), so the estimate keeps its
 // mean at about 60 % of the cost.
 //
-// Each cone traces one quarter of its footprint (trace_cone), cone_quarter(rank, i, shift).
+// With `cones.quarters` each cone traces one quarter of its footprint (trace_cone),
+// cone_quarter(rank, i, shift); without, the whole.
 fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, half: u32, vs: f32, rank: u32, shift: u32) -> Gathered {
     let frame = tangent_frame(n);
     let origin = p + n * vs * cones.origin_offset;
@@ -235,7 +236,7 @@ fn gather_diffuse(p: vec3<f32>, n: vec3<f32>, turn: vec2<f32>, with_ao: bool, ha
         let w = c.w * w_scale;
         let d = c.xyz;
         if cones.indirect != 0u {
-            let part = cone_quarter(rank, i, shift);
+            let part = select(WHOLE_FOOTPRINT, cone_quarter(rank, i, shift), cones.quarters != 0u);
             let r = trace_cone(origin, n, d, cones.diffuse_tan, cones.max_distance, vs, part);
             // Weights are fractions of the cosine-weighted hemisphere, whose integral is pi.
             e += PI * w * r.rgb;

@@ -43,6 +43,12 @@ struct Cones {
     origin_offset: f32,
     // 1: the per-pixel gather adds indirect light, 0: it does not (bounces = 0).
     indirect: u32,
+    // 1: each diffuse cone traces one quarter of its footprint (shared/cone.wgsl,
+    // trace_cone); 0: the whole footprint.
+    quarters: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // How much of a leaf the first directional level counts along direction `dir` (0..6: +X, -X,

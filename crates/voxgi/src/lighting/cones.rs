@@ -29,6 +29,10 @@ pub struct GpuCones {
     pub origin_offset: f32,
     /// 1: the per-pixel gather adds indirect light, 0: it does not (bounces = 0).
     pub indirect: u32,
+    /// 1: each diffuse cone traces one quarter of its footprint; 0: the whole footprint.
+    pub quarters: u32,
+    /// Padding to a multiple of 16 bytes; zero.
+    pub _pad: [u32; 3],
 }
 
 impl ConeSet {
@@ -112,6 +116,8 @@ pub fn cone_uniforms(options: &RendererOptions, grid: &Grid) -> GpuCones {
         ao_radius: options.ao_radius.unwrap_or(grid.extent() * 0.25),
         origin_offset: options.origin_offset,
         indirect: (options.bounces > 0) as u32,
+        quarters: options.cone_quarters as u32,
+        _pad: [0; 3],
     }
 }
 

@@ -433,6 +433,7 @@ impl Renderer {
         let cones = volume
             || old.cones != new.cones
             || old.step_factor != new.step_factor
+            || old.cone_quarters != new.cone_quarters
             || old.max_distance != new.max_distance
             || old.ao_radius != new.ao_radius
             || old.ao_lambda != new.ao_lambda

@@ -263,6 +263,18 @@ pub static SETTINGS: &[Setting] = &[
         access: access!(options float step_factor),
     },
     Setting {
+        key: "cone_quarters",
+        label: "cones trace quarters",
+        help: "Each diffuse cone traces one quarter of its footprint, a different one from \
+               pixel to pixel and frame to frame: nearer the path tracer where surfaces partly \
+               cover the cones (the open Cornell box's walls and ceiling). False traces whole \
+               footprints: about half the gather's time and less for the voxel bounces, with \
+               the light beside openings too bright.",
+        domain: Domain::Bool,
+        changes: Changes::Lighting,
+        access: access!(options bool cone_quarters),
+    },
+    Setting {
         key: "origin_offset",
         label: "cone origin offset (voxels)",
         help: "Cone origin offset along the normal, in finest voxels: keeps a cone from seeing \
