@@ -187,7 +187,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         e = g.irradiance;
         ao = g.ao;
     } else {
-        // Two-sided voxel: half the light from each side.
+        // Two-sided voxel: half the light from each side, each side's cones a quarter on.
         let n = vec3<f32>(0.0, 1.0, 0.0);
         let up = gather_diffuse(center, n, turn, IRRADIANCE, ALL_CONES, vs, rank, 0u);
         let down = gather_diffuse(center, -n, turn, IRRADIANCE, ALL_CONES, vs, rank, 1u);

@@ -43,7 +43,7 @@ fn step_opacity(a: f32, step: f32, ds: f32) -> f32 {
     return 1.0 - pow(1.0 - a, step / ds);
 }
 
-// Which part of its footprint a cone traces: one of four quarters (QUARTERS), or the whole.
+// Which part of its footprint a cone traces: one of the four quarters (0..3), or the whole.
 const WHOLE_FOOTPRINT: u32 = 4u;
 // A quarter's samples, as a fraction of the footprint's diameter: a disc of diameter 0.35
 // about a quarter's centre (a quarter diameter off the axis on both cross axes) covers the
@@ -59,13 +59,14 @@ const QUARTER_WIDTH: f32 = 0.35;
 // sample filled evenly (a medium), not for one a surface covers in part: the rays that a
 // block's back face stops behind the front face that covered the same part of an earlier
 // sample are stopped twice, and a cone beside an edge loses far more light than the rays
-// within it (at the Cornell box's back wall a normal's cone passed 0.23 where the path
-// tracer's rays escape 0.55: docs/QUALITY.md). A narrower sample is more nearly all or
-// nothing, so `part` < WHOLE_FOOTPRINT traces one quarter of the footprint with samples
-// QUARTER_WIDTH wide and as long: its transmittance follows the rays of that quarter, and
-// the mean of the four quarters (over the pixels of a block, the voxels about a leaf, the
-// frames) is the footprint's. Narrowing every sample instead lets light through a one-voxel
-// wall; the quarters' samples still overlap along the cone, so they do not.
+// within it (measured cone by cone against the path tracer: docs/QUALITY.md). A narrower
+// sample is more nearly all or nothing, so `part` < WHOLE_FOOTPRINT traces one quarter of
+// the footprint with samples QUARTER_WIDTH wide and as long: its transmittance follows the
+// rays of that quarter, and the mean of the four quarters (over the pixels of a block, the
+// voxels about a leaf, the frames) is the footprint's. Narrowing every sample instead lets
+// light through a one-voxel wall; the quarters' samples still overlap along the cone, so they
+// do not. A quarter stops where its own samples leave the volume, not its axis: a quarter
+// still inside a wall on the bounds that the axis has crossed has yet to meet the wall.
 fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, max_dist: f32, vs: f32, part: u32) -> vec4<f32> {
     var acc = vec4<f32>(0.0);
     var t = vs;
