@@ -438,11 +438,7 @@ fn the_export_is_what_voxgi_render_writes() {
     // What the viewer starts with (`Viewer::start`, `ExportDialog::new`).
     let ctx = headless::GpuContext::from_env().expect("a device");
     let cpu = ctx.info.device_type == voxgi::wgpu::DeviceType::Cpu;
-    let options = RendererOptions {
-        half_resolution: cpu,
-        voxel_resolution: if cpu { 64 } else { 128 },
-        ..RendererOptions::default()
-    };
+    let options = RendererOptions::interactive(cpu);
     let ((w, h), frames) = if cpu {
         ((960, 540), 16)
     } else {
