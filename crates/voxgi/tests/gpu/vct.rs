@@ -578,8 +578,8 @@ fn half_resolution_gather_matches_full_and_keeps_edges() {
     );
     // Measured at 64x64: ratio 1.042, RMS 0.27, edge RMS 0.38 (both resolutions reconstruct
     // sixteen turns of the bundle from windows of different sizes, so they differ in noise;
-    // with each cone tracing one quarter of its footprint, a quarter of the sixteen per
-    // quarter, more than the 0.19 and 0.30 of whole footprints), 635 edge pixels at full and
+    // with each cone tracing one quarter of its footprint, each quarter in four of the
+    // sixteen pixels, more than the 0.19 and 0.30 of whole footprints), 635 edge pixels at full and
     // 673 at half resolution. The ratio read 0.99 before each parity of the Bayer ranks drew
     // its own Hammersley set of turns, and 1.028 over 8-frame stills, so it is not noise: the
     // half-resolution gather gathers 3-4 % more, not yet explained. Without edge weights,
