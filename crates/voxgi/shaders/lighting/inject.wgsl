@@ -49,6 +49,16 @@ fn shading_point(i: u32, light: Light) -> vec3<f32> {
     return center + to_light(light, center) * leaf_size(i);
 }
 
+// The surface leaf `i`'s fragments lie on (a one-sided voxel's): where its light's geometry is
+// evaluated (`light_irradiance`); a two-sided voxel's is its centre.
+fn surface_point(i: u32) -> vec3<f32> {
+    let nw = leaf_normal(i);
+    if nw.w > 0.3 {
+        return leaf_center(i) - normalize(nw.xyz) * leaf_size(i) * leaf_surface(i);
+    }
+    return leaf_center(i);
+}
+
 fn to_light(l: Light, p: vec3<f32>) -> vec3<f32> {
     if l.kind == LIGHT_DIRECTIONAL {
         return -l.direction;
@@ -75,7 +85,7 @@ fn leaf_direct_light(i: u32) -> Direct {
         let n = normalize(nw.xyz);
         for (var l = 0u; l < params.light_count; l++) {
             let p = shading_point(i, lights[l]);
-            let el = light_irradiance(lights[l], p, n, 1.5);
+            let el = light_irradiance(lights[l], surface_point(i), p, n, 1.5);
             e += el;
             reflect_light(&spec, lights[l], p, n, el);
         }
@@ -86,7 +96,7 @@ fn leaf_direct_light(i: u32) -> Direct {
         // lobe: it would leave from both sides).
         for (var k = 0u; k < params.light_count; k++) {
             let l = lights[k];
-            e += 0.5 * light_irradiance(l, shading_point(i, l), to_light(l, center), 1.5);
+            e += 0.5 * light_irradiance(l, center, shading_point(i, l), to_light(l, center), 1.5);
         }
     }
     let radiance = albedo.rgb / PI * e + emission;
@@ -192,7 +202,7 @@ fn leaf_inputs_changed(i: u32) -> bool {
             n = normalize(nw.xyz);
         }
         let v = shadow_view_index(light, p);
-        if irradiance_reads(light, v, p, n, 1.5) || material_read(v, p) {
+        if irradiance_reads(light, v, surface_point(i), p, n, 1.5) || material_read(v, p) {
             return true;
         }
     }
@@ -353,9 +363,9 @@ fn tap_dirty(view: ShadowView, uv: vec2<f32>, dirt: vec4<f32>) -> bool {
         || texel_dirty(view, i + vec2<i32>(1, 1), dirt);
 }
 
-// Whether `light_irradiance(light, p, n, softness)` reads a changed texel of the view it
+// Whether `light_irradiance(light, surface, p, n, softness)` reads a changed texel of the view it
 // looks up, `v` (see `shadow_reads`); false when it returns before any lookup.
-fn irradiance_reads(light: Light, v: u32, p: vec3<f32>, n: vec3<f32>, softness: f32) -> bool {
+fn irradiance_reads(light: Light, v: u32, surface: vec3<f32>, p: vec3<f32>, n: vec3<f32>, softness: f32) -> bool {
     let dirt = view_dirt[v];
     if light.shadow_count == 0u || dirt.x >= dirt.z {
         return false;
@@ -365,7 +375,7 @@ fn irradiance_reads(light: Light, v: u32, p: vec3<f32>, n: vec3<f32>, softness: 
     if !is_area_light(light) {
         var l = -light.direction;
         if light.kind != LIGHT_DIRECTIONAL {
-            l = normalize(light.position - p);
+            l = normalize(light.position - surface);
         }
         // Clearly facing away only: light_irradiance's own test rounds differently.
         if dot(n, l) < -1e-4 {

@@ -79,6 +79,9 @@ fn trace_cone(origin: vec3<f32>, n: vec3<f32>, dir: vec3<f32>, tan_half: f32, ma
         let v = cross(dir, u);
         off = (u * (f32(part & 1u) - 0.5) + v * (f32(part >> 1u) - 0.5)) * 0.5;
         width = QUARTER_WIDTH;
+        // Its samples are a quarter cone's: the lobes' light is seen through that narrower
+        // aperture (shared/specular_lobe.wgsl, `chain_lobe_light`).
+        cone_tan_half = tan_half * QUARTER_WIDTH;
     }
     // Two loops: samples widen monotonically along a cone that leaves its surface, and once
     // they are WIDE_SAMPLE voxels across they no longer read the finest level (a quarter of the

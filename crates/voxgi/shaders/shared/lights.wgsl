@@ -409,11 +409,15 @@ fn area_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, clearance: f32) -> 
     return polygon_irradiance(light, p, n);
 }
 
-// Irradiance (W/m^2) arriving at p with normal n from one light, shadows included. Used where
-// only Lambertian reflection matters (light injection into voxels).
-fn light_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> vec3<f32> {
+// Irradiance (W/m^2) arriving at `surface` with normal n from one light, shadows included,
+// their lookups made from p (`surface` lifted off its own occluders in the shadow map). Used
+// where only Lambertian reflection matters (light injection into voxels). The light's geometry
+// is the surface's, not p's: p lies nearer a light in the surface's own plane (a lamp flush
+// with the ceiling, the walls' top rows under it), which made the voxels brighter than the
+// surfaces they hold (docs/QUALITY.md, "The voxels' direct light").
+fn light_irradiance(light: Light, surface: vec3<f32>, p: vec3<f32>, n: vec3<f32>, softness: f32) -> vec3<f32> {
     if is_area_light(light) {
-        let e = area_irradiance(light, p, n, 0.0);
+        let e = area_irradiance(light, surface, n, 0.0);
         if e <= 0.0 {
             return vec3<f32>(0.0);
         }
@@ -425,7 +429,7 @@ fn light_irradiance(light: Light, p: vec3<f32>, n: vec3<f32>, softness: f32) -> 
         l = -light.direction;
         e = light.radiance;
     } else {
-        let to = light.position - p;
+        let to = light.position - surface;
         let d2 = max(dot(to, to), 1e-8);
         let d = sqrt(d2);
         l = to / d;

@@ -846,16 +846,18 @@ fn wall_lit_by_a_metal(roughness: f32) -> (f32, f32) {
 #[test]
 fn a_metal_floor_lights_the_wall_its_reflection_reaches() {
     // (roughness, the least and the most the cones may reach of the path tracer's light)
-    // Measured on lavapipe: 0.73 at roughness 0.25 and 1.09 at 1 (0.85 and 1.52 before the
-    // diffuse cones traced one quarter of their footprint each; without the leaves' lobes the
-    // wall is black: 0). A coarse sample merges the lobes of all the floor it covers into
+    // Measured on lavapipe: 0.86 at roughness 0.25 and 1.08 at 1 (0.73 and 1.09 before samples
+    // finer than the first chain level saw its lobes, 0.80 with that alone, and before a
+    // quarter cone saw them through its quarter's aperture, 0.77 with that alone; 0.85 and 1.52
+    // with whole-footprint cones; without the leaves' lobes the wall is black: 0). A coarse sample merges the lobes of all the floor it covers into
     // one wider lobe, which spreads the reflection; a lobe as wide as a Lambertian surface's
     // leaves as one does, where rough GGX sends less to the grazing upper wall (docs/QUALITY.md,
     // "Specular light in the bounces"). The bounds keep each near its measure and fail (as
     // measured with whole-footprint cones) a lobe lost (0), the floor's unlit underside diluting its lobes in the chain (0.42: the two
     // faces of the 2 cm floor share the chain's first level), its light counted twice (1.7,
-    // 3.0), or a rough lobe without its directional albedo (2.5).
-    for (roughness, lo, hi) in [(0.25, 0.6, 1.1), (1.0, 0.85, 1.6)] {
+    // 3.0), a rough lobe without its directional albedo (2.5), or the finest samples without
+    // the lobes (0.73, 0.77).
+    for (roughness, lo, hi) in [(0.25, 0.8, 1.1), (1.0, 0.85, 1.6)] {
         let (cones, paths) = wall_lit_by_a_metal(roughness);
         eprintln!(
             "wall lit by a metal of roughness {roughness}: cones {cones:.5}, path tracer \

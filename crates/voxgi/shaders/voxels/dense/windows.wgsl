@@ -36,8 +36,11 @@ fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
     if !LOBE_CHAIN {
         return s;
     }
-    // The finest level has no lobes: they fade in as the chain does.
-    return with_lobes(s, uvw, max(lod - 1.0, 0.0), dir, win, min(lod, 1.0));
+    // The finest level has no lobes: a sample finer than the first chain level sees that
+    // level's lobes wherever it sees a surface. Faded in as the chain is, a quarter cone's
+    // narrow samples near a metal saw its leaves black (diffuse albedo 0) and little of what
+    // it reflects (docs/QUALITY.md, "Specular light in the bounces").
+    return with_lobes(s, uvw, max(lod - 1.0, 0.0), dir, win, 1.0);
 }
 
 // Sample `s` (optical depth, seen along `dir`) with the light the lobes of chain level `cl`

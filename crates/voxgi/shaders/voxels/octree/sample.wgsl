@@ -127,15 +127,20 @@ fn fetch_level(atlas: texture_3d<f32>, shape: AtlasShape, tile: u32, lvl: u32, l
             let z = textureSampleLevel(atlas, voxel_sampler, uz, 0.0);
             v = w.x * x + w.y * y + w.z * z;
         }
-        if LOBE_CHAIN {
-            // Level 0 has no lobes (its one block is the leaves' light).
-            let m = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, f32(LOBE_EXITANCE) * block)) * inv, 0.0);
-            let l = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, f32(LOBE_DIRECTION) * block)) * inv, 0.0);
-            let light = select(vec3<f32>(0.0), chain_lobe_light(m, l, dir), lvl > 0u);
-            v = vec4<f32>(v.rgb + light * v.a, v.a);
+        if LOBE_CHAIN && lvl > 0u {
+            v = vec4<f32>(v.rgb + brick_lobe_light(atlas, origin, block, inv, dir) * v.a, v.a);
         }
     }
     return select(vec4<f32>(0.0), v, tile != 0u);
+}
+
+// The light the lobes of a brick's texel at `origin` (its level's blocks `block` texels apart
+// in z) send back along `dir` (shared/specular_lobe.wgsl). Level 0 has none: its one block is
+// the leaves' light.
+fn brick_lobe_light(atlas: texture_3d<f32>, origin: vec3<f32>, block: f32, inv: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    let m = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, f32(LOBE_EXITANCE) * block)) * inv, 0.0);
+    let l = textureSampleLevel(atlas, voxel_sampler, (origin + vec3<f32>(0.0, 0.0, f32(LOBE_DIRECTION) * block)) * inv, 0.0);
+    return chain_lobe_light(m, l, dir);
 }
 
 // The even atlas's region for level `lvl` (even): the leaf region for 0, else the even one.
@@ -181,5 +186,14 @@ fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let le = select(lo + 1u, lo, a_even);
     let se = fetch_level(even_atlas, even_region(le), select(tb, ta, a_even), le, select(lb, la, a_even), dir);
     let so = fetch_level(odd_atlas, tree.odd_atlas, select(ta, tb, a_even), select(lo, lo + 1u, a_even), select(la, lb, a_even), dir);
-    return mix(select(so, se, a_even), select(se, so, a_even), f);
+    let s = mix(select(so, se, a_even), select(se, so, a_even), f);
+    if LOBE_CHAIN && lo == 0u && tree.dirs > 1u {
+        // Samples finer than level 1 see the lobes of level 1 wherever they see a surface, as
+        // the dense volume's (voxels/dense/windows.wgsl, `window_depth`).
+        let b = brick_index(tree, max(tb, class_base(tree, brick_class(1u))), 1u);
+        let origin = vec3<f32>(brick_texel(tree.odd_atlas, b, 0u)) + lb;
+        let light = brick_lobe_light(odd_atlas, origin, f32(tree.odd_atlas.block), tree.odd_atlas.inv_size.xyz, dir);
+        return vec4<f32>(s.rgb + select(vec3<f32>(0.0), light, tb != 0u) * (1.0 - f) * se.a, s.a);
+    }
+    return s;
 }
