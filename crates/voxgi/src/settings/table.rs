@@ -162,7 +162,7 @@ pub static SETTINGS: &[Setting] = &[
         label: "metals' reflections in the bounces",
         help: "Metals reflect the lights' light specularly into the voxels (a lobe per lit leaf, \
                kept up the voxels' levels beside the six directions): a wall facing a metal's \
-               reflection is lit (0.73 of the path tracer's light on examples/metal-floor.toml). \
+               reflection is lit (0.86 of the path tracer's light on examples/metal-floor.toml). \
                Needs anisotropic voxels.",
         domain: Domain::Bool,
         changes: Changes::Voxels,
