@@ -81,6 +81,18 @@ fn voxel_center(c: vec3<u32>, vol: Volume) -> vec3<f32> {
     return vol.origin + (vec3<f32>(c) + 0.5) * vol.voxel_size;
 }
 
+// The share of a sample's trilinear filter (at level of detail `lod` of a volume `resolution`
+// finest voxels a side) that lies inside the volume, each axis's: the textures clamp to their
+// edge (core WebGPU has no clamp-to-border sampler), so a sample within half a texel of a face
+// read the edge texel, geometry on the face, as if it went on outside (the open front of the
+// Cornell box read brighter and more opaque than it is). The depth outside is none, and depth
+// filters linearly.
+fn border_weight(uvw: vec3<f32>, lod: f32, resolution: f32) -> f32 {
+    let u = min(uvw, vec3<f32>(1.0) - uvw) * resolution * exp2(-lod);
+    let f = clamp(u + 0.5, vec3<f32>(0.5), vec3<f32>(1.0));
+    return f.x * f.y * f.z;
+}
+
 // Radiance textures hold optical depth, not opacity: (L sigma, sigma) per texel length, with
 // sigma = -ln(1 - alpha). Depth is what trilinear filtering may interpolate: opacity
 // interpolated between an opaque texel and an empty one thins a wall into a ramp that a cone

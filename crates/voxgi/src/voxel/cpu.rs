@@ -239,13 +239,21 @@ impl DenseSampler<'_> {
         let vs = self.grid.voxel_size;
         let top = self.grid.levels() as f32 - 1.0;
         let lod = (diameter / vs).max(1.0).log2().clamp(0.0, top);
-        self.window_depth(uvw, lod, dir, 0)
+        self.window_depth(uvw, lod, dir, 0) * border_weight(uvw, lod, self.grid.resolution)
     }
 
     /// `sample_voxels`: premultiplied radiance and opacity.
     pub fn sample_voxels(&self, p: Vec3, diameter: f32, dir: Vec3) -> Vec4 {
         from_depth(self.sample_depth(p, diameter, dir))
     }
+}
+
+/// The share of a sample's trilinear filter at level of detail `lod` that lies inside a volume
+/// of `resolution` finest voxels a side: `border_weight` in shared/volume.wgsl, which says why.
+pub fn border_weight(uvw: Vec3, lod: f32, resolution: u32) -> f32 {
+    let u = uvw.min(Vec3::ONE - uvw) * resolution as f32 * (-lod).exp2();
+    let f = (u + 0.5).clamp(Vec3::splat(0.5), Vec3::ONE);
+    f.x * f.y * f.z
 }
 
 /// Subdivisions of a voxel edge in which `splat` places a region of influence (`SUB` in

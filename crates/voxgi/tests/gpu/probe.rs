@@ -206,8 +206,9 @@ fn quarter_cones_pass_the_light_a_block_lets_by() {
         "back wall's normal cone passes: quarters {quarters:.3}, whole footprint {whole:.3}, \
          path tracer's rays escape {escaped:.3}"
     );
-    // Measured at 64³: quarters 0.419, whole 0.215, the path tracer 0.549 (at 128³ 0.436,
-    // 0.225 and 0.545). A quarter still composites its own partial coverage, so it passes
+    // Measured at 64³: quarters 0.435, whole 0.248, the path tracer 0.549 (0.419 and 0.215
+    // before samples at the volume's faces were weighed by their share inside it; at 128³
+    // 0.436, 0.225 and 0.545 before that). A quarter still composites its own partial coverage, so it passes
     // less than the rays; 0.7 to 1.05 of them holds it with room for the 256 paths' noise.
     // Whole footprints pass under half: the double count the quarters exist for (and the
     // proof that `cone_quarters: false` reaches the shader).

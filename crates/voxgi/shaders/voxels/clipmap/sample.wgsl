@@ -84,10 +84,13 @@ fn level_holding(p: vec3<f32>, diameter: f32, room: f32) -> u32 {
     return k;
 }
 
-// Level k's optical depth at p for a sample of `diameter`.
+// Level k's optical depth at p for a sample of `diameter`. Weighed at the window's faces as
+// the dense volume's samples are at its faces (`border_weight`): a level reads that near its
+// faces only where no coarser level takes over, past the scene's bounds, where there is nothing.
 fn level_depth(p: vec3<f32>, diameter: f32, dir: vec3<f32>, k: u32) -> vec4<f32> {
     let lod = clamp(log2(max(diameter / clip.levels[k].w, 1.0)), 0.0, f32(vol.levels - 1u));
-    return window_depth(clamp(level_uvw(p, k), vec3<f32>(0.0), vec3<f32>(1.0)), lod, dir, k);
+    let uvw = clamp(level_uvw(p, k), vec3<f32>(0.0), vec3<f32>(1.0));
+    return window_depth(uvw, lod, dir, k) * border_weight(uvw, lod, f32(clip.resolution));
 }
 
 // Optical depth per sample diameter: (L sigma, sigma).

@@ -38,7 +38,8 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
 fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let uvw = volume_uvw(pos);
     let lod = clamp(log2(max(diameter / vol.voxel_size, 1.0)), 0.0, f32(vol.levels - 1u));
-    return select(vec4<f32>(0.0), window_depth(uvw, lod, dir, 0u), inside_volume(uvw));
+    let s = window_depth(uvw, lod, dir, 0u) * border_weight(uvw, lod, f32(vol.resolution));
+    return select(vec4<f32>(0.0), s, inside_volume(uvw));
 }
 
 // sample_depth for a diameter of at least WIDE_SAMPLE voxels.
@@ -49,7 +50,7 @@ fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32>
     if LOBE_CHAIN {
         s = with_lobes(s, uvw, lod - 1.0, dir, 0u, 1.0);
     }
-    return select(vec4<f32>(0.0), s, inside_volume(uvw));
+    return select(vec4<f32>(0.0), s * border_weight(uvw, lod, f32(vol.resolution)), inside_volume(uvw));
 }
 
 // Texture coordinates of a world position over the whole volume.

@@ -54,13 +54,15 @@ fn sample_voxels(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
 fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let uvw = tree_uvw(pos);
     let lod = clamp(log2(max(diameter / tree.voxel_size, 1.0)), 0.0, f32(tree.depth));
-    return select(vec4<f32>(0.0), sample_levels(uvw, lod, dir), inside_tree(uvw));
+    let s = sample_levels(uvw, lod, dir) * border_weight(uvw, lod, f32(tree.resolution));
+    return select(vec4<f32>(0.0), s, inside_tree(uvw));
 }
 
 fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let uvw = tree_uvw(pos);
     let lod = clamp(log2(diameter / tree.voxel_size), 1.0, f32(tree.depth));
-    return select(vec4<f32>(0.0), sample_levels(uvw, lod, dir), inside_tree(uvw));
+    let s = sample_levels(uvw, lod, dir) * border_weight(uvw, lod, f32(tree.resolution));
+    return select(vec4<f32>(0.0), s, inside_tree(uvw));
 }
 
 fn tree_uvw(pos: vec3<f32>) -> vec3<f32> {

@@ -520,6 +520,7 @@ impl Clipmap {
             let lod = (diameter / g.voxel_size).max(1.0).log2().clamp(0.0, top);
             let uvw = ((p - g.origin) / g.extent()).clamp(Vec3::ZERO, Vec3::ONE);
             voxels.window_depth(uvw, lod, dir, k as u32)
+                * crate::voxel::cpu::border_weight(uvw, lod, g.resolution)
         };
         let fine = depth(k);
         let outer = if k == last {

@@ -160,7 +160,7 @@ impl OctreeSampler<'_> {
                 + w.y * self.level(uvw, lvl, b(dir.y < 0.0, 2))
                 + w.z * self.level(uvw, lvl, b(dir.z < 0.0, 4))
         };
-        at(lo).lerp(at(lo + 1), f)
+        at(lo).lerp(at(lo + 1), f) * crate::voxel::cpu::border_weight(uvw, lod, l.resolution)
     }
 
     /// `sample_voxels`: premultiplied radiance and opacity.
