@@ -83,9 +83,10 @@ fn leaf_direct_light(i: u32) -> Direct {
     var spec = Specular();
     if nw.w > 0.3 {
         let n = normalize(nw.xyz);
+        let surface = surface_point(i);
         for (var l = 0u; l < params.light_count; l++) {
             let p = shading_point(i, lights[l]);
-            let el = light_irradiance(lights[l], surface_point(i), p, n, 1.5);
+            let el = light_irradiance(lights[l], surface, p, n, 1.5);
             e += el;
             reflect_light(&spec, lights[l], p, n, el);
         }
@@ -191,6 +192,7 @@ fn leaf_inputs_changed(i: u32) -> bool {
         return true;
     }
     let nw = leaf_normal(i);
+    let surface = surface_point(i);
     for (var l = 0u; l < params.light_count; l++) {
         let light = lights[l];
         if light.shadow_count == 0u {
@@ -202,7 +204,7 @@ fn leaf_inputs_changed(i: u32) -> bool {
             n = normalize(nw.xyz);
         }
         let v = shadow_view_index(light, p);
-        if irradiance_reads(light, v, surface_point(i), p, n, 1.5) || material_read(v, p) {
+        if irradiance_reads(light, v, surface, p, n, 1.5) || material_read(v, p) {
             return true;
         }
     }
