@@ -262,19 +262,28 @@ impl Drop for Xvfb {
 }
 
 /// The viewer running on `x` with `args` (in `dir`), its first frame shown and its window given
-/// the keyboard; the thread collecting its log, which ends with it.
+/// the keyboard; the thread collecting its log, which ends with it. The log has egui's input
+/// for every frame (trace), so that a test's input can wait for the frames that saw it instead
+/// of guessing a CPU driver's frame time.
 struct Running {
     child: std::process::Child,
-    log: Option<std::thread::JoinHandle<String>>,
+    log: Option<std::thread::JoinHandle<()>>,
+    lines: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
     window: String,
 }
+
+/// The log line `run_ui` writes each frame, with the frame's input events.
+const FRAME_INPUT: &str = "egui input at";
 
 impl Running {
     fn start(x: &Xvfb, dir: &std::path::Path, args: &[&str]) -> Running {
         let mut child = Command::new(env!("CARGO_BIN_EXE_voxgi-viewer"))
             .current_dir(dir)
             .env("DISPLAY", &x.display)
-            .env("RUST_LOG", "voxgi_viewer=info")
+            .env(
+                "RUST_LOG",
+                "voxgi_viewer=info,voxgi_viewer::viewer::frame=trace",
+            )
             .args(args)
             .stderr(std::process::Stdio::piped())
             .spawn()
@@ -283,21 +292,22 @@ impl Running {
         // window shows the renderer being made.
         let (tx, rx) = std::sync::mpsc::channel();
         let stderr = child.stderr.take().expect("piped");
-        let log = std::thread::spawn(move || {
-            use std::io::BufRead;
-            let mut all = String::new();
-            for line in std::io::BufReader::new(stderr)
-                .lines()
-                .map_while(Result::ok)
-            {
-                if line.contains("first frame shown") {
-                    let _ = tx.send(());
+        let lines = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let log = {
+            let lines = lines.clone();
+            std::thread::spawn(move || {
+                use std::io::BufRead;
+                for line in std::io::BufReader::new(stderr)
+                    .lines()
+                    .map_while(Result::ok)
+                {
+                    if line.contains("first frame shown") {
+                        let _ = tx.send(());
+                    }
+                    lines.lock().unwrap().push(line);
                 }
-                all += &line;
-                all.push('\n');
-            }
-            all
-        });
+            })
+        };
         rx.recv_timeout(std::time::Duration::from_secs(180))
             .expect("no first frame within 3 minutes");
         let window = x.xdotool(&["search", "--name", "voxgi"]);
@@ -311,14 +321,64 @@ impl Running {
         Running {
             child,
             log: Some(log),
+            lines,
             window,
         }
+    }
+
+    /// Runs xdotool with `args`, then waits for the frame whose egui input has an event that
+    /// contains `event` (any frame for "") and for `frames` frames after it: input a frame
+    /// apart reaches egui in different frames (one frame's press and release are a click, not
+    /// a drag).
+    fn input(&self, x: &Xvfb, args: &[&str], event: &str, frames: usize) {
+        let from = self.lines.lock().unwrap().len();
+        x.xdotool(args);
+        let started = std::time::Instant::now();
+        loop {
+            {
+                let lines = self.lines.lock().unwrap();
+                let inputs: Vec<&String> = lines[from..]
+                    .iter()
+                    .filter(|l| l.contains(FRAME_INPUT))
+                    .collect();
+                let seen = inputs.iter().position(|l| l.contains(event));
+                if seen.is_some_and(|i| inputs.len() > i + frames) {
+                    return;
+                }
+                let ended = self.log.as_ref().is_none_or(|l| l.is_finished());
+                assert!(
+                    !ended && started.elapsed().as_secs() < 60,
+                    "xdotool {args:?}: no frame saw {event:?} and {frames} more after it \
+                     ({}; the viewer {}):\n{}",
+                    inputs.len(),
+                    if ended {
+                        "exited"
+                    } else {
+                        "ran on for a minute"
+                    },
+                    lines.join("\n")
+                );
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+    }
+
+    /// The log so far, one line a line, without the frames' input.
+    fn log(&self) -> String {
+        let lines = self.lines.lock().unwrap();
+        let kept: Vec<&str> = lines
+            .iter()
+            .filter(|l| !l.contains(FRAME_INPUT))
+            .map(String::as_str)
+            .collect();
+        kept.join("\n")
     }
 
     /// Waits for the viewer to exit (`--screenshot`); its log, after checking it succeeded.
     fn finish(mut self) -> String {
         let status = self.child.wait().expect("voxgi-viewer");
-        let log = self.log.take().expect("once").join().expect("the log");
+        self.log.take().expect("once").join().expect("the log");
+        let log = self.log();
         assert!(status.success(), "voxgi-viewer failed:\n{log}");
         log
     }
@@ -327,7 +387,8 @@ impl Running {
     fn kill(mut self) -> String {
         let _ = self.child.kill();
         let _ = self.child.wait();
-        self.log.take().expect("once").join().expect("the log")
+        self.log.take().expect("once").join().expect("the log");
+        self.log()
     }
 }
 
@@ -356,13 +417,22 @@ fn tab_hides_the_panel_and_the_keys_still_reach_the_viewer() {
     let viewer = Running::start(&x, &dir, &[&args[..], &shot[..]].concat());
     let window = viewer.window.clone();
     // The wheel up (zoom in) five times over the panel, then Tab, then G (the path tracer).
+    // The pointer's move and the wheel go in at once (the wheel in the move's frame is what
+    // once zoomed), the rest each after a frame saw what went before (the viewer's own keys,
+    // which egui's input does not show, after a couple of frames).
     x.xdotool(&["mousemove", "--window", &window, "100", "200"]);
-    for _ in 0..5 {
+    for _ in 0..4 {
         x.xdotool(&["click", "4"]);
     }
-    x.xdotool(&["mousemove", "--window", &window, "500", "200"]);
-    x.xdotool(&["key", "Tab"]);
-    x.xdotool(&["key", "g"]);
+    viewer.input(&x, &["click", "4"], "MouseWheel", 0);
+    viewer.input(
+        &x,
+        &["mousemove", "--window", &window, "500", "200"],
+        "PointerMoved",
+        0,
+    );
+    viewer.input(&x, &["key", "Tab"], "", 2);
+    viewer.input(&x, &["key", "g"], "", 2);
     let log = viewer.finish();
     let img = image::open(&png).expect("the screenshot").to_rgb8();
     // The panel hidden and the camera where it was: left of the box (the image spans the
@@ -423,10 +493,10 @@ fn the_export_is_what_voxgi_render_writes() {
     let png = dir.join("voxgi_cornell-box.png");
     let _ = std::fs::remove_file(&png);
     let viewer = Running::start(&x, &dir, &["--builtin", "cornell-box", "--size", "640x360"]);
-    x.xdotool(&["key", "x"]);
-    // The field takes the keyboard in the frame after the dialog opens.
-    std::thread::sleep(std::time::Duration::from_secs(3));
-    x.xdotool(&["key", "Return"]);
+    // X is the viewer's key, not egui's (its input does not show it): a few frames for it to
+    // open the dialog, whose field takes the keyboard in the frame after.
+    viewer.input(&x, &["key", "x"], "", 3);
+    viewer.input(&x, &["key", "Return"], "key: Enter", 0);
     let waiting = std::time::Instant::now();
     while !png.exists() && waiting.elapsed().as_secs() < 300 {
         std::thread::sleep(std::time::Duration::from_millis(200));
@@ -527,20 +597,24 @@ fn the_panel_is_resized_by_its_edge() {
     let args = ["--builtin", "cornell-box", "--size", "640x360", "--with-ui"];
     let viewer = Running::start(&x, &dir, &[&args[..], &shot[..]].concat());
     let w = viewer.window.clone();
-    // Just right of the edge (egui grabs a few points either side), then along, slowly: a
-    // frame of the CPU driver takes a few hundred milliseconds, more while other tests' viewers
-    // share its cores, and egui must see the pointer over the edge in one frame, pressed in a
-    // later one and moved in later ones still (one frame's events at once are a click). The
-    // screenshot waits for enough frames that the drag ends before it.
-    x.xdotool(&["mousemove", "--window", &w, "258", "200"]);
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    x.xdotool(&["mousedown", "1"]);
+    // Just right of the edge (egui grabs a few points either side), pressed, then along, each
+    // step in frames of its own (one frame's events at once are a click): egui must see the
+    // pointer over the edge in one frame, pressed in a later one and moved in later ones
+    // still. The screenshot's 60 frames leave room for the drag's dozen or so.
+    let mut steps = vec![
+        (
+            vec!["mousemove", "--window", &w, "258", "200"],
+            "PointerMoved",
+        ),
+        (vec!["mousedown", "1"], "pressed: true"),
+    ];
     for to in ["270", "300", "330", "360", "380", "400"] {
-        std::thread::sleep(std::time::Duration::from_millis(600));
-        x.xdotool(&["mousemove", "--window", &w, to, "200"]);
+        steps.push((vec!["mousemove", "--window", &w, to, "200"], "PointerMoved"));
     }
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    x.xdotool(&["mouseup", "1"]);
+    steps.push((vec!["mouseup", "1"], "pressed: false"));
+    for (args, event) in steps {
+        viewer.input(&x, &args, event, 1);
+    }
     viewer.finish();
     let img = image::open(&png).expect("the screenshot").to_rgb8();
     // Between 300 and 380 points: the panel's flat dark grey (27 of 255) where the picture was:
