@@ -1,7 +1,9 @@
-// upsample, stage one of two: at the gather's resolution, each sample averages the 4x4 window
-// of gather samples around it (one turn of the cone bundle each), weighted by depth and normal
-// similarity, so it holds all sixteen turns while light does not bleed across silhouettes
-// and creases. The composite upsamples the result to full resolution (shared/upsample.wgsl).
+// upsample, stage one of two: at the gather's resolution, each sample averages the 5x5 window
+// of gather samples centred on it with a tent's weights (its rim half, its corners a quarter),
+// weighted by depth and normal similarity. The tent is the mean of the four 4x4 windows
+// around the sample, each of which holds all sixteen turns of the cone bundle once, so every
+// turn weighs the same while light does not bleed across silhouettes and creases; a single
+// 4x4 window is half a sample off-centre and shifts the light towards it. The composite upsamples the result to full resolution (shared/upsample.wgsl).
 
 //!include shared/globals.wgsl
 //!include shared/half.wgsl
@@ -28,16 +30,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // The window moves inside the image rather than clamping, so it always holds all sixteen
     // turns and both halves of the cone set.
-    let base = clamp(vec2<i32>(gid.xy) - 1, vec2<i32>(0), max(vec2<i32>(low_size) - 4, vec2<i32>(0)));
+    let base = clamp(vec2<i32>(gid.xy) - 2, vec2<i32>(0), max(vec2<i32>(low_size) - 5, vec2<i32>(0)));
     // Even and odd Bayer ranks traced different halves of the cones: average each half on its
     // own, then the two, so rejected neighbours at edges cannot tip the balance.
     var sum0 = vec4<f32>(0.0);
     var sum1 = vec4<f32>(0.0);
     var w0 = 0.0;
     var w1 = 0.0;
-    for (var i = 0; i < 16; i++) {
-        let c = min(base + vec2<i32>(i & 3, i >> 2), vec2<i32>(low_size) - 1);
-        let w = edge_weight(textureLoad(guide, c, 0), g0.xyz, g0.a);
+    for (var i = 0; i < 25; i++) {
+        let o = vec2<i32>(i % 5, i / 5);
+        let c = min(base + o, vec2<i32>(low_size) - 1);
+        let rim = select(vec2<f32>(1.0), vec2<f32>(0.5), (o == vec2<i32>(0)) | (o == vec2<i32>(4)));
+        let w = rim.x * rim.y * edge_weight(textureLoad(guide, c, 0), g0.xyz, g0.a);
         let k = f32(cone_half(vec2<u32>(c)));
         let value = textureLoad(low, c, 0);
         sum0 += (w * (1.0 - k)) * value;

@@ -54,7 +54,7 @@ impl UpsamplePass {
         })
     }
 
-    /// Records the edge-aware 4x4 filter of `t.indirect_low` (guided by `t.guide_low`) into
+    /// Records the edge-aware 5x5 tent filter of `t.indirect_low` (guided by `t.guide_low`) into
     /// `t.indirect`, at the gather's resolution. Timed as "upsample".
     pub fn record(
         &self,

@@ -576,11 +576,12 @@ fn half_resolution_gather_matches_full_and_keeps_edges() {
         "half vs full resolution indirect: mean ratio {ratio:.4}, relative RMS {rms:.4}, \
          on {edges} edge pixels {edge_rms:.4}; {half_edges} edge pixels at half resolution"
     );
-    // Measured at 64x64: ratio 1.042, RMS 0.27, edge RMS 0.38 (both resolutions reconstruct
+    // Measured at 64x64: ratio 1.035, RMS 0.25, edge RMS 0.39 (both resolutions reconstruct
     // sixteen turns of the bundle from windows of different sizes, so they differ in noise;
     // with each cone tracing one quarter of its footprint, each quarter in four of the
-    // sixteen pixels, more than the 0.19 and 0.30 of whole footprints), 635 edge pixels at full and
-    // 673 at half resolution. The ratio read 0.99 before each parity of the Bayer ranks drew
+    // sixteen pixels, more than the 0.19 and 0.30 of whole footprints), 568 edge pixels at
+    // full and 643 at half resolution (1.042, 0.27, 635 and 673 while the upsample's window
+    // lay half a sample off centre). The ratio read 0.99 before each parity of the Bayer ranks drew
     // its own Hammersley set of turns, and 1.028 over 8-frame stills, so it is not noise: the
     // half-resolution gather gathers 3-4 % more, not yet explained. Without edge weights,
     // light bleeds across silhouettes and blurs the jumps away: 293 and 244 edge pixels.
