@@ -42,7 +42,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let c = min(base + o, vec2<i32>(low_size) - 1);
         let rim = select(vec2<f32>(1.0), vec2<f32>(0.5), (o == vec2<i32>(0)) | (o == vec2<i32>(4)));
         let w = rim.x * rim.y * edge_weight(textureLoad(guide, c, 0), g0.xyz, g0.a);
-        let k = f32(cone_half(vec2<u32>(c)));
+        let k = f32(cone_half(vec2<u32>(c), frame.light_sample));
         let value = textureLoad(low, c, 0);
         sum0 += (w * (1.0 - k)) * value;
         sum1 += (w * k) * value;

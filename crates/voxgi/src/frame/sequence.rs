@@ -31,9 +31,9 @@ pub fn jitter(k: u32) -> [f32; 2] {
     [wrap(radical_inverse(k, 2)), wrap(radical_inverse(k, 3))]
 }
 
-/// How far frame `k` shifts the diffuse cones' turns (`shaders/shared/cone.wgsl`,
-/// `diffuse_cone`; the gather wraps them round): about the normal and in zenith, each as a
-/// fraction of one interleaving step. The base-5 and base-7 radical inverses, bases prime to the
+/// How far frame `k` turns the diffuse cones (`shaders/shared/cone.wgsl`, `diffuse_cone`;
+/// the gather wraps them round): about the normal and in zenith, each as a fraction of a
+/// cone's cell, so that the frames sweep the whole cells. The base-5 and base-7 radical inverses, bases prime to the
 /// jitter's so that the turn and the sample position do not repeat together.
 pub fn cone_turn(k: u32) -> [f32; 2] {
     [
@@ -95,7 +95,7 @@ mod tests {
     }
 
     #[test]
-    fn cone_turns_spread_over_the_step() {
+    fn cone_turns_spread_over_the_cell() {
         // 25 = 5² and 49 = 7²: the base-5 radical inverse of 0..25 is exactly the multiples
         // of 1/25, the base-7 one of 0..49 those of 1/49.
         for (axis, n) in [(0, 25), (1, 49)] {

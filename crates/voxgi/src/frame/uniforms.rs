@@ -49,8 +49,8 @@ pub struct GpuFrame {
     /// What the temporal pass may do with the history: `HISTORY_*` in the WGSL (none, a
     /// moving view that is clamped to the frame, or a still that is averaged).
     pub history: u32,
-    /// How far this frame shifts the diffuse cones' turns about the normal and in zenith, as
-    /// fractions of one interleaving step (`sequence::cone_turn`; zero without temporal
+    /// How far this frame turns the diffuse cones about the normal and in zenith, as
+    /// fractions of a cone's cell (`sequence::cone_turn`; zero without temporal
     /// accumulation).
     pub cone_turn: [f32; 2],
     /// The frame's index in the sequence of area-light sample points: its sample views show

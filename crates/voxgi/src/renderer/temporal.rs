@@ -58,7 +58,7 @@ pub(super) struct FrameHistory {
     pub mode: u32,
     /// The camera's sub-pixel offset, pixels.
     pub jitter: [f32; 2],
-    /// The cone bundle's turn about the normal and in zenith, in interleaving steps.
+    /// The cone bundle's turn about the normal and in zenith, as fractions of a cone's cell.
     pub cone_turn: [f32; 2],
     /// The frame's index in the sample sequence (area lights' points, `sequence`).
     pub sample: u32,

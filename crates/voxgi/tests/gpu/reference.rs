@@ -791,8 +791,10 @@ fn metal_floor_indirect(roughness: f32) -> (f32, f32) {
 #[test]
 fn glossy_floor_reflects_the_lobes_mean() {
     // (roughness, the least and the most the cones may reach of the path tracer's reflection)
-    // Measured on lavapipe: 0.83, 0.77 and 0.98 at roughness 0.1, 0.3 and 0.5 (0.84, 0.77 and
-    // 1.03 while the upsample's window lay half a sample off centre; 0.81, 0.75 and 1.02
+    // Measured on lavapipe: 0.81, 0.72 and 1.00 at roughness 0.1, 0.3 and 0.5 (0.83, 0.77 and
+    // 0.98 while the frames turned the lobe's sixteen points within a sixteenth of their
+    // cells; 0.84, 0.77 and 1.03 while the upsample's window lay half a sample off centre;
+    // 0.81, 0.75 and 1.02
     // before the voxels' direct light took the lamp's geometry at their surface; one cone
     // along the lobe's dominant direction read 0.81, 0.58 and 0.64 on this strip). What remains
     // below 1 at the narrower lobes is the narrow cones' own error in the voxels, not the
@@ -848,8 +850,9 @@ fn wall_lit_by_a_metal(roughness: f32) -> (f32, f32) {
 #[test]
 fn a_metal_floor_lights_the_wall_its_reflection_reaches() {
     // (roughness, the least and the most the cones may reach of the path tracer's light)
-    // Measured on lavapipe: 0.87 at roughness 0.25 and 1.09 at 1 (0.86 and 1.08 while the
-    // upsample's window lay half a sample off centre; 0.73 and 1.09 before samples
+    // Measured on lavapipe: 0.93 at roughness 0.25 and 1.09 at 1 (0.87 while the frames
+    // turned the cones within a sixteenth of their cells; 0.86 and 1.08 while the upsample's
+    // window lay half a sample off centre; 0.73 and 1.09 before samples
     // finer than the first chain level saw its lobes, 0.80 with that alone, and before a
     // quarter cone saw them through its quarter's aperture, 0.77 with that alone; 0.85 and 1.52
     // with whole-footprint cones; without the leaves' lobes the wall is black: 0). A coarse sample merges the lobes of all the floor it covers into
