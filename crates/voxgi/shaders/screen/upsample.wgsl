@@ -3,7 +3,8 @@
 // weighted by depth and normal similarity. The tent is the mean of the four 4x4 windows
 // around the sample, each of which holds all sixteen turns of the cone bundle once, so every
 // turn weighs the same while light does not bleed across silhouettes and creases; a single
-// 4x4 window is half a sample off-centre and shifts the light towards it. The composite upsamples the result to full resolution (shared/upsample.wgsl).
+// 4x4 window is half a sample off-centre and shifts the light towards it. The composite
+// upsamples the result to full resolution (shared/upsample.wgsl).
 
 //!include shared/globals.wgsl
 //!include shared/half.wgsl

@@ -33,8 +33,9 @@ pub fn jitter(k: u32) -> [f32; 2] {
 
 /// How far frame `k` turns the diffuse cones (`shaders/shared/cone.wgsl`, `diffuse_cone`;
 /// the gather wraps them round): about the normal and in zenith, each as a fraction of a
-/// cone's cell, so that the frames sweep the whole cells. The base-5 and base-7 radical inverses, bases prime to the
-/// jitter's so that the turn and the sample position do not repeat together.
+/// cone's cell, so that the frames sweep the whole cells. The base-5 and base-7 radical
+/// inverses, bases prime to the jitter's so that the turn and the sample position do not
+/// repeat together.
 pub fn cone_turn(k: u32) -> [f32; 2] {
     [
         radical_inverse(k % PERIOD, 5),
