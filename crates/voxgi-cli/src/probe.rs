@@ -8,11 +8,10 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::time::Instant;
 use voxgi::reference::probe::{
-    ConeQuery, ConeTruth, TracedCone, hammersley_turns, trace_diffuse_cones,
+    ConeQuery, ConeTruth, TracedCone, hammersley_turns, pixel_ray, trace_diffuse_cones,
 };
 use voxgi::reference::{PRIM_DISC, flatten};
-use voxgi::scene::glam::{Vec2, Vec3};
-use voxgi::scene::{Camera, Projection};
+use voxgi::scene::glam::Vec3;
 use voxgi::{Bounces, PathTracer, headless};
 
 #[derive(Args)]
@@ -55,27 +54,6 @@ fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
     let x = x.trim().parse().map_err(|_| format!("bad column '{x}'"))?;
     let y = y.trim().parse().map_err(|_| format!("bad row '{y}'"))?;
     Ok((x, y))
-}
-
-/// The ray through the centre of pixel (x, y) of a `size` image seen by `camera`.
-fn pixel_ray(camera: &Camera, (x, y): (u32, u32), (w, h): (u32, u32)) -> (Vec3, Vec3) {
-    let ndc = Vec2::new(
-        (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-        1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
-    );
-    let right = camera.forward.cross(camera.up).normalize();
-    let aspect = w as f32 / h as f32;
-    match camera.projection {
-        Projection::Perspective { yfov } => {
-            let t = (yfov * 0.5).tan();
-            let d = camera.forward + right * (ndc.x * t * aspect) + camera.up * (ndc.y * t);
-            (camera.position, d.normalize())
-        }
-        Projection::Orthographic { ymag, .. } => (
-            camera.position + right * (ndc.x * ymag * aspect) + camera.up * (ndc.y * ymag),
-            camera.forward,
-        ),
-    }
 }
 
 /// The nearest triangle or point disc hit along the ray: the point and the surface's normal

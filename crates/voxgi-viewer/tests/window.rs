@@ -601,20 +601,22 @@ fn the_panel_is_resized_by_its_edge() {
     // step in frames of its own (one frame's events at once are a click): egui must see the
     // pointer over the edge in one frame, pressed in a later one and moved in later ones
     // still. The screenshot's 60 frames leave room for the drag's dozen or so.
-    let mut steps = vec![
-        (
-            vec!["mousemove", "--window", &w, "258", "200"],
-            "PointerMoved",
-        ),
-        (vec!["mousedown", "1"], "pressed: true"),
-    ];
+    viewer.input(
+        &x,
+        &["mousemove", "--window", &w, "258", "200"],
+        "PointerMoved",
+        1,
+    );
+    viewer.input(&x, &["mousedown", "1"], "pressed: true", 1);
     for to in ["270", "300", "330", "360", "380", "400"] {
-        steps.push((vec!["mousemove", "--window", &w, to, "200"], "PointerMoved"));
+        viewer.input(
+            &x,
+            &["mousemove", "--window", &w, to, "200"],
+            "PointerMoved",
+            1,
+        );
     }
-    steps.push((vec!["mouseup", "1"], "pressed: false"));
-    for (args, event) in steps {
-        viewer.input(&x, &args, event, 1);
-    }
+    viewer.input(&x, &["mouseup", "1"], "pressed: false", 1);
     viewer.finish();
     let img = image::open(&png).expect("the screenshot").to_rgb8();
     // Between 300 and 380 points: the panel's flat dark grey (27 of 255) where the picture was:

@@ -9,6 +9,7 @@ use super::{GpuParams, PATHS_PER_SUBMIT, PathTracer, bounce_limits};
 use crate::frame::sequence::radical_inverse;
 use crate::gpu::{checked, layout, readback, shader};
 use crate::lighting::cones::cone_uniforms;
+use crate::scene::{Camera, Projection};
 use crate::{Bounces, Error, Renderer, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
@@ -33,6 +34,27 @@ pub struct TracedCone {
     pub radiance: Vec3,
     /// Opacity gathered along it; 1 - opacity is its transmittance.
     pub opacity: f32,
+}
+
+/// The ray through the centre of pixel (x, y) of a `size` image seen by `camera`.
+pub fn pixel_ray(camera: &Camera, (x, y): (u32, u32), (w, h): (u32, u32)) -> (Vec3, Vec3) {
+    let ndc = Vec2::new(
+        (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+        1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+    );
+    let right = camera.forward.cross(camera.up).normalize();
+    let aspect = w as f32 / h as f32;
+    match camera.projection {
+        Projection::Perspective { yfov } => {
+            let t = (yfov * 0.5).tan();
+            let d = camera.forward + right * (ndc.x * t * aspect) + camera.up * (ndc.y * t);
+            (camera.position, d.normalize())
+        }
+        Projection::Orthographic { ymag, .. } => (
+            camera.position + right * (ndc.x * ymag * aspect) + camera.up * (ndc.y * ymag),
+            camera.forward,
+        ),
+    }
 }
 
 /// `n` turns of the cone bundle spread as the gather's pixels spread theirs: the points of a

@@ -4,7 +4,7 @@
 
 use crate::common::*;
 use voxgi::reference::probe::{
-    ConeQuery, ConeTruth, TracedCone, hammersley_turns, trace_diffuse_cones,
+    ConeQuery, ConeTruth, TracedCone, hammersley_turns, pixel_ray, trace_diffuse_cones,
 };
 use voxgi::scene::Scene;
 use voxgi::scene::builtin;
@@ -232,7 +232,6 @@ fn quarter_cones_pass_the_light_a_block_lets_by() {
 /// 0.90 to 1.09 of its cones' integral. 128x128 at 64³, 64 frames, the indirect view.
 #[test]
 fn a_converged_still_gathers_its_cones_integral_at_every_pixel() {
-    use voxgi::scene::Projection;
     let scene = builtin::cornell_box();
     let options = RendererOptions {
         voxel_resolution: 64,
@@ -246,13 +245,8 @@ fn a_converged_still_gathers_its_cones_integral_at_every_pixel() {
         ..FrameParams::new(cam.clone())
     };
     let still = headless::render_still(ctx(), &mut r, &params, w, h, 64).expect("still");
-    let Projection::Perspective { yfov } = cam.projection else {
-        panic!("the Cornell box's camera is a perspective one");
-    };
     let ceiling = scene.bounds().max.y;
     let albedo = Vec3::from(builtin::CORNELL_WHITE);
-    let right = cam.forward.cross(cam.up).normalize();
-    let t = (yfov * 0.5).tan();
     // Two 4x4 blocks across and one down each, on the ceiling: beside the open front at the
     // right and in the middle, and right of the lamp, nearer the back wall.
     for (x0, y0) in [(88, 3), (56, 3), (80, 19)] {
@@ -261,14 +255,9 @@ fn a_converged_still_gathers_its_cones_integral_at_every_pixel() {
             .collect();
         let points: Vec<(Vec3, Vec3)> = pixels
             .iter()
-            .map(|&(x, y)| {
-                let ndc = (
-                    (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-                    1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
-                );
-                let d = cam.forward + right * (ndc.0 * t) + cam.up * (ndc.1 * t);
-                let p = cam.position + d * ((ceiling - cam.position.y) / d.y);
-                (p, -Vec3::Y)
+            .map(|&px| {
+                let (o, d) = pixel_ray(&cam, px, (w, h));
+                (o + d * ((ceiling - o.y) / d.y), -Vec3::Y)
             })
             .collect();
         let turns = hammersley_turns(64);
