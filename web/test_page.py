@@ -328,8 +328,10 @@ def main():
         # A moving frame re-voxelizes the block and bounces twice: seconds on SwiftShader,
         # and the animation advances at most a quarter of a second a frame. Two frames
         # straddling the block's turn show it where it was (the lamp waits the first four
-        # seconds): of three spans of two frames in a row, one moves it by centimetres.
-        moving = change_over_frames(page, f"{out}/moving", spans=3)
+        # seconds), but the turns are two seconds apart: of two spans of two frames in a row,
+        # one is centred half a second or more from a turn and moves the block by 4 cm or
+        # more (it swings 7.5 cm either way).
+        moving = change_over_frames(page, f"{out}/moving", spans=2)
         # Paused (Space), the same frames' difference is the accumulation's noise alone.
         page.keyboard.press("Space")
         play = page.evaluate("document.getElementById('play').textContent")

@@ -55,6 +55,8 @@ fn the_web_page_renders_the_cornell_box_in_chromium() {
     let built = Command::new("bash")
         .arg(root.join("web/build.sh"))
         .arg(&out)
+        // The glue generator `cargo test` built with the workspace: no second native build.
+        .env("WEB_BINDGEN", env!("CARGO_BIN_EXE_web-bindgen"))
         .status()
         .expect("bash runs web/build.sh");
     assert!(built.success(), "web/build.sh failed ({built})");
