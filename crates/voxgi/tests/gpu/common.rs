@@ -113,16 +113,14 @@ pub fn render_with(
     frame(&mut renderer(scene, options), params, w, h)
 }
 
-/// The camera ray through the centre of pixel (x, y), as the renderer's projection makes it.
+/// The direction of the camera ray through the centre of pixel (x, y), as the renderer's
+/// projection makes it (`voxgi::reference::probe::pixel_ray`); the ray starts at the camera.
 pub fn pixel_ray(cam: &Camera, w: u32, h: u32, x: u32, y: u32) -> Vec3 {
-    let voxgi::scene::Projection::Perspective { yfov } = cam.projection else {
-        panic!("perspective cameras only");
-    };
-    let t = (yfov * 0.5).tan();
-    let ndc_x = (x as f32 + 0.5) / w as f32 * 2.0 - 1.0;
-    let ndc_y = 1.0 - (y as f32 + 0.5) / h as f32 * 2.0;
-    let right = cam.forward.cross(cam.up).normalize();
-    (cam.forward + right * ndc_x * t * (w as f32 / h as f32) + cam.up * ndc_y * t).normalize()
+    assert!(
+        matches!(cam.projection, voxgi::scene::Projection::Perspective { .. }),
+        "perspective cameras only"
+    );
+    voxgi::reference::probe::pixel_ray(cam, (x, y), (w, h)).1
 }
 
 /// Where the ray through pixel (x, y) meets the plane y = 0.
