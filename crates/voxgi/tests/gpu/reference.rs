@@ -37,6 +37,20 @@ pub(crate) fn trace_with(
         .expect("reference render")
 }
 
+/// The built-in Cornell box from its camera, path-traced at 64² with 128 spp and two bounces
+/// under the default settings (ACES): what the cone-traced Cornell box and its variants
+/// (vct.rs, `cornell_variant_against_the_path_tracer`) are measured against. Traced once for
+/// the whole binary; the tests that share it ask for the same image.
+pub(crate) fn cornell_reference() -> &'static RenderOutput {
+    static REFERENCE: std::sync::OnceLock<RenderOutput> = std::sync::OnceLock::new();
+    REFERENCE.get_or_init(|| {
+        let scene = builtin::cornell_box();
+        let params = FrameParams::new(scene.cameras[0].clone());
+        let opts = opts(128, Bounces::Exactly(2));
+        trace_with(&scene, &RendererOptions::default(), &params, 64, 64, opts)
+    })
+}
+
 pub(crate) fn opts(spp: u32, bounces: Bounces) -> ReferenceOptions {
     ReferenceOptions {
         spp,
@@ -399,21 +413,15 @@ fn cone_traced_cornell_box_agrees_with_the_path_tracer() {
     // The default settings (128³, two bounces).
     let settings = RendererOptions::default();
     let aces = FrameParams::new(cam.clone());
-    let pt = trace_with(
-        &scene,
-        &settings,
-        &aces,
-        w,
-        h,
-        opts(128, Bounces::Exactly(2)),
-    );
+    let pt = cornell_reference();
+    assert_eq!((pt.width, pt.height), (w, h));
     for &kind in VoxelKind::ALL {
         let settings = RendererOptions {
             voxels: kind,
             ..settings.clone()
         };
         let vct = render_with(&scene, &settings, &aces, w, h);
-        agrees_with_the_path_tracer(kind, &pt, &vct, w, h);
+        agrees_with_the_path_tracer(kind, pt, &vct, w, h);
     }
 }
 

@@ -703,14 +703,13 @@ pub(crate) fn cornell_variant_against_the_path_tracer(
     change: impl Fn(&mut RendererOptions),
 ) -> Vec<voxgi::RenderOutput> {
     use crate::point_gi::CORNELL_REGIONS;
-    use crate::reference::{opts, region, trace_with};
+    use crate::reference::{cornell_reference, region};
     use voxgi::compare::{Image, compare};
     let scene = builtin::cornell_box();
     let (w, h) = (64, 64);
     let settings = RendererOptions::default();
     let params = voxgi::FrameParams::new(scene.cameras[0].clone());
-    let spp = opts(128, voxgi::Bounces::Exactly(2));
-    let pt = trace_with(&scene, &settings, &params, w, h, spp);
+    let pt = cornell_reference();
     let ldr = |o: &voxgi::RenderOutput| Image::from_ldr_rgba8(w, h, &o.ldr);
     let mut renders = Vec::new();
     // The plain gather's own figures are `cone_traced_cornell_box_agrees_with_the_path_tracer`'s.
@@ -721,13 +720,13 @@ pub(crate) fn cornell_variant_against_the_path_tracer(
         };
         change(&mut changed);
         let b = render_with(&scene, &changed, &params, w, h);
-        let cb = compare(&ldr(&pt), &ldr(&b)).unwrap();
+        let cb = compare(&ldr(pt), &ldr(&b)).unwrap();
         eprintln!(
             "Cornell box ({kind:?}): mean FLIP against the path tracer {:.3} with {what}",
             cb.flip_mean
         );
         for (name, r) in CORNELL_REGIONS {
-            let got = region(&b, r.0, r.1, r.2, r.3) / region(&pt, r.0, r.1, r.2, r.3);
+            let got = region(&b, r.0, r.1, r.2, r.3) / region(pt, r.0, r.1, r.2, r.3);
             eprintln!("{name} ({kind:?}): {what} / path tracer {got:.3}");
             let tolerance = if name == "ceiling" { 0.5 } else { 0.12 };
             assert!(
