@@ -706,10 +706,10 @@ pub(crate) fn cornell_variant_against_the_path_tracer(
     use crate::reference::{cornell_reference, region};
     use voxgi::compare::{Image, compare};
     let scene = builtin::cornell_box();
-    let (w, h) = (64, 64);
     let settings = RendererOptions::default();
     let params = voxgi::FrameParams::new(scene.cameras[0].clone());
     let pt = cornell_reference();
+    let (w, h) = (pt.width, pt.height);
     let ldr = |o: &voxgi::RenderOutput| Image::from_ldr_rgba8(w, h, &o.ldr);
     let mut renders = Vec::new();
     // The plain gather's own figures are `cone_traced_cornell_box_agrees_with_the_path_tracer`'s.
