@@ -93,12 +93,14 @@ fn border_weight(uvw: vec3<f32>, lod: f32, resolution: f32) -> f32 {
     return f.x * f.y * f.z;
 }
 
-// Radiance textures hold optical depth, not opacity: (L sigma, sigma) per texel length, with
-// sigma = -ln(1 - alpha). Depth is what trilinear filtering may interpolate: opacity
-// interpolated between an opaque texel and an empty one thins a wall into a ramp that a cone
-// crosses with e^-2 (13 %) of its light left however finely it steps (a closed box lost 16 %
-// of its one-bounce light). Compositing and the filter work on premultiplied opacity; these
-// convert at the texture's edge.
+// The finest radiance level holds optical depth, not opacity: (L sigma, sigma) per texel
+// length, with sigma = -ln(1 - alpha). Depth is what interpolation along a cone may average:
+// opacity interpolated between an opaque texel and an empty one thins a wall into a ramp that a
+// cone crosses with e^-2 of its light left however finely it steps. Across a cone opacity is
+// what averages right (a texel beside an empty one passes half the rays, its depth halved far
+// fewer), so the levels above hold premultiplied opacity and samples read them along each
+// direction's axis in depth (voxels/dense/windows.wgsl, `chain_along`). Compositing and the
+// filter work on premultiplied opacity; these convert at the texture's edge.
 const MAX_OPACITY: f32 = 0.999;
 
 // Premultiplied (L alpha, alpha) to stored (L sigma, sigma).
@@ -113,4 +115,19 @@ fn from_depth(v: vec4<f32>) -> vec4<f32> {
     let sigma = max(v.a, 0.0);
     let a = 1.0 - exp(-sigma);
     return vec4<f32>(v.rgb * (a / max(sigma, 1e-6)), a);
+}
+
+// The axis a sample along `dir` reads an isotropic block along: dir's largest component (ties:
+// x, then y).
+fn main_axis(dir: vec3<f32>) -> u32 {
+    let a = abs(dir);
+    return select(select(2u, 1u, a.y >= a.z), 0u, a.x >= a.y && a.x >= a.z);
+}
+
+// The weights of the three axes a sample along `dir` reads: the squared direction cosines
+// (they sum to 1; seed 000 §9) where the blocks are directional; an isotropic block is read
+// along `main_axis` alone.
+fn axis_weights(dir: vec3<f32>, directional: bool) -> vec3<f32> {
+    let along = vec3<u32>(main_axis(dir)) == vec3<u32>(0u, 1u, 2u);
+    return select(select(vec3<f32>(0.0), vec3<f32>(1.0), along), dir * dir, directional);
 }

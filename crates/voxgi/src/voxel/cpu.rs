@@ -77,7 +77,8 @@ pub fn from_depth(v: Vec4) -> Vec4 {
 }
 
 /// One filtering step for one parent voxel, as `filter.wgsl` does it, on premultiplied
-/// values (the textures store optical depth: convert with `from_depth` and `to_depth`). `children[i]` is the
+/// values (the chains store them; the finest level stores optical depth: convert it with
+/// `from_depth`). `children[i]` is the
 /// child at offset (i & 1, (i >> 1) & 1, i >> 2); `dir` is None for the isotropic mean or
 /// Some(0..6) for +X, -X, +Y, -Y, +Z, -Z.
 pub fn filter_parent(children: &[Vec4; 8], dir: Option<u32>) -> Vec4 {
@@ -175,7 +176,8 @@ pub struct DenseSampler<'a> {
     pub windows: u32,
     /// The finest level: stored (L sigma, sigma) per voxel.
     pub radiance0: &'a Texture3d,
-    /// The levels above the finest, from half the resolution down: stored (L sigma, sigma).
+    /// The levels above the finest, from half the resolution down: stored premultiplied
+    /// (L alpha, alpha).
     pub chains: &'a Texture3d,
 }
 
@@ -188,46 +190,74 @@ impl DenseSampler<'_> {
         uvw.cmpge(Vec3::ZERO).all() && uvw.cmple(Vec3::ONE).all()
     }
 
-    /// `sample_chains` of window `win`, with every axis read (`SAMPLE_AXES` = 3).
-    fn chains(&self, uvw: Vec3, cl: f32, dir: Vec3, win: u32) -> Vec4 {
-        let levels = self.grid.levels() as f32;
-        let upper = (cl.floor() + 1.0).min(levels - 2.0);
-        let texels = ((self.grid.resolution / 2) as f32 * (-upper).exp2()).max(1.0);
-        let z = uvw.z.clamp(0.5 / texels, 1.0 - 0.5 / texels);
-        let (window, windows) = (win as f32, self.windows as f32);
-        if !self.anisotropic {
-            return self
-                .chains
-                .sample(Vec3::new(uvw.x, uvw.y, (window + z) / windows), cl);
-        }
-        // Each direction's block holds every window: block b, window w at b · windows + w.
-        let block = Vec3::new(
-            if dir.x >= 0.0 { 0.0 } else { 1.0 },
-            if dir.y >= 0.0 { 2.0 } else { 3.0 },
-            if dir.z >= 0.0 { 4.0 } else { 5.0 },
-        ) * windows
-            + window;
-        let w = dir * dir;
-        let at = |b: f32| {
-            self.chains
-                .sample(Vec3::new(uvw.x, uvw.y, (z + b) / (6.0 * windows)), cl)
+    /// `chain_along`: block `b` (counted with its window, of `blocks`) at chain level `c`, seen
+    /// along `axis`: the two layers of texels around `uvw` along it, each turned to optical
+    /// depth, interpolated.
+    fn chain_along(&self, uvw: Vec3, c: usize, b: f32, blocks: f32, axis: usize) -> Vec4 {
+        let n = ((self.grid.resolution / 2) as f32 * (-(c as f32)).exp2()).max(1.0);
+        let lo = 0.5 / n;
+        let p = uvw[axis] * n - 0.5;
+        let layer = p.floor();
+        let mut q0 = uvw.clamp(Vec3::splat(lo), Vec3::splat(1.0 - lo));
+        let mut q1 = q0;
+        q0[axis] = ((layer + 0.5) / n).clamp(lo, 1.0 - lo);
+        q1[axis] = ((layer + 1.5) / n).clamp(lo, 1.0 - lo);
+        let at = |q: Vec3| {
+            to_depth(
+                self.chains
+                    .sample_at(c, Vec3::new(q.x, q.y, (q.z + b) / blocks)),
+            )
         };
-        w.x * at(block.x) + w.y * at(block.y) + w.z * at(block.z)
+        at(q0).lerp(at(q1), p - layer)
     }
 
-    /// `window_depth`: optical depth at `uvw` over window `win`, filtered to `lod` levels
-    /// above its finest, seen along `dir`.
-    pub fn window_depth(&self, uvw: Vec3, lod: f32, dir: Vec3, win: u32) -> Vec4 {
-        let n = self.grid.resolution as f32;
-        let inside = if self.windows > 1 {
-            uvw.z.clamp(0.5 / n, 1.0 - 0.5 / n)
+    /// `sample_chains` of window `win` at chain level `cl` (an integer), with every axis read
+    /// (`SAMPLE_AXES` = 3).
+    fn chains(&self, uvw: Vec3, cl: usize, dir: Vec3, win: u32) -> Vec4 {
+        let (window, windows) = (win as f32, self.windows as f32);
+        let a = dir.abs();
+        let w = if self.anisotropic {
+            dir * dir
+        } else if a.x >= a.y && a.x >= a.z {
+            Vec3::X
+        } else if a.y >= a.z {
+            Vec3::Y
         } else {
-            uvw.z
+            Vec3::Z
         };
-        let z = (win as f32 + inside) / self.windows as f32;
-        let fine = self.radiance0.sample(Vec3::new(uvw.x, uvw.y, z), 0.0);
-        let coarse = self.chains(uvw, (lod - 1.0).max(0.0), dir, win);
-        fine.lerp(coarse, lod.min(1.0))
+        // Each direction's block holds every window: block b, window w at b · windows + w.
+        let (block, blocks) = if self.anisotropic {
+            let block = Vec3::new(
+                if dir.x >= 0.0 { 0.0 } else { 1.0 },
+                if dir.y >= 0.0 { 2.0 } else { 3.0 },
+                if dir.z >= 0.0 { 4.0 } else { 5.0 },
+            );
+            (block * windows + window, 6.0 * windows)
+        } else {
+            (Vec3::splat(window), windows)
+        };
+        (0..3)
+            .filter(|&axis| w[axis] > 0.0)
+            .map(|axis| w[axis] * self.chain_along(uvw, cl, block[axis], blocks, axis))
+            .sum()
+    }
+
+    /// `window_depth`: optical depth at `uvw` over window `win`, at the level nearest `lod`
+    /// levels above its finest, seen along `dir`.
+    pub fn window_depth(&self, uvw: Vec3, lod: f32, dir: Vec3, win: u32) -> Vec4 {
+        if lod < 0.5 {
+            let n = self.grid.resolution as f32;
+            let inside = if self.windows > 1 {
+                uvw.z.clamp(0.5 / n, 1.0 - 0.5 / n)
+            } else {
+                uvw.z
+            };
+            let z = (win as f32 + inside) / self.windows as f32;
+            return self.radiance0.sample(Vec3::new(uvw.x, uvw.y, z), 0.0);
+        }
+        let top = self.grid.levels() as f32 - 2.0;
+        let cl = (lod - 1.0 + 0.5).floor().clamp(0.0, top) as usize;
+        self.chains(uvw, cl, dir, win)
     }
 
     /// `sample_depth`: optical depth per sample diameter, filtered to `diameter`.

@@ -78,10 +78,10 @@ fn cones_in_a_closed_box_see_its_uniform_light() {
         eprintln!("closed box, point {i}: cones pass {leak:.4} on average, {most:.4} at most");
         // Nothing escapes a closed box, and no path does. A cone that crosses a wall
         // obliquely weighs the wall's depth by its squared direction cosine along the wall's
-        // normal (the three directional blocks), not by the longer path: such cones pass a
-        // few per cent (measured 1.6 and 1.8 % on average over 96 cones, at most 12 %, at
-        // 32³). 3 % on average holds that; a cone that left through a wall
-        // would pass most of its light.
+        // normal (the three directional blocks), not by the longer path, and a sample astride
+        // a corner averages the coverage across it: such cones pass a few per cent at 32³
+        // (docs/QUALITY.md has the figures). 3 % on average holds that; a cone that left
+        // through a wall would pass most of its light.
         assert!(leak < 0.03, "point {i}: the cones pass {leak} on average");
         assert!(
             truth.iter().all(|t| t.escaped == 0.0),
@@ -206,20 +206,18 @@ fn quarter_cones_pass_the_light_a_block_lets_by() {
         "back wall's normal cone passes: quarters {quarters:.3}, whole footprint {whole:.3}, \
          path tracer's rays escape {escaped:.3}"
     );
-    // Measured at 64³: quarters 0.435, whole 0.248, the path tracer 0.549 (0.419 and 0.215
-    // before samples at the volume's faces were weighed by their share inside it; at 128³
-    // 0.436, 0.225 and 0.545 before that). A quarter still composites its own partial coverage, so it passes
-    // less than the rays; 0.7 to 1.05 of them holds it with room for the 256 paths' noise.
-    // Whole footprints pass under half: the double count the quarters exist for (and the
-    // proof that `cone_quarters: false` reaches the shader).
+    // A quarter still composites its own partial coverage, so it passes less than the rays;
+    // 0.7 to 1.05 of them holds it with room for the 256 paths' noise (docs/QUALITY.md has
+    // the figures). Whole footprints pass well under what the quarters pass: the double count
+    // the quarters exist for (and the proof that `cone_quarters: false` reaches the shader).
     let ratio = quarters / escaped;
     assert!(
         (0.7..1.05).contains(&ratio),
         "quarters pass {quarters}, the path tracer's rays escape {escaped}"
     );
     assert!(
-        whole < 0.5 * escaped,
-        "whole footprints pass {whole}, the path tracer's rays escape {escaped}"
+        whole < 0.8 * quarters,
+        "whole footprints pass {whole}, quarters {quarters}, the path tracer's rays escape {escaped}"
     );
 }
 

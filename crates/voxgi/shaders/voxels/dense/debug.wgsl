@@ -53,7 +53,8 @@ fn cell_value(c: vec3<i32>) -> vec4<f32> {
     }
     let n = i32(vol.resolution) >> params.level;
     let block = n * i32(vol.windows) * i32(params.block);
-    return from_depth(textureLoad(chain, in_window(c, n) + vec3<i32>(0, 0, block), i32(params.level) - 1));
+    // The chains store premultiplied opacity, the finest level optical depth.
+    return textureLoad(chain, in_window(c, n) + vec3<i32>(0, 0, block), i32(params.level) - 1);
 }
 
 // Finest albedo under the coarse cell `cell` (of `scale` finest voxels per side) that the ray

@@ -48,8 +48,11 @@ struct FilterParams {
 // The volume's counters: the levels' bits and lists (changed.wgsl).
 @group(0) @binding(6) var<storage, read_write> counters: array<atomic<u32>>;
 
+// A child, premultiplied: the finest level stores optical depth, the chains opacity
+// (shared/volume.wgsl says why).
 fn child(base: vec3<i32>, o: vec3<i32>) -> vec4<f32> {
-    return from_depth(textureLoad(src, base + o, 0));
+    let v = textureLoad(src, base + o, 0);
+    return select(from_depth(v), v, params.src_blocked != 0u);
 }
 
 // A finest voxel as direction `block` counts it: its Lambertian light (weighed by its normals
@@ -135,7 +138,7 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
         for (var i = 0; i < 8; i++) {
             sum += child(base, vec3<i32>(i & 1, (i >> 1) & 1, (i >> 2) & 1));
         }
-        textureStore(dst, id, to_depth(sum * 0.125));
+        textureStore(dst, id, sum * 0.125);
         return;
     }
     let axis = i32(block / 2u);
@@ -154,7 +157,7 @@ fn filter_voxel(gid: vec3<u32>, block: u32) {
         let b = leaf_child(base, back, block);
         sum += f + (1.0 - f.a) * b;
     }
-    textureStore(dst, id, to_depth(sum * 0.25));
+    textureStore(dst, id, sum * 0.25);
 }
 
 // Twin: `Filtering::blocks`. The lobe chain's blocks come after the six directions.

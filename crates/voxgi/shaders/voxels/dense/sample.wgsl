@@ -46,9 +46,10 @@ fn sample_depth(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
 fn sample_depth_wide(pos: vec3<f32>, diameter: f32, dir: vec3<f32>) -> vec4<f32> {
     let uvw = volume_uvw(pos);
     let lod = clamp(log2(diameter / vol.voxel_size), 1.0, f32(vol.levels - 1u));
-    var s = sample_chains(uvw, lod - 1.0, dir, 0u);
+    let cl = nearest_chain(lod - 1.0);
+    var s = sample_chains(uvw, cl, dir, 0u);
     if LOBE_CHAIN {
-        s = with_lobes(s, uvw, lod - 1.0, dir, 0u, 1.0);
+        s = with_lobes(s, uvw, cl, dir, 0u, 1.0);
     }
     return select(vec4<f32>(0.0), s * border_weight(uvw, lod, f32(vol.resolution)), inside_volume(uvw));
 }

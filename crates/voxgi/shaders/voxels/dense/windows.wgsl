@@ -24,15 +24,17 @@
 const WIDE_SAMPLE: f32 = 2.0;
 
 // Optical depth (L sigma, sigma) at `uvw` (in [0, 1]^3 over window `w`) filtered to `lod`
-// levels above its finest (0 ..= levels - 1), seen along `dir`.
+// levels above its finest (0 ..= levels - 1), seen along `dir`: the level nearest `lod`, not a
+// blend of the two around it. Levels blended in depth saturate as the filter across a cone
+// does (`chain_along`); blended as opacities, the finest level's depth would be lost.
 fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32> {
     // Half a texel inside the window, so the filter never blends the next one's voxels.
     let inside = clamp(uvw.z, 0.5 / f32(vol.resolution), 1.0 - 0.5 / f32(vol.resolution));
     let z = (f32(win) + select(uvw.z, inside, vol.windows > 1u)) / f32(vol.windows);
     let fine = textureSampleLevel(radiance0, voxel_sampler, vec3<f32>(uvw.xy, z), 0.0);
-    let coarse = sample_chains(uvw, max(lod - 1.0, 0.0), dir, win);
-    // Only between the finest level and the first coarse one is the finest level read.
-    let s = mix(fine, coarse, min(lod, 1.0));
+    let cl = nearest_chain(lod - 1.0);
+    let coarse = sample_chains(uvw, cl, dir, win);
+    let s = select(fine, coarse, lod >= 0.5);
     if !LOBE_CHAIN {
         return s;
     }
@@ -40,12 +42,17 @@ fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
     // level's lobes wherever it sees a surface. Faded in as the chain is, a quarter cone's
     // narrow samples near a metal saw its leaves black (diffuse albedo 0) and little of what
     // it reflects (docs/QUALITY.md, "Specular light in the bounces").
-    return with_lobes(s, uvw, max(lod - 1.0, 0.0), dir, win, 1.0);
+    return with_lobes(s, uvw, cl, dir, win, 1.0);
 }
 
-// Sample `s` (optical depth, seen along `dir`) with the light the lobes of chain level `cl`
-// send back along the cone, times `weight`: radiance per covered area, as opaque as the sample
-// is along dir (L sigma gains L_lobe sigma).
+// The chain level (an integer) nearest chain level `cl`, inside the chains.
+fn nearest_chain(cl: f32) -> f32 {
+    return clamp(floor(cl + 0.5), 0.0, f32(vol.levels - 2u));
+}
+
+// Sample `s` (optical depth, seen along `dir`) with the light the lobes of chain level `cl` (an
+// integer) send back along the cone, times `weight`: radiance per covered area, as opaque as
+// the sample is along dir (L sigma gains L_lobe sigma).
 fn with_lobes(s: vec4<f32>, uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32, weight: f32) -> vec4<f32> {
     let z = chain_z(uvw.z, cl);
     let blocks = f32(LOBE_DIRECTION + 1u) * f32(vol.windows);
@@ -69,21 +76,41 @@ override ISOTROPIC_ONLY: bool = false;
 // or 2, the two of largest weight (a third fewer fetches).
 override SAMPLE_AXES: u32 = 3u;
 
-// A window's z at chain level `cl`, kept half a texel inside it at the coarser of the two levels
-// read, so the trilinear filter never blends a neighbouring window's or block's texels.
+// A window's z at chain level `cl` (an integer), kept half a texel inside it, so the trilinear
+// filter never blends a neighbouring window's or block's texels.
 fn chain_z(z: f32, cl: f32) -> f32 {
-    let upper = min(floor(cl) + 1.0, f32(vol.levels - 2u));
-    let texels = max(f32(vol.resolution / 2u) * exp2(-upper), 1.0);
+    let texels = max(f32(vol.resolution / 2u) * exp2(-cl), 1.0);
     return clamp(z, 0.5 / texels, 1.0 - 0.5 / texels);
 }
 
-// The directional chains of window `w` at chain level `cl` (the volume's level cl + 1).
+// Block `b` (counted with its window, of `blocks` stacked along z) at chain level `c` (an
+// integer), seen along `axis`: two filtered fetches at the centres of the two layers of texels
+// around `uvw` along the axis, each turned to optical depth, interpolated between them. The
+// chains store premultiplied opacity, so across the axis the sampler averages coverage (a
+// texel beside an empty one passes half the rays it covers, not the few that its depth averaged
+// with nothing lets through); along it a wall crossed keeps its whole depth. Each layer's
+// position is kept half a texel inside the window, as the sampler's own would be clamped.
+fn chain_along(uvw: vec3<f32>, c: f32, b: f32, blocks: f32, axis: u32) -> vec4<f32> {
+    let n = max(f32(vol.resolution / 2u) * exp2(-c), 1.0);
+    let lo = 0.5 / n;
+    let p = uvw[axis] * n - 0.5;
+    let layer = floor(p);
+    var q0 = clamp(uvw, vec3<f32>(lo), vec3<f32>(1.0 - lo));
+    var q1 = q0;
+    q0[axis] = clamp((layer + 0.5) / n, lo, 1.0 - lo);
+    q1[axis] = clamp((layer + 1.5) / n, lo, 1.0 - lo);
+    let s0 = textureSampleLevel(chains, voxel_sampler, vec3<f32>(q0.xy, (q0.z + b) / blocks), c);
+    let s1 = textureSampleLevel(chains, voxel_sampler, vec3<f32>(q1.xy, (q1.z + b) / blocks), c);
+    return mix(to_depth(s0), to_depth(s1), p - layer);
+}
+
+// The directional chains of window `w` at chain level `cl` (an integer: the volume's level
+// cl + 1).
 fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32> {
-    let z = chain_z(uvw.z, cl);
     let window = f32(win);
     let windows = f32(vol.windows);
     if ISOTROPIC_ONLY {
-        return textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (window + z) / windows), cl);
+        return chain_along(uvw, cl, window, windows, main_axis(dir));
     }
     // In isotropic mode the one block serves every axis.
     let aniso = vol.anisotropic != 0u;
@@ -96,23 +123,24 @@ fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
     let blocks = f32(select(select(1u, 6u, aniso), LOBE_DIRECTION + 1u, vol.anisotropic == 2u)) * windows;
     // Each direction's block holds every window: block b, window w at b * windows + w.
     let first = block * windows + window;
-    // Weighted by the squared direction cosines (they sum to 1).
-    let w = dir * dir;
+    let w = axis_weights(dir, aniso);
     if SAMPLE_AXES == 2u {
         // The two axes of largest weight, renormalised: the third weighs at most a third, and
         // its block is then assumed to hold the others' weighted mean.
         let drop_x = w.x <= w.y && w.x <= w.z;
         let drop_y = !drop_x && w.y <= w.z;
+        let a0 = select(0u, 1u, drop_x);
         let b0 = select(first.x, first.y, drop_x);
         let w0 = select(w.x, w.y, drop_x);
+        let a1 = select(select(1u, 2u, drop_y), 2u, drop_x);
         let b1 = select(select(first.y, first.z, drop_y), first.z, drop_x);
         let w1 = select(select(w.y, w.z, drop_y), w.z, drop_x);
-        let s0 = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + b0) / blocks), cl);
-        let s1 = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + b1) / blocks), cl);
+        let s0 = chain_along(uvw, cl, b0, blocks, a0);
+        let s1 = chain_along(uvw, cl, b1, blocks, a1);
         return (w0 * s0 + w1 * s1) / max(w0 + w1, 1e-6);
     }
-    let x = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first.x) / blocks), cl);
-    let y = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first.y) / blocks), cl);
-    let zz = textureSampleLevel(chains, voxel_sampler, vec3<f32>(uvw.xy, (z + first.z) / blocks), cl);
+    let x = chain_along(uvw, cl, first.x, blocks, 0u);
+    let y = chain_along(uvw, cl, first.y, blocks, 1u);
+    let zz = chain_along(uvw, cl, first.z, blocks, 2u);
     return w.x * x + w.y * y + w.z * zz;
 }

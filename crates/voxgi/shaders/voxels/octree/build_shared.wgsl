@@ -493,8 +493,9 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     atomicStore(&slots[base + 5u], pack2x16float(vec2<f32>(a.emission.b, a.surface)));
 }
 
-// Writes `v` (stored optical depth) as the value of octant `o` of node m's brick, holding level
-// `lvl`, direction block `block`: into m's brick and the positive borders of the bricks of m's
+// Writes `v` (as stored: optical depth at level 0, premultiplied opacity above; the clears'
+// zero is empty in both) as the value of octant `o` of node m's brick, holding level `lvl`,
+// direction block `block`: into m's brick and the positive borders of the bricks of m's
 // negative neighbours that hold it (as the filter and the leaf store do).
 fn store_value(m: u32, o: u32, lvl: u32, block: u32, v: vec4<f32>) {
     let x = neighbour(m, 0u);

@@ -58,10 +58,14 @@ fn cell_value(c: vec3<u32>, lvl: u32) -> vec4<f32> {
     }
     let block = select(dir_block(tree, params.block), 0u, lvl == 0u);
     let p = brick_texel(atlas_shape(tree, lvl), brick_index(tree, tile, lvl), block) + (c & vec3<u32>(1u));
-    if (lvl & 1u) == 0u {
+    // Level 0 stores optical depth; the levels above, premultiplied opacity.
+    if lvl == 0u {
         return from_depth(textureLoad(even_atlas, p, 0));
     }
-    return from_depth(textureLoad(odd_atlas, p, 0));
+    if (lvl & 1u) == 0u {
+        return textureLoad(even_atlas, p, 0);
+    }
+    return textureLoad(odd_atlas, p, 0);
 }
 
 // Whether the node of level `lvl`'s cell c (a node of depth D - lvl) has children.

@@ -6,6 +6,10 @@
 // mode; per direction, front-to-back pairs along it averaged, otherwise. Level k - 1 is read
 // from one atlas and level k written into the other (they alternate by level).
 //
+// Level 0 stores optical depth (the leaf store's); the levels written here store premultiplied
+// opacity (L alpha, alpha), which voxels/octree/sample.wgsl converts to depth after each fetch,
+// so that a fetch averages coverage, not depth, across its texels.
+//
 // Only flagged nodes are redone (voxels/octree/tree.wgsl's FLAG_SHIFT): a node's value
 // depends on its children's brick alone (and, for the first level, their leaves' normals,
 // which change only with their radiance), so an unflagged node's stored value is what the
@@ -45,15 +49,18 @@ fn neighbour(n: u32, axis: u32) -> u32 {
     return nodes[NODE_HEADER + n * NODE_STRIDE + 1u + axis];
 }
 
-fn source(base: vec3<u32>, o: vec3<u32>) -> vec4<f32> {
-    return from_depth(textureLoad(src, base + o, 0));
+// Voxel `o` of the level k - 1 brick at `base`, premultiplied: level 0 stores optical depth,
+// the levels above premultiplied opacity already.
+fn source(base: vec3<u32>, o: vec3<u32>, k: u32) -> vec4<f32> {
+    let v = textureLoad(src, base + o, 0);
+    return select(v, from_depth(v), k == 1u);
 }
 
 // Leaf voxel `o` of the leaf tile `below` (level 0) as direction d counts it: weighed by its
 // normals with `tree.ndf`, as the dense volume's filter weighs its finest voxels, and with what
 // its specular lobe sends that way (voxels/dense/filter.wgsl's `leaf_child`).
 fn leaf_source(base: vec3<u32>, o: vec3<u32>, below: u32, d: u32) -> vec4<f32> {
-    let v = source(base, o);
+    let v = source(base, o, 1u);
     // `filtered` also runs (and is discarded) for nodes without a brick: below 0.
     if below == 0u {
         return v;
@@ -91,7 +98,7 @@ fn lobe_filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
             sum += textureLoad(src, base + o, 0);
             continue;
         }
-        let a = source(base, o).a;
+        let a = source(base, o, 1u).a;
         let word = nodes[child_word(tree, below * 8u + j)];
         if a <= 0.0 || word == 0u {
             continue;
@@ -170,7 +177,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
 }
 
 // The value at level k, direction block d, of the node whose children's brick is `below`
-// (level k - 1): the dense volume's filter over its eight voxels, as stored optical depth.
+// (level k - 1): the dense volume's filter over its eight voxels, as stored: premultiplied.
 fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
     if d >= LOBE_EXITANCE {
         return lobe_filtered(below, k, d);
@@ -181,9 +188,9 @@ fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
     var value = vec4<f32>(0.0);
     if tree.anisotropic == 0u {
         for (var j = 0u; j < 8u; j++) {
-            value += source(base, octant_offset(j));
+            value += source(base, octant_offset(j), k);
         }
-        return to_depth(value * 0.125);
+        return value * 0.125;
     }
     let axis = d / 2u;
     let positive = (d & 1u) == 0u;
@@ -200,12 +207,12 @@ fn filtered(below: u32, k: u32, d: u32) -> vec4<f32> {
             f = leaf_source(base, front, below, d);
             b = leaf_source(base, back, below, d);
         } else {
-            f = source(base, front);
-            b = source(base, back);
+            f = source(base, front, k);
+            b = source(base, back, k);
         }
         value += f + (1.0 - f.a) * b;
     }
-    return to_depth(value * 0.25);
+    return value * 0.25;
 }
 
 // Level D, the volume as one voxel, from the root's brick, into the brick TOP_NODE names (its

@@ -1,13 +1,18 @@
 // The sparse voxel octree's side of the voxel contract (the dense volume's sample.wgsl lists
 // it; the test `every_structure_defines_the_voxel_contract` checks the signatures).
 //
-// A sample at level-of-detail lod blends the two levels around it (quadrilinear): for each,
-// one descent from the top grid to the node whose brick holds the level's voxel under the sample,
-// then trilinear fetches inside that brick (voxels/octree/tree.wgsl has the layout). Both
-// descents run in one loop without branches; a missing child parks a descent on node 1 (an
-// unused node of the root tile whose child pointer stays 0), which reads as empty. Levels
-// alternate between the even and the odd atlas, so of the two levels one is read from each,
-// without a branch.
+// A sample at level-of-detail lod reads the level nearest to it, round(lod): one descent from
+// the top grid to the node whose brick holds that level's voxel under the sample, then
+// trilinear fetches inside that brick (voxels/octree/tree.wgsl has the layout). The descents to
+// both levels around lod run in one loop without branches; a missing child parks a descent on
+// node 1 (an unused node of the root tile whose child pointer stays 0), which reads as empty.
+//
+// Level 0 stores optical depth (L sigma, sigma); the levels above store premultiplied opacity
+// (L alpha, alpha), converted to depth after each fetch. Across a direction block's axis two
+// fetches, one per texel layer, are blended as depth; along the other two axes the trilinear
+// filter averages opacity: partial coverage across the cone counts as partly covered, where
+// depth averaged there saturates (an opaque texel beside an empty one would read nearly opaque
+// halfway). Blending two levels would average depth again: the nearer level is read instead.
 //
 // Everything here reads @group(1) only; `OctreeVolume::sampling_layout` is its twin.
 
@@ -25,7 +30,7 @@
 
 const WIDE_SAMPLE: f32 = 2.0;
 
-// True when the pipeline serves an isotropic octree: one fetch per level instead of three.
+// True when the pipeline serves an isotropic octree: one block read per sample instead of three.
 override ISOTROPIC_ONLY: bool = false;
 // Directional blocks a sample reads: 3, every axis by its weight, or 2, the two of largest
 // weight (as the dense volume's).
@@ -90,47 +95,67 @@ fn descend_step(node: u32, o: u32) -> u32 {
     return select(tile * 8u + o, 1u, tile == 0u);
 }
 
+// Optical depth of the direction block whose first texel is `corner`, at brick-local texel
+// position `local` (in [0.5, 2.5): sample_levels' la and lb), read along `axis`: trilinear
+// fetches at the centres of the two texel layers around `local` across the axis, each made
+// depth (`opacity`: the texels store premultiplied opacity) and blended by `local`'s place
+// between them. Both layers lie inside the brick (0.5 ..= 2.5). Stored depth blends to what
+// one fetch at `local` reads.
+fn fetch_along(atlas: texture_3d<f32>, corner: vec3<f32>, local: vec3<f32>, axis: u32, inv: vec3<f32>, opacity: bool) -> vec4<f32> {
+    let p = local[axis] - 0.5;
+    let l0 = floor(p);
+    let on = vec3<u32>(axis) == vec3<u32>(0u, 1u, 2u);
+    let s0 = textureSampleLevel(atlas, voxel_sampler, (corner + select(local, vec3<f32>(l0 + 0.5), on)) * inv, 0.0);
+    let s1 = textureSampleLevel(atlas, voxel_sampler, (corner + select(local, vec3<f32>(l0 + 1.5), on)) * inv, 0.0);
+    return mix(select(s0, to_depth(s0), opacity), select(s1, to_depth(s1), opacity), p - l0);
+}
+
 // Level `lvl` of the brick of `tile` in `atlas` (the level's; `shape`, its region), at
-// brick-local texel position `local`, along `dir`: three fetches weighted by the squared
-// direction cosines (two with SAMPLE_AXES = 2, one in isotropic mode). Level 0 is isotropic:
-// its three fetches read the same texel (cheaper on CPU drivers than a branch around them).
+// brick-local texel position `local`, along `dir`, as optical depth: three blocks weighted by
+// the squared direction cosines, each read along its own axis (two with SAMPLE_AXES = 2, one
+// with ISOTROPIC_ONLY). Level 0 and an isotropic octree have one block: its three reads weigh
+// one along the main axis and none along the others (cheaper on CPU drivers than a branch).
 fn fetch_level(atlas: texture_3d<f32>, shape: AtlasShape, tile: u32, lvl: u32, local: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
     // A tile of 0 (no brick) reads some texel and is masked below.
     let b = brick_index(tree, max(tile, class_base(tree, brick_class(lvl))), lvl);
-    let origin = vec3<f32>(brick_texel(shape, b, 0u)) + local;
+    let corner = vec3<f32>(brick_texel(shape, b, 0u));
     let inv = shape.inv_size.xyz;
+    let opacity = lvl > 0u;
     var v: vec4<f32>;
     if ISOTROPIC_ONLY {
-        v = textureSampleLevel(atlas, voxel_sampler, origin * inv, 0.0);
+        v = fetch_along(atlas, corner, local, main_axis(dir), inv, opacity);
     } else {
         // An isotropic octree's one block serves every axis, as level 0's does.
-        let block = select(0.0, f32(shape.block), tree.dirs > 1u && lvl > 0u);
+        let directional = tree.dirs > 1u && lvl > 0u;
+        let block = select(0.0, f32(shape.block), directional);
         let bx = select(1.0, 0.0, dir.x >= 0.0);
         let by = select(3.0, 2.0, dir.y >= 0.0);
         let bz = select(5.0, 4.0, dir.z >= 0.0);
-        let w = dir * dir;
-        let ux = (origin + vec3<f32>(0.0, 0.0, bx * block)) * inv;
-        let uy = (origin + vec3<f32>(0.0, 0.0, by * block)) * inv;
-        let uz = (origin + vec3<f32>(0.0, 0.0, bz * block)) * inv;
+        let w = axis_weights(dir, directional);
+        let cx = corner + vec3<f32>(0.0, 0.0, bx * block);
+        let cy = corner + vec3<f32>(0.0, 0.0, by * block);
+        let cz = corner + vec3<f32>(0.0, 0.0, bz * block);
         if SAMPLE_AXES == 2u {
             // The two axes of largest weight, renormalised (as the dense volume's).
             let drop_x = w.x <= w.y && w.x <= w.z;
             let drop_y = !drop_x && w.y <= w.z;
-            let u0 = select(ux, uy, drop_x);
+            let c0 = select(cx, cy, drop_x);
+            let a0 = select(0u, 1u, drop_x);
             let w0 = select(w.x, w.y, drop_x);
-            let u1 = select(select(uy, uz, drop_y), uz, drop_x);
+            let c1 = select(select(cy, cz, drop_y), cz, drop_x);
+            let a1 = select(select(1u, 2u, drop_y), 2u, drop_x);
             let w1 = select(select(w.y, w.z, drop_y), w.z, drop_x);
-            let s0 = textureSampleLevel(atlas, voxel_sampler, u0, 0.0);
-            let s1 = textureSampleLevel(atlas, voxel_sampler, u1, 0.0);
+            let s0 = fetch_along(atlas, c0, local, a0, inv, opacity);
+            let s1 = fetch_along(atlas, c1, local, a1, inv, opacity);
             v = (w0 * s0 + w1 * s1) / max(w0 + w1, 1e-6);
         } else {
-            let x = textureSampleLevel(atlas, voxel_sampler, ux, 0.0);
-            let y = textureSampleLevel(atlas, voxel_sampler, uy, 0.0);
-            let z = textureSampleLevel(atlas, voxel_sampler, uz, 0.0);
+            let x = fetch_along(atlas, cx, local, 0u, inv, opacity);
+            let y = fetch_along(atlas, cy, local, 1u, inv, opacity);
+            let z = fetch_along(atlas, cz, local, 2u, inv, opacity);
             v = w.x * x + w.y * y + w.z * z;
         }
         if LOBE_CHAIN && lvl > 0u {
-            v = vec4<f32>(v.rgb + brick_lobe_light(atlas, origin, block, inv, dir) * v.a, v.a);
+            v = vec4<f32>(v.rgb + brick_lobe_light(atlas, corner + local, block, inv, dir) * v.a, v.a);
         }
     }
     return select(vec4<f32>(0.0), v, tile != 0u);
@@ -153,7 +178,7 @@ fn even_region(lvl: u32) -> AtlasShape {
     return AtlasShape(select(e.shift, l.shift, leaf), select(e.block, l.block, leaf), select(e.z0, l.z0, leaf), e.inv_size);
 }
 
-// Optical depth at lod, blended between the levels floor(lod) and floor(lod) + 1.
+// Optical depth at lod, read from the nearer of the levels floor(lod) and floor(lod) + 1.
 fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let lo = min(u32(lod), tree.depth - 1u);
     let f = lod - f32(lo);
@@ -179,23 +204,32 @@ fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
         a = descend_step(a, octant_of(na, da - sa - 1u - i));
         b = select(b, descend_step(b, octant_of(nb, (steps_b - 1u - i) & 31u)), i < steps_b);
     }
+    // Brick-local positions: q less twice its node's coordinate is in [0, 2), so these lie in
+    // [0.5, 2.5), inside the 3-texel brick.
     let la = qa - 2.0 * vec3<f32>(na) + 0.5;
     let lb = qb - 2.0 * vec3<f32>(nb) + 0.5;
     let ta = tree_child(a);
     let tb = tree_child(b);
-    // One of the two levels is even: read it from the even atlas and the other from the odd.
-    let a_even = (lo & 1u) == 0u;
-    let le = select(lo + 1u, lo, a_even);
-    let se = fetch_level(even_atlas, even_region(le), select(tb, ta, a_even), le, select(lb, la, a_even), dir);
-    let so = fetch_level(odd_atlas, tree.odd_atlas, select(ta, tb, a_even), select(lo, lo + 1u, a_even), select(la, lb, a_even), dir);
-    let s = mix(select(so, se, a_even), select(se, so, a_even), f);
-    if LOBE_CHAIN && lo == 0u && tree.dirs > 1u {
-        // Samples finer than level 1 see the lobes of level 1 wherever they see a surface, as
+    let upper = f >= 0.5;
+    let lvl = select(lo, lo + 1u, upper);
+    let tile = select(ta, tb, upper);
+    let local = select(la, lb, upper);
+    // Only the chosen level's atlas is fetched, behind a branch (a texture is no value to
+    // select): lanes disagree on it only where neighbouring samples lie either side of a half
+    // level, and only there does a CPU driver run both sides.
+    var s: vec4<f32>;
+    if (lvl & 1u) == 0u {
+        s = fetch_level(even_atlas, even_region(lvl), tile, lvl, local, dir);
+    } else {
+        s = fetch_level(odd_atlas, tree.odd_atlas, tile, lvl, local, dir);
+    }
+    if LOBE_CHAIN && lvl == 0u && tree.dirs > 1u {
+        // Samples that read level 0 see the lobes of level 1 wherever they see a surface, as
         // the dense volume's (voxels/dense/windows.wgsl, `window_depth`).
         let b = brick_index(tree, max(tb, class_base(tree, brick_class(1u))), 1u);
         let origin = vec3<f32>(brick_texel(tree.odd_atlas, b, 0u)) + lb;
         let light = brick_lobe_light(odd_atlas, origin, f32(tree.odd_atlas.block), tree.odd_atlas.inv_size.xyz, dir);
-        return vec4<f32>(s.rgb + select(vec3<f32>(0.0), light, tb != 0u) * (1.0 - f) * se.a, s.a);
+        return vec4<f32>(s.rgb + select(vec3<f32>(0.0), light, tb != 0u) * s.a, s.a);
     }
     return s;
 }

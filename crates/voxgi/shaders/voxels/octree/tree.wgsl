@@ -30,8 +30,7 @@
 // A region holds its bricks in rows and layers of powers of two (addressing by shifts: CPU
 // drivers have no vector integer division), and its direction blocks one after another along
 // z. Levels alternate between the even and the odd atlas, so filtering level k + 1 from level
-// k reads one texture and writes the other, and a sample's two levels are one fetch from each
-// texture without a branch.
+// k reads one texture and writes the other.
 
 // Where a region of an atlas keeps its bricks: log2 of the bricks per row and per layer, the
 // texels of one direction block along z, the region's first texel along z, and 1 / the atlas

@@ -32,8 +32,9 @@ use glam::IVec3;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
-/// Format of the radiance textures (finest level and chains): optical depth, rgb L·sigma and
-/// a sigma (see `to_depth` in shaders/shared/volume.wgsl).
+/// Format of the radiance textures: the finest level holds optical depth, rgb L·sigma and a
+/// sigma (see `to_depth` in shaders/shared/volume.wgsl), the chains premultiplied rgb L·alpha
+/// and a alpha.
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Format of the finest level's albedo: rgb linear albedo, a opacity.
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;

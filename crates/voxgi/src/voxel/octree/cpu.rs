@@ -2,7 +2,7 @@
 //! GPU against: the build's node sets exactly, the sampler to filtering precision.
 
 use super::GpuOctree;
-use crate::voxel::cpu::{Texture3d, from_depth};
+use crate::voxel::cpu::{Texture3d, from_depth, to_depth};
 use glam::{UVec3, Vec3, Vec4};
 use std::collections::BTreeSet;
 
@@ -78,7 +78,8 @@ pub fn walk(nodes: &[u32], layout: &GpuOctree) -> Vec<NodeSet> {
 }
 
 /// The octree as voxels/octree/sample.wgsl reads it: its layout, node words and both
-/// atlases (stored optical depth per texel, one level each).
+/// atlases (one level each: level 0 stored as optical depth per texel, the levels above as
+/// premultiplied opacity).
 pub struct OctreeSampler<'a> {
     /// The octree uniform.
     pub layout: GpuOctree,
@@ -116,8 +117,11 @@ impl OctreeSampler<'_> {
         self.child(node)
     }
 
-    /// Level `lvl` at uvw along the directional block `dir` (0..6), trilinear inside one brick.
-    fn level(&self, uvw: Vec3, lvl: u32, dir: u32) -> Vec4 {
+    /// Level `lvl` at uvw, directional block `dir` (0..6) read along `axis` (`fetch_along` in
+    /// sample.wgsl), as optical depth: trilinear fetches inside one brick at the centres of the
+    /// two texel layers around the sample across `axis`, each made depth (levels above 0 store
+    /// premultiplied opacity), blended by the sample's place between them.
+    fn level(&self, uvw: Vec3, lvl: u32, dir: u32, axis: usize) -> Vec4 {
         let l = &self.layout;
         let r = (l.resolution >> lvl) as f32;
         let q = (uvw * r - 0.5).clamp(Vec3::ZERO, Vec3::splat(r - 1.0));
@@ -132,13 +136,23 @@ impl OctreeSampler<'_> {
             _ => (self.odd, &l.odd_atlas, l.base_o),
         };
         let block = if lvl == 0 || l.dirs == 1 { 0 } else { dir };
-        let origin = UVec3::from_array(shape.brick_texel(tile - base, block));
+        let origin = UVec3::from_array(shape.brick_texel(tile - base, block)).as_vec3();
+        // In [0.5, 2.5) per axis: both layers lie inside the brick.
         let local = q - 2.0 * (v >> 1u32).as_vec3() + 0.5;
         let size = atlas.levels[0].1.as_vec3();
-        atlas.sample((origin.as_vec3() + local) / size, 0.0)
+        let p = local[axis] - 0.5;
+        let l0 = p.floor();
+        let layer = |c: f32| {
+            let mut at = local;
+            at[axis] = c;
+            let s = atlas.sample((origin + at) / size, 0.0);
+            if lvl == 0 { s } else { to_depth(s) }
+        };
+        layer(l0 + 0.5).lerp(layer(l0 + 1.5), p - l0)
     }
 
     /// `sample_depth`: optical depth per sample diameter, filtered to `diameter`, seen along `dir`.
+    /// Reads the level nearest to the diameter's (sample.wgsl's `sample_levels`).
     pub fn sample_depth(&self, p: Vec3, diameter: f32, dir: Vec3) -> Vec4 {
         let l = &self.layout;
         let extent = l.voxel_size * l.resolution as f32;
@@ -150,17 +164,28 @@ impl OctreeSampler<'_> {
         let lod = (diameter / l.voxel_size).max(1.0).log2().clamp(0.0, top);
         let lo = (lod as u32).min(l.depth - 1);
         let f = lod - lo as f32;
-        let at = |lvl: u32| {
-            if l.anisotropic == 0 {
-                return self.level(uvw, lvl, 0);
-            }
+        let lvl = if f < 0.5 { lo } else { lo + 1 };
+        // Isotropic blocks are read along dir's largest component (ties: x, then y).
+        let a = dir.abs();
+        let main = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let v = if l.anisotropic == 0 || lvl == 0 {
+            // One block: read along `main` alone.
+            self.level(uvw, lvl, 0, main)
+        } else {
+            // Each direction's block along its own axis, weighted by the squared cosines.
             let w = dir * dir;
             let b = |neg: bool, pos: u32| if neg { pos + 1 } else { pos };
-            w.x * self.level(uvw, lvl, b(dir.x < 0.0, 0))
-                + w.y * self.level(uvw, lvl, b(dir.y < 0.0, 2))
-                + w.z * self.level(uvw, lvl, b(dir.z < 0.0, 4))
+            w.x * self.level(uvw, lvl, b(dir.x < 0.0, 0), 0)
+                + w.y * self.level(uvw, lvl, b(dir.y < 0.0, 2), 1)
+                + w.z * self.level(uvw, lvl, b(dir.z < 0.0, 4), 2)
         };
-        at(lo).lerp(at(lo + 1), f) * crate::voxel::cpu::border_weight(uvw, lod, l.resolution)
+        v * crate::voxel::cpu::border_weight(uvw, lod, l.resolution)
     }
 
     /// `sample_voxels`: premultiplied radiance and opacity.

@@ -3,7 +3,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Format of both atlases: optical depth (L sigma, sigma), as the dense volume's radiance.
+/// Format of both atlases: level 0 (the leaves) optical depth (L sigma, sigma), the levels
+/// above premultiplied opacity (L alpha, alpha), as the dense volume's finest level and chains.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// u32 per node above the leaves: child pointer and the -x, -y, -z neighbours (`NODE_STRIDE`;
 /// a leaf voxel keeps its child word only).
