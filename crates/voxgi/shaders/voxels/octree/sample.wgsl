@@ -8,11 +8,11 @@
 // node 1 (an unused node of the root tile whose child pointer stays 0), which reads as empty.
 //
 // Level 0 stores optical depth (L sigma, sigma); the levels above store premultiplied opacity
-// (L alpha, alpha), converted to depth after each fetch. Across a direction block's axis two
-// fetches, one per texel layer, are blended as depth; along the other two axes the trilinear
-// filter averages opacity: partial coverage across the cone counts as partly covered, where
-// depth averaged there saturates (an opaque texel beside an empty one would read nearly opaque
-// halfway). Blending two levels would average depth again: the nearer level is read instead.
+// (L alpha, alpha), converted to depth after each fetch. Along a direction block's axis two
+// fetches, one per texel layer, are blended as depth; across it the trilinear filter averages
+// opacity: partial coverage across the cone counts as partly covered, where depth averaged
+// there saturates (an opaque texel beside an empty one would read nearly opaque halfway).
+// Blending two levels would average depth again: the nearer level is read instead.
 //
 // Everything here reads @group(1) only; `OctreeVolume::sampling_layout` is its twin.
 
@@ -214,15 +214,15 @@ fn sample_levels(uvw: vec3<f32>, lod: f32, dir: vec3<f32>) -> vec4<f32> {
     let lvl = select(lo, lo + 1u, upper);
     let tile = select(ta, tb, upper);
     let local = select(la, lb, upper);
-    // Only the chosen level's atlas is fetched, behind a branch (a texture is no value to
-    // select): lanes disagree on it only where neighbouring samples lie either side of a half
-    // level, and only there does a CPU driver run both sides.
-    var s: vec4<f32>;
-    if (lvl & 1u) == 0u {
-        s = fetch_level(even_atlas, even_region(lvl), tile, lvl, local, dir);
-    } else {
-        s = fetch_level(odd_atlas, tree.odd_atlas, tile, lvl, local, dir);
-    }
+    // A texture is no value to select, so both atlases are read, the other level's masked
+    // (tile 0), and the chosen one kept: on CPU drivers a branch between the two, which lanes
+    // disagree on wherever neighbouring samples lie either side of a half level, costs more.
+    let lo_even = (lo & 1u) == 0u;
+    let le = select(lo + 1u, lo, lo_even);
+    let lodd = select(lo, lo + 1u, lo_even);
+    let se = fetch_level(even_atlas, even_region(le), select(0u, tile, le == lvl), le, local, dir);
+    let so = fetch_level(odd_atlas, tree.odd_atlas, select(0u, tile, lodd == lvl), lodd, local, dir);
+    let s = select(so, se, le == lvl);
     if LOBE_CHAIN && lvl == 0u && tree.dirs > 1u {
         // Samples that read level 0 see the lobes of level 1 wherever they see a surface, as
         // the dense volume's (voxels/dense/windows.wgsl, `window_depth`).
