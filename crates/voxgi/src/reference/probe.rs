@@ -340,7 +340,9 @@ impl PathTracer {
                 width: n,
                 height: 1,
                 x0: 0,
-                sample_count: count,
+                // One path a cone per dispatch, as `accumulate` traces one sample a pixel
+                // per dispatch (progressive.rs says why).
+                sample_count: 1,
                 seed,
                 bounces,
                 mode: 2,
@@ -359,7 +361,9 @@ impl PathTracer {
                 });
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &bind, &[]);
-                pass.dispatch_workgroups(n.div_ceil(8), 1, 1);
+                for _ in 0..count {
+                    pass.dispatch_workgroups(n.div_ceil(8), 1, 1);
+                }
             }
             self.queue.submit([enc.finish()]);
             device

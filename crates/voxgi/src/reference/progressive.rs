@@ -292,7 +292,13 @@ impl PathTracer {
             width: acc.width,
             height: acc.height,
             x0: columns.start,
-            sample_count: opts.spp,
+            // One sample a pixel per dispatch, `opts.spp` dispatches: on lavapipe the loops
+            // of one invocation share one budget of iterations, past which every loop stops
+            // at once (llvmpipe's LP_MAX_TGSI_LOOP_ITERATIONS, 65,535), without an error;
+            // many samples in one invocation on a large scene lost their later samples' rays
+            // (docs/QUALITY.md, "The ground truth"). Each dispatch reads the count the last
+            // one left (a barrier between dispatches on the read-write buffer).
+            sample_count: 1,
             seed: opts.seed,
             bounces,
             mode,
@@ -311,11 +317,13 @@ impl PathTracer {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &acc.trace_group, &[]);
-            pass.dispatch_workgroups(
-                (columns.end - columns.start).div_ceil(8),
-                (region.rows.end - region.rows.start).div_ceil(8),
-                1,
-            );
+            for _ in 0..opts.spp {
+                pass.dispatch_workgroups(
+                    (columns.end - columns.start).div_ceil(8),
+                    (region.rows.end - region.rows.start).div_ceil(8),
+                    1,
+                );
+            }
         }
         // Resolved after each pass: a caller may trace without displaying, or the reverse.
         self.timer.resolve(encoder);
