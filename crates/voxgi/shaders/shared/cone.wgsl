@@ -17,7 +17,7 @@
 // neither occlude nor light itself, so a sample must not read the voxels of its cone's own
 // surface: those reach up to a voxel above the surface's plane (conservative voxelization
 // marks both sides of a plane on a voxel boundary). A sample of diameter ds reads texels up to
-// 2 ds wide (trilinear between two levels), and such a texel touches everything within 1.5 of
+// 2 ds wide (the level nearest its size, trilinear), and such a texel touches everything within 1.5 of
 // its widths below the sample: so ds <= (h - 1 voxel) / 3 at height h above the plane. Only
 // the cone's own surface is cleared this way; occluders in front are still seen (at a finer
 // level than the cone's width would pick).

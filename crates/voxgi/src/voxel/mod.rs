@@ -393,8 +393,8 @@ impl Filtering {
 }
 
 /// Values for the `override` constants every structure's sample.wgsl declares, for the
-/// pipelines that sample a structure of this mode: `anisotropic` (ISOTROPIC_ONLY: one fetch a
-/// sample), `lobes` (LOBE_CHAIN: the samples add the specular lobes' light) and `axes`, the
+/// pipelines that sample a structure of this mode: `anisotropic` (ISOTROPIC_ONLY: one block
+/// read a sample), `lobes` (LOBE_CHAIN: the samples add the specular lobes' light) and `axes`, the
 /// directional blocks a sample reads (SAMPLE_AXES).
 pub fn sampling_constants(anisotropic: bool, lobes: bool, axes: u32) -> Vec<(&'static str, f64)> {
     vec![

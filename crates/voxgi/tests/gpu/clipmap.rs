@@ -262,8 +262,8 @@ fn inside_a_finer_level_the_coarser_one_reads_its_mips() {
         );
         let levels = read_levels(clip);
         let cpu = cpu_levels(clip, &levels);
-        // Level 0's samples keep half a texel of the level above the one read (a chain
-        // texel of 8 voxels) inside its window, and the probes spread 5 % past the grid.
+        // Level 0's samples keep half a texel of the level read inside its window, and the
+        // probes spread 5 % past the grid.
         let margin = 6.0 * fine.voxel_size;
         let inner = Grid {
             origin: fine.origin + Vec3::splat(margin),

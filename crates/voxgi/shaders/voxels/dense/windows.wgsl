@@ -39,7 +39,7 @@ fn window_depth(uvw: vec3<f32>, lod: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
         return s;
     }
     // The finest level has no lobes: a sample finer than the first chain level sees that
-    // level's lobes wherever it sees a surface. Faded in as the chain is, a quarter cone's
+    // level's lobes wherever it sees a surface. Faded in as the chain once was, a quarter cone's
     // narrow samples near a metal saw its leaves black (diffuse albedo 0) and little of what
     // it reflects (docs/QUALITY.md, "Specular light in the bounces").
     return with_lobes(s, uvw, cl, dir, win, 1.0);
@@ -67,9 +67,9 @@ fn with_lobes(s: vec4<f32>, uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32, w
 // a pipeline without it still reads the six directions right.
 override LOBE_CHAIN: bool = false;
 
-// True when the pipeline serves an isotropic volume: each sample then makes one fetch, not
-// three equal ones (half the gather's time on lavapipe). Left false, the mode is read from
-// `vol` at run time.
+// True when the pipeline serves an isotropic volume: each sample then reads its one block along
+// one axis (two fetches), not three axes' worth. Left false, the mode is read from `vol` at run
+// time.
 override ISOTROPIC_ONLY: bool = false;
 
 // Directional blocks an anisotropic sample reads: 3, every axis by its weight (seed 000 §9),
@@ -112,7 +112,7 @@ fn sample_chains(uvw: vec3<f32>, cl: f32, dir: vec3<f32>, win: u32) -> vec4<f32>
     if ISOTROPIC_ONLY {
         return chain_along(uvw, cl, window, windows, main_axis(dir));
     }
-    // In isotropic mode the one block serves every axis.
+    // In isotropic mode the one block serves every axis, read along the nearest (`axis_weights`).
     let aniso = vol.anisotropic != 0u;
     let block = select(
         vec3<f32>(0.0),

@@ -97,7 +97,7 @@ fn descend_step(node: u32, o: u32) -> u32 {
 
 // Optical depth of the direction block whose first texel is `corner`, at brick-local texel
 // position `local` (in [0.5, 2.5): sample_levels' la and lb), read along `axis`: trilinear
-// fetches at the centres of the two texel layers around `local` across the axis, each made
+// fetches at the centres of the two layers of texels around `local` along the axis, each made
 // depth (`opacity`: the texels store premultiplied opacity) and blended by `local`'s place
 // between them. Both layers lie inside the brick (0.5 ..= 2.5). Stored depth blends to what
 // one fetch at `local` reads.
@@ -125,7 +125,8 @@ fn fetch_level(atlas: texture_3d<f32>, shape: AtlasShape, tile: u32, lvl: u32, l
     if ISOTROPIC_ONLY {
         v = fetch_along(atlas, corner, local, main_axis(dir), inv, opacity);
     } else {
-        // An isotropic octree's one block serves every axis, as level 0's does.
+        // An isotropic octree's one block serves every axis, as level 0's does: read along the
+        // nearest (`axis_weights`).
         let directional = tree.dirs > 1u && lvl > 0u;
         let block = select(0.0, f32(shape.block), directional);
         let bx = select(1.0, 0.0, dir.x >= 0.0);

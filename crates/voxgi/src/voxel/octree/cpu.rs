@@ -119,7 +119,7 @@ impl OctreeSampler<'_> {
 
     /// Level `lvl` at uvw, directional block `dir` (0..6) read along `axis` (`fetch_along` in
     /// sample.wgsl), as optical depth: trilinear fetches inside one brick at the centres of the
-    /// two texel layers around the sample across `axis`, each made depth (levels above 0 store
+    /// two layers of texels around the sample along `axis`, each made depth (levels above 0 store
     /// premultiplied opacity), blended by the sample's place between them.
     fn level(&self, uvw: Vec3, lvl: u32, dir: u32, axis: usize) -> Vec4 {
         let l = &self.layout;
