@@ -215,15 +215,10 @@ impl DenseSampler<'_> {
     /// (`SAMPLE_AXES` = 3).
     fn chains(&self, uvw: Vec3, cl: usize, dir: Vec3, win: u32) -> Vec4 {
         let (window, windows) = (win as f32, self.windows as f32);
-        let a = dir.abs();
         let w = if self.anisotropic {
             dir * dir
-        } else if a.x >= a.y && a.x >= a.z {
-            Vec3::X
-        } else if a.y >= a.z {
-            Vec3::Y
         } else {
-            Vec3::Z
+            Vec3::AXES[main_axis(dir)]
         };
         // Each direction's block holds every window: block b, window w at b · windows + w.
         let (block, blocks) = if self.anisotropic {
@@ -275,6 +270,19 @@ impl DenseSampler<'_> {
     /// `sample_voxels`: premultiplied radiance and opacity.
     pub fn sample_voxels(&self, p: Vec3, diameter: f32, dir: Vec3) -> Vec4 {
         from_depth(self.sample_depth(p, diameter, dir))
+    }
+}
+
+/// The axis an isotropic block is read along: `dir`'s largest component, ties to x, then y
+/// (`main_axis` in shaders/shared/volume.wgsl).
+pub fn main_axis(dir: Vec3) -> usize {
+    let a = dir.abs();
+    if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
     }
 }
 

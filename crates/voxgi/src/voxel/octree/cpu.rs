@@ -165,18 +165,9 @@ impl OctreeSampler<'_> {
         let lo = (lod as u32).min(l.depth - 1);
         let f = lod - lo as f32;
         let lvl = if f < 0.5 { lo } else { lo + 1 };
-        // Isotropic blocks are read along dir's largest component (ties: x, then y).
-        let a = dir.abs();
-        let main = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
         let v = if l.anisotropic == 0 || lvl == 0 {
-            // One block: read along `main` alone.
-            self.level(uvw, lvl, 0, main)
+            // One block: read along dir's largest component alone.
+            self.level(uvw, lvl, 0, crate::voxel::cpu::main_axis(dir))
         } else {
             // Each direction's block along its own axis, weighted by the squared cosines.
             let w = dir * dir;
