@@ -171,9 +171,6 @@ pub fn options_ui(ui: &mut egui::Ui, draft: &mut RendererOptions, dirty: bool) -
         .on_hover_text(s.help);
     }
     // The options that need another: what the library would refuse, the panel turns off.
-    if !draft.anisotropic {
-        draft.ndf_mips = false;
-    }
     if draft.bounces != UNLIMITED_BOUNCES {
         draft.progressive = false;
     }

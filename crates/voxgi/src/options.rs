@@ -296,10 +296,12 @@ pub struct RendererOptions {
     /// Six directional values per voxel above the finest level (true, default) or one.
     pub anisotropic: bool,
     /// The first directional level weighs each leaf's radiance and opacity along each of the six
-    /// directions by its normal distribution (Salm, §4.4.2): fully seen face-on, half edge-on,
-    /// not at all from behind, blended towards isotropic as its fragments' normals disagree
-    /// (Toksvig's length of the mean normal). Needs `anisotropic`. Default false: leaves count
-    /// as isotropic, which is what the figures in docs/QUALITY.md were calibrated with.
+    /// directions by its normal distribution (after Salm, §4.4.2): whole face-on and edge-on,
+    /// falling to nothing from behind, blended towards isotropic as its fragments' normals
+    /// disagree (Toksvig's length of the mean normal; `voxel::cpu::ndf_weight`). Default true:
+    /// a column's lit face is not seen from its shadowed side, nor a ledge's face by the cones
+    /// clearing its top (docs/QUALITY.md, "Normal distributions by default"). Isotropic volumes
+    /// have no directions to weigh: there it does nothing.
     pub ndf_mips: bool,
     /// Metals' specular reflections of the lights in the bounces: each lit metal leaf keeps a
     /// lobe of what it reflects, which every structure keeps up its levels in two more blocks
@@ -404,7 +406,7 @@ impl Default for RendererOptions {
             clipmap_budget: 1,
             voxel_size: None,
             anisotropic: true,
-            ndf_mips: false,
+            ndf_mips: true,
             specular_bounces: false,
             gather_axes: 3,
             cones: ConeSet::Six60,

@@ -58,7 +58,7 @@ fn ndf_weight(normal: vec4<f32>, dir: u32) -> f32 {
     let len = length(normal.xyz);
     let sign = select(-1.0, 1.0, (dir & 1u) == 0u);
     let facing = -sign * normal[dir / 2u] / max(len, 1e-4);
-    let w = 1.0 + clamp(normal.w, 0.0, 1.0) * (0.5 * (1.0 + facing) - 1.0);
+    let w = 1.0 + clamp(normal.w, 0.0, 1.0) * (min(1.0 + facing, 1.0) - 1.0);
     return select(w, 1.0, len < 1e-4);
 }
 

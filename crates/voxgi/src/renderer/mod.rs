@@ -191,7 +191,7 @@ impl SceneFacts {
             bounds: self.bounds,
             filtering: Filtering {
                 anisotropic: options.anisotropic,
-                ndf: options.ndf_mips,
+                ndf: options.ndf_mips && options.anisotropic,
                 lobes: self.lobes(options),
             },
             leaves: options

@@ -362,11 +362,6 @@ impl RendererOptions {
                 s.check(v, self.voxels)?;
             }
         }
-        if self.ndf_mips && !self.anisotropic {
-            return Err(Error::Setting(
-                "ndf_mips weighs six directional values: it needs the anisotropic volume".into(),
-            ));
-        }
         if self.specular_bounces && !self.anisotropic {
             return Err(Error::Setting(
                 "specular_bounces keeps the lobes beside six directional values: it needs the \

@@ -152,7 +152,8 @@ pub static SETTINGS: &[Setting] = &[
         key: "ndf_mips",
         label: "leaves weighed by their normals (NDF)",
         help: "Weigh each leaf's radiance and opacity per direction by its normals in the first \
-               directional level (the point-cloud thesis' NDF). Needs anisotropic voxels.",
+               directional level (after the point-cloud thesis' NDF): a face is not seen from \
+               behind. Only anisotropic voxels have directions to weigh.",
         domain: Domain::Bool,
         changes: Changes::Voxels,
         access: access!(options bool ndf_mips),

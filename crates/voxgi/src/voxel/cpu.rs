@@ -104,10 +104,14 @@ pub fn filter_parent(children: &[Vec4; 8], dir: Option<u32>) -> Vec4 {
 
 /// How much of a leaf the first directional level counts along direction `dir` (0..6: +X, -X,
 /// +Y, -Y, +Z, -Z, the way a cone travels), from its mean normal (xyz) and how well its
-/// fragments' normals agree (w, Toksvig's length of the mean normal): 1 where the cone meets
-/// its face head-on, 1/2 edge-on, 0 from behind (Salm, §4.4.2: a falloff from cosine 1 to -1,
-/// so that edge-on surfaces do not turn transparent), blended towards 1 as the normals
-/// disagree. `ndf_weight` in voxels/dense/filter.wgsl and octree_filter.wgsl.
+/// fragments' normals agree (w, Toksvig's length of the mean normal): all of it where the cone
+/// meets its face head-on or edge-on, falling to nothing as it comes from behind (1 + cos),
+/// blended towards 1 as the normals disagree. Seen from behind a face neither lights nor
+/// stops a cone: behind it lies the front of the solid it bounds, or the cone's own surface
+/// (the far side of a ledge its cone clears). Salm (§4.4.2) falls off from 1 head-on to 1/2
+/// edge-on too; edge-on leaves at half then let cones out of closed rooms through their edges
+/// and corners, and through a block's sides along them (docs/QUALITY.md, "Normal
+/// distributions by default"). `ndf_weight` in shared/volume.wgsl.
 pub fn ndf_weight(normal: Vec4, dir: u32) -> f32 {
     let n = normal.truncate();
     let len = n.length();
@@ -118,7 +122,7 @@ pub fn ndf_weight(normal: Vec4, dir: u32) -> f32 {
     let sign = if dir.is_multiple_of(2) { 1.0 } else { -1.0 };
     // The face a cone travelling along +axis meets has its normal along -axis.
     let facing = -sign * n[axis] / len;
-    let directional = 0.5 * (1.0 + facing);
+    let directional = (1.0 + facing).min(1.0);
     1.0 + normal.w.clamp(0.0, 1.0) * (directional - 1.0)
 }
 
@@ -382,11 +386,14 @@ mod tests {
     fn ndf_weight_counts_faces_by_how_a_cone_meets_them() {
         let floor = Vec4::new(0.0, 1.0, 0.0, 1.0);
         // A cone travelling down (-Y, direction 3) meets the floor head-on; up (+Y) from behind;
-        // along x edge-on.
+        // along x edge-on, where it counts whole.
         assert_eq!(ndf_weight(floor, 3), 1.0);
         assert_eq!(ndf_weight(floor, 2), 0.0);
-        assert_eq!(ndf_weight(floor, 0), 0.5);
-        assert_eq!(ndf_weight(floor, 5), 0.5);
+        assert_eq!(ndf_weight(floor, 0), 1.0);
+        assert_eq!(ndf_weight(floor, 5), 1.0);
+        // Half way between edge-on and behind: half.
+        let tilted = Vec4::new(0.0, 0.5, -(0.75f32.sqrt()), 1.0);
+        assert!((ndf_weight(tilted, 2) - 0.5).abs() < 1e-6);
         // Normals that disagree (Toksvig's length 0.4) count 60 % isotropic.
         let rough = Vec4::new(0.0, 0.4, 0.0, 0.4);
         assert!((ndf_weight(rough, 2) - 0.6).abs() < 1e-6);

@@ -38,10 +38,10 @@ impl Variant {
         }
     }
 
-    /// Structure `kind` with the NDF-weighted first level.
-    pub(crate) fn ndf(kind: VoxelKind) -> Self {
+    /// Structure `kind` with isotropic leaves in the first directional level (no NDF).
+    pub(crate) fn isotropic_leaves(kind: VoxelKind) -> Self {
         Variant {
-            ndf: true,
+            ndf: false,
             ..kind.into()
         }
     }
@@ -52,7 +52,7 @@ impl From<VoxelKind> for Variant {
         Variant {
             kind,
             indirect: IndirectShading::Cones,
-            ndf: false,
+            ndf: RendererOptions::default().ndf_mips,
         }
     }
 }
