@@ -339,21 +339,25 @@ fn check_filter_step(
 
 /// A measuring renderer of the Cornell box at `voxel_resolution`.
 fn cornell(voxel_resolution: u32, anisotropic: bool) -> Renderer {
-    let settings = RendererOptions {
+    renderer(
+        &builtin::cornell_box(),
+        &cornell_options(voxel_resolution, anisotropic),
+    )
+}
+
+fn cornell_options(voxel_resolution: u32, anisotropic: bool) -> RendererOptions {
+    RendererOptions {
         voxel_resolution,
         anisotropic,
         ..measuring()
-    };
-    renderer(&builtin::cornell_box(), &settings)
+    }
 }
 
 fn check_filtering(anisotropic: bool) {
     // The leaves as they are (NDF weights: `voxel_filter_weighs_leaves_by_their_normals`).
     let settings = RendererOptions {
-        voxel_resolution: 16,
-        anisotropic,
         ndf_mips: false,
-        ..measuring()
+        ..cornell_options(16, anisotropic)
     };
     let mut r = renderer(&builtin::cornell_box(), &settings);
     let cam = clamped(r.default_camera());
